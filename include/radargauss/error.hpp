@@ -1,0 +1,26 @@
+// Errors at the library's edges (files, flags, user data) are exceptions of
+// these types, with a one-line message that names the source and the fault.
+// Programmer errors inside the library are assertions instead.
+#pragma once
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+namespace radargauss {
+
+// Bad input data: a malformed, truncated or inconsistent file or scan.
+class DataError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// "<path>: <what>" and "<path>:<line>: <what>", the message forms of DataError.
+inline DataError FileError(const std::string& path, const std::string& what) {
+  return DataError(path + ": " + what);
+}
+inline DataError FileError(const std::string& path, std::size_t line, const std::string& what) {
+  return DataError(path + ":" + std::to_string(line) + ": " + what);
+}
+
+}  // namespace radargauss

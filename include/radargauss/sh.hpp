@@ -1,0 +1,109 @@
+// Real spherical harmonics up to degree 3, with the constants, ordering and
+// signs of the 3D Gaussian Splatting reference implementation (Kerbl et al.
+// 2023): index l^2 + l + m for m = -l..l, Condon-Shortley phase included
+// (so Y_1 = -C1 y, Y_2 = C1 z, Y_3 = -C1 x). The functions are orthonormal on
+// the unit sphere. Templated on the scalar (double or ceres::Jet) and on the
+// degree; a runtime-degree overload serves code that reads the degree from
+// data. Directions must be unit vectors (the paper's incidence vector d).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Core>
+
+namespace radargauss {
+
+inline constexpr int kMaxShDegree = 3;
+
+// Number of SH functions up to and including `degree`: (degree + 1)^2.
+constexpr int ShCoefficientCount(int degree) { return (degree + 1) * (degree + 1); }
+
+namespace sh_constants {
+inline constexpr double kC0 = 0.28209479177387814;
+inline constexpr double kC1 = 0.4886025119029199;
+inline constexpr double kC2[5] = {1.0925484305920792, -1.0925484305920792, 0.31539156525252005,
+                                  -1.0925484305920792, 0.5462742152960396};
+inline constexpr double kC3[7] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658,
+                                  0.3731763325901154,  -0.4570457994644658, 1.445305721320277,
+                                  -0.5900435899266435};
+}  // namespace sh_constants
+
+// Writes Y_0(d) .. Y_{(Degree+1)^2 - 1}(d) to `basis`.
+template <int Degree, typename T>
+void EvaluateShBasis(const Eigen::Matrix<T, 3, 1>& d, T* basis) {
+  static_assert(Degree >= 0 && Degree <= kMaxShDegree, "SH degree must be 0..3");
+  using namespace sh_constants;
+  basis[0] = T(kC0);
+  if constexpr (Degree >= 1) {
+    const T& x = d.x();
+    const T& y = d.y();
+    const T& z = d.z();
+    basis[1] = -T(kC1) * y;
+    basis[2] = T(kC1) * z;
+    basis[3] = -T(kC1) * x;
+    if constexpr (Degree >= 2) {
+      const T xx = x * x;
+      const T yy = y * y;
+      const T zz = z * z;
+      const T xy = x * y;
+      const T yz = y * z;
+      const T xz = x * z;
+      basis[4] = T(kC2[0]) * xy;
+      basis[5] = T(kC2[1]) * yz;
+      basis[6] = T(kC2[2]) * (T(2.0) * zz - xx - yy);
+      basis[7] = T(kC2[3]) * xz;
+      basis[8] = T(kC2[4]) * (xx - yy);
+      if constexpr (Degree >= 3) {
+        basis[9] = T(kC3[0]) * y * (T(3.0) * xx - yy);
+        basis[10] = T(kC3[1]) * xy * z;
+        basis[11] = T(kC3[2]) * y * (T(4.0) * zz - xx - yy);
+        basis[12] = T(kC3[3]) * z * (T(2.0) * zz - T(3.0) * xx - T(3.0) * yy);
+        basis[13] = T(kC3[4]) * x * (T(4.0) * zz - xx - yy);
+        basis[14] = T(kC3[5]) * z * (xx - yy);
+        basis[15] = T(kC3[6]) * x * (xx - T(3.0) * yy);
+      }
+    }
+  }
+}
+
+template <int Degree, typename T>
+Eigen::Matrix<T, ShCoefficientCount(Degree), 1> ShBasis(const Eigen::Matrix<T, 3, 1>& d) {
+  Eigen::Matrix<T, ShCoefficientCount(Degree), 1> basis;
+  EvaluateShBasis<Degree>(d, basis.data());
+  return basis;
+}
+
+// c . Y(d) with (Degree+1)^2 coefficients: the model's value in direction d.
+template <int Degree, typename T, typename CoefficientT>
+T EvaluateSh(const CoefficientT* coefficients, const Eigen::Matrix<T, 3, 1>& d) {
+  T basis[ShCoefficientCount(Degree)];
+  EvaluateShBasis<Degree>(d, basis);
+  T value = T(0.0);
+  for (int i = 0; i < ShCoefficientCount(Degree); ++i) value += T(coefficients[i]) * basis[i];
+  return value;
+}
+
+// Runtime-degree versions; throw std::invalid_argument for a degree outside 0..3.
+template <typename T>
+void EvaluateShBasis(int degree, const Eigen::Matrix<T, 3, 1>& d, T* basis) {
+  switch (degree) {
+    case 0: return EvaluateShBasis<0>(d, basis);
+    case 1: return EvaluateShBasis<1>(d, basis);
+    case 2: return EvaluateShBasis<2>(d, basis);
+    case 3: return EvaluateShBasis<3>(d, basis);
+    default:
+      throw std::invalid_argument("SH degree must be in 0..3, got " + std::to_string(degree));
+  }
+}
+
+template <typename T, typename CoefficientT>
+T EvaluateSh(int degree, const CoefficientT* coefficients, const Eigen::Matrix<T, 3, 1>& d) {
+  T basis[ShCoefficientCount(kMaxShDegree)];
+  EvaluateShBasis(degree, d, basis);
+  T value = T(0.0);
+  for (int i = 0; i < ShCoefficientCount(degree); ++i) value += T(coefficients[i]) * basis[i];
+  return value;
+}
+
+}  // namespace radargauss

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package radargauss needs that is not installed yet.
+# Works as root or through sudo; installs nothing when all are present.
+#   scripts/deps.sh            core build, tests and benchmarks
+#   RADARGAUSS_DEPS_EXTRA="pkg ..." scripts/deps.sh   plus these packages
+set -euo pipefail
+
+packages=(
+  # toolchain
+  g++ make cmake pkg-config
+  # core (DESIGN.md section 9)
+  libceres-dev libeigen3-dev libsuitesparse-dev libmetis-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+# shellcheck disable=SC2206
+packages+=(${RADARGAUSS_DEPS_EXTRA:-})
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+if [ "$(id -u)" -eq 0 ]; then
+  as_root=()
+elif command -v sudo >/dev/null 2>&1; then
+  as_root=(sudo)
+else
+  echo "deps: missing packages (${missing[*]}) and neither root nor sudo" >&2
+  exit 1
+fi
+
+echo "deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" apt-get update -qq
+"${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

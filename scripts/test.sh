@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs what is missing, then builds and runs every test twice: in a
+# Release tree and in an AddressSanitizer + UndefinedBehaviorSanitizer tree.
+#   scripts/test.sh            both trees
+#   RADARGAUSS_TEST_TREES=release scripts/test.sh   one tree only
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+jobs=$(nproc)
+trees=${RADARGAUSS_TEST_TREES:-"release sanitize"}
+
+"$root/scripts/deps.sh"
+
+for tree in $trees; do
+  build="$root/build/$tree"
+  case "$tree" in
+    release)
+      cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release ;;
+    sanitize)
+      # Debug keeps Eigen's and our assertions on; -O1 keeps it fast enough.
+      cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug \
+        -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DRADARGAUSS_SANITIZE=ON \
+        -DRADARGAUSS_BUILD_BENCHMARKS=OFF ;;
+    *)
+      echo "test.sh: unknown tree '$tree' (release, sanitize)" >&2
+      exit 2 ;;
+  esac
+  cmake --build "$build" -j "$jobs"
+  echo "== tests: $tree tree =="
+  (cd "$build" && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+     ctest --output-on-failure -j "$jobs")
+done

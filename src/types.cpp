@@ -1,0 +1,28 @@
+#include "radargauss/types.hpp"
+
+#include <cmath>
+
+#include "radargauss/error.hpp"
+
+namespace radargauss {
+
+void ValidateScan(const RadarScan& scan, const std::string& source) {
+  if (!std::isfinite(scan.timestamp)) throw FileError(source, "non-finite scan timestamp");
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    const RadarPoint& p = scan.points[i];
+    const auto fail = [&](const std::string& what) {
+      return FileError(source, "point " + std::to_string(i) + ": " + what);
+    };
+    if (!p.position.allFinite()) throw fail("non-finite position");
+    if (!std::isfinite(p.doppler)) throw fail("non-finite Doppler");
+    if (!std::isfinite(p.rcs)) throw fail("non-finite RCS");
+    if (p.std_dev) {
+      const MeasurementStd& s = *p.std_dev;
+      for (const float v : {s.range, s.azimuth, s.elevation, s.doppler}) {
+        if (!std::isfinite(v) || v < 0.0f) throw fail("standard deviation not finite and >= 0");
+      }
+    }
+  }
+}
+
+}  // namespace radargauss
