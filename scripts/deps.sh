@@ -10,6 +10,7 @@ packages=(
   g++ make cmake pkg-config
   # core (DESIGN.md section 9)
   libceres-dev libeigen3-dev libsuitesparse-dev libmetis-dev
+  libyaml-cpp-dev liblzf-dev libcli11-dev nlohmann-json3-dev libtbb-dev zlib1g-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

@@ -31,6 +31,9 @@ struct RadarPoint {
 struct RadarScan {
   double timestamp = 0.0;  // s
   std::vector<RadarPoint> points;
+  // Whether the source had these fields; when false the values are 0.
+  bool has_doppler = false;
+  bool has_rcs = false;
 };
 
 // Throws DataError naming `source` when a point has a non-finite position,

@@ -1,0 +1,56 @@
+// sensor_msgs/PointCloud2 topics of ROS1 bags, read through Debian's ROS1 bag
+// library (rosbag::Bag / rosbag::View: uncompressed, bz2 and lz4 bags). An
+// optional component: without it (RosbagSupported() false) every call throws
+// DataError saying so.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "radargauss/io/field_mapping.hpp"
+#include "radargauss/types.hpp"
+
+namespace radargauss {
+
+bool RosbagSupported();
+
+struct BagTopic {
+  std::string name;
+  std::string type;
+  std::size_t messages = 0;
+};
+
+std::vector<BagTopic> ListBagTopics(const std::string& bag_path);
+
+// One PointCloud2 message, as the bag holds it (for decoding and tests).
+struct PointCloud2Field {
+  std::string name;
+  std::uint32_t offset = 0;
+  std::uint8_t datatype = 7;  // sensor_msgs/PointField: 1 INT8 .. 7 FLOAT32, 8 FLOAT64
+  std::uint32_t count = 1;
+};
+struct PointCloud2Data {
+  std::uint32_t height = 1;
+  std::uint32_t width = 0;
+  std::vector<PointCloud2Field> fields;
+  bool is_bigendian = false;
+  std::uint32_t point_step = 0;
+  std::uint32_t row_step = 0;
+  std::vector<std::uint8_t> data;
+};
+
+// Decodes x y z and the mapped RCS / Doppler fields by name and datatype,
+// honouring is_bigendian, point_step and row_step. Throws DataError naming
+// `source` for inconsistent sizes, unknown datatypes or non-finite points.
+RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp,
+                            const FieldMapping& mapping, const std::string& source);
+
+// Every PointCloud2 message of `topic`, in bag order. The scan time is the
+// message header stamp, or the bag record time when the stamp is zero (the
+// ti_mmwave driver leaves it zero).
+std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
+                                    const FieldMapping& mapping = {});
+
+}  // namespace radargauss

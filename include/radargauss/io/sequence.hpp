@@ -1,0 +1,57 @@
+// A sequence: ordered radar scans, the reference trajectory of the radar and
+// the extrinsic that relates it to the ground-truth frame. Sources:
+//   (a) the Snail-Radar layout  <dir>/ars548/points/<secs>.<nsecs>.pcd
+//   (b) any folder of PCD files (or KITTI-style .bin files with a layout)
+//   (c) a ROS1 bag topic of sensor_msgs/PointCloud2
+// plus a TUM ground truth. Scans are matched to poses by timestamp
+// (interpolated); scans outside the trajectory's time span are skipped and
+// counted.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "radargauss/io/field_mapping.hpp"
+#include "radargauss/lie/se3.hpp"
+#include "radargauss/trajectory.hpp"
+#include "radargauss/types.hpp"
+
+namespace radargauss {
+
+struct SequenceOptions {
+  std::string sequence_dir;      // (a) or (b)
+  std::string bag;               // (c), with topic
+  std::string topic;
+  std::string ground_truth;      // TUM file; empty: scans without poses
+  // "auto" (default): snail-20231213 when the ground-truth file name contains
+  // "xt32" (Snail-Radar's utm50r_T_xt32.txt), else identity. Or a preset name
+  // (identity, snail-20231213), or a file holding "x y z qx qy qz qw"
+  // = T_gt_radar.
+  std::string extrinsic = "auto";
+  std::string bin_layout = "vod";  // record layout of .bin folders
+  FieldMapping fields;
+};
+
+struct Sequence {
+  std::string layout;                     // snail-radar, pcd-folder, bin-folder, rosbag
+  std::vector<RadarScan> scans;           // time order; with ground truth: matched scans only
+  std::vector<std::string> scan_sources;  // file (or bag message) of each scan
+  std::vector<SE3d> poses;                // T_world_radar of each scan; empty without ground truth
+  Trajectory trajectory;                  // ground truth times extrinsic: T_world_radar samples
+  SE3d extrinsic;                         // T_gt_radar
+  std::size_t total_scans = 0;            // scans read
+  std::size_t skipped_scans = 0;          // outside the trajectory's time span
+};
+
+// Throws DataError (one line naming the file and fault) on any bad input.
+Sequence LoadSequence(const SequenceOptions& options);
+
+// T_xt32_ars548 of the Snail-Radar 2023-12-13 sequences (DESIGN.md section 3).
+SE3d SnailRadar20231213Extrinsic();
+
+// Resolves SequenceOptions::extrinsic; throws DataError for an unknown preset
+// or a malformed file.
+SE3d ResolveExtrinsic(const std::string& spec, const std::string& ground_truth_path);
+
+}  // namespace radargauss

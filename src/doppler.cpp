@@ -1,0 +1,125 @@
+#include "radargauss/doppler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+namespace radargauss {
+
+int RansacIterations(double outlier_probability, double success_probability) {
+  const double clean_draw = std::pow(1.0 - outlier_probability, 3);
+  return static_cast<int>(
+      std::ceil(std::log(1.0 - success_probability) / std::log(1.0 - clean_draw)));
+}
+
+namespace {
+
+// Least squares on the rows `rows` of (H, y): v, sigma^2 (H^T H)^-1.
+bool SolveLeastSquares(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
+                       const std::vector<int>& rows, Eigen::Vector3d& v, Eigen::Matrix3d& cov) {
+  Eigen::Matrix3d hth = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d hty = Eigen::Vector3d::Zero();
+  for (const int i : rows) {
+    hth += H.row(i).transpose() * H.row(i);
+    hty += H.row(i).transpose() * y[i];
+  }
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(hth);
+  if (ldlt.info() != Eigen::Success || !(std::abs(hth.determinant()) > 1e-12)) return false;
+  v = ldlt.solve(hty);
+  double sse = 0.0;
+  for (const int i : rows) sse += std::pow(y[i] - H.row(i).dot(v), 2);
+  const double dof = std::max<double>(1.0, static_cast<double>(rows.size()) - 3.0);
+  cov = (sse / dof) * hth.inverse();
+  return v.allFinite();
+}
+
+}  // namespace
+
+EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOptions& options) {
+  EgoVelocityResult result;
+  result.inlier.assign(scan.points.size(), false);
+  if (!scan.has_doppler) {
+    result.reason = "scan has no Doppler field";
+    return result;
+  }
+  // Range gate; rows of H v = y for the gated points.
+  std::vector<int> gated;
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    const double range = scan.points[i].position.norm();
+    if (range >= options.min_range && range <= options.max_range &&
+        std::isfinite(scan.points[i].doppler)) {
+      gated.push_back(static_cast<int>(i));
+    }
+  }
+  const int n = static_cast<int>(gated.size());
+  if (n < 3) {
+    result.reason = "fewer than 3 points in the range gate (" + std::to_string(n) + ")";
+    return result;
+  }
+  Eigen::MatrixX3d H(n, 3);
+  Eigen::VectorXd y(n);
+  for (int k = 0; k < n; ++k) {
+    const RadarPoint& p = scan.points[gated[k]];
+    H.row(k) = -p.position.normalized().transpose();
+    y[k] = p.doppler;
+  }
+
+  // Zero-velocity check: the 75th percentile of |v_d|.
+  std::vector<double> abs_doppler(n);
+  for (int k = 0; k < n; ++k) abs_doppler[k] = std::abs(y[k]);
+  std::vector<double> sorted = abs_doppler;
+  const std::size_t q75 = static_cast<std::size_t>(0.75 * (n - 1));
+  std::nth_element(sorted.begin(), sorted.begin() + q75, sorted.end());
+  if (sorted[q75] < options.zero_velocity_threshold) {
+    result.success = true;
+    result.zero_velocity = true;
+    result.covariance = std::pow(options.zero_velocity_sigma, 2) * Eigen::Matrix3d::Identity();
+    for (int k = 0; k < n; ++k) {
+      result.inlier[gated[k]] = abs_doppler[k] < options.zero_velocity_threshold;
+    }
+    return result;
+  }
+
+  // RANSAC over 3-point draws, keeping the largest consensus set.
+  result.ransac_iterations = RansacIterations(options.outlier_probability,
+                                              options.success_probability);
+  std::mt19937 rng(options.seed);
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  std::vector<int> best;
+  std::vector<int> consensus;
+  for (int iteration = 0; iteration < result.ransac_iterations; ++iteration) {
+    int a = pick(rng), b = pick(rng), c = pick(rng);
+    while (b == a) b = pick(rng);
+    while (c == a || c == b) c = pick(rng);
+    Eigen::Matrix3d h;
+    h << H.row(a), H.row(b), H.row(c);
+    const Eigen::FullPivLU<Eigen::Matrix3d> lu(h);
+    if (!lu.isInvertible() || std::abs(h.determinant()) < 1e-6) continue;
+    const Eigen::Vector3d v = lu.solve(Eigen::Vector3d(y[a], y[b], y[c]));
+    consensus.clear();
+    for (int k = 0; k < n; ++k) {
+      if (std::abs(y[k] - H.row(k).dot(v)) < options.inlier_threshold) consensus.push_back(k);
+    }
+    if (consensus.size() > best.size()) best.swap(consensus);
+  }
+  if (best.size() < 3) {
+    result.reason = "RANSAC found no consensus of 3 or more points";
+    return result;
+  }
+  // Least-squares refit on all inliers, then the final inlier set.
+  if (!SolveLeastSquares(H, y, best, result.velocity, result.covariance)) {
+    result.reason = "least-squares refit is singular";
+    return result;
+  }
+  for (int k = 0; k < n; ++k) {
+    result.inlier[gated[k]] = std::abs(y[k] - H.row(k).dot(result.velocity)) <
+                              options.inlier_threshold;
+  }
+  result.success = true;
+  return result;
+}
+
+}  // namespace radargauss

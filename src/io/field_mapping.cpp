@@ -1,0 +1,29 @@
+#include "radargauss/io/field_mapping.hpp"
+
+#include <algorithm>
+
+#include "radargauss/error.hpp"
+
+namespace radargauss {
+
+int ResolveField(const std::vector<std::string>& available, const std::string& requested,
+                 const std::vector<std::string>& defaults, const std::string& role,
+                 const std::string& source) {
+  const auto index_of = [&](const std::string& name) {
+    const auto it = std::find(available.begin(), available.end(), name);
+    return it == available.end() ? -1 : static_cast<int>(it - available.begin());
+  };
+  if (requested == "none") return -1;
+  if (!requested.empty()) {
+    const int index = index_of(requested);
+    if (index < 0) throw FileError(source, role + " field '" + requested + "' not present");
+    return index;
+  }
+  for (const std::string& name : defaults) {
+    const int index = index_of(name);
+    if (index >= 0) return index;
+  }
+  return -1;
+}
+
+}  // namespace radargauss

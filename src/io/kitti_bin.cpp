@@ -1,0 +1,73 @@
+#include "radargauss/io/kitti_bin.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "radargauss/error.hpp"
+#include "radargauss/io/pcd.hpp"
+
+namespace radargauss {
+
+std::vector<std::string> ParseBinLayout(const std::string& layout) {
+  std::string text = layout == "vod" ? kViewOfDelftLayout : layout;
+  std::replace(text.begin(), text.end(), ',', ' ');
+  std::istringstream stream(text);
+  std::vector<std::string> fields;
+  std::set<std::string> seen;
+  std::string name;
+  while (stream >> name) {
+    if (!seen.insert(name).second) throw std::invalid_argument("bin layout repeats '" + name + "'");
+    fields.push_back(name);
+  }
+  for (const char* axis : {"x", "y", "z"}) {
+    if (!seen.count(axis)) {
+      throw std::invalid_argument(std::string("bin layout '") + layout + "' lacks field " + axis);
+    }
+  }
+  return fields;
+}
+
+RadarScan ReadKittiBin(const std::string& path, const std::vector<std::string>& layout,
+                       const FieldMapping& mapping) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError(path, "cannot open");
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t record = layout.size() * sizeof(float);
+  if (bytes.size() % record != 0) {
+    throw FileError(path, "truncated: " + std::to_string(bytes.size()) +
+                              " bytes is not a whole number of " + std::to_string(record) +
+                              "-byte records (" + std::to_string(layout.size()) + " float32 fields)");
+  }
+  const auto index_of = [&](const std::string& name) {
+    return static_cast<int>(std::find(layout.begin(), layout.end(), name) - layout.begin());
+  };
+  const int ix = index_of("x");
+  const int iy = index_of("y");
+  const int iz = index_of("z");
+  const int irc = ResolveField(layout, mapping.rcs_field, kRcsFieldNames, "RCS", path);
+  const int idop = ResolveField(layout, mapping.doppler_field, kDopplerFieldNames, "Doppler", path);
+
+  RadarScan scan;
+  if (!TimestampFromFileName(path, scan.timestamp)) scan.timestamp = 0.0;
+  scan.has_rcs = irc >= 0;
+  scan.has_doppler = idop >= 0;
+  const std::size_t n = bytes.size() / record;
+  scan.points.resize(n);
+  std::vector<float> values(layout.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    std::memcpy(values.data(), bytes.data() + i * record, record);
+    RadarPoint& p = scan.points[i];
+    p.position = Eigen::Vector3d(values[ix], values[iy], values[iz]);
+    if (irc >= 0) p.rcs = values[irc];
+    if (idop >= 0) p.doppler = mapping.doppler_sign * values[idop];
+  }
+  ValidateScan(scan, path);
+  return scan;
+}
+
+}  // namespace radargauss

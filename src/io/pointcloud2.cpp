@@ -1,0 +1,96 @@
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "radargauss/error.hpp"
+#include "radargauss/io/rosbag.hpp"
+
+namespace radargauss {
+
+namespace {
+
+int DatatypeSize(std::uint8_t datatype) {
+  switch (datatype) {
+    case 1: case 2: return 1;
+    case 3: case 4: return 2;
+    case 5: case 6: case 7: return 4;
+    case 8: return 8;
+    default: return 0;
+  }
+}
+
+double DecodeElement(const std::uint8_t* p, std::uint8_t datatype, bool big_endian) {
+  std::uint8_t bytes[8];
+  const int size = DatatypeSize(datatype);
+  for (int i = 0; i < size; ++i) bytes[i] = big_endian ? p[size - 1 - i] : p[i];
+  switch (datatype) {
+    case 1: { std::int8_t v; std::memcpy(&v, bytes, 1); return v; }
+    case 2: { std::uint8_t v; std::memcpy(&v, bytes, 1); return v; }
+    case 3: { std::int16_t v; std::memcpy(&v, bytes, 2); return v; }
+    case 4: { std::uint16_t v; std::memcpy(&v, bytes, 2); return v; }
+    case 5: { std::int32_t v; std::memcpy(&v, bytes, 4); return v; }
+    case 6: { std::uint32_t v; std::memcpy(&v, bytes, 4); return v; }
+    case 7: { float v; std::memcpy(&v, bytes, 4); return v; }
+    default: { double v; std::memcpy(&v, bytes, 8); return v; }
+  }
+}
+
+}  // namespace
+
+RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp,
+                            const FieldMapping& mapping, const std::string& source) {
+  std::vector<std::string> names;
+  for (const PointCloud2Field& field : cloud.fields) {
+    if (DatatypeSize(field.datatype) == 0) {
+      throw FileError(source, "field '" + field.name + "' has unknown datatype " +
+                                  std::to_string(field.datatype));
+    }
+    if (std::size_t(field.offset) + DatatypeSize(field.datatype) > cloud.point_step) {
+      throw FileError(source, "field '" + field.name + "' lies outside point_step");
+    }
+    names.push_back(field.name);
+  }
+  if (std::size_t(cloud.width) * cloud.point_step > cloud.row_step) {
+    throw FileError(source, "row_step is smaller than width x point_step");
+  }
+  if (std::size_t(cloud.row_step) * cloud.height > cloud.data.size()) {
+    throw FileError(source, "data holds " + std::to_string(cloud.data.size()) +
+                                " bytes, height x row_step needs " +
+                                std::to_string(std::size_t(cloud.row_step) * cloud.height));
+  }
+  const auto required = [&](const char* name) {
+    const int index = ResolveField(names, "", {name}, name, source);
+    if (index < 0) throw FileError(source, std::string("PointCloud2 has no '") + name + "' field");
+    return index;
+  };
+  const int ix = required("x");
+  const int iy = required("y");
+  const int iz = required("z");
+  const int irc = ResolveField(names, mapping.rcs_field, kRcsFieldNames, "RCS", source);
+  const int idop = ResolveField(names, mapping.doppler_field, kDopplerFieldNames, "Doppler", source);
+
+  RadarScan scan;
+  scan.timestamp = timestamp;
+  scan.has_rcs = irc >= 0;
+  scan.has_doppler = idop >= 0;
+  scan.points.reserve(std::size_t(cloud.width) * cloud.height);
+  const auto value = [&](const std::uint8_t* point, int field) {
+    const PointCloud2Field& f = cloud.fields[field];
+    return DecodeElement(point + f.offset, f.datatype, cloud.is_bigendian);
+  };
+  for (std::uint32_t row = 0; row < cloud.height; ++row) {
+    for (std::uint32_t column = 0; column < cloud.width; ++column) {
+      const std::uint8_t* point =
+          cloud.data.data() + std::size_t(row) * cloud.row_step + std::size_t(column) * cloud.point_step;
+      RadarPoint p;
+      p.position = Eigen::Vector3d(value(point, ix), value(point, iy), value(point, iz));
+      if (irc >= 0) p.rcs = value(point, irc);
+      if (idop >= 0) p.doppler = mapping.doppler_sign * value(point, idop);
+      scan.points.push_back(p);
+    }
+  }
+  ValidateScan(scan, source);
+  return scan;
+}
+
+}  // namespace radargauss

@@ -1,0 +1,83 @@
+// Built only when Debian's ROS1 bag library is found (RADARGAUSS_HAVE_ROSBAG).
+#include "radargauss/io/rosbag.hpp"
+
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/PointCloud2.h>
+
+#include <map>
+
+#include "radargauss/error.hpp"
+
+namespace radargauss {
+
+bool RosbagSupported() { return true; }
+
+namespace {
+
+void OpenBag(rosbag::Bag& bag, const std::string& path) {
+  try {
+    bag.open(path, rosbag::bagmode::Read);
+  } catch (const std::exception& e) {
+    throw FileError(path, std::string("cannot read ROS1 bag: ") + e.what());
+  }
+}
+
+}  // namespace
+
+std::vector<BagTopic> ListBagTopics(const std::string& bag_path) {
+  rosbag::Bag bag;
+  OpenBag(bag, bag_path);
+  std::map<std::string, BagTopic> topics;
+  try {
+    rosbag::View view(bag);
+    for (const rosbag::ConnectionInfo* connection : view.getConnections()) {
+      BagTopic& topic = topics[connection->topic];
+      topic.name = connection->topic;
+      topic.type = connection->datatype;
+    }
+    for (const rosbag::MessageInstance& message : view) ++topics[message.getTopic()].messages;
+  } catch (const std::exception& e) {
+    throw FileError(bag_path, std::string("corrupt ROS1 bag: ") + e.what());
+  }
+  std::vector<BagTopic> result;
+  for (auto& entry : topics) result.push_back(entry.second);
+  return result;
+}
+
+std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
+                                    const FieldMapping& mapping) {
+  rosbag::Bag bag;
+  OpenBag(bag, bag_path);
+  std::vector<RadarScan> scans;
+  std::size_t index = 0;
+  bool topic_seen = false;
+  try {
+    rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{topic}));
+    for (const rosbag::MessageInstance& message : view) {
+      topic_seen = true;
+      const sensor_msgs::PointCloud2::ConstPtr msg = message.instantiate<sensor_msgs::PointCloud2>();
+      const std::string source = bag_path + ":" + topic + "#" + std::to_string(index++);
+      if (!msg) throw FileError(source, "message is " + message.getDataType() + ", not sensor_msgs/PointCloud2");
+      PointCloud2Data cloud;
+      cloud.height = msg->height;
+      cloud.width = msg->width;
+      for (const auto& f : msg->fields) cloud.fields.push_back({f.name, f.offset, f.datatype, f.count});
+      cloud.is_bigendian = msg->is_bigendian;
+      cloud.point_step = msg->point_step;
+      cloud.row_step = msg->row_step;
+      cloud.data = msg->data;
+      const double stamp = msg->header.stamp.isZero() ? message.getTime().toSec()
+                                                      : msg->header.stamp.toSec();
+      scans.push_back(DecodePointCloud2(cloud, stamp, mapping, source));
+    }
+  } catch (const DataError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw FileError(bag_path, std::string("corrupt ROS1 bag: ") + e.what());
+  }
+  if (!topic_seen) throw FileError(bag_path, "no messages on topic '" + topic + "'");
+  return scans;
+}
+
+}  // namespace radargauss

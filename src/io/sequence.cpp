@@ -1,0 +1,179 @@
+#include "radargauss/io/sequence.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "radargauss/error.hpp"
+#include "radargauss/io/kitti_bin.hpp"
+#include "radargauss/io/pcd.hpp"
+#include "radargauss/io/rosbag.hpp"
+
+namespace radargauss {
+
+namespace fs = std::filesystem;
+
+SE3d SnailRadar20231213Extrinsic() {
+  Eigen::Matrix3d R_body_xt32;
+  R_body_xt32 << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+  Eigen::Matrix3d R_x36d_xt32;
+  R_x36d_xt32 << -0.001402106, -0.999967799, 0.007901562,  //
+      0.999997759, -0.001414596, -0.001575345,              //
+      0.001586472, 0.007899336, 0.999967541;
+  Eigen::Matrix3d R_x36d_ars548;
+  R_x36d_ars548 << 0.99912647794293, 0.039117559886893, -0.0147002578838332,  //
+      -0.0390210149947843, 0.999215265264576, 0.00679809171902766,            //
+      0.0149546468407877, -0.00621853445265288, 0.999868835581512;
+  const Eigen::Matrix3d R_body_x36d = R_body_xt32 * R_x36d_xt32.transpose();
+  const Eigen::Matrix3d R_body_ars548 = R_body_x36d * R_x36d_ars548;
+  const SE3d T_body_xt32(SO3d::FromMatrix(R_body_xt32), Eigen::Vector3d::Zero());
+  const SE3d T_body_ars548(SO3d::FromMatrix(R_body_ars548), Eigen::Vector3d(0.0, 0.0, 0.07));
+  return T_body_xt32.Inverse() * T_body_ars548;
+}
+
+SE3d ResolveExtrinsic(const std::string& spec, const std::string& ground_truth_path) {
+  if (spec == "identity") return SE3d();
+  if (spec == "snail-20231213") return SnailRadar20231213Extrinsic();
+  if (spec == "auto") {
+    const std::string name = fs::path(ground_truth_path).filename().string();
+    return name.find("xt32") != std::string::npos ? SnailRadar20231213Extrinsic() : SE3d();
+  }
+  std::ifstream in(spec);
+  if (!in) {
+    throw FileError(spec, "not an extrinsic preset (identity, snail-20231213, auto) nor a readable file");
+  }
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream tokens(line);
+    double v[7];
+    for (double& value : v) {
+      if (!(tokens >> value)) throw FileError(spec, "extrinsic needs 'x y z qx qy qz qw'");
+    }
+    std::string rest;
+    if (tokens >> rest) throw FileError(spec, "extrinsic needs exactly 7 numbers");
+    const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+    if (std::abs(q.norm() - 1.0) > kTumQuaternionNormTolerance) {
+      throw FileError(spec, "extrinsic quaternion is not unit");
+    }
+    return SE3d(SO3d(q), Eigen::Vector3d(v[0], v[1], v[2]));
+  }
+  throw FileError(spec, "extrinsic file is empty");
+}
+
+namespace {
+
+// Files with `extension` directly in `dir`, sorted by the time in their name
+// when all have one, else by name.
+std::vector<std::string> ListScanFiles(const fs::path& dir, const std::string& extension) {
+  std::vector<std::pair<double, std::string>> files;
+  bool all_timed = true;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+    if (!entry.is_regular_file() || entry.path().extension() != extension) continue;
+    double time = 0.0;
+    all_timed = TimestampFromFileName(entry.path().string(), time) && all_timed;
+    files.emplace_back(time, entry.path().string());
+  }
+  if (all_timed) {
+    std::sort(files.begin(), files.end());
+  } else {
+    std::sort(files.begin(), files.end(),
+              [](const auto& a, const auto& b) { return a.second < b.second; });
+  }
+  std::vector<std::string> paths;
+  for (auto& file : files) paths.push_back(std::move(file.second));
+  return paths;
+}
+
+bool HasFilesWith(const fs::path& dir, const std::string& extension) {
+  std::error_code error;
+  if (!fs::is_directory(dir, error)) return false;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+    if (entry.is_regular_file() && entry.path().extension() == extension) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+Sequence LoadSequence(const SequenceOptions& options) {
+  Sequence sequence;
+  std::vector<RadarScan> scans;
+  std::vector<std::string> sources;
+  if (!options.bag.empty()) {
+    if (options.topic.empty()) throw FileError(options.bag, "a bag needs --topic");
+    sequence.layout = "rosbag";
+    scans = ReadBagScans(options.bag, options.topic, options.fields);
+    for (std::size_t i = 0; i < scans.size(); ++i) {
+      sources.push_back(options.bag + ":" + options.topic + "#" + std::to_string(i));
+    }
+  } else {
+    if (options.sequence_dir.empty()) throw DataError("no sequence given (--sequence DIR or --bag FILE)");
+    const fs::path dir(options.sequence_dir);
+    std::error_code error;
+    if (!fs::is_directory(dir, error)) throw FileError(options.sequence_dir, "not a directory");
+    fs::path points = dir / "ars548" / "points";
+    std::string extension = ".pcd";
+    if (HasFilesWith(points, ".pcd")) {
+      sequence.layout = "snail-radar";
+    } else if (HasFilesWith(dir, ".pcd")) {
+      sequence.layout = "pcd-folder";
+      points = dir;
+    } else if (HasFilesWith(dir, ".bin")) {
+      sequence.layout = "bin-folder";
+      points = dir;
+      extension = ".bin";
+    } else {
+      throw FileError(options.sequence_dir,
+                      "no scans found (expected ars548/points/*.pcd, *.pcd or *.bin)");
+    }
+    sources = ListScanFiles(points, extension);
+    std::vector<std::string> layout;
+    if (extension == ".bin") {
+      try {
+        layout = ParseBinLayout(options.bin_layout);
+      } catch (const std::invalid_argument& e) {
+        throw DataError(e.what());
+      }
+    }
+    for (const std::string& path : sources) {
+      scans.push_back(extension == ".pcd" ? ReadPcdScan(path, options.fields)
+                                          : ReadKittiBin(path, layout, options.fields));
+    }
+  }
+  sequence.total_scans = scans.size();
+  if (scans.empty()) throw DataError("sequence has no scans");
+  for (std::size_t i = 1; i < scans.size(); ++i) {
+    if (!(scans[i].timestamp > scans[i - 1].timestamp)) {
+      throw FileError(sources[i], "scan time does not increase (missing or repeated timestamps)");
+    }
+  }
+
+  if (options.ground_truth.empty()) {
+    sequence.scans = std::move(scans);
+    sequence.scan_sources = std::move(sources);
+    return sequence;
+  }
+  sequence.extrinsic = ResolveExtrinsic(options.extrinsic, options.ground_truth);
+  const Trajectory ground_truth = ReadTum(options.ground_truth);
+  if (ground_truth.size() < 2) throw FileError(options.ground_truth, "needs at least 2 poses");
+  sequence.trajectory = ground_truth.RightMultiplied(sequence.extrinsic);
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    const std::optional<SE3d> pose = sequence.trajectory.Interpolate(scans[i].timestamp);
+    if (!pose) {
+      ++sequence.skipped_scans;
+      continue;
+    }
+    sequence.poses.push_back(*pose);
+    sequence.scans.push_back(std::move(scans[i]));
+    sequence.scan_sources.push_back(sources[i]);
+  }
+  if (sequence.scans.empty()) {
+    throw FileError(options.ground_truth, "no scan time lies within the trajectory's time span");
+  }
+  return sequence;
+}
+
+}  // namespace radargauss
