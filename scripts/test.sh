@@ -9,18 +9,20 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 jobs=$(nproc)
 trees=${RADARGAUSS_TEST_TREES:-"release sanitize"}
 
-"$root/scripts/deps.sh"
+# The optional ROS1 bag component is on here (and required): its packages too.
+RADARGAUSS_DEPS_EXTRA="librosbag-storage-dev libsensor-msgs-dev ${RADARGAUSS_DEPS_EXTRA:-}" \
+  "$root/scripts/deps.sh"
 
 for tree in $trees; do
   build="$root/build/$tree"
   case "$tree" in
     release)
-      cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release ;;
+      cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DRADARGAUSS_WITH_ROSBAG=ON ;;
     sanitize)
       # Debug keeps Eigen's and our assertions on; -O1 keeps it fast enough.
       cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug \
         -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DRADARGAUSS_SANITIZE=ON \
-        -DRADARGAUSS_BUILD_BENCHMARKS=OFF ;;
+        -DRADARGAUSS_BUILD_BENCHMARKS=OFF -DRADARGAUSS_WITH_ROSBAG=ON ;;
     *)
       echo "test.sh: unknown tree '$tree' (release, sanitize)" >&2
       exit 2 ;;

@@ -11,8 +11,9 @@ namespace radargauss {
 
 int RansacIterations(double outlier_probability, double success_probability) {
   const double clean_draw = std::pow(1.0 - outlier_probability, 3);
-  return static_cast<int>(
-      std::ceil(std::log(1.0 - success_probability) / std::log(1.0 - clean_draw)));
+  if (clean_draw >= 1.0) return 1;  // no outliers expected: one draw suffices
+  return std::max(1, static_cast<int>(std::ceil(std::log(1.0 - success_probability) /
+                                                std::log(1.0 - clean_draw))));
 }
 
 namespace {

@@ -283,8 +283,19 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
   const MeasurementStd stds{float(config.range_noise), float(config.azimuth_noise_deg * kDeg),
                             float(config.elevation_noise_deg * kDeg), float(config.doppler_noise)};
 
+  // Scan times in integer nanoseconds, so that file names are exact.
+  const long long start_seconds = static_cast<long long>(std::floor(config.start_time));
+  const long long start_nanoseconds =
+      std::llround((config.start_time - static_cast<double>(start_seconds)) * 1e9);
   for (int k = 0; k < config.scans; ++k) {
-    const double time_offset = k / config.rate_hz;
+    const long long offset_nanoseconds = std::llround(k * 1e9 / config.rate_hz);
+    const long long total = start_nanoseconds + offset_nanoseconds;
+    const long long seconds = start_seconds + total / 1000000000LL;
+    const long long nanoseconds = total % 1000000000LL;
+    char stem[64];
+    std::snprintf(stem, sizeof(stem), "%lld.%09lld", seconds, nanoseconds);
+    sequence.file_stems.push_back(stem);
+    const double time_offset = offset_nanoseconds * 1e-9;
     SE3d pose;
     Eigen::Vector3d velocity_world;
     SensorState(config, path, time_offset, pose, velocity_world);
@@ -296,7 +307,7 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
     }
 
     RadarScan scan;
-    scan.timestamp = config.start_time + time_offset;
+    scan.timestamp = static_cast<double>(seconds) + static_cast<double>(nanoseconds) * 1e-9;
     scan.has_doppler = true;
     scan.has_rcs = true;
     std::vector<DetectionTruth> truth;
@@ -537,9 +548,9 @@ void WriteSimulatedSequence(const std::string& dir, const SimulatedSequence& seq
   fs::create_directories(points, error);
   if (error) throw FileError(points.string(), "cannot create directory: " + error.message());
   std::string times;
-  for (const RadarScan& scan : sequence.scans) {
-    const std::string stem = TimestampStem(scan.timestamp);
-    WritePcdScan((points / (stem + ".pcd")).string(), scan, PcdFormat::kBinary);
+  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
+    const std::string& stem = sequence.file_stems[k];
+    WritePcdScan((points / (stem + ".pcd")).string(), sequence.scans[k], PcdFormat::kBinary);
     times += stem + "\n";
   }
   WriteFileAtomically((points / "times.txt").string(), [&](std::ostream& out) { out << times; });

@@ -109,6 +109,7 @@ struct SimulatedSequence {
   std::vector<std::vector<DetectionTruth>> truth;  // per scan, per detection
   std::vector<Eigen::Vector3d> sensor_velocity;    // per scan, radar frame, m/s
   Trajectory ground_truth;                         // T_world_radar per scan time
+  std::vector<std::string> file_stems;             // "<secs>.<nsecs>" per scan, exact
 };
 
 SimulatedSequence Simulate(const SimulationConfig& config);
@@ -118,7 +119,9 @@ SimulatedSequence Simulate(const SimulationConfig& config);
 // <dir>/gt_radar_tum.txt (TUM) and the configuration <dir>/simulation.yaml.
 void WriteSimulatedSequence(const std::string& dir, const SimulatedSequence& sequence);
 
-// "<secs>.<nsecs>" with nine decimals: the Snail-Radar file stem of a time.
+// "<secs>.<nsecs>" with nine decimals: the Snail-Radar file stem of a time,
+// to the nearest nanosecond of the double (whose own resolution near 1.7e9 s
+// is about 0.24 us; the simulator builds its stems from integers instead).
 std::string TimestampStem(double time);
 
 }  // namespace radargauss

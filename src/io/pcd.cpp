@@ -204,7 +204,9 @@ void DecodeAscii(const std::string& path, const std::string& bytes, PcdCloud& cl
         throw FileError(path, "data line " + std::to_string(point + 1) + ": not a number: '" +
                                   word + "'");
       }
-      cloud.values[f][point] = value;
+      // A float32 field holds the float nearest the decimal, as in the binary formats.
+      const bool is_float32 = h.fields[f].type == 'F' && h.fields[f].size == 4;
+      cloud.values[f][point] = is_float32 ? double(static_cast<float>(value)) : value;
       token += h.fields[f].count;
     }
     ++point;

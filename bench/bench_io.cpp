@@ -1,0 +1,102 @@
+// Data in: load throughput (points/s) per format, and Doppler ego velocity
+// per 800-point scan.
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "radargauss/doppler.hpp"
+#include "radargauss/io/kitti_bin.hpp"
+#include "radargauss/io/pcd.hpp"
+#include "radargauss/io/rosbag.hpp"
+#include "radargauss/simulator.hpp"
+
+namespace radargauss {
+namespace {
+
+namespace fs = std::filesystem;
+
+// One simulated scan of about 800 points (the ARS548 maximum) with every field.
+const RadarScan& BenchmarkScan() {
+  static const RadarScan scan = [] {
+    SimulationConfig config;
+    config.scans = 1;
+    config.min_detections = config.max_detections = 800;
+    return Simulate(config).scans.front();
+  }();
+  return scan;
+}
+
+std::string BenchmarkFile(const std::string& name) {
+  static const fs::path dir = fs::temp_directory_path() / "radargauss_bench_io";
+  fs::create_directories(dir);
+  return (dir / name).string();
+}
+
+void BM_ReadPcd(benchmark::State& state, PcdFormat format, const char* name) {
+  const std::string path = BenchmarkFile(name);
+  WritePcdScan(path, BenchmarkScan(), format);
+  std::size_t points = 0;
+  for (auto _ : state) {
+    const RadarScan scan = ReadPcdScan(path);
+    points += scan.points.size();
+    benchmark::DoNotOptimize(scan.points.data());
+  }
+  state.counters["points/s"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate);
+}
+BENCHMARK_CAPTURE(BM_ReadPcd, ascii, PcdFormat::kAscii, "scan_ascii.pcd");
+BENCHMARK_CAPTURE(BM_ReadPcd, binary, PcdFormat::kBinary, "scan_binary.pcd");
+BENCHMARK_CAPTURE(BM_ReadPcd, binary_compressed, PcdFormat::kBinaryCompressed,
+                  "scan_compressed.pcd");
+
+void BM_ReadKittiBin(benchmark::State& state) {
+  const std::string path = BenchmarkFile("scan.bin");
+  {
+    std::ofstream out(path, std::ios::binary);
+    for (const RadarPoint& p : BenchmarkScan().points) {
+      const float record[7] = {float(p.position.x()), float(p.position.y()), float(p.position.z()),
+                               float(p.rcs), float(p.doppler), 0.0f, 0.0f};
+      out.write(reinterpret_cast<const char*>(record), sizeof(record));
+    }
+  }
+  const std::vector<std::string> layout = ParseBinLayout("vod");
+  std::size_t points = 0;
+  for (auto _ : state) {
+    const RadarScan scan = ReadKittiBin(path, layout);
+    points += scan.points.size();
+    benchmark::DoNotOptimize(scan.points.data());
+  }
+  state.counters["points/s"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_ReadKittiBin);
+
+// The whole TI mmWave demo bag (412 messages, 17,872 points), when present.
+void BM_ReadBag(benchmark::State& state) {
+  const std::string bag = std::string(RADARGAUSS_SHARED_DATA_DIR) +
+                          "/ti_mmwave_demo/demo_ti_mmwave_rospkg_format.bag";
+  if (!RosbagSupported() || !fs::exists(bag)) {
+    state.SkipWithError("no ROS1 bag support or no shared data");
+    return;
+  }
+  std::size_t points = 0;
+  for (auto _ : state) {
+    for (const RadarScan& scan : ReadBagScans(bag, "/ti_mmwave/radar_scan_pcl")) {
+      points += scan.points.size();
+    }
+  }
+  state.counters["points/s"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_ReadBag)->Unit(benchmark::kMillisecond);
+
+void BM_EgoVelocity800(benchmark::State& state) {
+  const RadarScan& scan = BenchmarkScan();
+  for (auto _ : state) benchmark::DoNotOptimize(EstimateEgoVelocity(scan).velocity);
+  state.counters["points"] = double(scan.points.size());
+}
+BENCHMARK(BM_EgoVelocity800)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace radargauss
+
+BENCHMARK_MAIN();

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# End-to-end checks of the radargauss command-line tool: good runs work, bad
+# input gives a one-line error on stderr and a non-zero exit.
+#   cli_test.sh <path to radargauss>
+set -u
+tool=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+passed=0
+failed=0
+
+# expect_fail <description> <stderr substring> -- command...
+expect_fail() {
+  local description=$1 needle=$2
+  shift 3
+  "$@" >"$work/out" 2>"$work/err"
+  local status=$?
+  local lines
+  lines=$(wc -l <"$work/err")
+  if [ "$status" -ne 0 ] && grep -q -- "$needle" "$work/err" && [ "$lines" -le 2 ]; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAIL: $description (exit $status, $lines stderr lines)"; cat "$work/err"
+  fi
+}
+
+# expect_ok <description> <stdout substring> -- command...
+expect_ok() {
+  local description=$1 needle=$2
+  shift 3
+  if "$@" >"$work/out" 2>"$work/err" && grep -q -- "$needle" "$work/out"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAIL: $description"; cat "$work/out" "$work/err"
+  fi
+}
+
+expect_fail "no subcommand" "subcommand" -- "$tool"
+expect_fail "unknown flag" "bogus" -- "$tool" info --bogus
+expect_fail "missing sequence" "radargauss: error:" -- "$tool" info --sequence "$work/absent"
+expect_fail "no sequence at all" "radargauss: error: no sequence" -- "$tool" info
+expect_fail "simulate without --out" "out" -- "$tool" simulate
+expect_fail "bad scan count" "scans" -- "$tool" simulate --out "$work/s" --scans -3
+expect_ok "simulate" "simulated 6 scans" -- "$tool" simulate --out "$work/seq" --scans 6 --seed 3
+expect_ok "info on the simulation" "scans: 6 read, 6 matched" -- \
+  "$tool" info --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt"
+expect_fail "simulate over an existing sequence" "already holds" -- \
+  "$tool" simulate --out "$work/seq" --scans 2
+expect_ok "simulate --force" "simulated 2 scans" -- "$tool" simulate --out "$work/seq" --scans 2 --force
+expect_fail "bad doppler sign" "doppler-sign" -- \
+  "$tool" info --sequence "$work/seq" --doppler-sign 2
+printf 'scans: lots\n' >"$work/bad.yaml"
+expect_fail "bad config" "wrong type" -- "$tool" simulate --out "$work/s2" --config "$work/bad.yaml"
+expect_fail "bad ground truth" "expected 8 columns" -- \
+  bash -c "printf '0 1 2\n' > '$work/gt.txt'; '$tool' info --sequence '$work/seq' --gt '$work/gt.txt'"
+first=$(ls "$work/seq/ars548/points/"*.pcd | head -1)
+head -c 300 "$first" >"$work/cut" && mv "$work/cut" "$first"
+expect_fail "truncated scan" "truncated" -- "$tool" info --sequence "$work/seq"
+
+echo "cli: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
