@@ -7,12 +7,20 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <memory>
 
 #include "radargauss/doppler.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/io/sequence.hpp"
+#include "radargauss/map/builder.hpp"
+#include "radargauss/map/map_cloud.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/map/rcs_model.hpp"
+#include "radargauss/progress.hpp"
 #include "radargauss/simulator.hpp"
+
+#include <tbb/global_control.h>
 
 namespace {
 
@@ -130,6 +138,118 @@ int RunSimulate(const std::string& out, const std::string& config_path, std::uin
   return 0;
 }
 
+// Options of the map-building stages, shared by build-map (and localize later).
+struct MapBuildSettings {
+  GaussianMapOptions map;
+  RcsFitOptions rcs;
+  std::string builder = "kmeans";
+  std::string incidence = "offset";
+  bool no_adaptive = false;
+  bool no_doppler_filter = false;
+};
+
+void AddMapBuildOptions(CLI::App* app, MapBuildSettings& s) {
+  app->add_option("--builder", s.builder, "kmeans (RA-L default) or voxel (NDT-style baseline)")
+      ->check(CLI::IsMember({"kmeans", "voxel"}))
+      ->capture_default_str();
+  app->add_option("--points-per-gaussian", s.map.points_per_gaussian,
+                  "K = round(N_downsampled / this) (about 4 for ARS548, 16 for Oculii Eagle)")
+      ->check(CLI::Range(1.0, 1e6))
+      ->capture_default_str();
+  app->add_option("--downsample", s.map.downsample_voxel, "Voxel downsample edge (m)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--em-iterations", s.map.em_iterations, "Hard-EM rounds")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app->add_option("--min-std", s.map.min_std, "Minimum principal std of a Gaussian (m)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--ndt-voxel", s.map.ndt_voxel, "Voxel edge of the voxel builder (m)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--gate", s.map.association_gate, "Association gate tau (Mahalanobis distance)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--map-seed", s.map.seed, "Seed of the bisecting k-means")->capture_default_str();
+  app->add_option("--degree", s.rcs.max_degree, "SH degree of the RCS models (0..3)")
+      ->check(CLI::Range(0, kMaxShDegree))
+      ->capture_default_str();
+  app->add_option("--incidence", s.incidence, "Incidence vector: offset (paper) or view")
+      ->check(CLI::IsMember({"offset", "view"}))
+      ->capture_default_str();
+  app->add_flag("--no-adaptive", s.no_adaptive,
+                "Give no model instead of lowering the degree when members are too few");
+  app->add_flag("--no-doppler-filter", s.no_doppler_filter, "Keep dynamic points too");
+}
+
+// Sequence -> static map cloud -> Gaussians -> RCS models.
+GaussianMap BuildMapFromSequence(const Sequence& sequence, MapBuildSettings s, bool verbose) {
+  s.map.builder = MapBuilderFromString(s.builder);
+  s.rcs.incidence = IncidenceModelFromString(s.incidence);
+  s.rcs.adaptive = !s.no_adaptive;
+  MapCloudOptions cloud_options;
+  cloud_options.doppler_filter = !s.no_doppler_filter;
+  MapCloudStats cloud_stats;
+  const MapCloud cloud = BuildMapCloud(sequence, cloud_options, &cloud_stats);
+  if (cloud.points.empty()) throw DataError("no static points to build a map from");
+  ProgressBar bar;
+  GaussianMap map;
+  map.gaussians = BuildGaussians(cloud.points, s.map, [&](const char* stage, std::size_t done,
+                                                          std::size_t total) {
+    bar.Update(stage, done, total);
+  });
+  bar.Finish();
+  const GaussianIndex index(map.gaussians, s.map.index_cell);
+  const std::vector<int> association = AssociatePoints(cloud.points, index, s.map.association_gate);
+  const RcsFitStats rcs = FitRcsModels(map, cloud, association, s.rcs);
+  if (verbose) {
+    std::printf("map cloud: %zu scans (%zu without ego velocity), %zu of %zu points static\n",
+                cloud_stats.scans, cloud_stats.scans_without_ego_velocity,
+                cloud_stats.points_static, cloud_stats.points_in);
+    std::printf("gaussians: %zu (%s builder)\n", map.gaussians.size(), s.builder.c_str());
+    std::printf("rcs models (%s incidence, degree <= %d, %s): %zu with a model (%zu at a lowered "
+                "degree), %zu without; mean fit RMSE %.4f\n",
+                s.incidence.c_str(), s.rcs.max_degree, s.rcs.adaptive ? "adaptive" : "fixed",
+                rcs.with_model, rcs.lowered_degree, rcs.no_model, rcs.mean_fit_rmse);
+  }
+  return map;
+}
+
+int RunMapInfo(const std::string& path) {
+  const GaussianMap map = ReadMap(path);
+  std::array<std::size_t, kMaxShDegree + 1> histogram{};
+  std::size_t with_model = 0;
+  std::size_t members = 0;
+  double rmse = 0.0;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY);
+  Eigen::Vector3d hi = -lo;
+  for (const Gaussian& g : map.gaussians) {
+    members += g.point_count;
+    lo = lo.cwiseMin(g.mean);
+    hi = hi.cwiseMax(g.mean);
+    if (g.rcs.valid()) {
+      ++with_model;
+      ++histogram[g.rcs.degree];
+      rmse += g.rcs.fit_rmse;
+    }
+  }
+  const std::size_t n = map.gaussians.size();
+  std::printf("map: %s (version %u)\n", path.c_str(), kMapFileVersion);
+  std::printf("gaussians: %zu, member points: %zu\n", n, members);
+  std::printf("incidence model: %s\n", ToString(map.incidence).c_str());
+  std::printf("rcs coverage: %zu of %zu (%.1f%%) have a model\n", with_model, n,
+              n ? 100.0 * double(with_model) / double(n) : 0.0);
+  std::printf("sh degree histogram: none %zu", n - with_model);
+  for (int d = 0; d <= kMaxShDegree; ++d) std::printf(", %d: %zu", d, histogram[d]);
+  std::printf("\nmean fit RMSE (normalised): %.4f\n", with_model ? rmse / double(with_model) : 0.0);
+  if (n) {
+    std::printf("extent: x %.2f..%.2f, y %.2f..%.2f, z %.2f..%.2f m\n", lo.x(), hi.x(), lo.y(),
+                hi.y(), lo.z(), hi.z());
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -153,13 +273,46 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   simulate->add_flag("--force", sim_force, "Overwrite an existing sequence in --out");
 
+  SequenceOptions build_sequence;
+  MapBuildSettings build_settings;
+  std::string build_out;
+  std::string build_ply;
+  CLI::App* build_map = app.add_subcommand("build-map", "Build a Gaussian-RCS map of a sequence");
+  AddSequenceOptions(build_map, build_sequence);
+  AddMapBuildOptions(build_map, build_settings);
+  build_map->add_option("--out", build_out, "Map file (.rgm)")->required();
+  build_map->add_option("--ply", build_ply, "Also export a 3DGS-layout PLY");
+
+  std::string info_map;
+  CLI::App* map_info = app.add_subcommand("map-info", "Summarise a map file");
+  map_info->add_option("map", info_map, "Map file (.rgm)")->required();
+
+  int threads = 0;
+  app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  std::unique_ptr<tbb::global_control> thread_limit;
+  if (threads > 0) {
+    thread_limit = std::make_unique<tbb::global_control>(
+        tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+  }
   try {
     if (info->parsed()) return RunInfo(info_options);
+    if (map_info->parsed()) return RunMapInfo(info_map);
+    if (build_map->parsed()) {
+      if (build_sequence.ground_truth.empty()) throw DataError("build-map needs --gt");
+      const Sequence sequence = LoadSequence(build_sequence);
+      const GaussianMap map = BuildMapFromSequence(sequence, build_settings, true);
+      WriteMap(build_out, map);
+      if (!build_ply.empty()) ExportPly(build_ply, map);
+      std::printf("wrote %s%s%s\n", build_out.c_str(), build_ply.empty() ? "" : " and ",
+                  build_ply.c_str());
+      return 0;
+    }
     if (simulate->parsed()) {
       return RunSimulate(sim_out, sim_config, sim_seed, seed_option->count() > 0, sim_scans,
                          sim_force);

@@ -1,0 +1,97 @@
+// The Gaussian-RCS map (paper section III-A, DESIGN.md section 4): 3D
+// Gaussians in the world frame, each with an optional RCS model, and the
+// spatial index used to associate points with them.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "radargauss/sh.hpp"
+
+namespace radargauss {
+
+// How the incidence vector d of a member point is formed (DESIGN.md section
+// 4), in the radar frame of the point's scan, mu_r = R^T (mu - t):
+//   kOffset (the paper's): d = normalize(p_r - mu_r)
+//   kView (radar-to-centre ray): d = normalize(-mu_r)
+// In both, d is flipped when d.x > 0 so that it faces the radar.
+enum class IncidenceModel : std::uint8_t { kOffset = 0, kView = 1 };
+
+std::string ToString(IncidenceModel model);
+IncidenceModel IncidenceModelFromString(const std::string& name);  // throws std::invalid_argument
+
+// Per-Gaussian RCS model: y = (rcs - median) / scale in [-1, 1] is
+// predicted as c . Y(d) with real SH up to `degree` (sh.hpp).
+struct RcsModel {
+  int degree = -1;  // -1: no model (too few members or scale 0)
+  double median = 0.0;  // dBsm
+  double scale = 0.0;   // dBsm
+  std::array<double, ShCoefficientCount(kMaxShDegree)> coefficients{};
+  double fit_rmse = 0.0;  // normalised units, over the inliers
+  std::uint32_t inliers = 0;
+
+  bool valid() const { return degree >= 0; }
+  // The normalised measurement of a raw RCS value.
+  double Normalise(double rcs) const { return (rcs - median) / scale; }
+};
+
+struct Gaussian {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();            // world frame, m
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // m^2, symmetric positive definite
+  std::uint32_t point_count = 0;                             // member points
+  RcsModel rcs;
+};
+
+struct GaussianMap {
+  std::vector<Gaussian> gaussians;
+  IncidenceModel incidence = IncidenceModel::kOffset;  // how the RCS models were fitted
+};
+
+// The ellipsoid of a covariance: std devs (ascending) and the rotation whose
+// columns are the principal axes (det +1). Sigma = R diag(std^2) R^T.
+void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs,
+                   Eigen::Matrix3d& axes);
+
+// Clamps every principal std to at least `min_std` (DESIGN.md section 4).
+Eigen::Matrix3d ClampCovariance(const Eigen::Matrix3d& covariance, double min_std);
+
+// Spatial index: a voxel hash over each Gaussian's box of +/- `extent_sigmas`
+// standard deviations, so a query point has a few candidates; association is
+// the candidate of smallest Mahalanobis^2, gated by tau^2.
+class GaussianIndex {
+ public:
+  GaussianIndex() = default;
+  GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size = 1.0,
+                double extent_sigmas = 3.0);
+
+  // Index of the associated Gaussian, or -1 if no candidate has
+  // Mahalanobis^2 <= gate_sq. Writes the Mahalanobis^2 when asked.
+  int Associate(const Eigen::Vector3d& point, double gate_sq, double* mahalanobis_sq = nullptr) const;
+
+  // Gaussians whose box contains the cell of `point`.
+  const std::uint32_t* Candidates(const Eigen::Vector3d& point, std::size_t& count) const;
+
+  const Eigen::Matrix3d& Information(std::size_t i) const { return information_[i]; }
+  // L^T with Sigma^-1 = L L^T (Cholesky), so ||L^T (x - mu)||^2 is the Mahalanobis^2.
+  const Eigen::Matrix3d& SqrtInformationT(std::size_t i) const { return sqrt_information_t_[i]; }
+  const Eigen::Vector3d& Mean(std::size_t i) const { return means_[i]; }
+  std::size_t size() const { return means_.size(); }
+  std::size_t MemoryBytes() const;
+
+ private:
+  std::int64_t Key(const Eigen::Vector3d& p) const;
+
+  double cell_size_ = 1.0;
+  std::vector<Eigen::Vector3d> means_;
+  std::vector<Eigen::Matrix3d> information_;
+  std::vector<Eigen::Matrix3d> sqrt_information_t_;
+  std::vector<std::uint32_t> cell_entries_;  // Gaussian ids grouped by cell
+  std::unordered_map<std::int64_t, std::pair<std::uint32_t, std::uint32_t>> cells_;  // key -> [begin, end)
+};
+
+}  // namespace radargauss

@@ -1,0 +1,44 @@
+// The map cloud: the static points of a sequence (Doppler ego-velocity
+// inliers) merged into the world frame with the reference poses. Every point
+// keeps the index of its scan, so its radar pose is known when incidence
+// vectors are formed.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "radargauss/doppler.hpp"
+#include "radargauss/io/sequence.hpp"
+#include "radargauss/lie/se3.hpp"
+
+namespace radargauss {
+
+struct MapCloud {
+  std::vector<Eigen::Vector3d> points;  // world frame
+  std::vector<double> rcs;              // dBsm (0 when the sequence has none)
+  std::vector<std::uint32_t> scan;      // index into poses
+  std::vector<SE3d> poses;              // T_world_radar of each scan of the sequence
+  bool has_rcs = false;
+};
+
+struct MapCloudOptions {
+  bool doppler_filter = true;  // keep only ego-velocity inliers (needs Doppler)
+  EgoVelocityOptions ego_velocity;
+};
+
+struct MapCloudStats {
+  std::size_t scans = 0;
+  std::size_t scans_without_ego_velocity = 0;  // filter failed: the scan adds nothing
+  std::size_t points_in = 0;
+  std::size_t points_static = 0;
+};
+
+// Requires sequence.poses (a ground truth). Scans whose ego velocity fails
+// contribute no points and are counted. Without Doppler in the sequence the
+// filter is skipped (every point kept).
+MapCloud BuildMapCloud(const Sequence& sequence, const MapCloudOptions& options = {},
+                       MapCloudStats* stats = nullptr);
+
+}  // namespace radargauss

@@ -1,0 +1,37 @@
+// Gaussian-RCS map files.
+//
+// .rgm, version 1, little-endian:
+//   "RGAUSMAP" | u32 version | u8 incidence model | 3 zero bytes | u64 count |
+//   count x { f64 mean[3] | f64 covariance[6] (xx xy xz yy yz zz) |
+//             u32 point_count | i32 sh_degree (-1: no model) | f64 rcs_median |
+//             f64 rcs_scale | f64 fit_rmse | u32 inliers | f64 coefficients[16] } |
+//   u32 CRC32 (zlib) of everything before it.
+// Written to a temporary file and renamed: never a half-written map.
+//
+// PLY export in the 3D Gaussian Splatting layout (binary little-endian
+// float32: x y z nx ny nz f_dc_0..2 f_rest_0..44 opacity scale_0..2 rot_0..3):
+// scale = log of the principal stds, rot = the principal axes as a quaternion
+// (w first), and the RCS model mapped to colour: every channel's SH
+// coefficients are 0.5 c, so a splat viewer shows 0.5 + 0.5 y, the
+// normalised RCS, as a grey level that changes with the viewing direction
+// (evaluated with the viewer's world-frame direction; ours is radar-frame).
+// Gaussians without a model are flat grey.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "radargauss/map/gaussian_map.hpp"
+
+namespace radargauss {
+
+inline constexpr std::uint32_t kMapFileVersion = 1;
+
+void WriteMap(const std::string& path, const GaussianMap& map);
+// Throws DataError naming the file for a missing or truncated file, a wrong
+// magic or version, a CRC mismatch, or an invalid Gaussian.
+GaussianMap ReadMap(const std::string& path);
+
+void ExportPly(const std::string& path, const GaussianMap& map);
+
+}  // namespace radargauss

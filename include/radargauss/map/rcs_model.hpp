@@ -1,0 +1,73 @@
+// Per-Gaussian RCS models (paper section III-A, DESIGN.md section 4).
+//
+// Normalisation: m = median of the members' RCS (mean of the two middle
+// values for an even count), s = min(m - min, max - m); members with
+// |rcs - m| > s are outliers, the others map to y = (rcs - m) / s in [-1, 1].
+// s = 0 (all equal, or one side of the median empty) means no model.
+// Fit: c solves A c = y, A_ij = Y_j(d_i), by column-pivoting QR; when the
+// inliers are too few (fewer than (L+1)^2) or the directions do not span the
+// SH space (rank-deficient A) for degree L, the degree is lowered (adaptive)
+// or the Gaussian gets no model.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/map/map_cloud.hpp"
+
+namespace radargauss {
+
+struct RcsNormalisation {
+  bool valid = false;
+  double median = 0.0;
+  double scale = 0.0;
+};
+
+RcsNormalisation NormaliseRcs(std::vector<double> rcs);
+
+// The incidence vector d (unit, radar frame, facing the radar: d.x <= 0) of a
+// point p_r for a Gaussian centred at mu_r, both in the radar frame.
+// Templated so that residuals can differentiate it. Requires a non-zero vector.
+template <typename T>
+Eigen::Matrix<T, 3, 1> IncidenceDirection(IncidenceModel model,
+                                          const Eigen::Matrix<T, 3, 1>& point_radar,
+                                          const Eigen::Matrix<T, 3, 1>& mean_radar) {
+  Eigen::Matrix<T, 3, 1> d = model == IncidenceModel::kOffset ? Eigen::Matrix<T, 3, 1>(point_radar - mean_radar)
+                                                              : Eigen::Matrix<T, 3, 1>(-mean_radar);
+  using std::sqrt;
+  d /= sqrt(d.squaredNorm());
+  if (d.x() > T(0.0)) d = -d;
+  return d;
+}
+
+struct RcsFitOptions {
+  int max_degree = kMaxShDegree;
+  bool adaptive = true;
+  IncidenceModel incidence = IncidenceModel::kOffset;
+  double rank_threshold = 1e-6;  // relative pivot threshold of the QR
+};
+
+// Fits one model from the members' incidence directions and raw RCS.
+RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::vector<double>& rcs,
+                     const RcsFitOptions& options = {});
+
+struct RcsFitStats {
+  std::size_t gaussians = 0;
+  std::size_t with_model = 0;
+  std::size_t lowered_degree = 0;  // has a model below max_degree
+  std::size_t no_model = 0;
+  std::array<std::size_t, kMaxShDegree + 1> degree_histogram{};
+  double mean_fit_rmse = 0.0;  // over the Gaussians with a model
+};
+
+// Fits the RCS model of every Gaussian of `map` from the cloud points
+// associated to it (`association[i]` = Gaussian of point i or -1); sets
+// map.incidence. Parallel over Gaussians; the same for any thread count.
+RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud,
+                         const std::vector<int>& association, const RcsFitOptions& options = {});
+
+}  // namespace radargauss

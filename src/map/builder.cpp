@@ -1,0 +1,301 @@
+#include "radargauss/map/builder.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <random>
+#include <stdexcept>
+
+#include <Eigen/LU>
+
+namespace radargauss {
+
+MapBuilder MapBuilderFromString(const std::string& name) {
+  if (name == "kmeans") return MapBuilder::kKMeans;
+  if (name == "voxel") return MapBuilder::kVoxel;
+  throw std::invalid_argument("unknown map builder '" + name + "' (kmeans, voxel)");
+}
+
+namespace {
+
+struct VoxelKey {
+  std::int64_t x, y, z;
+  bool operator<(const VoxelKey& o) const {
+    return x != o.x ? x < o.x : (y != o.y ? y < o.y : z < o.z);
+  }
+  bool operator==(const VoxelKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+
+VoxelKey KeyOf(const Eigen::Vector3d& p, double voxel) {
+  return {static_cast<std::int64_t>(std::floor(p.x() / voxel)),
+          static_cast<std::int64_t>(std::floor(p.y() / voxel)),
+          static_cast<std::int64_t>(std::floor(p.z() / voxel))};
+}
+
+// Points grouped by voxel: (key, point index) sorted.
+std::vector<std::pair<VoxelKey, std::uint32_t>> SortedByVoxel(
+    const std::vector<Eigen::Vector3d>& points, double voxel) {
+  std::vector<std::pair<VoxelKey, std::uint32_t>> keyed(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    keyed[i] = {KeyOf(points[i], voxel), static_cast<std::uint32_t>(i)};
+  }
+  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) {
+    return a.first < b.first || (a.first == b.first && a.second < b.second);
+  });
+  return keyed;
+}
+
+// Mean and (ML) covariance of the points listed by `members`, clamped.
+Gaussian FitGaussian(const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<std::uint32_t>& members, double min_std) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const std::uint32_t i : members) sum += points[i];
+  Gaussian g;
+  g.mean = sum / double(members.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const std::uint32_t i : members) {
+    const Eigen::Vector3d e = points[i] - g.mean;
+    scatter += e * e.transpose();
+  }
+  g.covariance = ClampCovariance(scatter / double(members.size()), min_std);
+  return g;
+}
+
+struct Cluster {
+  std::vector<std::uint32_t> members;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double sse = 0.0;
+};
+
+void UpdateCluster(const std::vector<Eigen::Vector3d>& points, Cluster& cluster) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const std::uint32_t i : cluster.members) sum += points[i];
+  cluster.mean = sum / double(cluster.members.size());
+  cluster.sse = 0.0;
+  for (const std::uint32_t i : cluster.members) cluster.sse += (points[i] - cluster.mean).squaredNorm();
+}
+
+// Splits `cluster` in two with 2-means (Lloyd) from two seeded members;
+// false if it cannot be split (all members at one position).
+bool Bisect(const std::vector<Eigen::Vector3d>& points, const Cluster& cluster, int iterations,
+            std::mt19937& rng, Cluster& left, Cluster& right) {
+  const std::size_t n = cluster.members.size();
+  if (n < 2 || cluster.sse <= 0.0) return false;
+  std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+  Eigen::Vector3d a = points[cluster.members[pick(rng)]];
+  Eigen::Vector3d b = a;
+  for (int attempt = 0; attempt < 16 && (b - a).squaredNorm() == 0.0; ++attempt) {
+    b = points[cluster.members[pick(rng)]];
+  }
+  if ((b - a).squaredNorm() == 0.0) {
+    // Fall back to the member farthest from a.
+    for (const std::uint32_t i : cluster.members) {
+      if ((points[i] - a).squaredNorm() > (b - a).squaredNorm()) b = points[i];
+    }
+  }
+  std::vector<char> side(n, 0);
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    Eigen::Vector3d sum_a = Eigen::Vector3d::Zero(), sum_b = Eigen::Vector3d::Zero();
+    std::size_t count_a = 0;
+    bool changed = false;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Eigen::Vector3d& p = points[cluster.members[k]];
+      const char s = (p - b).squaredNorm() < (p - a).squaredNorm() ? 1 : 0;
+      changed = changed || s != side[k] || iteration == 0;
+      side[k] = s;
+      if (s == 0) {
+        sum_a += p;
+        ++count_a;
+      } else {
+        sum_b += p;
+      }
+    }
+    if (count_a == 0 || count_a == n) return false;
+    a = sum_a / double(count_a);
+    b = sum_b / double(n - count_a);
+    if (!changed) break;
+  }
+  left.members.clear();
+  right.members.clear();
+  for (std::size_t k = 0; k < n; ++k) {
+    (side[k] == 0 ? left : right).members.push_back(cluster.members[k]);
+  }
+  if (left.members.empty() || right.members.empty()) return false;
+  UpdateCluster(points, left);
+  UpdateCluster(points, right);
+  return true;
+}
+
+// Bisecting k-means: split the cluster of largest SSE until there are k.
+std::vector<std::vector<std::uint32_t>> BisectingKMeans(const std::vector<Eigen::Vector3d>& points,
+                                                        std::size_t k,
+                                                        const GaussianMapOptions& options,
+                                                        const ProgressCallback& progress) {
+  std::mt19937 rng(options.seed);
+  std::vector<Cluster> clusters(1);
+  clusters[0].members.resize(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) clusters[0].members[i] = std::uint32_t(i);
+  UpdateCluster(points, clusters[0]);
+  // (sse, -id): largest SSE first, then the oldest cluster.
+  std::priority_queue<std::pair<double, long>> queue;
+  queue.push({clusters[0].sse, 0});
+  std::vector<bool> final_cluster(1, false);
+  std::size_t count = 1;
+  while (count < k && !queue.empty()) {
+    const long id = -queue.top().second;
+    queue.pop();
+    Cluster left, right;
+    if (!Bisect(points, clusters[id], options.kmeans_iterations, rng, left, right)) continue;
+    clusters[id] = std::move(left);
+    clusters.push_back(std::move(right));
+    queue.push({clusters[id].sse, -id});
+    queue.push({clusters.back().sse, -long(clusters.size() - 1)});
+    ++count;
+    if (progress && count % 1024 == 0) progress("bisecting k-means", count, k);
+  }
+  std::vector<std::vector<std::uint32_t>> result;
+  for (Cluster& cluster : clusters) result.push_back(std::move(cluster.members));
+  return result;
+}
+
+// Hard EM from an initial partition; returns the final Gaussians.
+std::vector<Gaussian> HardEm(const std::vector<Eigen::Vector3d>& points,
+                             std::vector<std::vector<std::uint32_t>> partition,
+                             const GaussianMapOptions& options, const ProgressCallback& progress) {
+  std::vector<Gaussian> gaussians;
+  std::vector<int> label(points.size(), -1);
+  for (const auto& members : partition) {
+    for (const std::uint32_t i : members) label[i] = int(gaussians.size());
+    gaussians.push_back(FitGaussian(points, members, options.min_std));
+  }
+  for (int iteration = 0; iteration < options.em_iterations; ++iteration) {
+    const GaussianIndex index(gaussians, options.index_cell);
+    std::vector<double> half_log_det(gaussians.size());
+    for (std::size_t g = 0; g < gaussians.size(); ++g) {
+      half_log_det[g] = 0.5 * std::log(gaussians[g].covariance.determinant());
+    }
+    // E step (hard): the Gaussian of highest likelihood among the candidates.
+    std::vector<int> next(points.size());
+    tbb::parallel_for(std::size_t(0), points.size(), [&](std::size_t i) {
+      std::size_t count = 0;
+      const std::uint32_t* candidates = index.Candidates(points[i], count);
+      int best = label[i];
+      double best_cost = INFINITY;
+      for (std::size_t c = 0; c < count; ++c) {
+        const std::uint32_t g = candidates[c];
+        const Eigen::Vector3d e = points[i] - index.Mean(g);
+        const double cost = 0.5 * e.dot(index.Information(g) * e) + half_log_det[g];
+        if (cost < best_cost) {
+          best_cost = cost;
+          best = int(g);
+        }
+      }
+      next[i] = best;
+    });
+    const bool changed = next != label;
+    label.swap(next);
+    // M step: refit every Gaussian from its points; drop empty ones.
+    std::vector<std::vector<std::uint32_t>> members(gaussians.size());
+    for (std::size_t i = 0; i < points.size(); ++i) members[label[i]].push_back(std::uint32_t(i));
+    std::vector<Gaussian> refit;
+    std::vector<int> renumber(gaussians.size(), -1);
+    for (std::size_t g = 0; g < gaussians.size(); ++g) {
+      if (members[g].empty()) continue;
+      renumber[g] = int(refit.size());
+      refit.push_back(FitGaussian(points, members[g], options.min_std));
+    }
+    for (int& l : label) l = renumber[l];
+    gaussians.swap(refit);
+    if (progress) progress("hard EM", std::size_t(iteration + 1), std::size_t(options.em_iterations));
+    if (!changed) break;
+  }
+  return gaussians;
+}
+
+std::vector<Gaussian> VoxelGaussians(const std::vector<Eigen::Vector3d>& points,
+                                     const GaussianMapOptions& options) {
+  const auto keyed = SortedByVoxel(points, options.ndt_voxel);
+  std::vector<Gaussian> gaussians;
+  std::vector<std::uint32_t> members;
+  for (std::size_t begin = 0; begin < keyed.size();) {
+    std::size_t end = begin;
+    members.clear();
+    while (end < keyed.size() && keyed[end].first == keyed[begin].first) {
+      members.push_back(keyed[end].second);
+      ++end;
+    }
+    if (int(members.size()) >= options.ndt_min_points) {
+      gaussians.push_back(FitGaussian(points, members, options.min_std));
+    }
+    begin = end;
+  }
+  return gaussians;
+}
+
+void ValidateOptions(const GaussianMapOptions& o) {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(what);
+  };
+  require(o.downsample_voxel > 0.0, "downsample voxel must be > 0");
+  require(o.points_per_gaussian >= 1.0, "points per Gaussian must be >= 1");
+  require(o.kmeans_iterations >= 1 && o.em_iterations >= 0, "iteration counts must be >= 1 (EM >= 0)");
+  require(o.min_std > 0.0, "min std must be > 0");
+  require(o.ndt_voxel > 0.0 && o.ndt_min_points >= 1, "NDT voxel must be > 0 and min points >= 1");
+  require(o.index_cell > 0.0, "index cell must be > 0");
+  require(o.association_gate > 0.0, "association gate must be > 0");
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points,
+                                             double voxel) {
+  const auto keyed = SortedByVoxel(points, voxel);
+  std::vector<Eigen::Vector3d> centroids;
+  for (std::size_t begin = 0; begin < keyed.size();) {
+    std::size_t end = begin;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    while (end < keyed.size() && keyed[end].first == keyed[begin].first) {
+      sum += points[keyed[end].second];
+      ++end;
+    }
+    centroids.push_back(sum / double(end - begin));
+    begin = end;
+  }
+  return centroids;
+}
+
+std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points,
+                                 const GaussianIndex& index, double gate) {
+  std::vector<int> association(points.size());
+  tbb::parallel_for(std::size_t(0), points.size(), [&](std::size_t i) {
+    association[i] = index.Associate(points[i], gate * gate);
+  });
+  return association;
+}
+
+std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
+                                     const GaussianMapOptions& options,
+                                     const ProgressCallback& progress) {
+  ValidateOptions(options);
+  if (points.empty()) throw std::invalid_argument("cannot build a map from an empty cloud");
+  std::vector<Gaussian> gaussians;
+  if (options.builder == MapBuilder::kVoxel) {
+    gaussians = VoxelGaussians(points, options);
+  } else {
+    const std::vector<Eigen::Vector3d> downsampled = VoxelDownsample(points, options.downsample_voxel);
+    const std::size_t k = std::max<std::size_t>(
+        1, std::size_t(std::llround(double(downsampled.size()) / options.points_per_gaussian)));
+    gaussians = HardEm(downsampled, BisectingKMeans(downsampled, k, options, progress), options,
+                       progress);
+  }
+  // Members: every input point, associated by smallest Mahalanobis^2 within the gate.
+  const GaussianIndex index(gaussians, options.index_cell);
+  for (const int g : AssociatePoints(points, index, options.association_gate)) {
+    if (g >= 0) ++gaussians[g].point_count;
+  }
+  return gaussians;
+}
+
+}  // namespace radargauss

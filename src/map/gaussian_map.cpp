@@ -1,0 +1,134 @@
+#include "radargauss/map/gaussian_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <Eigen/Eigenvalues>
+
+namespace radargauss {
+
+std::string ToString(IncidenceModel model) {
+  return model == IncidenceModel::kOffset ? "offset" : "view";
+}
+
+IncidenceModel IncidenceModelFromString(const std::string& name) {
+  if (name == "offset") return IncidenceModel::kOffset;
+  if (name == "view") return IncidenceModel::kView;
+  throw std::invalid_argument("unknown incidence model '" + name + "' (offset, view)");
+}
+
+void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs,
+                   Eigen::Matrix3d& axes) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  std_devs = solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  axes = solver.eigenvectors();
+  if (axes.determinant() < 0.0) axes.col(0) = -axes.col(0);
+}
+
+Eigen::Matrix3d ClampCovariance(const Eigen::Matrix3d& covariance, double min_std) {
+  Eigen::Vector3d std_devs;
+  Eigen::Matrix3d axes;
+  PrincipalAxes(covariance, std_devs, axes);
+  const Eigen::Vector3d variances = std_devs.cwiseMax(min_std).array().square();
+  return axes * variances.asDiagonal() * axes.transpose();
+}
+
+namespace {
+
+constexpr std::int64_t kKeyBits = 21;
+constexpr std::int64_t kKeyOffset = std::int64_t(1) << (kKeyBits - 1);
+constexpr std::int64_t kKeyMask = (std::int64_t(1) << kKeyBits) - 1;
+
+std::int64_t PackKey(std::int64_t x, std::int64_t y, std::int64_t z) {
+  return ((x + kKeyOffset) & kKeyMask) | (((y + kKeyOffset) & kKeyMask) << kKeyBits) |
+         (((z + kKeyOffset) & kKeyMask) << (2 * kKeyBits));
+}
+
+}  // namespace
+
+std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
+  return PackKey(static_cast<std::int64_t>(std::floor(p.x() / cell_size_)),
+                 static_cast<std::int64_t>(std::floor(p.y() / cell_size_)),
+                 static_cast<std::int64_t>(std::floor(p.z() / cell_size_)));
+}
+
+GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size,
+                             double extent_sigmas)
+    : cell_size_(cell_size) {
+  if (!(cell_size > 0.0)) throw std::invalid_argument("index cell size must be > 0");
+  const std::size_t n = gaussians.size();
+  means_.resize(n);
+  information_.resize(n);
+  sqrt_information_t_.resize(n);
+  std::vector<std::pair<std::int64_t, std::uint32_t>> entries;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Gaussian& g = gaussians[i];
+    means_[i] = g.mean;
+    information_[i] = g.covariance.inverse();
+    const Eigen::LLT<Eigen::Matrix3d> llt(information_[i]);
+    sqrt_information_t_[i] = llt.matrixL().transpose();
+    const Eigen::Vector3d half = extent_sigmas * g.covariance.diagonal().cwiseSqrt();
+    const Eigen::Vector3d lo = ((g.mean - half) / cell_size).array().floor();
+    const Eigen::Vector3d hi = ((g.mean + half) / cell_size).array().floor();
+    for (auto x = std::int64_t(lo.x()); x <= std::int64_t(hi.x()); ++x) {
+      for (auto y = std::int64_t(lo.y()); y <= std::int64_t(hi.y()); ++y) {
+        for (auto z = std::int64_t(lo.z()); z <= std::int64_t(hi.z()); ++z) {
+          entries.emplace_back(PackKey(x, y, z), static_cast<std::uint32_t>(i));
+        }
+      }
+    }
+  }
+  std::sort(entries.begin(), entries.end());
+  cell_entries_.resize(entries.size());
+  cells_.reserve(entries.size() / 2 + 1);
+  for (std::size_t begin = 0; begin < entries.size();) {
+    std::size_t end = begin;
+    while (end < entries.size() && entries[end].first == entries[begin].first) {
+      cell_entries_[end] = entries[end].second;
+      ++end;
+    }
+    cells_.emplace(entries[begin].first, std::make_pair(std::uint32_t(begin), std::uint32_t(end)));
+    begin = end;
+  }
+}
+
+const std::uint32_t* GaussianIndex::Candidates(const Eigen::Vector3d& point, std::size_t& count) const {
+  const auto it = cells_.find(Key(point));
+  if (it == cells_.end()) {
+    count = 0;
+    return nullptr;
+  }
+  count = it->second.second - it->second.first;
+  return cell_entries_.data() + it->second.first;
+}
+
+int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
+                             double* mahalanobis_sq) const {
+  std::size_t count = 0;
+  const std::uint32_t* candidates = Candidates(point, count);
+  int best = -1;
+  double best_d2 = gate_sq;
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::uint32_t i = candidates[k];
+    const Eigen::Vector3d e = point - means_[i];
+    const double d2 = e.dot(information_[i] * e);
+    // Candidates come sorted by id, so ties go to the smallest id.
+    if (d2 < best_d2 || (best < 0 && d2 <= gate_sq)) {
+      best_d2 = d2;
+      best = static_cast<int>(i);
+    }
+  }
+  if (mahalanobis_sq && best >= 0) *mahalanobis_sq = best_d2;
+  return best;
+}
+
+std::size_t GaussianIndex::MemoryBytes() const {
+  return means_.size() * (sizeof(Eigen::Vector3d) + 2 * sizeof(Eigen::Matrix3d)) +
+         cell_entries_.size() * sizeof(std::uint32_t) +
+         cells_.size() * (sizeof(std::int64_t) + 2 * sizeof(std::uint32_t) + 2 * sizeof(void*));
+}
+
+}  // namespace radargauss

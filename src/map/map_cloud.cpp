@@ -1,0 +1,50 @@
+#include "radargauss/map/map_cloud.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include "radargauss/error.hpp"
+
+namespace radargauss {
+
+MapCloud BuildMapCloud(const Sequence& sequence, const MapCloudOptions& options,
+                       MapCloudStats* stats) {
+  if (sequence.poses.size() != sequence.scans.size()) {
+    throw DataError("building a map needs a ground truth (--gt) for every scan");
+  }
+  const std::size_t n = sequence.scans.size();
+  // Ego velocity per scan in parallel; results are per scan, so the merge
+  // below is the same for any thread count.
+  std::vector<std::vector<bool>> keep(n);
+  tbb::parallel_for(std::size_t(0), n, [&](std::size_t k) {
+    const RadarScan& scan = sequence.scans[k];
+    if (options.doppler_filter && scan.has_doppler) {
+      keep[k] = EstimateEgoVelocity(scan, options.ego_velocity).inlier;
+    } else {
+      keep[k].assign(scan.points.size(), true);
+    }
+  });
+  MapCloud cloud;
+  cloud.poses = sequence.poses;
+  cloud.has_rcs = n > 0;
+  MapCloudStats local;
+  for (std::size_t k = 0; k < n; ++k) {
+    const RadarScan& scan = sequence.scans[k];
+    cloud.has_rcs = cloud.has_rcs && scan.has_rcs;
+    local.points_in += scan.points.size();
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < scan.points.size(); ++i) {
+      if (!keep[k][i]) continue;
+      cloud.points.push_back(sequence.poses[k] * scan.points[i].position);
+      cloud.rcs.push_back(scan.points[i].rcs);
+      cloud.scan.push_back(static_cast<std::uint32_t>(k));
+      ++kept;
+    }
+    local.scans_without_ego_velocity += (kept == 0 && !scan.points.empty());
+    local.points_static += kept;
+  }
+  local.scans = n;
+  if (stats) *stats = local;
+  return cloud;
+}
+
+}  // namespace radargauss

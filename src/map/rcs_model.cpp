@@ -1,0 +1,117 @@
+#include "radargauss/map/rcs_model.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/QR>
+
+namespace radargauss {
+
+RcsNormalisation NormaliseRcs(std::vector<double> rcs) {
+  RcsNormalisation result;
+  if (rcs.size() < 2) return result;
+  const std::size_t n = rcs.size();
+  std::sort(rcs.begin(), rcs.end());
+  result.median = n % 2 ? rcs[n / 2] : 0.5 * (rcs[n / 2 - 1] + rcs[n / 2]);
+  result.scale = std::min(result.median - rcs.front(), rcs.back() - result.median);
+  result.valid = result.scale > 0.0;
+  return result;
+}
+
+RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::vector<double>& rcs,
+                     const RcsFitOptions& options) {
+  RcsModel model;
+  const RcsNormalisation normalisation = NormaliseRcs(rcs);
+  if (!normalisation.valid) return model;
+  model.median = normalisation.median;
+  model.scale = normalisation.scale;
+  std::vector<int> inliers;
+  for (std::size_t i = 0; i < rcs.size(); ++i) {
+    if (std::abs(rcs[i] - model.median) <= model.scale) inliers.push_back(int(i));
+  }
+  const int n = int(inliers.size());
+  Eigen::VectorXd y(n);
+  Eigen::MatrixXd basis(n, ShCoefficientCount(kMaxShDegree));
+  for (int k = 0; k < n; ++k) {
+    y[k] = model.Normalise(rcs[inliers[k]]);
+    double values[ShCoefficientCount(kMaxShDegree)];
+    EvaluateShBasis<kMaxShDegree>(directions[inliers[k]], values);
+    for (int j = 0; j < ShCoefficientCount(kMaxShDegree); ++j) basis(k, j) = values[j];
+  }
+  for (int degree = options.max_degree; degree >= 0; --degree) {
+    const int count = ShCoefficientCount(degree);
+    const bool enough = n >= count;
+    if (enough) {
+      const Eigen::MatrixXd A = basis.leftCols(count);
+      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+      qr.setThreshold(options.rank_threshold);
+      if (qr.rank() == count) {
+        const Eigen::VectorXd c = qr.solve(y);
+        model.degree = degree;
+        model.coefficients.fill(0.0);
+        for (int j = 0; j < count; ++j) model.coefficients[j] = c[j];
+        model.fit_rmse = std::sqrt((A * c - y).squaredNorm() / n);
+        model.inliers = std::uint32_t(n);
+        return model;
+      }
+    }
+    if (!options.adaptive) break;
+  }
+  model.degree = -1;
+  return model;
+}
+
+RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud,
+                         const std::vector<int>& association, const RcsFitOptions& options) {
+  map.incidence = options.incidence;
+  const std::size_t n_gaussians = map.gaussians.size();
+  // Members of each Gaussian, in point order (CSR).
+  std::vector<std::uint32_t> offsets(n_gaussians + 1, 0);
+  for (const int g : association) {
+    if (g >= 0) ++offsets[g + 1];
+  }
+  for (std::size_t g = 0; g < n_gaussians; ++g) offsets[g + 1] += offsets[g];
+  std::vector<std::uint32_t> members(offsets.back());
+  std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+  for (std::size_t i = 0; i < association.size(); ++i) {
+    if (association[i] >= 0) members[fill[association[i]]++] = std::uint32_t(i);
+  }
+  tbb::parallel_for(std::size_t(0), n_gaussians, [&](std::size_t g) {
+    Gaussian& gaussian = map.gaussians[g];
+    std::vector<Eigen::Vector3d> directions;
+    std::vector<double> rcs;
+    for (std::uint32_t k = offsets[g]; k < offsets[g + 1]; ++k) {
+      const std::uint32_t i = members[k];
+      const SE3d& pose = cloud.poses[cloud.scan[i]];
+      const SE3d world_to_radar = pose.Inverse();
+      const Eigen::Vector3d point_radar = world_to_radar * cloud.points[i];
+      const Eigen::Vector3d mean_radar = world_to_radar * gaussian.mean;
+      const Eigen::Vector3d v = options.incidence == IncidenceModel::kOffset
+                                    ? Eigen::Vector3d(point_radar - mean_radar)
+                                    : Eigen::Vector3d(-mean_radar);
+      if (v.squaredNorm() < 1e-18) continue;  // no direction: skip the member
+      directions.push_back(IncidenceDirection(options.incidence, point_radar, mean_radar));
+      rcs.push_back(cloud.rcs[i]);
+    }
+    gaussian.rcs = cloud.has_rcs ? FitRcsModel(directions, rcs, options) : RcsModel{};
+  });
+  RcsFitStats stats;
+  stats.gaussians = n_gaussians;
+  double rmse_sum = 0.0;
+  for (const Gaussian& g : map.gaussians) {
+    if (!g.rcs.valid()) {
+      ++stats.no_model;
+      continue;
+    }
+    ++stats.with_model;
+    ++stats.degree_histogram[g.rcs.degree];
+    stats.lowered_degree += g.rcs.degree < options.max_degree;
+    rmse_sum += g.rcs.fit_rmse;
+  }
+  stats.mean_fit_rmse = stats.with_model ? rmse_sum / double(stats.with_model) : 0.0;
+  return stats;
+}
+
+}  // namespace radargauss
