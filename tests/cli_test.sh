@@ -49,6 +49,14 @@ expect_ok "info on the simulation" "scans: 6 read, 6 matched" -- \
 expect_fail "simulate over an existing sequence" "already holds" -- \
   "$tool" simulate --out "$work/seq" --scans 2
 expect_ok "simulate --force" "simulated 2 scans" -- "$tool" simulate --out "$work/seq" --scans 2 --force
+expect_ok "build-map" "wrote $work/seq.rgm" -- \
+  "$tool" build-map --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --out "$work/seq.rgm"
+expect_ok "map-info" "rcs coverage" -- "$tool" map-info "$work/seq.rgm"
+expect_fail "build-map without gt" "needs --gt" -- "$tool" build-map --sequence "$work/seq" --out "$work/x.rgm"
+expect_fail "bad incidence" "incidence" -- \
+  "$tool" build-map --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --out "$work/x.rgm" --incidence side
+head -c 100 "$work/seq.rgm" > "$work/cut.rgm"
+expect_fail "truncated map" "radargauss: error:" -- "$tool" map-info "$work/cut.rgm"
 expect_fail "bad doppler sign" "doppler-sign" -- \
   "$tool" info --sequence "$work/seq" --doppler-sign 2
 printf 'scans: lots\n' >"$work/bad.yaml"

@@ -33,7 +33,8 @@ Eigen::Matrix3d ClampCovariance(const Eigen::Matrix3d& covariance, double min_st
   Eigen::Matrix3d axes;
   PrincipalAxes(covariance, std_devs, axes);
   const Eigen::Vector3d variances = std_devs.cwiseMax(min_std).array().square();
-  return axes * variances.asDiagonal() * axes.transpose();
+  const Eigen::Matrix3d clamped = axes * variances.asDiagonal() * axes.transpose();
+  return 0.5 * (clamped + clamped.transpose());  // exactly symmetric
 }
 
 namespace {

@@ -1,0 +1,118 @@
+// Map building: the whole map + RCS fit for 100k and 1M map points, the
+// association of one point, the RCS fit of one Gaussian, and the memory of
+// a Gaussian (map entry + spatial index).
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "radargauss/map/builder.hpp"
+#include "radargauss/map/map_cloud.hpp"
+#include "radargauss/map/rcs_model.hpp"
+
+namespace radargauss {
+namespace {
+
+// A town-like map cloud: points on random vertical walls (10 m x 5 m, 5 cm
+// noise) seen from poses along a line, with RCS values. Deterministic.
+MapCloud TownCloud(std::size_t n) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  const std::size_t walls = std::max<std::size_t>(1, n / 2500);  // ~50 points per m^2
+  std::vector<Eigen::Vector3d> origin(walls), along(walls);
+  for (std::size_t w = 0; w < walls; ++w) {
+    origin[w] = Eigen::Vector3d(600.0 * unit(rng), 600.0 * unit(rng), 0.0);
+    const double yaw = 2.0 * M_PI * unit(rng);
+    along[w] = Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0);
+  }
+  MapCloud cloud;
+  cloud.has_rcs = true;
+  for (int k = 0; k < 1000; ++k) {
+    cloud.poses.emplace_back(SO3d(), Eigen::Vector3d(0.6 * k, 300.0, 1.0));
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t w = i % walls;
+    const Eigen::Vector3d normal(-along[w].y(), along[w].x(), 0.0);
+    cloud.points.push_back(origin[w] + 10.0 * unit(rng) * along[w] +
+                           Eigen::Vector3d(0, 0, 5.0 * unit(rng)) + noise(rng) * normal);
+    cloud.rcs.push_back(5.0 + 3.0 * std::sin(7.0 * unit(rng)) + noise(rng) * 20.0);
+    cloud.scan.push_back(std::uint32_t(rng() % cloud.poses.size()));
+  }
+  return cloud;
+}
+
+// The build-map pipeline after the Doppler filter: Gaussians, members, RCS models.
+void BM_BuildMapAndRcs(benchmark::State& state) {
+  const MapCloud cloud = TownCloud(std::size_t(state.range(0)));
+  GaussianMapOptions options;
+  std::size_t gaussians = 0;
+  for (auto _ : state) {
+    GaussianMap map;
+    map.gaussians = BuildGaussians(cloud.points, options);
+    const GaussianIndex index(map.gaussians, options.index_cell);
+    const std::vector<int> association = AssociatePoints(cloud.points, index, options.association_gate);
+    FitRcsModels(map, cloud, association);
+    gaussians = map.gaussians.size();
+  }
+  state.counters["gaussians"] = double(gaussians);
+}
+BENCHMARK(BM_BuildMapAndRcs)->Arg(100000)->Arg(1000000)->Unit(benchmark::kSecond)->Iterations(1);
+
+struct BuiltMap {
+  MapCloud cloud;
+  GaussianMap map;
+  GaussianIndex index;
+};
+
+const BuiltMap& Built() {
+  static const BuiltMap built = [] {
+    BuiltMap b;
+    b.cloud = TownCloud(100000);
+    b.map.gaussians = BuildGaussians(b.cloud.points, GaussianMapOptions{});
+    b.index = GaussianIndex(b.map.gaussians, 1.0);
+    return b;
+  }();
+  return built;
+}
+
+void BM_AssociatePoint(benchmark::State& state) {
+  const BuiltMap& b = Built();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(b.index.Associate(b.cloud.points[i], 9.0));
+    i = (i + 7919) % b.cloud.points.size();
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_AssociatePoint);
+
+void BM_FitRcsModelDegree3(benchmark::State& state) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  std::vector<Eigen::Vector3d> directions;
+  std::vector<double> rcs;
+  for (int i = 0; i < state.range(0); ++i) {
+    Eigen::Vector3d d(normal(rng), normal(rng), normal(rng));
+    d.normalize();
+    if (d.x() > 0) d = -d;
+    directions.push_back(d);
+    rcs.push_back(normal(rng));
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(FitRcsModel(directions, rcs).coefficients[0]);
+}
+BENCHMARK(BM_FitRcsModelDegree3)->Arg(20)->Arg(100)->Unit(benchmark::kMicrosecond);
+
+// Bytes per Gaussian in memory: the map entry plus its share of the index.
+void BM_BytesPerGaussian(benchmark::State& state) {
+  const BuiltMap& b = Built();
+  for (auto _ : state) benchmark::DoNotOptimize(b.index.MemoryBytes());
+  const double n = double(b.map.gaussians.size());
+  state.counters["map_bytes_per_gaussian"] = double(sizeof(Gaussian));
+  state.counters["index_bytes_per_gaussian"] = double(b.index.MemoryBytes()) / n;
+}
+BENCHMARK(BM_BytesPerGaussian)->Iterations(1);
+
+}  // namespace
+}  // namespace radargauss
+
+BENCHMARK_MAIN();
