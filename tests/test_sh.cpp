@@ -152,5 +152,21 @@ TEST(SphericalHarmonics, JetDerivativesMatchNumeric) {
   }
 }
 
+TEST(SphericalHarmonics, AnalyticGradientMatchesJets) {
+  using Jet3 = ceres::Jet<double, 3>;
+  std::mt19937 rng(10);
+  for (int sample = 0; sample < 200; ++sample) {
+    const Eigen::Vector3d d = RandomUnitVector(rng);
+    Eigen::Matrix<Jet3, 3, 1> d_jet;
+    for (int i = 0; i < 3; ++i) d_jet[i] = Jet3(d[i], i);
+    const auto y_jet = ShBasis<kMaxShDegree>(d_jet);
+    double gradient[3 * kCount];
+    EvaluateShBasisGradient<kMaxShDegree>(d, gradient);
+    for (int i = 0; i < kCount; ++i) {
+      for (int k = 0; k < 3; ++k) ASSERT_NEAR(gradient[3 * i + k], y_jet[i].v[k], 1e-12) << i << " " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace radargauss

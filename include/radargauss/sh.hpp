@@ -84,6 +84,55 @@ T EvaluateSh(const CoefficientT* coefficients, const Eigen::Matrix<T, 3, 1>& d) 
   return value;
 }
 
+// Gradient of each basis function with respect to the direction components:
+// gradient[3 * i + k] = dY_i / dd_k, for the polynomial forms above (d is not
+// renormalised). The analytic twin of the Jet derivatives of EvaluateShBasis.
+template <int Degree>
+void EvaluateShBasisGradient(const Eigen::Vector3d& d, double* gradient) {
+  static_assert(Degree >= 0 && Degree <= kMaxShDegree, "SH degree must be 0..3");
+  using namespace sh_constants;
+  const auto set = [gradient](int i, double gx, double gy, double gz) {
+    gradient[3 * i] = gx;
+    gradient[3 * i + 1] = gy;
+    gradient[3 * i + 2] = gz;
+  };
+  set(0, 0.0, 0.0, 0.0);
+  if constexpr (Degree >= 1) {
+    const double x = d.x(), y = d.y(), z = d.z();
+    set(1, 0.0, -kC1, 0.0);
+    set(2, 0.0, 0.0, kC1);
+    set(3, -kC1, 0.0, 0.0);
+    if constexpr (Degree >= 2) {
+      set(4, kC2[0] * y, kC2[0] * x, 0.0);
+      set(5, 0.0, kC2[1] * z, kC2[1] * y);
+      set(6, -2.0 * kC2[2] * x, -2.0 * kC2[2] * y, 4.0 * kC2[2] * z);
+      set(7, kC2[3] * z, 0.0, kC2[3] * x);
+      set(8, 2.0 * kC2[4] * x, -2.0 * kC2[4] * y, 0.0);
+      if constexpr (Degree >= 3) {
+        const double xx = x * x, yy = y * y, zz = z * z;
+        set(9, 6.0 * kC3[0] * x * y, 3.0 * kC3[0] * (xx - yy), 0.0);
+        set(10, kC3[1] * y * z, kC3[1] * x * z, kC3[1] * x * y);
+        set(11, -2.0 * kC3[2] * x * y, kC3[2] * (4.0 * zz - xx - 3.0 * yy), 8.0 * kC3[2] * y * z);
+        set(12, -6.0 * kC3[3] * x * z, -6.0 * kC3[3] * y * z, kC3[3] * (6.0 * zz - 3.0 * xx - 3.0 * yy));
+        set(13, kC3[4] * (4.0 * zz - 3.0 * xx - yy), -2.0 * kC3[4] * x * y, 8.0 * kC3[4] * x * z);
+        set(14, 2.0 * kC3[5] * x * z, -2.0 * kC3[5] * y * z, kC3[5] * (xx - yy));
+        set(15, 3.0 * kC3[6] * (xx - yy), -6.0 * kC3[6] * x * y, 0.0);
+      }
+    }
+  }
+}
+
+inline void EvaluateShBasisGradient(int degree, const Eigen::Vector3d& d, double* gradient) {
+  switch (degree) {
+    case 0: return EvaluateShBasisGradient<0>(d, gradient);
+    case 1: return EvaluateShBasisGradient<1>(d, gradient);
+    case 2: return EvaluateShBasisGradient<2>(d, gradient);
+    case 3: return EvaluateShBasisGradient<3>(d, gradient);
+    default:
+      throw std::invalid_argument("SH degree must be in 0..3, got " + std::to_string(degree));
+  }
+}
+
 // Runtime-degree versions; throw std::invalid_argument for a degree outside 0..3.
 template <typename T>
 void EvaluateShBasis(int degree, const Eigen::Matrix<T, 3, 1>& d, T* basis) {

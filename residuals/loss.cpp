@@ -1,0 +1,40 @@
+#include "residuals/loss.hpp"
+
+#include <stdexcept>
+
+namespace radargauss {
+
+LossType LossTypeFromString(const std::string& name) {
+  if (name == "trivial" || name == "none") return LossType::kTrivial;
+  if (name == "huber") return LossType::kHuber;
+  if (name == "cauchy") return LossType::kCauchy;
+  if (name == "geman-mcclure") return LossType::kGemanMcClure;
+  if (name == "tukey") return LossType::kTukey;
+  throw std::invalid_argument("unknown loss '" + name +
+                              "' (trivial, huber, cauchy, geman-mcclure, tukey)");
+}
+
+std::string ToString(LossType type) {
+  switch (type) {
+    case LossType::kTrivial: return "trivial";
+    case LossType::kHuber: return "huber";
+    case LossType::kCauchy: return "cauchy";
+    case LossType::kGemanMcClure: return "geman-mcclure";
+    case LossType::kTukey: return "tukey";
+  }
+  return "unknown";
+}
+
+ceres::LossFunction* MakeLoss(const LossConfig& config) {
+  if (!(config.scale > 0.0)) throw std::invalid_argument("loss scale must be > 0");
+  switch (config.type) {
+    case LossType::kTrivial: return nullptr;
+    case LossType::kHuber: return new ceres::HuberLoss(config.scale);
+    case LossType::kCauchy: return new ceres::CauchyLoss(config.scale);
+    case LossType::kGemanMcClure: return new GemanMcClureLoss(config.scale);
+    case LossType::kTukey: return new ceres::TukeyLoss(config.scale);
+  }
+  return nullptr;
+}
+
+}  // namespace radargauss

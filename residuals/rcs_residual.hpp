@@ -1,0 +1,173 @@
+// The RCS residual of scan matching (paper section III-B, DESIGN.md section
+// 5), for a radar point p_r whose normalised RCS y (with the associated
+// Gaussian's median and scale) lies in [-1, 1]:
+//
+//   r_rcs = y - c . Y(d),   d = IncidenceDirection(model, p_r, mu_r),
+//   mu_r  = R^T (mu - t)    (the Gaussian centre in the radar frame),
+//
+// with the Gaussian's SH coefficients c up to its degree (runtime). Two forms:
+//   RcsResidual          rotation and translation blocks ("full");
+//   RcsRotationResidual  the rotation block only, the translation a constant
+//                        of the current association (the paper's choice).
+#pragma once
+
+#include <array>
+
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/sized_cost_function.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/map/rcs_model.hpp"
+#include "radargauss/sh.hpp"
+#include "residuals/quaternion_jacobians.hpp"
+
+namespace radargauss {
+
+// What an RCS residual needs to know of its point and Gaussian.
+struct RcsTerm {
+  Eigen::Vector3d point_radar;  // p_r
+  Eigen::Vector3d mean;         // mu, world frame
+  double measurement = 0.0;     // y, normalised RCS in [-1, 1]
+  int degree = 0;
+  std::array<double, ShCoefficientCount(kMaxShDegree)> coefficients{};
+  IncidenceModel incidence = IncidenceModel::kOffset;
+};
+
+// y - c . Y(d) for a rotation quaternion and a translation.
+template <typename T>
+T RcsResidualValue(const RcsTerm& term, const T* rotation, const Eigen::Matrix<T, 3, 1>& translation) {
+  const Eigen::Map<const Eigen::Quaternion<T>> q(rotation);
+  const Eigen::Matrix<T, 3, 1> mean_radar = q.conjugate() * (term.mean.cast<T>() - translation);
+  const Eigen::Matrix<T, 3, 1> d =
+      IncidenceDirection<T>(term.incidence, term.point_radar.cast<T>(), mean_radar);
+  return T(term.measurement) - EvaluateSh<T>(term.degree, term.coefficients.data(), d);
+}
+
+class RcsResidual {
+ public:
+  explicit RcsResidual(const RcsTerm& term) : term_(term) {}
+
+  template <typename T>
+  bool operator()(const T* rotation, const T* translation, T* residual) const {
+    residual[0] = RcsResidualValue<T>(term_, rotation, Eigen::Map<const Eigen::Matrix<T, 3, 1>>(translation));
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const RcsTerm& term) {
+    return new ceres::AutoDiffCostFunction<RcsResidual, 1, 4, 3>(new RcsResidual(term));
+  }
+
+ private:
+  const RcsTerm term_;
+};
+
+class RcsRotationResidual {
+ public:
+  RcsRotationResidual(const RcsTerm& term, const Eigen::Vector3d& translation)
+      : term_(term), translation_(translation) {}
+
+  template <typename T>
+  bool operator()(const T* rotation, T* residual) const {
+    residual[0] = RcsResidualValue<T>(term_, rotation, translation_.cast<T>());
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const RcsTerm& term, const Eigen::Vector3d& translation) {
+    return new ceres::AutoDiffCostFunction<RcsRotationResidual, 1, 4>(
+        new RcsRotationResidual(term, translation));
+  }
+
+ private:
+  const RcsTerm term_;
+  const Eigen::Vector3d translation_;
+};
+
+// Analytic linearisation shared by the analytic twins: the residual, its
+// derivative with respect to u (the un-normalised incidence vector) and u's
+// derivatives. With d = s u / |u| (s = -1 when u.x > 0):
+//   dr/du = -(c^T dY/dd) s (I - d d^T) / |u|,
+//   u = p_r - mu_r (offset) or -mu_r (view), so du/dq = -d(R^T a)/dq and
+//   du/dt = R^T, with a = mu - t.
+struct RcsLinearisation {
+  double residual = 0.0;
+  Eigen::RowVector3d dr_du = Eigen::RowVector3d::Zero();
+  Eigen::Vector3d mean_radar = Eigen::Vector3d::Zero();
+};
+
+inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Quaterniond& q,
+                                     const Eigen::Vector3d& translation) {
+  RcsLinearisation out;
+  out.mean_radar = q.conjugate() * (term.mean - translation);
+  const Eigen::Vector3d u = term.incidence == IncidenceModel::kOffset
+                                ? Eigen::Vector3d(term.point_radar - out.mean_radar)
+                                : Eigen::Vector3d(-out.mean_radar);
+  const double norm = u.norm();
+  const double sign = u.x() > 0.0 ? -1.0 : 1.0;
+  const Eigen::Vector3d d = sign * u / norm;
+  double basis[ShCoefficientCount(kMaxShDegree)];
+  double gradient[3 * ShCoefficientCount(kMaxShDegree)];
+  EvaluateShBasis(term.degree, d, basis);
+  EvaluateShBasisGradient(term.degree, d, gradient);
+  double prediction = 0.0;
+  Eigen::RowVector3d c_dY = Eigen::RowVector3d::Zero();
+  for (int i = 0; i < ShCoefficientCount(term.degree); ++i) {
+    prediction += term.coefficients[i] * basis[i];
+    c_dY += term.coefficients[i] * Eigen::Map<const Eigen::RowVector3d>(gradient + 3 * i);
+  }
+  out.residual = term.measurement - prediction;
+  out.dr_du = -c_dY * (sign / norm) * (Eigen::Matrix3d::Identity() - d * d.transpose());
+  return out;
+}
+
+// The analytic twin of RcsResidual ("full": rotation and translation).
+class RcsCostFunction final : public ceres::SizedCostFunction<1, 4, 3> {
+ public:
+  explicit RcsCostFunction(const RcsTerm& term) : term_(term) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
+    const Eigen::Map<const Eigen::Vector3d> t(parameters[1]);
+    const RcsLinearisation lin = LineariseRcs(term_, q, t);
+    residuals[0] = lin.residual;
+    if (jacobians == nullptr) return true;
+    if (jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
+      J = -lin.dr_du * InverseRotatePointJacobian(parameters[0], term_.mean - t);
+    }
+    if (jacobians[1] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 1, 3>> J(jacobians[1]);
+      J = lin.dr_du * q.conjugate().toRotationMatrix();
+    }
+    return true;
+  }
+
+ private:
+  const RcsTerm term_;
+};
+
+// The analytic twin of RcsRotationResidual.
+class RcsRotationCostFunction final : public ceres::SizedCostFunction<1, 4> {
+ public:
+  RcsRotationCostFunction(const RcsTerm& term, const Eigen::Vector3d& translation)
+      : term_(term), translation_(translation) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
+    const RcsLinearisation lin = LineariseRcs(term_, q, translation_);
+    residuals[0] = lin.residual;
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
+      J = -lin.dr_du * InverseRotatePointJacobian(parameters[0], term_.mean - translation_);
+    }
+    return true;
+  }
+
+ private:
+  const RcsTerm term_;
+  const Eigen::Vector3d translation_;
+};
+
+}  // namespace radargauss

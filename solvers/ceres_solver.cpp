@@ -1,0 +1,120 @@
+#include "solvers/ceres_solver.hpp"
+
+#include <ceres/loss_function.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <chrono>
+
+#include "radargauss/lie/manifold.hpp"
+#include "residuals/geometric_residual.hpp"
+#include "residuals/rcs_residual.hpp"
+
+namespace radargauss {
+
+CeresSolver::CeresSolver(const ScanMatchingOptions& options, const CeresSolverOptions& ceres_options)
+    : options_(options), ceres_options_(ceres_options) {
+  ValidateOptions(options_);
+}
+
+std::string CeresSolver::Name() const {
+  std::string name = ceres_options_.dogleg ? "ceres-dogleg" : "ceres";
+  if (options_.jacobians == JacobianMode::kAutoDiff) name += "-autodiff";
+  return name;
+}
+
+ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& map,
+                                      const SE3d& initial) const {
+  const auto start = std::chrono::steady_clock::now();
+  ScanMatchingResult result;
+  result.pose = initial;
+  const double w = options_.w_rcs;
+  const bool analytic = options_.jacobians == JacobianMode::kAnalytic;
+  const bool rotation_only = options_.rcs_translation == RcsTranslation::kRotationOnly;
+  Eigen::Vector4d rotation = initial.rotation().quaternion().coeffs();
+  Eigen::Vector3d translation = initial.translation();
+  SO3Manifold so3;
+  ceres::Solver::Options solver_options;
+  solver_options.trust_region_strategy_type = ceres_options_.dogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = ceres_options_.max_inner_iterations;
+  solver_options.num_threads = ceres_options_.threads;
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.function_tolerance = 1e-12;
+  solver_options.gradient_tolerance = 1e-12;
+  solver_options.parameter_tolerance = 1e-10;
+
+  Correspondences c = FindCorrespondences(scan, map, result.pose, options_.gate, w > 0.0);
+  for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
+    if (options_.reassociate && iteration > 1) {
+      c = FindCorrespondences(scan, map, result.pose, options_.gate, w > 0.0);
+    }
+    if (!CheckCorrespondences(scan, c, options_, result.reason)) break;
+    result.iterations = iteration;
+    ceres::Problem::Options problem_options;
+    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    problem.AddParameterBlock(rotation.data(), 4, &so3);
+    if (w < 1.0) {
+      const double weight = (1.0 - w) / double(c.geometric.size());
+      for (const GeometricTerm& term : c.geometric) {
+        const Eigen::Vector3d& mean = map.index().Mean(term.gaussian);
+        const Eigen::Matrix3d& LT = map.index().SqrtInformationT(term.gaussian);
+        ceres::CostFunction* cost = analytic ? static_cast<ceres::CostFunction*>(
+                                                   new GeometricCostFunction(term.point_radar, mean, LT))
+                                             : GeometricResidual::Create(term.point_radar, mean, LT);
+        problem.AddResidualBlock(cost, new ceres::ScaledLoss(MakeLoss(options_.geometric_loss), weight,
+                                                             ceres::TAKE_OWNERSHIP),
+                                 rotation.data(), translation.data());
+      }
+    }
+    if (w > 0.0) {
+      const double weight = w / double(c.rcs.size());
+      for (const RcsTerm& term : c.rcs) {
+        ceres::LossFunction* loss =
+            new ceres::ScaledLoss(MakeLoss(options_.rcs_loss), weight, ceres::TAKE_OWNERSHIP);
+        if (rotation_only) {
+          ceres::CostFunction* cost =
+              analytic ? static_cast<ceres::CostFunction*>(new RcsRotationCostFunction(term, c.translation))
+                       : RcsRotationResidual::Create(term, c.translation);
+          problem.AddResidualBlock(cost, loss, rotation.data());
+        } else {
+          ceres::CostFunction* cost = analytic ? static_cast<ceres::CostFunction*>(new RcsCostFunction(term))
+                                               : RcsResidual::Create(term);
+          problem.AddResidualBlock(cost, loss, rotation.data(), translation.data());
+        }
+      }
+    }
+    ceres::Solver::Summary summary;
+    const SE3d before(SO3d(Eigen::Quaterniond(rotation[3], rotation[0], rotation[1], rotation[2])), translation);
+    ceres::Solve(solver_options, &problem, &summary);
+    if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
+      result.reason = "Ceres: " + summary.message;
+      rotation = before.rotation().quaternion().coeffs();
+      translation = before.translation();
+      break;
+    }
+    result.pose = SE3d(SO3d(Eigen::Quaterniond(rotation[3], rotation[0], rotation[1], rotation[2])), translation);
+    const SE3d step = before.Inverse() * result.pose;
+    const bool small = (result.pose.translation() - before.translation()).norm() < options_.translation_tolerance &&
+                       step.rotation().Log().norm() < options_.rotation_tolerance;
+    if (small || !options_.reassociate) {
+      result.converged = summary.termination_type == ceres::CONVERGENCE || small;
+      if (!result.converged) result.reason = "Ceres: " + summary.message;
+      break;
+    }
+  }
+  if (!result.converged && result.reason.empty()) result.reason = "iteration limit reached";
+  if (result.iterations > 0) {
+    const Correspondences final_c =
+        options_.reassociate ? FindCorrespondences(scan, map, result.pose, options_.gate, w > 0.0) : c;
+    result.n_geo = final_c.geometric.size();
+    result.n_rcs = final_c.rcs.size();
+    result.final_cost = EvaluateCost(final_c, map, result.pose, options_);
+  }
+  result.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace radargauss

@@ -1,0 +1,40 @@
+// Multi-hypothesis scan matching (the RA-L work): several starts around the
+// initial pose (x/y and yaw perturbations), each refined by an inner solver;
+// the best score wins. Score (lower is better): the mean over all scan points
+// of min(Mahalanobis^2, tau^2) at the refined pose, so a start that leaves
+// points unassociated pays for them; a non-converged refinement only wins
+// when none converged.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "solvers/scan_matcher.hpp"
+
+namespace radargauss {
+
+struct MultiHypothesisOptions {
+  int starts = 8;            // the first `starts` of the pattern below (1..13)
+  double xy_offset = 1.0;    // m
+  double yaw_offset = 0.05;  // rad
+};
+
+// Start offsets (dx, dy, dyaw) in the radar frame: the initial pose, +/-x,
+// +/-y, +/-yaw, the four xy diagonals, and +/-yaw at +x.
+std::vector<Eigen::Vector3d> HypothesisOffsets(const MultiHypothesisOptions& options);
+
+class MultiHypothesisSolver final : public ScanMatcher {
+ public:
+  MultiHypothesisSolver(std::shared_ptr<const ScanMatcher> inner, const ScanMatchingOptions& options,
+                        const MultiHypothesisOptions& hypotheses = {});
+  std::string Name() const override;
+  ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map,
+                           const SE3d& initial) const override;
+
+ private:
+  std::shared_ptr<const ScanMatcher> inner_;
+  ScanMatchingOptions options_;
+  MultiHypothesisOptions hypotheses_;
+};
+
+}  // namespace radargauss

@@ -1,0 +1,97 @@
+#include "solvers/scan_matcher.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace radargauss {
+
+void ValidateOptions(const ScanMatchingOptions& o) {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(what);
+  };
+  require(o.w_rcs >= 0.0 && o.w_rcs <= 1.0, "w_rcs must be in [0, 1]");
+  require(o.geometric_loss.scale > 0.0 && o.rcs_loss.scale > 0.0, "loss scales must be > 0");
+  require(o.gate > 0.0, "association gate must be > 0");
+  require(o.max_iterations >= 1, "max iterations must be >= 1");
+  require(o.translation_tolerance > 0.0 && o.rotation_tolerance > 0.0, "tolerances must be > 0");
+}
+
+Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, const SE3d& pose,
+                                    double gate, bool with_rcs) {
+  Correspondences out;
+  out.translation = pose.translation();
+  out.geometric.reserve(scan.points.size());
+  const bool rcs = with_rcs && scan.has_rcs;
+  const Eigen::Matrix3d R = pose.rotation().Matrix();
+  const Eigen::Matrix3d Rt = R.transpose();
+  for (const RadarPoint& point : scan.points) {
+    const Eigen::Vector3d world = R * point.position + pose.translation();
+    const int g = map.index().Associate(world, gate * gate);
+    if (g < 0) continue;
+    out.geometric.push_back({point.position, std::uint32_t(g)});
+    if (!rcs) continue;
+    const Gaussian& gaussian = map.map().gaussians[g];
+    if (!gaussian.rcs.valid()) continue;
+    const double y = gaussian.rcs.Normalise(point.rcs);
+    if (!(std::abs(y) <= 1.0)) continue;  // RCS outlier: no residual (eq. 2)
+    const Eigen::Vector3d mean_radar = Rt * (gaussian.mean - pose.translation());
+    const Eigen::Vector3d u = map.map().incidence == IncidenceModel::kOffset
+                                  ? Eigen::Vector3d(point.position - mean_radar)
+                                  : Eigen::Vector3d(-mean_radar);
+    if (u.squaredNorm() < 1e-12) continue;  // no incidence direction
+    RcsTerm term;
+    term.point_radar = point.position;
+    term.mean = gaussian.mean;
+    term.measurement = y;
+    term.degree = gaussian.rcs.degree;
+    term.coefficients = gaussian.rcs.coefficients;
+    term.incidence = map.map().incidence;
+    out.rcs.push_back(term);
+  }
+  return out;
+}
+
+double EvaluateCost(const Correspondences& c, const MatchingMap& map, const SE3d& pose,
+                    const ScanMatchingOptions& options) {
+  const RobustLoss geometric_loss(options.geometric_loss);
+  const RobustLoss rcs_loss(options.rcs_loss);
+  double rho = 0.0, weight = 0.0;
+  double geometric = 0.0;
+  for (const GeometricTerm& term : c.geometric) {
+    const Eigen::Vector3d r = map.index().SqrtInformationT(term.gaussian) *
+                              (pose * term.point_radar - map.index().Mean(term.gaussian));
+    geometric_loss.Evaluate(r.squaredNorm(), rho, weight);
+    geometric += rho;
+  }
+  double rcs = 0.0;
+  const Eigen::Vector3d rcs_translation =
+      options.rcs_translation == RcsTranslation::kRotationOnly ? c.translation : pose.translation();
+  for (const RcsTerm& term : c.rcs) {
+    const double r = RcsResidualValue<double>(term, pose.rotation().data(), rcs_translation);
+    rcs_loss.Evaluate(r * r, rho, weight);
+    rcs += rho;
+  }
+  double f = 0.0;
+  if (options.w_rcs < 1.0 && !c.geometric.empty()) f += (1.0 - options.w_rcs) / c.geometric.size() * geometric;
+  if (options.w_rcs > 0.0 && !c.rcs.empty()) f += options.w_rcs / c.rcs.size() * rcs;
+  return f;
+}
+
+bool CheckCorrespondences(const RadarScan& scan, const Correspondences& c,
+                          const ScanMatchingOptions& options, std::string& reason) {
+  if (scan.points.empty()) {
+    reason = "empty scan";
+    return false;
+  }
+  if (options.w_rcs < 1.0 && c.geometric.empty()) {
+    reason = "no point associated to the map";
+    return false;
+  }
+  if (options.w_rcs > 0.0 && c.rcs.empty()) {
+    reason = "no RCS residuals (no RCS in the scan, no models, or all RCS outliers)";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace radargauss
