@@ -2,7 +2,10 @@
 // iteration, re-associate, accumulate H and g per residual with IRLS weights
 // rho'(s) from the losses, combine with eq. 2's weights, solve the 6x6 system
 // H dx = -g by LDLT, update t += dt, R = R Exp(dphi); stop on a small update
-// or at the iteration limit.
+// or at the iteration limit. On the exact map the step is halved (at most
+// max_step_halvings times) while it increases eq. 2 for the current
+// association, so that the steep RCS term cannot make the iteration oscillate.
+// Coarse levels of the MatchingMap take plain steps.
 //
 // Rotation-only RCS (the paper): the rows and columns of the RCS Hessian
 // that belong to translation become the identity and its translation
@@ -25,8 +28,8 @@ struct LinearSystem {
 
 // The geometric and RCS systems at `pose` for fixed correspondences (public
 // so that tests and benchmarks can compare the analytic and autodiff paths).
-LinearSystem BuildGeometricSystem(const Correspondences& correspondences, const MatchingMap& map,
-                                  const SE3d& pose, const ScanMatchingOptions& options);
+LinearSystem BuildGeometricSystem(const Correspondences& correspondences, const SE3d& pose,
+                                  const ScanMatchingOptions& options);
 LinearSystem BuildRcsSystem(const Correspondences& correspondences, const SE3d& pose,
                             const ScanMatchingOptions& options);
 

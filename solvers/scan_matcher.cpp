@@ -1,6 +1,7 @@
 #include "solvers/scan_matcher.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <stdexcept>
 
 namespace radargauss {
@@ -12,13 +13,27 @@ void ValidateOptions(const ScanMatchingOptions& o) {
   require(o.w_rcs >= 0.0 && o.w_rcs <= 1.0, "w_rcs must be in [0, 1]");
   require(o.geometric_loss.scale > 0.0 && o.rcs_loss.scale > 0.0, "loss scales must be > 0");
   require(o.gate > 0.0, "association gate must be > 0");
-  require(o.max_iterations >= 1, "max iterations must be >= 1");
+  require(o.max_iterations >= 1 && o.coarse_iterations >= 1, "iteration limits must be >= 1");
+  require(o.max_step_halvings >= 0, "max step halvings must be >= 0");
   require(o.translation_tolerance > 0.0 && o.rotation_tolerance > 0.0, "tolerances must be > 0");
 }
 
-Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, const SE3d& pose,
-                                    double gate, bool with_rcs) {
+MatchingMap::MatchingMap(const GaussianMap& map, const std::vector<double>& inflation,
+                         double index_cell)
+    : map_(map) {
+  for (const double sigma : inflation) {
+    if (!(sigma > 0.0)) throw std::invalid_argument("coarse-to-fine inflation must be > 0");
+    std::vector<Gaussian> inflated = map.gaussians;
+    for (Gaussian& g : inflated) g.covariance += sigma * sigma * Eigen::Matrix3d::Identity();
+    levels_.emplace_back(inflated, std::max(index_cell, sigma));
+  }
+  levels_.emplace_back(map.gaussians, index_cell);
+}
+
+Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level,
+                                    const SE3d& pose, double gate, bool with_rcs) {
   Correspondences out;
+  out.index = &map.level(level);
   out.translation = pose.translation();
   out.geometric.reserve(scan.points.size());
   const bool rcs = with_rcs && scan.has_rcs;
@@ -26,7 +41,7 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
   const Eigen::Matrix3d Rt = R.transpose();
   for (const RadarPoint& point : scan.points) {
     const Eigen::Vector3d world = R * point.position + pose.translation();
-    const int g = map.index().Associate(world, gate * gate);
+    const int g = out.index->Associate(world, gate * gate);
     if (g < 0) continue;
     out.geometric.push_back({point.position, std::uint32_t(g)});
     if (!rcs) continue;
@@ -51,15 +66,14 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
   return out;
 }
 
-double EvaluateCost(const Correspondences& c, const MatchingMap& map, const SE3d& pose,
-                    const ScanMatchingOptions& options) {
+double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchingOptions& options) {
   const RobustLoss geometric_loss(options.geometric_loss);
   const RobustLoss rcs_loss(options.rcs_loss);
   double rho = 0.0, weight = 0.0;
   double geometric = 0.0;
   for (const GeometricTerm& term : c.geometric) {
-    const Eigen::Vector3d r = map.index().SqrtInformationT(term.gaussian) *
-                              (pose * term.point_radar - map.index().Mean(term.gaussian));
+    const Eigen::Vector3d r = c.index->SqrtInformationT(term.gaussian) *
+                              (pose * term.point_radar - c.index->Mean(term.gaussian));
     geometric_loss.Evaluate(r.squaredNorm(), rho, weight);
     geometric += rho;
   }
@@ -89,6 +103,15 @@ bool CheckCorrespondences(const RadarScan& scan, const Correspondences& c,
   }
   if (options.w_rcs > 0.0 && c.rcs.empty()) {
     reason = "no RCS residuals (no RCS in the scan, no models, or all RCS outliers)";
+    return false;
+  }
+  // Enough residuals for the degrees of freedom the weighted terms drive.
+  const std::size_t residuals = (options.w_rcs < 1.0 ? 3 * c.geometric.size() : 0) +
+                                (options.w_rcs > 0.0 ? c.rcs.size() : 0);
+  const std::size_t freedom = options.w_rcs < 1.0 || options.rcs_translation == RcsTranslation::kFull ? 6 : 3;
+  if (residuals < freedom) {
+    reason = "too few residuals (" + std::to_string(residuals) + ") for " + std::to_string(freedom) +
+             " degrees of freedom";
     return false;
   }
   return true;

@@ -32,10 +32,12 @@ struct ScanMatchingOptions {
   RcsTranslation rcs_translation = RcsTranslation::kRotationOnly;
   JacobianMode jacobians = JacobianMode::kAnalytic;
   double gate = 3.0;          // tau: association gate (Mahalanobis distance)
-  int max_iterations = 30;    // outer iterations (association + update)
+  int max_iterations = 30;    // outer iterations (association + update) on the exact map
+  int coarse_iterations = 15; // outer iterations on each coarse level of the MatchingMap
+  int max_step_halvings = 8;  // own GN: backtracking halvings of a step that raises the cost
   bool reassociate = true;    // false: associate once at the initial pose
   double translation_tolerance = 1e-4;  // m: stop when the update is smaller ...
-  double rotation_tolerance = 1e-5;     // rad ... in both parts
+  double rotation_tolerance = 1e-5;     // rad ... in both parts (100x looser on coarse levels)
 };
 
 // Throws std::invalid_argument naming the bad option.
@@ -52,17 +54,26 @@ struct ScanMatchingResult {
   double time_ms = 0.0;
 };
 
-// The map as the solvers use it: the Gaussians and their spatial index.
+// The map as the solvers use it: the Gaussians and a coarse-to-fine list of
+// spatial indexes. Level k holds the Gaussians with covariance Sigma +
+// sigma_k^2 I (sigma_k from `inflation`, coarse first); the last level is the
+// map itself. Solvers match level by level, so that points far from their
+// Gaussians (metres of initial error) still find candidates early on. Coarse
+// levels steer with the geometric term alone (their associations are too
+// rough for RCS); eq. 2 with the requested w is minimised on the exact map,
+// and with w = 1 the coarse levels are skipped.
 class MatchingMap {
  public:
-  explicit MatchingMap(const GaussianMap& map, double index_cell = 1.0)
-      : map_(map), index_(map.gaussians, index_cell) {}
+  explicit MatchingMap(const GaussianMap& map, const std::vector<double>& inflation = {1.0, 0.5, 0.25},
+                       double index_cell = 1.0);
   const GaussianMap& map() const { return map_; }
-  const GaussianIndex& index() const { return index_; }
+  std::size_t levels() const { return levels_.size(); }
+  const GaussianIndex& level(std::size_t k) const { return levels_[k]; }
+  const GaussianIndex& index() const { return levels_.back(); }  // the exact map
 
  private:
   const GaussianMap& map_;
-  GaussianIndex index_;
+  std::vector<GaussianIndex> levels_;
 };
 
 struct GeometricTerm {
@@ -71,20 +82,22 @@ struct GeometricTerm {
 };
 
 struct Correspondences {
+  const GaussianIndex* index = nullptr;  // the level they were made with
   std::vector<GeometricTerm> geometric;
   std::vector<RcsTerm> rcs;
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();  // of the pose they were made at
 };
 
-// Associates every point at `pose` (smallest Mahalanobis^2 within the gate);
-// RCS terms too when `with_rcs` (and the scan has RCS).
-Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, const SE3d& pose,
-                                    double gate, bool with_rcs);
+// Associates every point at `pose` with the Gaussians of `level`
+// (smallest Mahalanobis^2 within the gate); RCS terms too when `with_rcs`
+// (and the scan has RCS).
+Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level,
+                                    const SE3d& pose, double gate, bool with_rcs);
 
 // f of eq. 2 for fixed correspondences at `pose`. RCS residuals take the
 // translation of the correspondences when rotation-only.
-double EvaluateCost(const Correspondences& correspondences, const MatchingMap& map,
-                    const SE3d& pose, const ScanMatchingOptions& options);
+double EvaluateCost(const Correspondences& correspondences, const SE3d& pose,
+                    const ScanMatchingOptions& options);
 
 // Checks the inputs every solver shares; false with a reason for an empty
 // scan or a term that has no residuals although its weight is not zero.

@@ -1,0 +1,378 @@
+#include <ceres/cost_function.h>
+#include <Eigen/Cholesky>
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <cctype>
+#include <random>
+
+#include "radargauss/map/builder.hpp"
+#include "radargauss/map/map_cloud.hpp"
+#include "radargauss/map/rcs_model.hpp"
+#include "radargauss/simulator.hpp"
+#include "residuals/geometric_residual.hpp"
+#include "residuals/loss.hpp"
+#include "residuals/rcs_residual.hpp"
+#include "solvers/ceres_solver.hpp"
+#include "solvers/gauss_newton.hpp"
+#include "solvers/multi_hypothesis.hpp"
+#include "test_util.hpp"
+
+namespace radargauss {
+namespace {
+
+using testing::NumericJacobian;
+using testing::RandomUnitVector;
+
+// ---------------------------------------------------------------------------
+// Jacobians: analytic twin vs autodiff vs central differences, in the ambient
+// parameters (quaternion x y z w, translation).
+
+// Evaluates a cost function with two or one parameter blocks; returns the
+// residuals and fills the Jacobians (row-major per block).
+Eigen::VectorXd EvaluateWithJacobians(const ceres::CostFunction& cost, const std::vector<double*>& blocks,
+                                      std::vector<Eigen::MatrixXd>& jacobians) {
+  const int m = cost.num_residuals();
+  Eigen::VectorXd residuals(m);
+  std::vector<std::vector<double>> storage;
+  std::vector<double*> pointers;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    storage.emplace_back(m * cost.parameter_block_sizes()[b]);
+    pointers.push_back(storage.back().data());
+  }
+  EXPECT_TRUE(cost.Evaluate(blocks.data(), residuals.data(), pointers.data()));
+  jacobians.clear();
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const int n = cost.parameter_block_sizes()[b];
+    jacobians.push_back(Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+        storage[b].data(), m, n));
+  }
+  return residuals;
+}
+
+Eigen::MatrixXd NumericBlockJacobian(const ceres::CostFunction& cost, std::vector<double*> blocks, int which) {
+  const int n = cost.parameter_block_sizes()[which];
+  Eigen::VectorXd x = Eigen::Map<Eigen::VectorXd>(blocks[which], n);
+  return NumericJacobian(
+      [&](const Eigen::VectorXd& value) {
+        Eigen::VectorXd copy = value;
+        std::vector<double*> b = blocks;
+        b[which] = copy.data();
+        Eigen::VectorXd r(cost.num_residuals());
+        cost.Evaluate(b.data(), r.data(), nullptr);
+        return r;
+      },
+      x, 1e-6);
+}
+
+double Relative(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).norm() / std::max(1e-12, b.norm());
+}
+
+RcsTerm RandomRcsTerm(std::mt19937& rng, IncidenceModel incidence) {
+  std::normal_distribution<double> normal;
+  RcsTerm term;
+  term.point_radar = Eigen::Vector3d(8.0 + normal(rng), 2.0 * normal(rng), normal(rng));
+  term.mean = Eigen::Vector3d(3.0 * normal(rng), 3.0 * normal(rng), normal(rng)) + Eigen::Vector3d(10, 0, 0);
+  term.measurement = 0.3;
+  term.degree = 3;
+  for (double& c : term.coefficients) c = 0.5 * normal(rng);
+  term.incidence = incidence;
+  return term;
+}
+
+class JacobianTest : public ::testing::TestWithParam<IncidenceModel> {};
+
+TEST(ResidualJacobians, GeometricAnalyticAutodiffNumeric) {
+  std::mt19937 rng(1);
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::Vector4d q = SO3d::Exp(2.0 * RandomUnitVector(rng)).quaternion().coeffs();
+    Eigen::Vector3d t = 5.0 * RandomUnitVector(rng);
+    const Eigen::Vector3d p = 10.0 * RandomUnitVector(rng);
+    const Eigen::Vector3d mean = 3.0 * RandomUnitVector(rng);
+    Eigen::Matrix3d A = Eigen::Matrix3d::Random();
+    const Eigen::Matrix3d LT = (A * A.transpose() + Eigen::Matrix3d::Identity()).llt().matrixU();
+    const GeometricCostFunction analytic(p, mean, LT);
+    const std::unique_ptr<ceres::CostFunction> autodiff(GeometricResidual::Create(p, mean, LT));
+    std::vector<Eigen::MatrixXd> ja, jd;
+    const std::vector<double*> blocks = {q.data(), t.data()};
+    const Eigen::VectorXd ra = EvaluateWithJacobians(analytic, blocks, ja);
+    const Eigen::VectorXd rd = EvaluateWithJacobians(*autodiff, blocks, jd);
+    EXPECT_LT((ra - rd).norm(), 1e-12);
+    for (int b = 0; b < 2; ++b) {
+      EXPECT_LT(Relative(ja[b], jd[b]), 1e-8) << "block " << b;
+      EXPECT_LT(Relative(ja[b], NumericBlockJacobian(analytic, blocks, b)), 1e-5) << "block " << b;
+    }
+  }
+}
+
+TEST_P(JacobianTest, RcsAnalyticAutodiffNumeric) {
+  std::mt19937 rng(2);
+  for (int trial = 0; trial < 20; ++trial) {
+    const RcsTerm term = RandomRcsTerm(rng, GetParam());
+    Eigen::Vector4d q = SO3d::Exp(0.5 * RandomUnitVector(rng)).quaternion().coeffs();
+    Eigen::Vector3d t = RandomUnitVector(rng);
+    // Full: rotation and translation blocks.
+    const RcsCostFunction analytic(term);
+    const std::unique_ptr<ceres::CostFunction> autodiff(RcsResidual::Create(term));
+    std::vector<Eigen::MatrixXd> ja, jd;
+    const std::vector<double*> blocks = {q.data(), t.data()};
+    const Eigen::VectorXd ra = EvaluateWithJacobians(analytic, blocks, ja);
+    const Eigen::VectorXd rd = EvaluateWithJacobians(*autodiff, blocks, jd);
+    EXPECT_NEAR(ra[0], rd[0], 1e-12);
+    for (int b = 0; b < 2; ++b) {
+      EXPECT_LT(Relative(ja[b], jd[b]), 1e-8) << "block " << b;
+      EXPECT_LT(Relative(ja[b], NumericBlockJacobian(analytic, blocks, b)), 1e-5) << "block " << b;
+    }
+    // Rotation only.
+    const RcsRotationCostFunction analytic_rotation(term, t);
+    const std::unique_ptr<ceres::CostFunction> autodiff_rotation(RcsRotationResidual::Create(term, t));
+    const std::vector<double*> rotation_block = {q.data()};
+    EvaluateWithJacobians(analytic_rotation, rotation_block, ja);
+    EvaluateWithJacobians(*autodiff_rotation, rotation_block, jd);
+    EXPECT_LT(Relative(ja[0], jd[0]), 1e-8);
+    EXPECT_LT(Relative(ja[0], NumericBlockJacobian(analytic_rotation, rotation_block, 0)), 1e-5);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(BothIncidenceModels, JacobianTest,
+                         ::testing::Values(IncidenceModel::kOffset, IncidenceModel::kView));
+
+TEST(Losses, GemanMcClureDerivativesAndFactory) {
+  const GemanMcClureLoss loss(0.7);
+  for (const double s : {0.1, 1.0, 5.0}) {
+    double rho[3], plus[3], minus[3];
+    loss.Evaluate(s, rho);
+    loss.Evaluate(s + 1e-6, plus);
+    loss.Evaluate(s - 1e-6, minus);
+    const double h = 2e-6;
+    EXPECT_NEAR(rho[1], (plus[0] - minus[0]) / h, 1e-6);
+    EXPECT_NEAR(rho[2], (plus[1] - minus[1]) / h, 1e-5);
+  }
+  double rho = 0.0, weight = 0.0;
+  loss.Evaluate(0.0, &rho);
+  for (const char* name : {"trivial", "huber", "cauchy", "geman-mcclure", "tukey"}) {
+    const RobustLoss robust({LossTypeFromString(name), 1.0});
+    robust.Evaluate(1e-9, rho, weight);
+    EXPECT_NEAR(weight, 1.0, 1e-6) << name;  // rho'(0) = 1 for every loss
+    robust.Evaluate(100.0, rho, weight);
+    EXPECT_LE(weight, 1.0) << name;
+  }
+  EXPECT_THROW(LossTypeFromString("l7"), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------
+// Solvers on a simulated scan against the map of its sequence.
+
+struct World {
+  SimulatedSequence simulated;
+  GaussianMap map;
+  std::unique_ptr<MatchingMap> matching;
+};
+
+const World& SimulatedWorld() {
+  static const World* world = [] {
+    auto* w = new World;
+    SimulationConfig config;
+    config.scans = 80;
+    config.seed = 5;
+    w->simulated = Simulate(config);
+    Sequence sequence;
+    sequence.scans = w->simulated.scans;
+    for (const auto& sample : w->simulated.ground_truth) sequence.poses.push_back(sample.pose);
+    const MapCloud cloud = BuildMapCloud(sequence);
+    GaussianMapOptions options;
+    w->map.gaussians = BuildGaussians(cloud.points, options);
+    const GaussianIndex index(w->map.gaussians, options.index_cell);
+    FitRcsModels(w->map, cloud, AssociatePoints(cloud.points, index, options.association_gate));
+    w->matching = std::make_unique<MatchingMap>(w->map);
+    return w;
+  }();
+  return *world;
+}
+
+constexpr int kTestScan = 40;
+
+SE3d Perturbed(const SE3d& pose, double translation, double angle_deg, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  return SE3d(pose.rotation() * SO3d::Exp(angle_deg * M_PI / 180.0 * RandomUnitVector(rng)),
+              pose.translation() + translation * RandomUnitVector(rng));
+}
+
+void PoseError(const SE3d& estimate, const SE3d& truth, double& translation, double& rotation_deg) {
+  translation = (estimate.translation() - truth.translation()).norm();
+  rotation_deg = (truth.rotation().Inverse() * estimate.rotation()).Log().norm() * 180.0 / M_PI;
+}
+
+struct SolverCase {
+  std::string name;
+  double w_rcs;
+};
+
+std::unique_ptr<ScanMatcher> MakeSolver(const std::string& name, const ScanMatchingOptions& base) {
+  ScanMatchingOptions options = base;
+  if (name == "gn") return std::make_unique<GaussNewtonSolver>(options);
+  if (name == "gn-autodiff") {
+    options.jacobians = JacobianMode::kAutoDiff;
+    return std::make_unique<GaussNewtonSolver>(options);
+  }
+  if (name == "ceres") return std::make_unique<CeresSolver>(options);
+  if (name == "mh8-gn") {
+    return std::make_unique<MultiHypothesisSolver>(std::make_shared<GaussNewtonSolver>(options), options);
+  }
+  throw std::invalid_argument(name);
+}
+
+class SolverTest : public ::testing::TestWithParam<SolverCase> {};
+
+// From 2 m / 5 deg initial error, to within 5 cm / 0.2 deg of the reference.
+TEST_P(SolverTest, ConvergesFromTwoMetresFiveDegrees) {
+  const World& world = SimulatedWorld();
+  const RadarScan& scan = world.simulated.scans[kTestScan];
+  const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
+  ScanMatchingOptions options;
+  options.w_rcs = GetParam().w_rcs;
+  const auto solver = MakeSolver(GetParam().name, options);
+  for (const std::uint32_t seed : {1u, 2u, 3u}) {
+    const ScanMatchingResult result = solver->Match(scan, *world.matching, Perturbed(truth, 2.0, 5.0, seed));
+    double dt = 0.0, dr = 0.0;
+    PoseError(result.pose, truth, dt, dr);
+    EXPECT_TRUE(result.converged) << result.reason;
+    EXPECT_LT(dt, 0.05) << GetParam().name << " seed " << seed;
+    EXPECT_LT(dr, 0.2) << GetParam().name << " seed " << seed;
+    EXPECT_GT(result.n_geo, scan.points.size() / 2);
+    if (options.w_rcs > 0.0) {
+      EXPECT_GT(result.n_rcs, 10u);
+    }
+    EXPECT_TRUE(std::isfinite(result.final_cost));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EverySolver, SolverTest,
+    ::testing::Values(SolverCase{"gn", 0.0}, SolverCase{"gn", 0.25}, SolverCase{"gn-autodiff", 0.0},
+                      SolverCase{"gn-autodiff", 0.25}, SolverCase{"ceres", 0.0}, SolverCase{"ceres", 0.25},
+                      SolverCase{"mh8-gn", 0.0}, SolverCase{"mh8-gn", 0.25}),
+    [](const ::testing::TestParamInfo<SolverCase>& info) {
+      std::string name = info.param.name + "_w" + std::to_string(int(info.param.w_rcs * 100));
+      for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+      return name;
+    });
+
+// The analytic and autodiff linear systems of the own GN are the same.
+TEST(GaussNewton, AnalyticAndAutodiffSystemsAgree) {
+  const World& world = SimulatedWorld();
+  const SE3d pose = Perturbed(world.simulated.ground_truth[kTestScan].pose, 0.1, 0.5, 9);
+  const MatchingMap& map = *world.matching;
+  for (const RcsTranslation mode : {RcsTranslation::kRotationOnly, RcsTranslation::kFull}) {
+    ScanMatchingOptions analytic;
+    analytic.w_rcs = 0.25;
+    analytic.rcs_translation = mode;
+    analytic.geometric_loss = {LossType::kHuber, 1.0};
+    ScanMatchingOptions autodiff = analytic;
+    autodiff.jacobians = JacobianMode::kAutoDiff;
+    const Correspondences c =
+        FindCorrespondences(world.simulated.scans[kTestScan], map, map.levels() - 1, pose, 3.0, true);
+    ASSERT_GT(c.rcs.size(), 10u);
+    const LinearSystem ga = BuildGeometricSystem(c, pose, analytic);
+    const LinearSystem gd = BuildGeometricSystem(c, pose, autodiff);
+    EXPECT_LT(Relative(ga.H, gd.H), 1e-8);
+    EXPECT_LT(Relative(ga.g, gd.g), 1e-8);
+    const LinearSystem ra = BuildRcsSystem(c, pose, analytic);
+    const LinearSystem rd = BuildRcsSystem(c, pose, autodiff);
+    EXPECT_LT(Relative(ra.H, rd.H), 1e-8);
+    EXPECT_LT(Relative(ra.g, rd.g), 1e-8);
+  }
+}
+
+// Own GN and Ceres LM reach the same optimum on the same association.
+TEST(SolverAgreement, SameOptimumOnSameAssociation) {
+  const World& world = SimulatedWorld();
+  const MatchingMap single(world.map, {});  // no coarse levels: one association
+  const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
+  for (const double w : {0.0, 0.25}) {
+    ScanMatchingOptions options;
+    options.w_rcs = w;
+    options.reassociate = false;
+    options.max_iterations = 100;
+    options.translation_tolerance = 1e-9;
+    options.rotation_tolerance = 1e-10;
+    CeresSolverOptions ceres_options;
+    ceres_options.max_inner_iterations = 200;
+    const SE3d initial = Perturbed(truth, 0.05, 0.3, 4);
+    const ScanMatchingResult gn = GaussNewtonSolver(options).Match(world.simulated.scans[kTestScan], single, initial);
+    const ScanMatchingResult lm =
+        CeresSolver(options, ceres_options).Match(world.simulated.scans[kTestScan], single, initial);
+    ASSERT_TRUE(gn.converged) << gn.reason;
+    double dt = 0.0, dr = 0.0;
+    PoseError(gn.pose, lm.pose, dt, dr);
+    EXPECT_LT(dt, 1e-4) << "w " << w;
+    EXPECT_LT(dr * M_PI / 180.0, 1e-4) << "w " << w;
+    EXPECT_NEAR(gn.final_cost, lm.final_cost, 1e-6 + 1e-4 * gn.final_cost);
+  }
+}
+
+// w = 1 with rotation-only RCS: the translation does not move, and a pure
+// rotation error is reduced by the RCS term alone.
+TEST(RotationOnlyRcs, TranslationFixedAndRotationErrorReduced) {
+  const World& world = SimulatedWorld();
+  const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
+  ScanMatchingOptions options;
+  options.w_rcs = 1.0;
+  const MatchingMap single(world.map, {});
+  for (const std::string name : {"gn", "ceres"}) {
+    const auto solver = MakeSolver(name, options);
+    const SE3d shifted(truth.rotation(), truth.translation() + Eigen::Vector3d(0.3, -0.2, 0.1));
+    const ScanMatchingResult moved = solver->Match(world.simulated.scans[kTestScan], single, shifted);
+    EXPECT_EQ(moved.pose.translation(), shifted.translation()) << name;
+    // Pure rotation error of 1 degree about z.
+    const SE3d rotated(truth.rotation() * SO3d::Exp(Eigen::Vector3d(0, 0, M_PI / 180.0)), truth.translation());
+    const ScanMatchingResult result = solver->Match(world.simulated.scans[kTestScan], single, rotated);
+    double dt = 0.0, dr = 0.0;
+    PoseError(result.pose, truth, dt, dr);
+    EXPECT_EQ(dt, 0.0) << name;
+    EXPECT_LT(dr, 1.0) << name << ": " << result.reason;
+    std::printf("%s, w = 1, RCS alone: rotation error 1.000 -> %.3f deg\n", name.c_str(), dr);
+  }
+}
+
+// Degenerate inputs: converged = false with a reason, never NaN, never a crash.
+TEST(DegenerateInputs, FailWithAReason) {
+  const World& world = SimulatedWorld();
+  const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
+  RadarScan empty;
+  empty.has_rcs = empty.has_doppler = true;
+  RadarScan one = empty;
+  one.points.push_back(world.simulated.scans[kTestScan].points.front());
+  RadarScan far_away = world.simulated.scans[kTestScan];
+  for (RadarPoint& p : far_away.points) p.position += Eigen::Vector3d(0, 0, 500.0);
+  RadarScan outliers = world.simulated.scans[kTestScan];
+  for (RadarPoint& p : outliers.points) p.rcs = 1000.0;
+  for (const std::string name : {"gn", "gn-autodiff", "ceres", "mh8-gn"}) {
+    for (const auto& [scan, w] : std::vector<std::pair<const RadarScan*, double>>{
+             {&empty, 0.0}, {&one, 0.0}, {&far_away, 0.0}, {&outliers, 0.25}, {&outliers, 1.0}}) {
+      ScanMatchingOptions options;
+      options.w_rcs = w;
+      const ScanMatchingResult result = MakeSolver(name, options)->Match(*scan, *world.matching, truth);
+      EXPECT_FALSE(result.converged) << name << " " << scan->points.size() << " points, w " << w;
+      EXPECT_FALSE(result.reason.empty()) << name;
+      EXPECT_TRUE(result.pose.Matrix().allFinite()) << name;
+      EXPECT_TRUE(std::isfinite(result.final_cost)) << name;
+    }
+  }
+}
+
+TEST(ScanMatchingOptionsTest, Validation) {
+  ScanMatchingOptions options;
+  options.w_rcs = 1.5;
+  EXPECT_THROW(GaussNewtonSolver{options}, std::invalid_argument);
+  options.w_rcs = 0.5;
+  options.gate = 0.0;
+  EXPECT_THROW(CeresSolver{options}, std::invalid_argument);
+  MultiHypothesisOptions hypotheses;
+  hypotheses.starts = 14;
+  EXPECT_THROW(HypothesisOffsets(hypotheses), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace radargauss
