@@ -51,6 +51,7 @@ ScanMatchingResult MultiHypothesisSolver::Match(const RadarScan& scan, const Mat
   ScanMatchingResult best;
   double best_score = INFINITY;
   bool best_converged = false;
+  bool have_best = false;
   int total_iterations = 0;
   for (const Eigen::Vector3d& offset : HypothesisOffsets(hypotheses_)) {
     const SE3d perturbation(SO3d::Exp(Eigen::Vector3d(0, 0, offset.z())),
@@ -58,9 +59,10 @@ ScanMatchingResult MultiHypothesisSolver::Match(const RadarScan& scan, const Mat
     ScanMatchingResult candidate = inner_->Match(scan, map, initial * perturbation);
     total_iterations += candidate.iterations;
     const double score = Score(scan, map, candidate.pose, options_.gate);
-    const bool better = (candidate.converged && !best_converged) ||
+    const bool better = !have_best || (candidate.converged && !best_converged) ||
                         (candidate.converged == best_converged && score < best_score);
     if (better) {
+      have_best = true;
       best = candidate;
       best_score = score;
       best_converged = candidate.converged;
