@@ -12,6 +12,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/sized_cost_function.h>
@@ -34,16 +35,24 @@ struct RcsTerm {
   int degree = 0;
   std::array<double, ShCoefficientCount(kMaxShDegree)> coefficients{};
   IncidenceModel incidence = IncidenceModel::kOffset;
+  std::uint32_t gaussian = 0;   // index in the map (for joint refinement)
 };
 
-// y - c . Y(d) for a rotation quaternion and a translation.
-template <typename T>
-T RcsResidualValue(const RcsTerm& term, const T* rotation, const Eigen::Matrix<T, 3, 1>& translation) {
+// y - c . Y(d) for a rotation quaternion, a translation and coefficients c
+// (the term's own, or a parameter block in joint refinement).
+template <typename T, typename CoefficientT>
+T RcsResidualValue(const RcsTerm& term, const T* rotation, const Eigen::Matrix<T, 3, 1>& translation,
+                   const CoefficientT* coefficients) {
   const Eigen::Map<const Eigen::Quaternion<T>> q(rotation);
   const Eigen::Matrix<T, 3, 1> mean_radar = q.conjugate() * (term.mean.cast<T>() - translation);
   const Eigen::Matrix<T, 3, 1> d =
       IncidenceDirection<T>(term.incidence, term.point_radar.cast<T>(), mean_radar);
-  return T(term.measurement) - EvaluateSh<T>(term.degree, term.coefficients.data(), d);
+  return T(term.measurement) - EvaluateSh<T>(term.degree, coefficients, d);
+}
+
+template <typename T>
+T RcsResidualValue(const RcsTerm& term, const T* rotation, const Eigen::Matrix<T, 3, 1>& translation) {
+  return RcsResidualValue<T>(term, rotation, translation, term.coefficients.data());
 }
 
 class RcsResidual {

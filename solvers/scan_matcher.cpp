@@ -61,6 +61,7 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
     term.degree = gaussian.rcs.degree;
     term.coefficients = gaussian.rcs.coefficients;
     term.incidence = map.map().incidence;
+    term.gaussian = std::uint32_t(g);
     out.rcs.push_back(term);
   }
   return out;

@@ -45,10 +45,14 @@ RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::
     const bool enough = n >= count;
     if (enough) {
       const Eigen::MatrixXd A = basis.leftCols(count);
-      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
-      qr.setThreshold(options.rank_threshold);
-      if (qr.rank() == count) {
-        const Eigen::VectorXd c = qr.solve(y);
+      // Rank-revealing least squares: the minimum-norm solution with the
+      // directions whose pivots fall below the threshold truncated, so an
+      // ill-determined combination gets no weight instead of a huge one.
+      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+      cod.setThreshold(options.rank_threshold);
+      cod.compute(A);
+      if (cod.rank() >= std::max(1, count / 2) || !options.adaptive) {
+        const Eigen::VectorXd c = cod.solve(y);
         model.degree = degree;
         model.coefficients.fill(0.0);
         for (int j = 0; j < count; ++j) model.coefficients[j] = c[j];
