@@ -1,0 +1,244 @@
+// Scan matching: each residual analytic vs autodiff (with Jacobians), per-scan
+// matching for 150, 800 and 4000 points at w = 0 and 0.25 for each solver
+// from the paper's initial errors, multi-hypothesis with 8 starts, and joint
+// refinement for 100 and 1000 scans. The map is the Gaussian-RCS map of a
+// simulated 1000-scan drive (about 20k Gaussians).
+#include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
+
+#include <map>
+#include <memory>
+#include <type_traits>
+#include <random>
+
+#include "radargauss/map/builder.hpp"
+#include "radargauss/map/map_cloud.hpp"
+#include "radargauss/map/rcs_model.hpp"
+#include "radargauss/simulator.hpp"
+#include "residuals/geometric_residual.hpp"
+#include "residuals/rcs_residual.hpp"
+#include "solvers/ceres_solver.hpp"
+#include "solvers/gauss_newton.hpp"
+#include "solvers/joint_refinement.hpp"
+#include "solvers/multi_hypothesis.hpp"
+
+namespace radargauss {
+namespace {
+
+// ---------------------------------------------------------------------------
+// Residuals: one evaluation with Jacobians.
+
+struct Analytic {};
+struct AutoDiff {};
+
+template <typename Kind>
+void BM_GeometricResidual(benchmark::State& state) {
+  const Eigen::Vector3d p(12.0, -3.0, 1.0), mean(11.5, -2.5, 1.2);
+  const Eigen::Matrix3d LT = 10.0 * Eigen::Matrix3d::Identity();
+  std::unique_ptr<ceres::CostFunction> cost;
+  if constexpr (std::is_same_v<Kind, Analytic>) {
+    cost = std::make_unique<GeometricCostFunction>(p, mean, LT);
+  } else {
+    cost.reset(GeometricResidual::Create(p, mean, LT));
+  }
+  Eigen::Vector4d q = SO3d::Exp(Eigen::Vector3d(0.1, -0.2, 0.3)).quaternion().coeffs();
+  Eigen::Vector3d t(1.0, 2.0, 0.5);
+  const double* parameters[2] = {q.data(), t.data()};
+  double residuals[3], j0[12], j1[9];
+  double* jacobians[2] = {j0, j1};
+  for (auto _ : state) {
+    cost->Evaluate(parameters, residuals, jacobians);
+    benchmark::DoNotOptimize(j0[0]);
+  }
+}
+BENCHMARK_TEMPLATE(BM_GeometricResidual, Analytic);
+BENCHMARK_TEMPLATE(BM_GeometricResidual, AutoDiff);
+
+RcsTerm BenchmarkTerm(IncidenceModel incidence) {
+  RcsTerm term;
+  term.point_radar = Eigen::Vector3d(12.0, -3.0, 1.0);
+  term.mean = Eigen::Vector3d(11.0, -2.0, 1.5);
+  term.measurement = 0.2;
+  term.degree = 3;
+  for (int i = 0; i < 16; ++i) term.coefficients[i] = 0.1 * (i % 5) - 0.2;
+  term.incidence = incidence;
+  return term;
+}
+
+template <typename Kind>
+void BM_RcsResidualRotationOnly(benchmark::State& state) {
+  const RcsTerm term = BenchmarkTerm(IncidenceModel(state.range(0)));
+  const Eigen::Vector3d t(1.0, 2.0, 0.5);
+  std::unique_ptr<ceres::CostFunction> cost;
+  if constexpr (std::is_same_v<Kind, Analytic>) {
+    cost = std::make_unique<RcsRotationCostFunction>(term, t);
+  } else {
+    cost.reset(RcsRotationResidual::Create(term, t));
+  }
+  Eigen::Vector4d q = SO3d::Exp(Eigen::Vector3d(0.1, -0.2, 0.3)).quaternion().coeffs();
+  const double* parameters[1] = {q.data()};
+  double residual, j0[4];
+  double* jacobians[1] = {j0};
+  for (auto _ : state) {
+    cost->Evaluate(parameters, &residual, jacobians);
+    benchmark::DoNotOptimize(j0[0]);
+  }
+  state.SetLabel(ToString(term.incidence) + ", degree 3");
+}
+BENCHMARK_TEMPLATE(BM_RcsResidualRotationOnly, Analytic)->Arg(0)->Arg(1);
+BENCHMARK_TEMPLATE(BM_RcsResidualRotationOnly, AutoDiff)->Arg(0)->Arg(1);
+
+// ---------------------------------------------------------------------------
+// Per-scan matching.
+
+struct MatchingWorld {
+  GaussianMap map;
+  std::unique_ptr<MatchingMap> matching;
+  std::map<int, SimulatedSequence> scans;  // by detections per scan
+  SimulatedSequence drive;                 // the 1000-scan drive of the map
+};
+
+const MatchingWorld& World() {
+  static const MatchingWorld* world = [] {
+    auto* w = new MatchingWorld;
+    SimulationConfig config;
+    config.scans = 1000;
+    w->drive = Simulate(config);
+    Sequence sequence;
+    sequence.scans = w->drive.scans;
+    for (const auto& sample : w->drive.ground_truth) sequence.poses.push_back(sample.pose);
+    const MapCloud cloud = BuildMapCloud(sequence);
+    GaussianMapOptions options;
+    w->map.gaussians = BuildGaussians(cloud.points, options);
+    const GaussianIndex index(w->map.gaussians, options.index_cell);
+    FitRcsModels(w->map, cloud, AssociatePoints(cloud.points, index, options.association_gate));
+    w->matching = std::make_unique<MatchingMap>(w->map);
+    for (const int n : {150, 800, 4000}) {
+      SimulationConfig scan_config;  // same seed: the same world and drive
+      scan_config.scans = 20;
+      scan_config.min_detections = scan_config.max_detections = n;
+      scan_config.max_rays = 200000;
+      w->scans[n] = Simulate(scan_config);
+    }
+    return w;
+  }();
+  return *world;
+}
+
+// The paper's protocol: translation error uniform in [0, 2] m, rotation
+// uniform in [0, 5] deg, random directions; seeded.
+std::vector<SE3d> InitialPoses(const SimulatedSequence& sequence) {
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal;
+  std::vector<SE3d> initial;
+  for (const auto& sample : sequence.ground_truth) {
+    const Eigen::Vector3d axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+    const Eigen::Vector3d direction = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+    initial.emplace_back(sample.pose.rotation() * SO3d::Exp(5.0 * M_PI / 180.0 * unit(rng) * axis),
+                         sample.pose.translation() + 2.0 * unit(rng) * direction);
+  }
+  return initial;
+}
+
+std::unique_ptr<ScanMatcher> Solver(int kind, const ScanMatchingOptions& base) {
+  ScanMatchingOptions options = base;
+  switch (kind) {
+    case 0: return std::make_unique<GaussNewtonSolver>(options);
+    case 1:
+      options.jacobians = JacobianMode::kAutoDiff;
+      return std::make_unique<GaussNewtonSolver>(options);
+    case 2: return std::make_unique<CeresSolver>(options);
+    default:
+      return std::make_unique<MultiHypothesisSolver>(std::make_shared<GaussNewtonSolver>(options), options);
+  }
+}
+
+// Args: points per scan, solver (0 gn, 1 gn-autodiff, 2 ceres, 3 mh8-gn), w_rcs x 100.
+void BM_MatchScan(benchmark::State& state) {
+  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const MatchingWorld& world = World();
+  const SimulatedSequence& scans = world.scans.at(int(state.range(0)));
+  const std::vector<SE3d> initial = InitialPoses(scans);
+  ScanMatchingOptions options;
+  options.w_rcs = double(state.range(2)) / 100.0;
+  const auto solver = Solver(int(state.range(1)), options);
+  std::size_t k = 0, points = 0, converged = 0, runs = 0;
+  double translation_error = 0.0;
+  for (auto _ : state) {
+    const ScanMatchingResult result = solver->Match(scans.scans[k], *world.matching, initial[k]);
+    points += scans.scans[k].points.size();
+    converged += result.converged;
+    translation_error += (result.pose.translation() - scans.ground_truth[k].pose.translation()).norm();
+    ++runs;
+    k = (k + 1) % scans.scans.size();
+  }
+  state.SetLabel(solver->Name() + " w=" + std::to_string(options.w_rcs).substr(0, 4));
+  state.counters["points"] = double(points) / double(runs);
+  state.counters["converged"] = double(converged) / double(runs);
+  state.counters["t_err_m"] = translation_error / double(runs);
+}
+BENCHMARK(BM_MatchScan)
+    ->ArgsProduct({{150, 800, 4000}, {0, 1, 2}, {0, 25}})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MatchScan)->Args({800, 3, 0})->Args({800, 3, 25})->Unit(benchmark::kMillisecond);
+
+// Refinement only (the exact map, from 5 cm / 0.2 deg): the per-iteration
+// cost of tracking, where the coarse levels are not needed.
+void BM_RefineScan(benchmark::State& state) {
+  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const MatchingWorld& world = World();
+  const MatchingMap exact(world.map, {});
+  const SimulatedSequence& scans = world.scans.at(800);
+  std::vector<SE3d> initial;
+  for (const auto& sample : scans.ground_truth) {
+    initial.emplace_back(sample.pose.rotation() * SO3d::Exp(Eigen::Vector3d(0, 0, 0.2 * M_PI / 180.0)),
+                         sample.pose.translation() + Eigen::Vector3d(0.05, 0.0, 0.0));
+  }
+  ScanMatchingOptions options;
+  options.w_rcs = double(state.range(1)) / 100.0;
+  const auto solver = Solver(int(state.range(0)), options);
+  std::size_t k = 0, iterations = 0, runs = 0;
+  for (auto _ : state) {
+    iterations += solver->Match(scans.scans[k], exact, initial[k]).iterations;
+    ++runs;
+    k = (k + 1) % scans.scans.size();
+  }
+  state.SetLabel(solver->Name() + " w=" + std::to_string(options.w_rcs).substr(0, 4));
+  state.counters["iterations"] = double(iterations) / double(runs);
+}
+BENCHMARK(BM_RefineScan)->ArgsProduct({{0, 1, 2}, {0, 25}})->Unit(benchmark::kMillisecond);
+
+// ---------------------------------------------------------------------------
+// Joint refinement of n scans of the drive (poses perturbed by 0.15 m / 0.5 deg).
+
+void BM_JointRefinement(benchmark::State& state) {
+  const MatchingWorld& world = World();
+  const std::size_t n = std::size_t(state.range(0));
+  std::vector<RadarScan> scans;
+  std::vector<SE3d> poses;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const std::size_t stride = world.drive.scans.size() / n;
+  for (std::size_t k = 0; k < n; ++k) {
+    scans.push_back(world.drive.scans[k * stride]);
+    const SE3d& truth = world.drive.ground_truth[k * stride].pose;
+    poses.push_back(k == 0 ? truth
+                           : SE3d(truth.rotation() * SO3d::Exp(0.005 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng))),
+                                  truth.translation() + 0.1 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng))));
+  }
+  JointRefinementOptions options;
+  options.matching.w_rcs = 0.25;
+  options.coefficient_prior = 1.0;
+  options.threads = 2;
+  options.rounds = 2;
+  int iterations = 0;
+  for (auto _ : state) iterations = RefineJointly(scans, poses, world.map, options).iterations;
+  state.counters["ceres_iterations"] = iterations;
+}
+BENCHMARK(BM_JointRefinement)->Arg(100)->Arg(1000)->Unit(benchmark::kSecond)->Iterations(1);
+
+}  // namespace
+}  // namespace radargauss
+
+BENCHMARK_MAIN();
