@@ -9,7 +9,9 @@
 #include <limits>
 #include <memory>
 
+#include "radargauss/atomic_file.hpp"
 #include "radargauss/doppler.hpp"
+#include "radargauss/experiment.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/io/sequence.hpp"
@@ -19,6 +21,10 @@
 #include "radargauss/map/rcs_model.hpp"
 #include "radargauss/progress.hpp"
 #include "radargauss/simulator.hpp"
+#include "solvers/ceres_solver.hpp"
+#include "solvers/gauss_newton.hpp"
+#include "solvers/multi_hypothesis.hpp"
+#include "yaml_config.hpp"
 
 #include <tbb/global_control.h>
 
@@ -183,37 +189,227 @@ void AddMapBuildOptions(CLI::App* app, MapBuildSettings& s) {
   app->add_flag("--no-doppler-filter", s.no_doppler_filter, "Keep dynamic points too");
 }
 
-// Sequence -> static map cloud -> Gaussians -> RCS models.
-GaussianMap BuildMapFromSequence(const Sequence& sequence, MapBuildSettings s, bool verbose) {
+// The geometric part of a map: static map cloud, Gaussians, members.
+struct GaussianStage {
+  MapCloud cloud;
+  GaussianMap map;
+  std::vector<int> association;
+  MapCloudStats cloud_stats;
+};
+
+GaussianStage BuildGaussianStage(const Sequence& sequence, MapBuildSettings& s) {
   s.map.builder = MapBuilderFromString(s.builder);
-  s.rcs.incidence = IncidenceModelFromString(s.incidence);
-  s.rcs.adaptive = !s.no_adaptive;
   MapCloudOptions cloud_options;
   cloud_options.doppler_filter = !s.no_doppler_filter;
-  MapCloudStats cloud_stats;
-  const MapCloud cloud = BuildMapCloud(sequence, cloud_options, &cloud_stats);
-  if (cloud.points.empty()) throw DataError("no static points to build a map from");
+  GaussianStage stage;
+  stage.cloud = BuildMapCloud(sequence, cloud_options, &stage.cloud_stats);
+  if (stage.cloud.points.empty()) throw DataError("no static points to build a map from");
   ProgressBar bar;
-  GaussianMap map;
-  map.gaussians = BuildGaussians(cloud.points, s.map, [&](const char* stage, std::size_t done,
-                                                          std::size_t total) {
-    bar.Update(stage, done, total);
+  stage.map.gaussians = BuildGaussians(stage.cloud.points, s.map, [&](const char* step, std::size_t done,
+                                                                     std::size_t total) {
+    bar.Update(step, done, total);
   });
   bar.Finish();
-  const GaussianIndex index(map.gaussians, s.map.index_cell);
-  const std::vector<int> association = AssociatePoints(cloud.points, index, s.map.association_gate);
-  const RcsFitStats rcs = FitRcsModels(map, cloud, association, s.rcs);
+  const GaussianIndex index(stage.map.gaussians, s.map.index_cell);
+  stage.association = AssociatePoints(stage.cloud.points, index, s.map.association_gate);
+  return stage;
+}
+
+// The RCS models of a Gaussian stage for one incidence model and degree.
+GaussianMap FitRcsStage(const GaussianStage& stage, const MapBuildSettings& s, IncidenceModel incidence,
+                        int degree, bool verbose) {
+  GaussianMap map = stage.map;
+  RcsFitOptions rcs = s.rcs;
+  rcs.incidence = incidence;
+  rcs.max_degree = degree;
+  rcs.adaptive = !s.no_adaptive;
+  const RcsFitStats stats = FitRcsModels(map, stage.cloud, stage.association, rcs);
   if (verbose) {
-    std::printf("map cloud: %zu scans (%zu without ego velocity), %zu of %zu points static\n",
-                cloud_stats.scans, cloud_stats.scans_without_ego_velocity,
-                cloud_stats.points_static, cloud_stats.points_in);
-    std::printf("gaussians: %zu (%s builder)\n", map.gaussians.size(), s.builder.c_str());
     std::printf("rcs models (%s incidence, degree <= %d, %s): %zu with a model (%zu at a lowered "
                 "degree), %zu without; mean fit RMSE %.4f\n",
-                s.incidence.c_str(), s.rcs.max_degree, s.rcs.adaptive ? "adaptive" : "fixed",
-                rcs.with_model, rcs.lowered_degree, rcs.no_model, rcs.mean_fit_rmse);
+                ToString(incidence).c_str(), degree, rcs.adaptive ? "adaptive" : "fixed", stats.with_model,
+                stats.lowered_degree, stats.no_model, stats.mean_fit_rmse);
   }
   return map;
+}
+
+// Sequence -> static map cloud -> Gaussians -> RCS models.
+GaussianMap BuildMapFromSequence(const Sequence& sequence, MapBuildSettings s, bool verbose) {
+  const GaussianStage stage = BuildGaussianStage(sequence, s);
+  if (verbose) {
+    std::printf("map cloud: %zu scans (%zu without ego velocity), %zu of %zu points static\n",
+                stage.cloud_stats.scans, stage.cloud_stats.scans_without_ego_velocity,
+                stage.cloud_stats.points_static, stage.cloud_stats.points_in);
+    std::printf("gaussians: %zu (%s builder)\n", stage.map.gaussians.size(), s.builder.c_str());
+  }
+  return FitRcsStage(stage, s, IncidenceModelFromString(s.incidence), s.rcs.max_degree, verbose);
+}
+
+// ---------------------------------------------------------------------------
+// localize: the paper's experiment.
+
+struct LocalizeSettings {
+  SequenceOptions sequence;
+  MapBuildSettings build;
+  std::string map_path;
+  std::string out;
+  std::vector<double> w_rcs = {0.0, 0.25, 1.0};
+  std::vector<std::string> solvers = {"gn"};
+  std::vector<std::string> losses = {"trivial"};
+  std::vector<std::string> incidences;
+  std::vector<int> degrees;
+  std::string rcs_loss = "cauchy";
+  double loss_scale = 1.0;
+  double rcs_loss_scale = 1.0;
+  double max_translation = 2.0;
+  double max_rotation = 5.0;
+  std::uint32_t seed = 42;
+  int stride = 1;
+};
+
+void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
+  AddSequenceOptions(app, s.sequence);
+  AddMapBuildOptions(app, s.build);
+  app->add_option("--map", s.map_path, "Map file (.rgm); without it the map is built from the sequence");
+  app->add_option("--out", s.out, "Results folder")->required();
+  app->add_option("--w-rcs", s.w_rcs, "Weights w_rcs of eq. 2 to sweep (0..1)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app->add_option("--solver", s.solvers, "Solvers: gn, gn-autodiff, ceres, ceres-dogleg, mh-gn")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"gn", "gn-autodiff", "ceres", "ceres-dogleg", "mh-gn"}))
+      ->capture_default_str();
+  app->add_option("--loss", s.losses, "Geometric losses: trivial, huber, cauchy, geman-mcclure, tukey")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"trivial", "huber", "cauchy", "geman-mcclure", "tukey"}))
+      ->capture_default_str();
+  app->add_option("--loss-scale", s.loss_scale, "Scale of the geometric loss")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--rcs-loss", s.rcs_loss, "RCS loss (the paper: cauchy)")
+      ->check(CLI::IsMember({"trivial", "huber", "cauchy", "geman-mcclure", "tukey"}))
+      ->capture_default_str();
+  app->add_option("--rcs-loss-scale", s.rcs_loss_scale, "Scale of the RCS loss")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--incidences", s.incidences, "Incidence models to sweep (map built here)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"offset", "view"}));
+  app->add_option("--degrees", s.degrees, "SH degrees to sweep (map built here)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, kMaxShDegree));
+  app->add_option("--max-translation", s.max_translation, "Initial translation error bound (m)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app->add_option("--max-rotation", s.max_rotation, "Initial rotation error bound (deg)")
+      ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
+  app->add_option("--seed", s.seed, "Seed of the initial errors")->capture_default_str();
+  app->add_option("--stride", s.stride, "Match every n-th scan (the map uses all)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
+std::unique_ptr<ScanMatcher> MakeMatcher(const std::string& solver, const ScanMatchingOptions& options) {
+  ScanMatchingOptions o = options;
+  if (solver == "gn") return std::make_unique<GaussNewtonSolver>(o);
+  if (solver == "gn-autodiff") {
+    o.jacobians = JacobianMode::kAutoDiff;
+    return std::make_unique<GaussNewtonSolver>(o);
+  }
+  if (solver == "ceres") return std::make_unique<CeresSolver>(o);
+  if (solver == "ceres-dogleg") {
+    CeresSolverOptions ceres;
+    ceres.dogleg = true;
+    return std::make_unique<CeresSolver>(o, ceres);
+  }
+  return std::make_unique<MultiHypothesisSolver>(std::make_shared<GaussNewtonSolver>(o), o);
+}
+
+std::string FormatWeight(double w) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", w);
+  return text;
+}
+
+int RunLocalize(LocalizeSettings s) {
+  if (s.sequence.ground_truth.empty()) throw DataError("localize needs --gt");
+  const Sequence sequence = LoadSequence(s.sequence);
+  // The maps to match against: one per (incidence, degree).
+  std::vector<GaussianMap> maps;
+  if (!s.map_path.empty()) {
+    if (!s.incidences.empty() || !s.degrees.empty()) {
+      throw DataError("--incidences/--degrees need the map built here (drop --map)");
+    }
+    maps.push_back(ReadMap(s.map_path));
+    s.degrees = {s.build.rcs.max_degree};
+  } else {
+    if (s.incidences.empty()) s.incidences = {s.build.incidence};
+    if (s.degrees.empty()) s.degrees = {s.build.rcs.max_degree};
+    const GaussianStage stage = BuildGaussianStage(sequence, s.build);
+    std::printf("map: %zu Gaussians from %zu static points\n", stage.map.gaussians.size(),
+                stage.cloud.points.size());
+    for (const std::string& incidence : s.incidences) {
+      for (const int degree : s.degrees) {
+        maps.push_back(FitRcsStage(stage, s.build, IncidenceModelFromString(incidence), degree, true));
+      }
+    }
+  }
+  std::vector<RadarScan> scans;
+  std::vector<SE3d> references;
+  for (std::size_t k = 0; k < sequence.scans.size(); k += std::size_t(s.stride)) {
+    scans.push_back(sequence.scans[k]);
+    references.push_back(sequence.poses[k]);
+  }
+  const std::vector<SE3d> errors = InitialErrors(scans.size(), s.max_translation, s.max_rotation, s.seed);
+  std::vector<ConfigurationRun> runs;
+  ProgressBar bar;
+  std::size_t total = 0, done = 0;
+  for (std::size_t m = 0; m < maps.size(); ++m) total += s.solvers.size() * s.losses.size() * s.w_rcs.size();
+  for (std::size_t m = 0; m < maps.size(); ++m) {
+    const MatchingMap matching(maps[m]);
+    const int degree = s.map_path.empty() ? s.degrees[m % s.degrees.size()] : s.degrees[0];
+    for (const std::string& solver : s.solvers) {
+      for (const std::string& loss : s.losses) {
+        for (const double w : s.w_rcs) {
+          ScanMatchingOptions options;
+          options.w_rcs = w;
+          options.geometric_loss = {LossTypeFromString(loss), s.loss_scale};
+          options.rcs_loss = {LossTypeFromString(s.rcs_loss), s.rcs_loss_scale};
+          const auto matcher = MakeMatcher(solver, options);
+          const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" +
+                                   ToString(maps[m].incidence) + "-L" + std::to_string(degree);
+          bar.Update("localize", done, total);
+          runs.push_back(RunConfiguration(name, w, *matcher, matching, scans, references, errors));
+          ++done;
+        }
+      }
+    }
+  }
+  bar.Update("localize", done, total);
+  bar.Finish();
+  const std::string table = WriteExperimentResults(s.out, runs);
+  // For the plots: the reference trajectory and the map's Gaussian means.
+  Trajectory reference;
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    if (reference.empty() || scans[k].timestamp > reference.EndTime()) reference.Append(scans[k].timestamp, references[k]);
+  }
+  namespace fs = std::filesystem;
+  WriteTum((fs::path(s.out) / "reference.tum").string(), reference);
+  WriteFileAtomically((fs::path(s.out) / "map_means.csv").string(), [&](std::ostream& out) {
+    out << "x,y,z\n";
+    for (const Gaussian& g : maps.front().gaussians) out << g.mean.x() << ',' << g.mean.y() << ',' << g.mean.z() << '\n';
+  });
+  double initial_t = 0.0;
+  for (const ScanOutcome& o : runs.front().outcomes) initial_t += o.initial_translation_error;
+  std::printf("%zu scans, %zu configurations; initial errors: mean %.3f m (uniform in [0, %g] m, [0, %g] deg)\n\n%s\n",
+              scans.size(), runs.size(), initial_t / std::max<std::size_t>(1, scans.size()), s.max_translation,
+              s.max_rotation, table.c_str());
+  std::printf("results: %s (per_scan.csv, summary.json, table.md, trajectories/); plots: "
+              "scripts/plot_results.py %s --reference %s/reference.tum\n",
+              s.out.c_str(), s.out.c_str(), s.out.c_str());
+  return 0;
 }
 
 int RunMapInfo(const std::string& path) {
@@ -287,8 +483,17 @@ int main(int argc, char** argv) {
   CLI::App* map_info = app.add_subcommand("map-info", "Summarise a map file");
   map_info->add_option("map", info_map, "Map file (.rgm)")->required();
 
+  LocalizeSettings localize_settings;
+  CLI::App* localize = app.add_subcommand("localize", "The paper's localisation experiment (w_rcs sweep)");
+  AddLocalizeOptions(localize, localize_settings);
+
   int threads = 0;
   app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+  // Every subcommand reads a YAML file of its flags with --config; flags override it.
+  for (CLI::App* command : {info, simulate, build_map, localize}) {
+    if (command != simulate) command->set_config("--config", "", "YAML file of this command's flags");
+    command->config_formatter(std::make_shared<YamlConfig>());
+  }
 
   try {
     app.parse(argc, argv);
@@ -303,6 +508,7 @@ int main(int argc, char** argv) {
   try {
     if (info->parsed()) return RunInfo(info_options);
     if (map_info->parsed()) return RunMapInfo(info_map);
+    if (localize->parsed()) return RunLocalize(localize_settings);
     if (build_map->parsed()) {
       if (build_sequence.ground_truth.empty()) throw DataError("build-map needs --gt");
       const Sequence sequence = LoadSequence(build_sequence);

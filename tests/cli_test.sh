@@ -57,6 +57,18 @@ expect_fail "bad incidence" "incidence" -- \
   "$tool" build-map --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --out "$work/x.rgm" --incidence side
 head -c 100 "$work/seq.rgm" > "$work/cut.rgm"
 expect_fail "truncated map" "radargauss: error:" -- "$tool" map-info "$work/cut.rgm"
+expect_ok "localize" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0,0.25 --solver gn,ceres --out "$work/results"
+for f in per_scan.csv summary.json table.md reference.tum trajectories/gn-w0-trivial-offset-L3.tum; do
+  if [ -s "$work/results/$f" ]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: missing $f"; fi
+done
+expect_fail "localize with a bad weight" "w-rcs" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --w-rcs 1.5 --out "$work/r2"
+expect_fail "localize with a map of another version" "map version" -- \
+  bash -c "cp '$work/seq.rgm' '$work/v2.rgm' && printf '\\x02' | dd of='$work/v2.rgm' bs=1 seek=8 conv=notrunc 2>/dev/null && '$tool' localize --sequence '$work/seq' --gt '$work/seq/gt_radar_tum.txt' --map '$work/v2.rgm' --out '$work/r3'"
+expect_fail "localize --map with --degrees" "drop --map" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" --degrees 1 --out "$work/r4"
 expect_fail "bad doppler sign" "doppler-sign" -- \
   "$tool" info --sequence "$work/seq" --doppler-sign 2
 printf 'scans: lots\n' >"$work/bad.yaml"
