@@ -489,11 +489,21 @@ int main(int argc, char** argv) {
 
   int threads = 0;
   app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
-  // Every subcommand reads a YAML file of its flags with --config; flags override it.
-  for (CLI::App* command : {info, simulate, build_map, localize}) {
-    if (command != simulate) command->set_config("--config", "", "YAML file of this command's flags");
-    command->config_formatter(std::make_shared<YamlConfig>());
+  // info, build-map and localize read a YAML file of their flags with
+  // --config (simulate's --config is the world's parameters); flags given on
+  // the command line override the file.
+  std::string section;
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "info" || word == "build-map" || word == "localize" || word == "map-info") {
+      section = word;
+      break;
+    }
   }
+  app.set_config("--config", "", "YAML file of the subcommand's flags (info, build-map, localize)");
+  app.config_formatter(std::make_shared<YamlConfig>(section));
+  app.allow_config_extras(CLI::config_extras_mode::error);
+  for (CLI::App* command : {info, build_map, localize}) command->fallthrough();
 
   try {
     app.parse(argc, argv);

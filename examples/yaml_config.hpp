@@ -19,6 +19,10 @@ namespace radargauss {
 
 class YamlConfig final : public CLI::Config {
  public:
+  // `section`: the subcommand the keys belong to (CLI11 2.1 reads config
+  // files on the main app only, so the items are addressed to it).
+  explicit YamlConfig(std::string section) : section_(std::move(section)) {}
+
   std::string to_config(const CLI::App*, bool, bool, std::string) const override { return {}; }
 
   std::vector<CLI::ConfigItem> from_config(std::istream& input) const override {
@@ -35,6 +39,7 @@ class YamlConfig final : public CLI::Config {
     if (!root.IsMap()) throw CLI::ConversionError("config file: expected a map of flag: value");
     for (const auto& entry : root) {
       CLI::ConfigItem item;
+      if (!section_.empty()) item.parents = {section_};
       item.name = entry.first.as<std::string>();
       const YAML::Node& value = entry.second;
       if (value.IsSequence()) {
@@ -48,6 +53,9 @@ class YamlConfig final : public CLI::Config {
     }
     return items;
   }
+
+ private:
+  std::string section_;
 };
 
 }  // namespace radargauss

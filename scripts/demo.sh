@@ -14,7 +14,7 @@ demo="$root/build/demo"
 mkdir -p "$demo"
 
 "$tool" simulate --out "$demo/sequence" --config "$root/configs/synthetic_world.yaml" --force
-"$tool" build-map --config "$root/configs/synthetic_world_localize.yaml" \
+"$tool" build-map \
   --sequence "$demo/sequence" --gt "$demo/sequence/gt_radar_tum.txt" \
   --out "$demo/map.rgm" --ply "$demo/map.ply"
 "$tool" localize --config "$root/configs/synthetic_world_localize.yaml" \

@@ -69,6 +69,12 @@ expect_fail "localize with a map of another version" "map version" -- \
   bash -c "cp '$work/seq.rgm' '$work/v2.rgm' && printf '\\x02' | dd of='$work/v2.rgm' bs=1 seek=8 conv=notrunc 2>/dev/null && '$tool' localize --sequence '$work/seq' --gt '$work/seq/gt_radar_tum.txt' --map '$work/v2.rgm' --out '$work/r3'"
 expect_fail "localize --map with --degrees" "drop --map" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" --degrees 1 --out "$work/r4"
+printf 'w-rcs: [0, 1]\nstride: 1\n' > "$work/loc.yaml"
+expect_ok "localize --config" "2 configurations" -- \
+  "$tool" localize --config "$work/loc.yaml" --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" --out "$work/r5"
+printf 'bogus-key: 1\n' > "$work/bad_loc.yaml"
+expect_fail "localize --config with an unknown key" "bogus-key" -- \
+  "$tool" localize --config "$work/bad_loc.yaml" --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --out "$work/r6"
 expect_fail "bad doppler sign" "doppler-sign" -- \
   "$tool" info --sequence "$work/seq" --doppler-sign 2
 printf 'scans: lots\n' >"$work/bad.yaml"
