@@ -17,10 +17,9 @@
 #include "radargauss/simulator.hpp"
 #include "residuals/geometric_residual.hpp"
 #include "residuals/rcs_residual.hpp"
-#include "solvers/ceres_solver.hpp"
-#include "solvers/gauss_newton.hpp"
+#include "radargauss/experiment.hpp"
+#include "solvers/factory.hpp"
 #include "solvers/joint_refinement.hpp"
-#include "solvers/multi_hypothesis.hpp"
 
 namespace radargauss {
 namespace {
@@ -125,33 +124,18 @@ const MatchingWorld& World() {
   return *world;
 }
 
-// The paper's protocol: translation error uniform in [0, 2] m, rotation
-// uniform in [0, 5] deg, random directions; seeded.
+// The paper's protocol (experiment.hpp): translation error uniform in
+// [0, 2] m, rotation uniform in [0, 5] deg, random directions; seeded.
 std::vector<SE3d> InitialPoses(const SimulatedSequence& sequence) {
-  std::mt19937 rng(42);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::normal_distribution<double> normal;
+  const std::vector<SE3d> errors = InitialErrors(sequence.ground_truth.size(), 2.0, 5.0, 42);
   std::vector<SE3d> initial;
-  for (const auto& sample : sequence.ground_truth) {
-    const Eigen::Vector3d axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-    const Eigen::Vector3d direction = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-    initial.emplace_back(sample.pose.rotation() * SO3d::Exp(5.0 * M_PI / 180.0 * unit(rng) * axis),
-                         sample.pose.translation() + 2.0 * unit(rng) * direction);
-  }
+  for (std::size_t k = 0; k < errors.size(); ++k) initial.push_back(sequence.ground_truth[k].pose * errors[k]);
   return initial;
 }
 
-std::unique_ptr<ScanMatcher> Solver(int kind, const ScanMatchingOptions& base) {
-  ScanMatchingOptions options = base;
-  switch (kind) {
-    case 0: return std::make_unique<GaussNewtonSolver>(options);
-    case 1:
-      options.jacobians = JacobianMode::kAutoDiff;
-      return std::make_unique<GaussNewtonSolver>(options);
-    case 2: return std::make_unique<CeresSolver>(options);
-    default:
-      return std::make_unique<MultiHypothesisSolver>(std::make_shared<GaussNewtonSolver>(options), options);
-  }
+std::unique_ptr<ScanMatcher> Solver(int kind, const ScanMatchingOptions& options) {
+  static const char* names[] = {"gn", "gn-autodiff", "ceres", "mh-gn"};
+  return MakeScanMatcher(names[kind], options);
 }
 
 // Args: points per scan, solver (0 gn, 1 gn-autodiff, 2 ceres, 3 mh8-gn), w_rcs x 100.

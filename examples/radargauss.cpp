@@ -21,9 +21,7 @@
 #include "radargauss/map/rcs_model.hpp"
 #include "radargauss/progress.hpp"
 #include "radargauss/simulator.hpp"
-#include "solvers/ceres_solver.hpp"
-#include "solvers/gauss_newton.hpp"
-#include "solvers/multi_hypothesis.hpp"
+#include "solvers/factory.hpp"
 #include "yaml_config.hpp"
 
 #include <tbb/global_control.h>
@@ -278,7 +276,7 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
       ->capture_default_str();
   app->add_option("--solver", s.solvers, "Solvers: gn, gn-autodiff, ceres, ceres-dogleg, mh-gn")
       ->delimiter(',')
-      ->check(CLI::IsMember({"gn", "gn-autodiff", "ceres", "ceres-dogleg", "mh-gn"}))
+      ->check(CLI::IsMember(ScanMatcherNames()))
       ->capture_default_str();
   app->add_option("--loss", s.losses, "Geometric losses: trivial, huber, cauchy, geman-mcclure, tukey")
       ->delimiter(',')
@@ -309,22 +307,6 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--stride", s.stride, "Match every n-th scan (the map uses all)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-}
-
-std::unique_ptr<ScanMatcher> MakeMatcher(const std::string& solver, const ScanMatchingOptions& options) {
-  ScanMatchingOptions o = options;
-  if (solver == "gn") return std::make_unique<GaussNewtonSolver>(o);
-  if (solver == "gn-autodiff") {
-    o.jacobians = JacobianMode::kAutoDiff;
-    return std::make_unique<GaussNewtonSolver>(o);
-  }
-  if (solver == "ceres") return std::make_unique<CeresSolver>(o);
-  if (solver == "ceres-dogleg") {
-    CeresSolverOptions ceres;
-    ceres.dogleg = true;
-    return std::make_unique<CeresSolver>(o, ceres);
-  }
-  return std::make_unique<MultiHypothesisSolver>(std::make_shared<GaussNewtonSolver>(o), o);
 }
 
 std::string FormatWeight(double w) {
@@ -377,7 +359,7 @@ int RunLocalize(LocalizeSettings s) {
           options.w_rcs = w;
           options.geometric_loss = {LossTypeFromString(loss), s.loss_scale};
           options.rcs_loss = {LossTypeFromString(s.rcs_loss), s.rcs_loss_scale};
-          const auto matcher = MakeMatcher(solver, options);
+          const auto matcher = MakeScanMatcher(solver, options);
           const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" +
                                    ToString(maps[m].incidence) + "-L" + std::to_string(degree);
           bar.Update("localize", done, total);

@@ -4,7 +4,6 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
-#include <chrono>
 
 #include "radargauss/lie/manifold.hpp"
 #include "residuals/geometric_residual.hpp"
@@ -25,10 +24,6 @@ std::string CeresSolver::Name() const {
 
 ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& map,
                                       const SE3d& initial) const {
-  const auto start = std::chrono::steady_clock::now();
-  ScanMatchingResult result;
-  result.pose = initial;
-  const double w = options_.w_rcs;
   const bool analytic = options_.jacobians == JacobianMode::kAnalytic;
   const bool rotation_only = options_.rcs_translation == RcsTranslation::kRotationOnly;
   Eigen::Vector4d rotation = initial.rotation().quaternion().coeffs();
@@ -44,97 +39,63 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
   solver_options.gradient_tolerance = 1e-12;
   solver_options.parameter_tolerance = 1e-10;
 
-  Correspondences c;
-  bool failed = false;
-  // As the own GN: coarse levels with the geometric term only, eq. 2 with
-  // the requested w on the exact map (w = 1: no coarse levels).
-  for (std::size_t level = w < 1.0 ? 0 : map.levels() - 1; level < map.levels() && !failed; ++level) {
-    const bool finest = level + 1 == map.levels();
-    ScanMatchingOptions level_options = options_;
-    level_options.w_rcs = finest ? w : 0.0;
-    const double w_level = level_options.w_rcs;
-    const double looseness = finest ? 1.0 : 100.0;
-    const int max_iterations = finest ? options_.max_iterations : options_.coarse_iterations;
-    result.converged = false;
-    c = FindCorrespondences(scan, map, level, result.pose, options_.gate, w_level > 0.0);
-    for (int iteration = 1; iteration <= max_iterations; ++iteration) {
-      if (options_.reassociate && iteration > 1) {
-        c = FindCorrespondences(scan, map, level, result.pose, options_.gate, w_level > 0.0);
-      }
-      if (!CheckCorrespondences(scan, c, level_options, result.reason)) {
-        failed = true;
-        break;
-      }
-      ++result.iterations;
-      ceres::Problem::Options problem_options;
-      problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-      ceres::Problem problem(problem_options);
-      problem.AddParameterBlock(rotation.data(), 4, &so3);
-      if (w_level < 1.0) {
-        const double weight = (1.0 - w_level) / double(c.geometric.size());
-        for (const GeometricTerm& term : c.geometric) {
-          const Eigen::Vector3d& mean = c.index->Mean(term.gaussian);
-          const Eigen::Matrix3d& LT = c.index->SqrtInformationT(term.gaussian);
-          ceres::CostFunction* cost = analytic ? static_cast<ceres::CostFunction*>(
-                                                     new GeometricCostFunction(term.point_radar, mean, LT))
-                                               : GeometricResidual::Create(term.point_radar, mean, LT);
-          problem.AddResidualBlock(cost, new ceres::ScaledLoss(MakeLoss(options_.geometric_loss), weight,
-                                                               ceres::TAKE_OWNERSHIP),
-                                   rotation.data(), translation.data());
-        }
-      }
-      if (w_level > 0.0) {
-        const double weight = w_level / double(c.rcs.size());
-        for (const RcsTerm& term : c.rcs) {
-          ceres::LossFunction* loss =
-              new ceres::ScaledLoss(MakeLoss(options_.rcs_loss), weight, ceres::TAKE_OWNERSHIP);
-          if (rotation_only) {
-            ceres::CostFunction* cost =
-                analytic ? static_cast<ceres::CostFunction*>(new RcsRotationCostFunction(term, c.translation))
-                         : RcsRotationResidual::Create(term, c.translation);
-            problem.AddResidualBlock(cost, loss, rotation.data());
-          } else {
-            ceres::CostFunction* cost = analytic ? static_cast<ceres::CostFunction*>(new RcsCostFunction(term))
-                                                 : RcsResidual::Create(term);
-            problem.AddResidualBlock(cost, loss, rotation.data(), translation.data());
-          }
-        }
-      }
-      ceres::Solver::Summary summary;
-      const SE3d before = result.pose;
-      ceres::Solve(solver_options, &problem, &summary);
-      if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
-        result.reason = "Ceres: " + summary.message;
-        rotation = before.rotation().quaternion().coeffs();
-        translation = before.translation();
-        failed = true;
-        break;
-      }
-      result.pose = SE3d(SO3d(Eigen::Quaterniond(rotation[3], rotation[0], rotation[1], rotation[2])), translation);
-      const SE3d step = before.Inverse() * result.pose;
-      const bool small =
-          (result.pose.translation() - before.translation()).norm() < looseness * options_.translation_tolerance &&
-          step.rotation().Log().norm() < looseness * options_.rotation_tolerance;
-      if (small || !options_.reassociate) {
-        result.converged = summary.termination_type == ceres::CONVERGENCE || small;
-        if (!result.converged) result.reason = "Ceres: " + summary.message;
-        break;
+  return RunCoarseToFine(scan, map, initial, options_, [&](const LevelStep& level, ScanMatchingResult& result) {
+    const Correspondences& c = level.correspondences;
+    const double w = level.options.w_rcs;
+    ceres::Problem::Options problem_options;
+    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    problem.AddParameterBlock(rotation.data(), 4, &so3);
+    if (w < 1.0) {
+      const double weight = (1.0 - w) / double(c.geometric.size());
+      for (const GeometricTerm& term : c.geometric) {
+        const Eigen::Vector3d& mean = c.index->Mean(term.gaussian);
+        const Eigen::Matrix3d& LT = c.index->SqrtInformationT(term.gaussian);
+        ceres::CostFunction* cost = analytic ? static_cast<ceres::CostFunction*>(
+                                                   new GeometricCostFunction(term.point_radar, mean, LT))
+                                             : GeometricResidual::Create(term.point_radar, mean, LT);
+        problem.AddResidualBlock(cost, new ceres::ScaledLoss(MakeLoss(options_.geometric_loss), weight,
+                                                             ceres::TAKE_OWNERSHIP),
+                                 rotation.data(), translation.data());
       }
     }
-  }
-  if (failed) result.converged = false;
-  if (!result.converged && result.reason.empty()) result.reason = "iteration limit reached";
-  if (result.iterations > 0) {
-    const Correspondences final_c =
-        options_.reassociate ? FindCorrespondences(scan, map, map.levels() - 1, result.pose, options_.gate, w > 0.0)
-                             : c;
-    result.n_geo = final_c.geometric.size();
-    result.n_rcs = final_c.rcs.size();
-    result.final_cost = EvaluateCost(final_c, result.pose, options_);
-  }
-  result.time_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  return result;
+    if (w > 0.0) {
+      const double weight = w / double(c.rcs.size());
+      for (const RcsTerm& term : c.rcs) {
+        ceres::LossFunction* loss =
+            new ceres::ScaledLoss(MakeLoss(options_.rcs_loss), weight, ceres::TAKE_OWNERSHIP);
+        if (rotation_only) {
+          ceres::CostFunction* cost =
+              analytic ? static_cast<ceres::CostFunction*>(new RcsRotationCostFunction(term, c.translation))
+                       : RcsRotationResidual::Create(term, c.translation);
+          problem.AddResidualBlock(cost, loss, rotation.data());
+        } else {
+          ceres::CostFunction* cost = analytic ? static_cast<ceres::CostFunction*>(new RcsCostFunction(term))
+                                               : RcsResidual::Create(term);
+          problem.AddResidualBlock(cost, loss, rotation.data(), translation.data());
+        }
+      }
+    }
+    ceres::Solver::Summary summary;
+    const SE3d before = result.pose;
+    ceres::Solve(solver_options, &problem, &summary);
+    if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
+      result.reason = "Ceres: " + summary.message;
+      rotation = before.rotation().quaternion().coeffs();
+      translation = before.translation();
+      return StepOutcome::kFailed;
+    }
+    result.pose = SE3d(SO3d(Eigen::Quaterniond(rotation[3], rotation[0], rotation[1], rotation[2])), translation);
+    const SE3d step = before.Inverse() * result.pose;
+    const bool small =
+        (result.pose.translation() - before.translation()).norm() < level.looseness * options_.translation_tolerance &&
+        step.rotation().Log().norm() < level.looseness * options_.rotation_tolerance;
+    // Converged when the pose settled, or, on a fixed association, when Ceres did.
+    if (small || (!options_.reassociate && summary.termination_type == ceres::CONVERGENCE)) {
+      return StepOutcome::kConverged;
+    }
+    return StepOutcome::kContinue;
+  });
 }
 
 }  // namespace radargauss

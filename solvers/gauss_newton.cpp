@@ -2,7 +2,6 @@
 
 #include <ceres/jet.h>
 
-#include <chrono>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -132,94 +131,50 @@ std::string GaussNewtonSolver::Name() const {
 
 ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const MatchingMap& map,
                                             const SE3d& initial) const {
-  const auto start = std::chrono::steady_clock::now();
-  ScanMatchingResult result;
-  result.pose = initial;
-  const double w = options_.w_rcs;
-  const bool with_rcs = w > 0.0;  // on the exact map
-  Correspondences c;
-  bool failed = false;
-  // Coarse levels steer into the basin with the geometric term only; eq. 2
-  // with the requested w applies on the exact map (w = 1: no coarse levels).
-  for (std::size_t level = w < 1.0 ? 0 : map.levels() - 1; level < map.levels() && !failed; ++level) {
-    const bool finest = level + 1 == map.levels();
-    ScanMatchingOptions level_options = options_;
-    level_options.w_rcs = finest ? w : 0.0;
-    const double w_level = level_options.w_rcs;
-    const double looseness = finest ? 1.0 : 100.0;
-    const int max_iterations = finest ? options_.max_iterations : options_.coarse_iterations;
-    result.converged = false;
-    c = FindCorrespondences(scan, map, level, result.pose, options_.gate, w_level > 0.0);
-    for (int iteration = 1; iteration <= max_iterations; ++iteration) {
-      if (options_.reassociate && iteration > 1) {
-        c = FindCorrespondences(scan, map, level, result.pose, options_.gate, w_level > 0.0);
-      }
-      if (!CheckCorrespondences(scan, c, level_options, result.reason)) {
-        failed = true;
-        break;
-      }
-      ++result.iterations;
-      // Eq. 2: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs (likewise g).
-      Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-      Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-      if (w_level < 1.0) {
-        const LinearSystem geometric = BuildGeometricSystem(c, result.pose, level_options);
-        H += (1.0 - w_level) / double(geometric.residuals) * geometric.H;
-        g += (1.0 - w_level) / double(geometric.residuals) * geometric.g;
-      }
-      if (w_level > 0.0) {
-        const LinearSystem rcs = BuildRcsSystem(c, result.pose, level_options);
-        H += w_level / double(rcs.residuals) * rcs.H;
-        g += w_level / double(rcs.residuals) * rcs.g;
-      }
-      const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
-      const Eigen::Matrix<double, 6, 1> pivots = ldlt.vectorD();
-      if (ldlt.info() != Eigen::Success || !(pivots.minCoeff() > 1e-10 * std::max(1e-300, pivots.maxCoeff()))) {
-        result.reason = "degenerate normal equations (too few or ill-placed residuals)";
-        failed = true;
-        break;
-      }
-      const Eigen::Matrix<double, 6, 1> dx = ldlt.solve(-g);
-      if (!dx.allFinite()) {
-        result.reason = "non-finite update";
-        failed = true;
-        break;
-      }
-      // Backtracking on the exact map: halve the step while eq. 2 grows for
-      // this association (coarse levels only steer into the basin).
-      const double cost = finest ? EvaluateCost(c, result.pose, level_options) : 0.0;
-      double scale = 1.0;
-      SE3d next = Step(result.pose, dx);
-      for (int halving = 0; finest && halving < options_.max_step_halvings &&
-                            EvaluateCost(c, next, level_options) > cost;
-           ++halving) {
-        scale *= 0.5;
-        next = Step(result.pose, scale * dx);
-      }
-      result.pose = next;
-      const Eigen::Matrix<double, 6, 1> step = scale * dx;
-      if (step.segment<3>(kTranslationOffset).norm() < looseness * options_.translation_tolerance &&
-          step.segment<3>(kRotationOffset).norm() < looseness * options_.rotation_tolerance) {
-        result.converged = true;
-        break;
-      }
+  return RunCoarseToFine(scan, map, initial, options_, [this](const LevelStep& level, ScanMatchingResult& result) {
+    const Correspondences& c = level.correspondences;
+    const double w = level.options.w_rcs;
+    // Eq. 2: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs (likewise g).
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    if (w < 1.0) {
+      const LinearSystem geometric = BuildGeometricSystem(c, result.pose, level.options);
+      H += (1.0 - w) / double(geometric.residuals) * geometric.H;
+      g += (1.0 - w) / double(geometric.residuals) * geometric.g;
     }
-  }
-  if (failed) result.converged = false;
-  if (!result.converged && result.reason.empty()) result.reason = "iteration limit reached";
-  if (result.iterations > 0) {
-    const Correspondences final_c =
-        options_.reassociate ? FindCorrespondences(scan, map, map.levels() - 1, result.pose, options_.gate, with_rcs)
-                             : c;
-    result.n_geo = final_c.geometric.size();
-    result.n_rcs = final_c.rcs.size();
-    result.final_cost = EvaluateCost(final_c, result.pose, options_);
-  } else {
-    result.pose = initial;
-  }
-  result.time_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  return result;
+    if (w > 0.0) {
+      const LinearSystem rcs = BuildRcsSystem(c, result.pose, level.options);
+      H += w / double(rcs.residuals) * rcs.H;
+      g += w / double(rcs.residuals) * rcs.g;
+    }
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
+    const Eigen::Matrix<double, 6, 1> pivots = ldlt.vectorD();
+    if (ldlt.info() != Eigen::Success || !(pivots.minCoeff() > 1e-10 * std::max(1e-300, pivots.maxCoeff()))) {
+      result.reason = "degenerate normal equations (too few or ill-placed residuals)";
+      return StepOutcome::kFailed;
+    }
+    const Eigen::Matrix<double, 6, 1> dx = ldlt.solve(-g);
+    if (!dx.allFinite()) {
+      result.reason = "non-finite update";
+      return StepOutcome::kFailed;
+    }
+    // Backtracking on the exact map: halve the step while eq. 2 grows for
+    // this association (coarse levels only steer into the basin).
+    const double cost = level.finest ? EvaluateCost(c, result.pose, level.options) : 0.0;
+    double scale = 1.0;
+    SE3d next = Step(result.pose, dx);
+    for (int halving = 0; level.finest && halving < options_.max_step_halvings &&
+                          EvaluateCost(c, next, level.options) > cost;
+         ++halving) {
+      scale *= 0.5;
+      next = Step(result.pose, scale * dx);
+    }
+    result.pose = next;
+    const Eigen::Matrix<double, 6, 1> step = scale * dx;
+    const bool small = step.segment<3>(kTranslationOffset).norm() < level.looseness * options_.translation_tolerance &&
+                       step.segment<3>(kRotationOffset).norm() < level.looseness * options_.rotation_tolerance;
+    return small ? StepOutcome::kConverged : StepOutcome::kContinue;
+  });
 }
 
 }  // namespace radargauss

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <algorithm>
+#include <chrono>
 #include <stdexcept>
 
 namespace radargauss {
@@ -116,6 +117,56 @@ bool CheckCorrespondences(const RadarScan& scan, const Correspondences& c,
     return false;
   }
   return true;
+}
+
+ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                                   const ScanMatchingOptions& options, const SolverStep& step) {
+  const auto start = std::chrono::steady_clock::now();
+  ScanMatchingResult result;
+  result.pose = initial;
+  const double w = options.w_rcs;
+  Correspondences c;
+  bool failed = false;
+  for (std::size_t level = w < 1.0 ? 0 : map.levels() - 1; level < map.levels() && !failed; ++level) {
+    const bool finest = level + 1 == map.levels();
+    ScanMatchingOptions level_options = options;
+    level_options.w_rcs = finest ? w : 0.0;
+    const int max_iterations = finest ? options.max_iterations : options.coarse_iterations;
+    const bool with_rcs = level_options.w_rcs > 0.0;
+    result.converged = false;
+    c = FindCorrespondences(scan, map, level, result.pose, options.gate, with_rcs);
+    for (int iteration = 1; iteration <= max_iterations; ++iteration) {
+      if (options.reassociate && iteration > 1) {
+        c = FindCorrespondences(scan, map, level, result.pose, options.gate, with_rcs);
+      }
+      if (!CheckCorrespondences(scan, c, level_options, result.reason)) {
+        failed = true;
+        break;
+      }
+      ++result.iterations;
+      const StepOutcome outcome = step({c, level_options, finest, finest ? 1.0 : 100.0}, result);
+      if (outcome == StepOutcome::kFailed) failed = true;
+      if (outcome != StepOutcome::kContinue) {
+        result.converged = outcome == StepOutcome::kConverged;
+        break;
+      }
+    }
+  }
+  if (failed) result.converged = false;
+  if (!result.converged && result.reason.empty()) result.reason = "iteration limit reached";
+  if (result.iterations > 0) {
+    const Correspondences final_c =
+        options.reassociate ? FindCorrespondences(scan, map, map.levels() - 1, result.pose, options.gate, w > 0.0)
+                            : c;
+    result.n_geo = final_c.geometric.size();
+    result.n_rcs = final_c.rcs.size();
+    result.final_cost = EvaluateCost(final_c, result.pose, options);
+  } else {
+    result.pose = initial;
+  }
+  result.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
 }
 
 }  // namespace radargauss

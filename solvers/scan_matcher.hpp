@@ -9,6 +9,7 @@
 // Pose: rotation quaternion + translation; updates [dt (world); dphi (radar)].
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -103,6 +104,23 @@ double EvaluateCost(const Correspondences& correspondences, const SE3d& pose,
 // scan or a term that has no residuals although its weight is not zero.
 bool CheckCorrespondences(const RadarScan& scan, const Correspondences& correspondences,
                           const ScanMatchingOptions& options, std::string& reason);
+
+// The outer loop every single-scan solver shares (kiss-icp style): map level
+// by map level, coarse to fine (coarse levels with the geometric term only,
+// w = 1 without them), associate (again each iteration when reassociating),
+// check the correspondences, and let `step` update result.pose. At the end:
+// the final association, N_geo, N_rcs, the cost of eq. 2 and the time.
+struct LevelStep {
+  const Correspondences& correspondences;
+  const ScanMatchingOptions& options;  // with this level's w_rcs
+  bool finest = false;
+  double looseness = 1.0;              // tolerance multiplier (100 on coarse levels)
+};
+enum class StepOutcome { kContinue, kConverged, kFailed };
+using SolverStep = std::function<StepOutcome(const LevelStep&, ScanMatchingResult&)>;
+
+ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                                   const ScanMatchingOptions& options, const SolverStep& step);
 
 class ScanMatcher {
  public:

@@ -14,6 +14,7 @@
 #include "residuals/loss.hpp"
 #include "residuals/rcs_residual.hpp"
 #include "solvers/ceres_solver.hpp"
+#include "solvers/factory.hpp"
 #include "solvers/gauss_newton.hpp"
 #include "solvers/multi_hypothesis.hpp"
 #include "test_util.hpp"
@@ -150,7 +151,6 @@ TEST(Losses, GemanMcClureDerivativesAndFactory) {
     EXPECT_NEAR(rho[2], (plus[1] - minus[1]) / h, 1e-5);
   }
   double rho = 0.0, weight = 0.0;
-  loss.Evaluate(0.0, &rho);
   for (const char* name : {"trivial", "huber", "cauchy", "geman-mcclure", "tukey"}) {
     const RobustLoss robust({LossTypeFromString(name), 1.0});
     robust.Evaluate(1e-9, rho, weight);
@@ -215,18 +215,8 @@ struct SolverCase {
   double w_rcs;
 };
 
-std::unique_ptr<ScanMatcher> MakeSolver(const std::string& name, const ScanMatchingOptions& base) {
-  ScanMatchingOptions options = base;
-  if (name == "gn") return std::make_unique<GaussNewtonSolver>(options);
-  if (name == "gn-autodiff") {
-    options.jacobians = JacobianMode::kAutoDiff;
-    return std::make_unique<GaussNewtonSolver>(options);
-  }
-  if (name == "ceres") return std::make_unique<CeresSolver>(options);
-  if (name == "mh8-gn") {
-    return std::make_unique<MultiHypothesisSolver>(std::make_shared<GaussNewtonSolver>(options), options);
-  }
-  throw std::invalid_argument(name);
+std::unique_ptr<ScanMatcher> MakeSolver(const std::string& name, const ScanMatchingOptions& options) {
+  return MakeScanMatcher(name, options);
 }
 
 class SolverTest : public ::testing::TestWithParam<SolverCase> {};
@@ -258,7 +248,7 @@ INSTANTIATE_TEST_SUITE_P(
     EverySolver, SolverTest,
     ::testing::Values(SolverCase{"gn", 0.0}, SolverCase{"gn", 0.25}, SolverCase{"gn-autodiff", 0.0},
                       SolverCase{"gn-autodiff", 0.25}, SolverCase{"ceres", 0.0}, SolverCase{"ceres", 0.25},
-                      SolverCase{"mh8-gn", 0.0}, SolverCase{"mh8-gn", 0.25}),
+                      SolverCase{"mh-gn", 0.0}, SolverCase{"mh-gn", 0.25}),
     [](const ::testing::TestParamInfo<SolverCase>& info) {
       std::string name = info.param.name + "_w" + std::to_string(int(info.param.w_rcs * 100));
       for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
@@ -375,7 +365,7 @@ TEST(DegenerateInputs, FailWithAReason) {
   for (RadarPoint& p : far_away.points) p.position += Eigen::Vector3d(0, 0, 500.0);
   RadarScan outliers = world.simulated.scans[kTestScan];
   for (RadarPoint& p : outliers.points) p.rcs = 1000.0;
-  for (const std::string name : {"gn", "gn-autodiff", "ceres", "mh8-gn"}) {
+  for (const std::string name : {"gn", "gn-autodiff", "ceres", "ceres-dogleg", "mh-gn"}) {
     for (const auto& [scan, w] : std::vector<std::pair<const RadarScan*, double>>{
              {&empty, 0.0}, {&one, 0.0}, {&far_away, 0.0}, {&outliers, 0.25}, {&outliers, 1.0}}) {
       ScanMatchingOptions options;
@@ -399,6 +389,7 @@ TEST(ScanMatchingOptionsTest, Validation) {
   MultiHypothesisOptions hypotheses;
   hypotheses.starts = 14;
   EXPECT_THROW(HypothesisOffsets(hypotheses), std::invalid_argument);
+  EXPECT_THROW(MakeScanMatcher("lm", ScanMatchingOptions{}), std::invalid_argument);
 }
 
 }  // namespace
