@@ -22,6 +22,9 @@
 #include "radargauss/progress.hpp"
 #include "radargauss/simulator.hpp"
 #include "solvers/factory.hpp"
+#ifdef RADARGAUSS_HAVE_PCL
+#include "peers/pcl_peers.hpp"
+#endif
 #include "yaml_config.hpp"
 
 #include <tbb/global_control.h>
@@ -265,6 +268,16 @@ struct LocalizeSettings {
   int stride = 1;
 };
 
+// Our solvers, plus the PCL peers when built with RADARGAUSS_WITH_PCL.
+std::vector<std::string> SolverNames() {
+  std::vector<std::string> names = ScanMatcherNames();
+#ifdef RADARGAUSS_HAVE_PCL
+  names.push_back("pcl-ndt");
+  names.push_back("pcl-gicp");
+#endif
+  return names;
+}
+
 void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
   AddSequenceOptions(app, s.sequence);
   AddMapBuildOptions(app, s.build);
@@ -274,9 +287,11 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
       ->delimiter(',')
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  app->add_option("--solver", s.solvers, "Solvers: gn, gn-autodiff, ceres, ceres-dogleg, mh-gn")
+  app->add_option("--solver", s.solvers,
+                  "Solvers: gn, gn-autodiff, ceres, ceres-dogleg, mh-gn (and pcl-ndt, pcl-gicp when built "
+                  "with RADARGAUSS_WITH_PCL)")
       ->delimiter(',')
-      ->check(CLI::IsMember(ScanMatcherNames()))
+      ->check(CLI::IsMember(SolverNames()))
       ->capture_default_str();
   app->add_option("--loss", s.losses, "Geometric losses: trivial, huber, cauchy, geman-mcclure, tukey")
       ->delimiter(',')
@@ -346,6 +361,7 @@ int RunLocalize(LocalizeSettings s) {
   }
   const std::vector<SE3d> errors = InitialErrors(scans.size(), s.max_translation, s.max_rotation, s.seed);
   std::vector<ConfigurationRun> runs;
+  std::vector<Eigen::Vector3d> map_cloud;  // the PCL peers' target
   ProgressBar bar;
   std::size_t total = 0, done = 0;
   for (std::size_t m = 0; m < maps.size(); ++m) total += s.solvers.size() * s.losses.size() * s.w_rcs.size();
@@ -353,6 +369,18 @@ int RunLocalize(LocalizeSettings s) {
     const MatchingMap matching(maps[m]);
     const int degree = s.map_path.empty() ? s.degrees[m % s.degrees.size()] : s.degrees[0];
     for (const std::string& solver : s.solvers) {
+      if (solver.rfind("pcl-", 0) == 0) {
+#ifdef RADARGAUSS_HAVE_PCL
+        // Peers: the merged map cloud as the target, once (no w_rcs, no loss).
+        if (m > 0) continue;
+        if (map_cloud.empty()) map_cloud = BuildMapCloud(sequence).points;
+        const PclPeerMatcher peer(solver == "pcl-ndt" ? PclMethod::kNdt : PclMethod::kGicp, map_cloud);
+        bar.Update("localize", done, total);
+        runs.push_back(RunConfiguration(solver, 0.0, peer, matching, scans, references, errors));
+        ++done;
+#endif
+        continue;
+      }
       for (const std::string& loss : s.losses) {
         for (const double w : s.w_rcs) {
           ScanMatchingOptions options;

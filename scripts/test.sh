@@ -9,15 +9,18 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 jobs=$(nproc)
 trees=${RADARGAUSS_TEST_TREES:-"release sanitize"}
 
-# The optional ROS1 bag component is on here (and required): its packages too.
-RADARGAUSS_DEPS_EXTRA="librosbag-storage-dev libsensor-msgs-dev ${RADARGAUSS_DEPS_EXTRA:-}" \
+# The optional components are on here (and required): the ROS1 bag reader in
+# both trees, the PCL NDT/GICP peers in the Release tree (Debian's PCL is not
+# built with the sanitizers, so the sanitizer tree leaves the peers out).
+RADARGAUSS_DEPS_EXTRA="librosbag-storage-dev libsensor-msgs-dev libpcl-dev ${RADARGAUSS_DEPS_EXTRA:-}" \
   "$root/scripts/deps.sh"
 
 for tree in $trees; do
   build="$root/build/$tree"
   case "$tree" in
     release)
-      cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DRADARGAUSS_WITH_ROSBAG=ON ;;
+      cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DRADARGAUSS_WITH_ROSBAG=ON \
+        -DRADARGAUSS_WITH_PCL=ON ;;
     sanitize)
       # Debug keeps Eigen's and our assertions on; -O1 keeps it fast enough.
       cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug \
