@@ -103,10 +103,7 @@ const MatchingWorld& World() {
     SimulationConfig config;
     config.scans = 1000;
     w->drive = Simulate(config);
-    Sequence sequence;
-    sequence.scans = w->drive.scans;
-    for (const auto& sample : w->drive.ground_truth) sequence.poses.push_back(sample.pose);
-    const MapCloud cloud = BuildMapCloud(sequence);
+    const MapCloud cloud = BuildMapCloud(AsSequence(w->drive));
     GaussianMapOptions options;
     w->map.gaussians = BuildGaussians(cloud.points, options);
     const GaussianIndex index(w->map.gaussians, options.index_cell);

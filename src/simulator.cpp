@@ -541,6 +541,16 @@ std::string SimulationConfigToYaml(const SimulationConfig& config) {
   return out.str();
 }
 
+Sequence AsSequence(const SimulatedSequence& simulated) {
+  Sequence sequence;
+  sequence.layout = "simulated";
+  sequence.scans = simulated.scans;
+  sequence.total_scans = simulated.scans.size();
+  sequence.trajectory = simulated.ground_truth;
+  for (const StampedPose& sample : simulated.ground_truth) sequence.poses.push_back(sample.pose);
+  return sequence;
+}
+
 void WriteSimulatedSequence(const std::string& dir, const SimulatedSequence& sequence) {
   namespace fs = std::filesystem;
   const fs::path points = fs::path(dir) / "ars548" / "points";

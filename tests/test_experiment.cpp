@@ -42,9 +42,7 @@ TEST_F(Experiment, ShortSequenceEndToEnd) {
   config.scans = 30;
   config.seed = 9;
   const SimulatedSequence simulated = Simulate(config);
-  Sequence sequence;
-  sequence.scans = simulated.scans;
-  for (const auto& sample : simulated.ground_truth) sequence.poses.push_back(sample.pose);
+  const Sequence sequence = AsSequence(simulated);
   const MapCloud cloud = BuildMapCloud(sequence);
   GaussianMap map;
   map.gaussians = BuildGaussians(cloud.points, GaussianMapOptions{});

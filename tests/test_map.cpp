@@ -261,9 +261,7 @@ TEST(RcsModelFit, SimulatedSequenceCoverage) {
   SimulationConfig config;
   config.scans = 150;
   const SimulatedSequence simulated = Simulate(config);
-  Sequence sequence;
-  sequence.scans = simulated.scans;
-  for (const auto& sample : simulated.ground_truth) sequence.poses.push_back(sample.pose);
+  const Sequence sequence = AsSequence(simulated);
   const MapCloud cloud = BuildMapCloud(sequence);
   GaussianMapOptions options;
   GaussianMap map;

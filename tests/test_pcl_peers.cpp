@@ -17,9 +17,7 @@ TEST(PclPeers, LowerTheErrorsOnAShortSequence) {
   config.scans = 20;
   config.seed = 4;
   const SimulatedSequence simulated = Simulate(config);
-  Sequence sequence;
-  sequence.scans = simulated.scans;
-  for (const auto& sample : simulated.ground_truth) sequence.poses.push_back(sample.pose);
+  const Sequence sequence = AsSequence(simulated);
   const MapCloud cloud = BuildMapCloud(sequence);
   const GaussianMap unused;
   const MatchingMap matching(unused, {});

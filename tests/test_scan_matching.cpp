@@ -178,10 +178,7 @@ const World& SimulatedWorld() {
     config.scans = 80;
     config.seed = 5;
     w->simulated = Simulate(config);
-    Sequence sequence;
-    sequence.scans = w->simulated.scans;
-    for (const auto& sample : w->simulated.ground_truth) sequence.poses.push_back(sample.pose);
-    const MapCloud cloud = BuildMapCloud(sequence);
+    const MapCloud cloud = BuildMapCloud(AsSequence(w->simulated));
     GaussianMapOptions options;
     w->map.gaussians = BuildGaussians(cloud.points, options);
     const GaussianIndex index(w->map.gaussians, options.index_cell);

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "radargauss/io/sequence.hpp"
 #include "radargauss/trajectory.hpp"
 #include "radargauss/types.hpp"
 
@@ -113,6 +114,10 @@ struct SimulatedSequence {
 };
 
 SimulatedSequence Simulate(const SimulationConfig& config);
+
+// The simulated scans as a Sequence matched to their ground-truth poses (what
+// LoadSequence gives for the written files, without the float32 rounding).
+Sequence AsSequence(const SimulatedSequence& simulated);
 
 // Writes the Snail-Radar layout: <dir>/ars548/points/<secs>.<nsecs>.pcd (the
 // nine float32 fields), <dir>/ars548/points/times.txt, the radar ground truth
