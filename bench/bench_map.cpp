@@ -48,9 +48,8 @@ void BM_BuildMapAndRcs(benchmark::State& state) {
   std::size_t gaussians = 0;
   for (auto _ : state) {
     GaussianMap map;
-    map.gaussians = BuildGaussians(cloud.points, options);
-    const GaussianIndex index(map.gaussians, options.index_cell);
-    const std::vector<int> association = AssociatePoints(cloud.points, index, options.association_gate);
+    std::vector<int> association;
+    map.gaussians = BuildGaussians(cloud.points, options, {}, &association);
     FitRcsModels(map, cloud, association);
     gaussians = map.gaussians.size();
   }

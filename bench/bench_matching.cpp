@@ -105,9 +105,9 @@ const MatchingWorld& World() {
     w->drive = Simulate(config);
     const MapCloud cloud = BuildMapCloud(AsSequence(w->drive));
     GaussianMapOptions options;
-    w->map.gaussians = BuildGaussians(cloud.points, options);
-    const GaussianIndex index(w->map.gaussians, options.index_cell);
-    FitRcsModels(w->map, cloud, AssociatePoints(cloud.points, index, options.association_gate));
+    std::vector<int> association;
+    w->map.gaussians = BuildGaussians(cloud.points, options, {}, &association);
+    FitRcsModels(w->map, cloud, association);
     w->matching = std::make_unique<MatchingMap>(w->map);
     for (const int n : {150, 800, 4000}) {
       SimulationConfig scan_config;  // same seed: the same world and drive

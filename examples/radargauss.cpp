@@ -206,13 +206,11 @@ GaussianStage BuildGaussianStage(const Sequence& sequence, MapBuildSettings& s) 
   stage.cloud = BuildMapCloud(sequence, cloud_options, &stage.cloud_stats);
   if (stage.cloud.points.empty()) throw DataError("no static points to build a map from");
   ProgressBar bar;
-  stage.map.gaussians = BuildGaussians(stage.cloud.points, s.map, [&](const char* step, std::size_t done,
-                                                                     std::size_t total) {
-    bar.Update(step, done, total);
-  });
+  stage.map.gaussians = BuildGaussians(
+      stage.cloud.points, s.map,
+      [&](const char* step, std::size_t done, std::size_t total) { bar.Update(step, done, total); },
+      &stage.association);
   bar.Finish();
-  const GaussianIndex index(stage.map.gaussians, s.map.index_cell);
-  stage.association = AssociatePoints(stage.cloud.points, index, s.map.association_gate);
   return stage;
 }
 

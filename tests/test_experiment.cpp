@@ -45,8 +45,9 @@ TEST_F(Experiment, ShortSequenceEndToEnd) {
   const Sequence sequence = AsSequence(simulated);
   const MapCloud cloud = BuildMapCloud(sequence);
   GaussianMap map;
-  map.gaussians = BuildGaussians(cloud.points, GaussianMapOptions{});
-  FitRcsModels(map, cloud, AssociatePoints(cloud.points, GaussianIndex(map.gaussians), 3.0));
+  std::vector<int> association;
+  map.gaussians = BuildGaussians(cloud.points, GaussianMapOptions{}, {}, &association);
+  FitRcsModels(map, cloud, association);
   const MatchingMap matching(map);
   const std::vector<SE3d> errors = InitialErrors(sequence.scans.size(), 2.0, 5.0, 42);
   std::vector<ConfigurationRun> runs;

@@ -265,9 +265,8 @@ TEST(RcsModelFit, SimulatedSequenceCoverage) {
   const MapCloud cloud = BuildMapCloud(sequence);
   GaussianMapOptions options;
   GaussianMap map;
-  map.gaussians = BuildGaussians(cloud.points, options);
-  const GaussianIndex index(map.gaussians, options.index_cell);
-  const std::vector<int> association = AssociatePoints(cloud.points, index, options.association_gate);
+  std::vector<int> association;
+  map.gaussians = BuildGaussians(cloud.points, options, {}, &association);
   for (const IncidenceModel incidence : {IncidenceModel::kOffset, IncidenceModel::kView}) {
     RcsFitOptions fit;
     fit.incidence = incidence;

@@ -180,9 +180,8 @@ const World& SimulatedWorld() {
     w->simulated = Simulate(config);
     const MapCloud cloud = BuildMapCloud(AsSequence(w->simulated));
     GaussianMapOptions options;
-    w->map.gaussians = BuildGaussians(cloud.points, options);
-    const GaussianIndex index(w->map.gaussians, options.index_cell);
-    const std::vector<int> association = AssociatePoints(cloud.points, index, options.association_gate);
+    std::vector<int> association;
+    w->map.gaussians = BuildGaussians(cloud.points, options, {}, &association);
     w->view_map = w->map;
     FitRcsModels(w->map, cloud, association);
     RcsFitOptions view;

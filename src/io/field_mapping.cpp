@@ -26,4 +26,20 @@ int ResolveField(const std::vector<std::string>& available, const std::string& r
   return -1;
 }
 
+RadarFieldIndices ResolveRadarFields(const std::vector<std::string>& available,
+                                     const FieldMapping& mapping, const std::string& source) {
+  const auto required = [&](const char* name) {
+    const int index = ResolveField(available, "", {name}, name, source);
+    if (index < 0) throw FileError(source, std::string("no '") + name + "' field");
+    return index;
+  };
+  RadarFieldIndices fields;
+  fields.x = required("x");
+  fields.y = required("y");
+  fields.z = required("z");
+  fields.rcs = ResolveField(available, mapping.rcs_field, kRcsFieldNames, "RCS", source);
+  fields.doppler = ResolveField(available, mapping.doppler_field, kDopplerFieldNames, "Doppler", source);
+  return fields;
+}
+
 }  // namespace radargauss

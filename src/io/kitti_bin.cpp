@@ -43,14 +43,8 @@ RadarScan ReadKittiBin(const std::string& path, const std::vector<std::string>& 
                               " bytes is not a whole number of " + std::to_string(record) +
                               "-byte records (" + std::to_string(layout.size()) + " float32 fields)");
   }
-  const auto index_of = [&](const std::string& name) {
-    return static_cast<int>(std::find(layout.begin(), layout.end(), name) - layout.begin());
-  };
-  const int ix = index_of("x");
-  const int iy = index_of("y");
-  const int iz = index_of("z");
-  const int irc = ResolveField(layout, mapping.rcs_field, kRcsFieldNames, "RCS", path);
-  const int idop = ResolveField(layout, mapping.doppler_field, kDopplerFieldNames, "Doppler", path);
+  const RadarFieldIndices fields = ResolveRadarFields(layout, mapping, path);
+  const int ix = fields.x, iy = fields.y, iz = fields.z, irc = fields.rcs, idop = fields.doppler;
 
   RadarScan scan;
   if (!TimestampFromFileName(path, scan.timestamp)) scan.timestamp = 0.0;

@@ -311,16 +311,8 @@ bool TimestampFromFileName(const std::string& path, double& timestamp) {
 RadarScan ReadPcdScan(const std::string& path, const FieldMapping& mapping) {
   const PcdCloud cloud = ReadPcdCloud(path);
   const std::vector<std::string> names = cloud.FieldNames();
-  const auto required = [&](const std::string& name) {
-    const int index = ResolveField(names, "", {name}, name, path);
-    if (index < 0) throw FileError(path, "PCD has no '" + name + "' field");
-    return index;
-  };
-  const int ix = required("x");
-  const int iy = required("y");
-  const int iz = required("z");
-  const int irc = ResolveField(names, mapping.rcs_field, kRcsFieldNames, "RCS", path);
-  const int idop = ResolveField(names, mapping.doppler_field, kDopplerFieldNames, "Doppler", path);
+  const RadarFieldIndices fields = ResolveRadarFields(names, mapping, path);
+  const int ix = fields.x, iy = fields.y, iz = fields.z, irc = fields.rcs, idop = fields.doppler;
   std::vector<int> istd;
   for (const std::string& name : kStdFieldNames) {
     istd.push_back(ResolveField(names, "", {name}, name, path));

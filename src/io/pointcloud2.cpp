@@ -58,16 +58,8 @@ RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp,
                                 " bytes, height x row_step needs " +
                                 std::to_string(std::size_t(cloud.row_step) * cloud.height));
   }
-  const auto required = [&](const char* name) {
-    const int index = ResolveField(names, "", {name}, name, source);
-    if (index < 0) throw FileError(source, std::string("PointCloud2 has no '") + name + "' field");
-    return index;
-  };
-  const int ix = required("x");
-  const int iy = required("y");
-  const int iz = required("z");
-  const int irc = ResolveField(names, mapping.rcs_field, kRcsFieldNames, "RCS", source);
-  const int idop = ResolveField(names, mapping.doppler_field, kDopplerFieldNames, "Doppler", source);
+  const RadarFieldIndices fields = ResolveRadarFields(names, mapping, source);
+  const int ix = fields.x, iy = fields.y, iz = fields.z, irc = fields.rcs, idop = fields.doppler;
 
   RadarScan scan;
   scan.timestamp = timestamp;

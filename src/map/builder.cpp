@@ -277,7 +277,7 @@ std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points,
 
 std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
                                      const GaussianMapOptions& options,
-                                     const ProgressCallback& progress) {
+                                     const ProgressCallback& progress, std::vector<int>* association) {
   ValidateOptions(options);
   if (points.empty()) throw std::invalid_argument("cannot build a map from an empty cloud");
   std::vector<Gaussian> gaussians;
@@ -292,9 +292,11 @@ std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
   }
   // Members: every input point, associated by smallest Mahalanobis^2 within the gate.
   const GaussianIndex index(gaussians, options.index_cell);
-  for (const int g : AssociatePoints(points, index, options.association_gate)) {
+  std::vector<int> members = AssociatePoints(points, index, options.association_gate);
+  for (const int g : members) {
     if (g >= 0) ++gaussians[g].point_count;
   }
+  if (association) *association = std::move(members);
   return gaussians;
 }
 

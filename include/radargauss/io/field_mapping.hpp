@@ -31,4 +31,12 @@ int ResolveField(const std::vector<std::string>& available, const std::string& r
                  const std::vector<std::string>& defaults, const std::string& role,
                  const std::string& source);
 
+// The radar fields of a record: x y z (required) and RCS / Doppler by the
+// mapping (-1 when absent or "none"). Throws DataError naming `source`.
+struct RadarFieldIndices {
+  int x = -1, y = -1, z = -1, rcs = -1, doppler = -1;
+};
+RadarFieldIndices ResolveRadarFields(const std::vector<std::string>& available,
+                                     const FieldMapping& mapping, const std::string& source);
+
 }  // namespace radargauss

@@ -41,11 +41,14 @@ struct GaussianMapOptions {
 using ProgressCallback = std::function<void(const char*, std::size_t, std::size_t)>;
 
 // Means and covariances of the map of `points` (world frame). point_count of
-// each Gaussian counts the members among `points` (association gated by tau).
+// each Gaussian counts the members among `points` (association gated by tau);
+// when `association` is given it receives that association (the Gaussian of
+// each point or -1), so the RCS fit need not associate again.
 // Throws std::invalid_argument for bad options or an empty cloud.
 std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
                                      const GaussianMapOptions& options,
-                                     const ProgressCallback& progress = {});
+                                     const ProgressCallback& progress = {},
+                                     std::vector<int>* association = nullptr);
 
 // Centroids of the occupied voxels of edge `voxel`, ordered by voxel key.
 std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points,
