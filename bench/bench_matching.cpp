@@ -19,6 +19,7 @@
 #include "residuals/rcs_residual.hpp"
 #include "radargauss/experiment.hpp"
 #include "solvers/factory.hpp"
+#include "solvers/gauss_newton.hpp"
 #include "solvers/joint_refinement.hpp"
 
 namespace radargauss {
@@ -144,20 +145,28 @@ void BM_MatchScan(benchmark::State& state) {
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(2)) / 100.0;
   const auto solver = Solver(int(state.range(1)), options);
-  std::size_t k = 0, points = 0, converged = 0, runs = 0;
-  double translation_error = 0.0;
+  std::size_t k = 0, points = 0, converged = 0, runs = 0, iterations = 0, within = 0;
+  double translation_error = 0.0, rotation_error = 0.0;
   for (auto _ : state) {
     const ScanMatchingResult result = solver->Match(scans.scans[k], *world.matching, initial[k]);
     points += scans.scans[k].points.size();
     converged += result.converged;
-    translation_error += (result.pose.translation() - scans.ground_truth[k].pose.translation()).norm();
+    const double t_err = (result.pose.translation() - scans.ground_truth[k].pose.translation()).norm();
+    translation_error += t_err;
+    const double r_err = (scans.ground_truth[k].pose.rotation().Inverse() * result.pose.rotation()).Log().norm();
+    rotation_error += r_err;
+    iterations += result.iterations;
+    within += t_err < 0.1 && r_err < 0.5 * M_PI / 180.0;
     ++runs;
     k = (k + 1) % scans.scans.size();
   }
   state.SetLabel(solver->Name() + " w=" + std::to_string(options.w_rcs).substr(0, 4));
   state.counters["points"] = double(points) / double(runs);
+  state.counters["iterations"] = double(iterations) / double(runs);
+  state.counters["within_10cm_0.5deg"] = double(within) / double(runs);
   state.counters["converged"] = double(converged) / double(runs);
   state.counters["t_err_m"] = translation_error / double(runs);
+  state.counters["r_err_deg"] = rotation_error / double(runs) * 180.0 / M_PI;
 }
 BENCHMARK(BM_MatchScan)
     ->ArgsProduct({{150, 800, 4000}, {0, 1, 2}, {0, 25}})
@@ -180,15 +189,68 @@ void BM_RefineScan(benchmark::State& state) {
   options.w_rcs = double(state.range(1)) / 100.0;
   const auto solver = Solver(int(state.range(0)), options);
   std::size_t k = 0, iterations = 0, runs = 0;
+  double translation_error = 0.0, rotation_error = 0.0;
   for (auto _ : state) {
-    iterations += solver->Match(scans.scans[k], exact, initial[k]).iterations;
+    const ScanMatchingResult result = solver->Match(scans.scans[k], exact, initial[k]);
+    iterations += result.iterations;
+    translation_error += (result.pose.translation() - scans.ground_truth[k].pose.translation()).norm();
+    rotation_error += (scans.ground_truth[k].pose.rotation().Inverse() * result.pose.rotation()).Log().norm();
     ++runs;
     k = (k + 1) % scans.scans.size();
   }
   state.SetLabel(solver->Name() + " w=" + std::to_string(options.w_rcs).substr(0, 4));
   state.counters["iterations"] = double(iterations) / double(runs);
+  state.counters["t_err_m"] = translation_error / double(runs);
+  state.counters["r_err_deg"] = rotation_error / double(runs) * 180.0 / M_PI;
 }
 BENCHMARK(BM_RefineScan)->ArgsProduct({{0, 1, 2}, {0, 25}})->Unit(benchmark::kMillisecond);
+
+// The two parts of one outer iteration on the exact map, 800 points at the
+// reference pose: association (FindCorrespondences) and the geometric normal
+// equations (BuildGeometricSystem, analytic).
+void BM_AssociateScan(benchmark::State& state) {
+  const MatchingWorld& world = World();
+  const SimulatedSequence& scans = world.scans.at(800);
+  const bool with_rcs = state.range(0) != 0;
+  std::size_t k = 0, points = 0;
+  for (auto _ : state) {
+    const Correspondences c = FindCorrespondences(scans.scans[k], *world.matching, world.matching->levels() - 1,
+                                                  scans.ground_truth[k].pose, 3.0, with_rcs);
+    benchmark::DoNotOptimize(c.geometric.data());
+    points += scans.scans[k].points.size();
+    k = (k + 1) % scans.scans.size();
+  }
+  state.counters["per_point"] =
+      benchmark::Counter(double(points), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.SetLabel(with_rcs ? "geometric + RCS terms" : "geometric terms");
+}
+BENCHMARK(BM_AssociateScan)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+void BM_BuildSystem(benchmark::State& state) {
+  const MatchingWorld& world = World();
+  const SimulatedSequence& scans = world.scans.at(800);
+  std::vector<Correspondences> correspondences;
+  for (std::size_t k = 0; k < scans.scans.size(); ++k) {
+    correspondences.push_back(FindCorrespondences(scans.scans[k], *world.matching, world.matching->levels() - 1,
+                                                  scans.ground_truth[k].pose, 3.0, true));
+  }
+  ScanMatchingOptions options;
+  options.jacobians = state.range(0) == 0 ? JacobianMode::kAnalytic : JacobianMode::kAutoDiff;
+  std::size_t k = 0, terms = 0;
+  for (auto _ : state) {
+    const LinearSystem system = state.range(1) == 0
+                                    ? BuildGeometricSystem(correspondences[k], scans.ground_truth[k].pose, options)
+                                    : BuildRcsSystem(correspondences[k], scans.ground_truth[k].pose, options);
+    benchmark::DoNotOptimize(system.H.data());
+    terms += system.residuals;
+    k = (k + 1) % correspondences.size();
+  }
+  state.counters["per_term"] =
+      benchmark::Counter(double(terms), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.SetLabel(std::string(state.range(1) == 0 ? "geometric" : "RCS") +
+                 (state.range(0) == 0 ? ", analytic" : ", autodiff"));
+}
+BENCHMARK(BM_BuildSystem)->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
 // ---------------------------------------------------------------------------
 // Joint refinement of n scans of the drive (poses perturbed by 0.15 m / 0.5 deg).

@@ -66,8 +66,8 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
             new ceres::ScaledLoss(MakeLoss(options_.rcs_loss), weight, ceres::TAKE_OWNERSHIP);
         if (rotation_only) {
           ceres::CostFunction* cost =
-              analytic ? static_cast<ceres::CostFunction*>(new RcsRotationCostFunction(term, c.translation))
-                       : RcsRotationResidual::Create(term, c.translation);
+              analytic ? static_cast<ceres::CostFunction*>(new RcsRotationCostFunction(term, c.pose.translation()))
+                       : RcsRotationResidual::Create(term, c.pose.translation());
           problem.AddResidualBlock(cost, loss, rotation.data());
         } else {
           ceres::CostFunction* cost = analytic ? static_cast<ceres::CostFunction*>(new RcsCostFunction(term))

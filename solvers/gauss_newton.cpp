@@ -30,12 +30,16 @@ void SeedJets(const SE3d& pose, const Eigen::Vector3d& translation, Jet7 rotatio
   for (int i = 0; i < 3; ++i) t[i] = Jet7(translation[i], 4 + i);
 }
 
-void Accumulate(LinearSystem& system, const Eigen::Ref<const Eigen::MatrixXd>& J,
-                const Eigen::Ref<const Eigen::VectorXd>& r, const RobustLoss& loss) {
+// Fixed sizes throughout: this is the inner loop of every iteration.
+template <int Rows>
+void Accumulate(LinearSystem& system, const Eigen::Matrix<double, Rows, 6>& J,
+                const Eigen::Matrix<double, Rows, 1>& r, const RobustLoss& loss) {
   double rho = 0.0, weight = 0.0;
   loss.Evaluate(r.squaredNorm(), rho, weight);
-  system.H.noalias() += weight * J.transpose() * J;
-  system.g.noalias() += weight * J.transpose() * r;
+  const Eigen::Matrix<double, Rows, 6> weighted_J = weight * J;
+  system.H.noalias() += weighted_J.transpose() * J;
+  system.g.noalias() += weighted_J.transpose() * r;
+  system.rho_sum += rho;
   ++system.residuals;
 }
 
@@ -52,30 +56,59 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
   LinearSystem system;
   const RobustLoss loss(options.geometric_loss);
   const Eigen::Matrix3d R = pose.rotation().Matrix();
+  if (options.jacobians == JacobianMode::kAnalytic) {
+    // r = L^T e, e = q + t - mu with q = R p; dr/ddt = L^T and
+    // dr/ddphi = -L^T R [p]x = -L^T [q]x R. R is common to all terms, so the
+    // sums are taken without it and applied once: with Sigma^-1 = L L^T,
+    // H_tt = sum w Sigma^-1, H_tr = (sum -w Sigma^-1 [q]x) R,
+    // H_rr = R^T (sum w [q]x^T Sigma^-1 [q]x) R, g_t = sum w Sigma^-1 e,
+    // g_r = R^T (sum w [q]x Sigma^-1 e).
+    Eigen::Matrix3d A_tt = Eigen::Matrix3d::Zero(), A_tr = Eigen::Matrix3d::Zero(),
+                    A_rr = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b_t = Eigen::Vector3d::Zero(), b_r = Eigen::Vector3d::Zero();
+    double rho = 0.0, weight = 0.0;
+    for (const GeometricTerm& term : c.geometric) {
+      const Eigen::Matrix3d& information = c.index->Information(term.gaussian);
+      const Eigen::Vector3d q = R * term.point_radar;
+      const Eigen::Vector3d e = q + pose.translation() - c.index->Mean(term.gaussian);
+      const Eigen::Vector3d information_e = information * e;
+      loss.Evaluate(e.dot(information_e), rho, weight);
+      system.rho_sum += rho;
+      const Eigen::Matrix3d q_hat = SO3d::Hat(q);
+      const Eigen::Matrix3d information_q_hat = information * q_hat;
+      A_tt.noalias() += weight * information;
+      A_tr.noalias() -= weight * information_q_hat;
+      A_rr.noalias() -= weight * q_hat * information_q_hat;  // [q]x^T = -[q]x
+      b_t.noalias() += weight * information_e;
+      b_r.noalias() += weight * q.cross(information_e);
+    }
+    system.H.block<3, 3>(kTranslationOffset, kTranslationOffset) = A_tt;
+    system.H.block<3, 3>(kTranslationOffset, kRotationOffset) = A_tr * R;
+    system.H.block<3, 3>(kRotationOffset, kTranslationOffset) = (A_tr * R).transpose();
+    system.H.block<3, 3>(kRotationOffset, kRotationOffset) = R.transpose() * A_rr * R;
+    system.g.segment<3>(kTranslationOffset) = b_t;
+    system.g.segment<3>(kRotationOffset) = R.transpose() * b_r;
+    system.residuals = c.geometric.size();
+    return system;
+  }
+  // Autodiff: the Ceres functor evaluated with Jets, per term.
   const Eigen::Matrix<double, 4, 3> P = QuaternionTangent(pose.rotation());
   for (const GeometricTerm& term : c.geometric) {
     const Eigen::Matrix3d& LT = c.index->SqrtInformationT(term.gaussian);
     const Eigen::Vector3d& mean = c.index->Mean(term.gaussian);
+    Jet7 rotation[4], t[3], residual[3];
+    SeedJets(pose, pose.translation(), rotation, t);
+    const GeometricResidual functor(term.point_radar, mean, LT);
+    functor(rotation, t, residual);
     Eigen::Vector3d r;
-    Matrix3x6 J;
-    if (options.jacobians == JacobianMode::kAnalytic) {
-      // r = L^T (R p + t - mu); dr/ddt = L^T, dr/ddphi = -L^T R [p]x.
-      r = LT * (R * term.point_radar + pose.translation() - mean);
-      J.block<3, 3>(0, kTranslationOffset) = LT;
-      J.block<3, 3>(0, kRotationOffset) = -LT * R * SO3d::Hat(term.point_radar);
-    } else {
-      Jet7 rotation[4], t[3], residual[3];
-      SeedJets(pose, pose.translation(), rotation, t);
-      const GeometricResidual functor(term.point_radar, mean, LT);
-      functor(rotation, t, residual);
-      Eigen::Matrix<double, 3, 7> ambient;
-      for (int i = 0; i < 3; ++i) {
-        r[i] = residual[i].a;
-        ambient.row(i) = residual[i].v.transpose();
-      }
-      J.block<3, 3>(0, kTranslationOffset) = ambient.rightCols<3>();
-      J.block<3, 3>(0, kRotationOffset) = ambient.leftCols<4>() * P;
+    Eigen::Matrix<double, 3, 7> ambient;
+    for (int i = 0; i < 3; ++i) {
+      r[i] = residual[i].a;
+      ambient.row(i) = residual[i].v.transpose();
     }
+    Matrix3x6 J;
+    J.block<3, 3>(0, kTranslationOffset) = ambient.rightCols<3>();
+    J.block<3, 3>(0, kRotationOffset) = ambient.leftCols<4>() * P;
     Accumulate(system, J, r, loss);
   }
   return system;
@@ -87,7 +120,7 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
   const RobustLoss loss(options.rcs_loss);
   // Rotation-only: the translation is the association's constant.
   const Eigen::Vector3d translation =
-      options.rcs_translation == RcsTranslation::kRotationOnly ? c.translation : pose.translation();
+      options.rcs_translation == RcsTranslation::kRotationOnly ? c.pose.translation() : pose.translation();
   const Eigen::Matrix3d Rt = pose.rotation().Matrix().transpose();
   const Eigen::Matrix<double, 4, 3> P = QuaternionTangent(pose.rotation());
   for (const RcsTerm& term : c.rcs) {
@@ -137,15 +170,20 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
     // Eq. 2: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs (likewise g).
     Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    double cost = 0.0;  // eq. 2 at the current pose, as EvaluateCost
     if (w < 1.0) {
       const LinearSystem geometric = BuildGeometricSystem(c, result.pose, level.options);
-      H += (1.0 - w) / double(geometric.residuals) * geometric.H;
-      g += (1.0 - w) / double(geometric.residuals) * geometric.g;
+      const double weight = (1.0 - w) / double(geometric.residuals);
+      H += weight * geometric.H;
+      g += weight * geometric.g;
+      cost += weight * geometric.rho_sum;
     }
     if (w > 0.0) {
       const LinearSystem rcs = BuildRcsSystem(c, result.pose, level.options);
-      H += w / double(rcs.residuals) * rcs.H;
-      g += w / double(rcs.residuals) * rcs.g;
+      const double weight = w / double(rcs.residuals);
+      H += weight * rcs.H;
+      g += weight * rcs.g;
+      cost += weight * rcs.rho_sum;
     }
     const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
     const Eigen::Matrix<double, 6, 1> pivots = ldlt.vectorD();
@@ -160,7 +198,6 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
     }
     // Backtracking on the exact map: halve the step while eq. 2 grows for
     // this association (coarse levels only steer into the basin).
-    const double cost = level.finest ? EvaluateCost(c, result.pose, level.options) : 0.0;
     double scale = 1.0;
     SE3d next = Step(result.pose, dx);
     for (int halving = 0; level.finest && halving < options_.max_step_halvings &&

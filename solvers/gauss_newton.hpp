@@ -1,5 +1,6 @@
 // The own Gauss-Newton scan matcher (DESIGN.md section 5): per outer
-// iteration, re-associate, accumulate H and g per residual with IRLS weights
+// iteration, re-associate (lazily on the exact map: RunCoarseToFine),
+// accumulate H and g per residual with IRLS weights
 // rho'(s) from the losses, combine with eq. 2's weights, solve the 6x6 system
 // H dx = -g by LDLT, update t += dt, R = R Exp(dphi); stop on a small update
 // or at the iteration limit. On the exact map the step is halved (at most
@@ -24,6 +25,7 @@ struct LinearSystem {
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
   std::size_t residuals = 0;
+  double rho_sum = 0.0;  // sum of rho(s) over the residuals: the term's cost before eq. 2's weight
 };
 
 // The geometric and RCS systems at `pose` for fixed correspondences (public

@@ -145,7 +145,7 @@ JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
         for (const RcsTerm& term : c.rcs) {
           const std::uint32_t g = term.gaussian;
           auto* cost = new ceres::DynamicAutoDiffCostFunction<RcsCoefficientResidual, 4>(
-              new RcsCoefficientResidual(term, c.translation, full));
+              new RcsCoefficientResidual(term, c.pose.translation(), full));
           cost->AddParameterBlock(4);
           cost->AddParameterBlock(int(coefficients[g].size()));
           std::vector<double*> blocks = {rotations[k].data(), coefficients[g].data()};

@@ -17,6 +17,8 @@ void ValidateOptions(const ScanMatchingOptions& o) {
   require(o.max_iterations >= 1 && o.coarse_iterations >= 1, "iteration limits must be >= 1");
   require(o.max_step_halvings >= 0, "max step halvings must be >= 0");
   require(o.translation_tolerance > 0.0 && o.rotation_tolerance > 0.0, "tolerances must be > 0");
+  require(o.reassociation_translation >= 0.0 && o.reassociation_rotation >= 0.0,
+          "re-association thresholds must be >= 0");
 }
 
 MatchingMap::MatchingMap(const GaussianMap& map, const std::vector<double>& inflation,
@@ -35,7 +37,8 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
                                     const SE3d& pose, double gate, bool with_rcs) {
   Correspondences out;
   out.index = &map.level(level);
-  out.translation = pose.translation();
+  out.pose = pose;
+  out.with_rcs = with_rcs;
   out.geometric.reserve(scan.points.size());
   const bool rcs = with_rcs && scan.has_rcs;
   const Eigen::Matrix3d R = pose.rotation().Matrix();
@@ -81,7 +84,7 @@ double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchi
   }
   double rcs = 0.0;
   const Eigen::Vector3d rcs_translation =
-      options.rcs_translation == RcsTranslation::kRotationOnly ? c.translation : pose.translation();
+      options.rcs_translation == RcsTranslation::kRotationOnly ? c.pose.translation() : pose.translation();
   for (const RcsTerm& term : c.rcs) {
     const double r = RcsResidualValue<double>(term, pose.rotation().data(), rcs_translation);
     rcs_loss.Evaluate(r * r, rho, weight);
@@ -119,6 +122,26 @@ bool CheckCorrespondences(const RadarScan& scan, const Correspondences& c,
   return true;
 }
 
+namespace {
+
+// At most `count` points of `scan`, evenly strided (all when count is 0).
+RadarScan Subsample(const RadarScan& scan, std::size_t count) {
+  if (count == 0 || scan.points.size() <= count) return scan;
+  RadarScan subsampled = scan;
+  subsampled.points.clear();
+  subsampled.points.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) subsampled.points.push_back(scan.points[k * scan.points.size() / count]);
+  return subsampled;
+}
+
+// Whether the pose has moved far enough from `associated_at` to associate again.
+bool MovedSince(const SE3d& associated_at, const SE3d& pose, const ScanMatchingOptions& options) {
+  return (pose.translation() - associated_at.translation()).norm() > options.reassociation_translation ||
+         (associated_at.rotation().Inverse() * pose.rotation()).Log().norm() > options.reassociation_rotation;
+}
+
+}  // namespace
+
 ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
                                    const ScanMatchingOptions& options, const SolverStep& step) {
   const auto start = std::chrono::steady_clock::now();
@@ -127,6 +150,7 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
   const double w = options.w_rcs;
   Correspondences c;
   bool failed = false;
+  const RadarScan coarse_scan = w < 1.0 && map.levels() > 1 ? Subsample(scan, options.coarse_points) : RadarScan();
   for (std::size_t level = w < 1.0 ? 0 : map.levels() - 1; level < map.levels() && !failed; ++level) {
     const bool finest = level + 1 == map.levels();
     ScanMatchingOptions level_options = options;
@@ -134,12 +158,13 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     const int max_iterations = finest ? options.max_iterations : options.coarse_iterations;
     const bool with_rcs = level_options.w_rcs > 0.0;
     result.converged = false;
-    c = FindCorrespondences(scan, map, level, result.pose, options.gate, with_rcs);
+    const RadarScan& level_scan = finest ? scan : coarse_scan;
+    c = FindCorrespondences(level_scan, map, level, result.pose, options.gate, with_rcs);
     for (int iteration = 1; iteration <= max_iterations; ++iteration) {
-      if (options.reassociate && iteration > 1) {
-        c = FindCorrespondences(scan, map, level, result.pose, options.gate, with_rcs);
+      if (options.reassociate && iteration > 1 && (!finest || MovedSince(c.pose, result.pose, options))) {
+        c = FindCorrespondences(level_scan, map, level, result.pose, options.gate, with_rcs);
       }
-      if (!CheckCorrespondences(scan, c, level_options, result.reason)) {
+      if (!CheckCorrespondences(level_scan, c, level_options, result.reason)) {
         failed = true;
         break;
       }
@@ -155,9 +180,13 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
   if (failed) result.converged = false;
   if (!result.converged && result.reason.empty()) result.reason = "iteration limit reached";
   if (result.iterations > 0) {
+    // The final association: the last one, when it was made on the exact map
+    // within the re-association thresholds of the final pose (or when not
+    // re-associating); otherwise a new one at the final pose.
+    const bool last_is_final = !options.reassociate || (c.index == &map.index() && c.with_rcs == (w > 0.0) &&
+                                                        !MovedSince(c.pose, result.pose, options));
     const Correspondences final_c =
-        options.reassociate ? FindCorrespondences(scan, map, map.levels() - 1, result.pose, options.gate, w > 0.0)
-                            : c;
+        last_is_final ? c : FindCorrespondences(scan, map, map.levels() - 1, result.pose, options.gate, w > 0.0);
     result.n_geo = final_c.geometric.size();
     result.n_rcs = final_c.rcs.size();
     result.final_cost = EvaluateCost(final_c, result.pose, options);

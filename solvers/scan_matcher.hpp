@@ -35,8 +35,16 @@ struct ScanMatchingOptions {
   double gate = 3.0;          // tau: association gate (Mahalanobis distance)
   int max_iterations = 30;    // outer iterations (association + update) on the exact map
   int coarse_iterations = 15; // outer iterations on each coarse level of the MatchingMap
+  std::size_t coarse_points = 0;  // points (evenly strided) used on coarse levels; 0: all
   int max_step_halvings = 8;  // own GN: backtracking halvings of a step that raises the cost
   bool reassociate = true;    // false: associate once at the initial pose
+  // Lazy re-association on the exact map: associate again only once the pose
+  // has moved more than this (translation or rotation) since the last
+  // association; smaller steps refine on the current one, which ends the
+  // back-and-forth of points between overlapping Gaussians that otherwise
+  // keeps steps of a few mm going. 0 re-associates after every step.
+  double reassociation_translation = 0.01;  // m
+  double reassociation_rotation = 0.002;    // rad
   double translation_tolerance = 1e-4;  // m: stop when the update is smaller ...
   double rotation_tolerance = 1e-5;     // rad ... in both parts (100x looser on coarse levels)
 };
@@ -66,7 +74,7 @@ struct ScanMatchingResult {
 class MatchingMap {
  public:
   explicit MatchingMap(const GaussianMap& map, const std::vector<double>& inflation = {1.0, 0.5, 0.25},
-                       double index_cell = 1.0);
+                       double index_cell = 0.5);
   const GaussianMap& map() const { return map_; }
   std::size_t levels() const { return levels_.size(); }
   const GaussianIndex& level(std::size_t k) const { return levels_[k]; }
@@ -86,7 +94,8 @@ struct Correspondences {
   const GaussianIndex* index = nullptr;  // the level they were made with
   std::vector<GeometricTerm> geometric;
   std::vector<RcsTerm> rcs;
-  Eigen::Vector3d translation = Eigen::Vector3d::Zero();  // of the pose they were made at
+  SE3d pose;              // the pose they were made at
+  bool with_rcs = false;  // whether RCS terms were asked for
 };
 
 // Associates every point at `pose` with the Gaussians of `level`
@@ -106,10 +115,13 @@ bool CheckCorrespondences(const RadarScan& scan, const Correspondences& correspo
                           const ScanMatchingOptions& options, std::string& reason);
 
 // The outer loop every single-scan solver shares (kiss-icp style): map level
-// by map level, coarse to fine (coarse levels with the geometric term only,
-// w = 1 without them), associate (again each iteration when reassociating),
-// check the correspondences, and let `step` update result.pose. At the end:
-// the final association, N_geo, N_rcs, the cost of eq. 2 and the time.
+// by map level, coarse to fine (coarse levels with the geometric term only
+// and at most coarse_points points, w = 1 without them), associate (again
+// each iteration on coarse levels; on the exact map once the pose has moved
+// past the re-association thresholds), check the correspondences, and let
+// `step` update result.pose. At the end: the final association (the last
+// one when it is within the thresholds of the final pose), N_geo, N_rcs,
+// the cost of eq. 2 and the time.
 struct LevelStep {
   const Correspondences& correspondences;
   const ScanMatchingOptions& options;  // with this level's w_rcs

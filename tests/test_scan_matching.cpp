@@ -274,6 +274,11 @@ TEST(GaussNewton, AnalyticAndAutodiffSystemsAgree) {
     const LinearSystem rd = BuildRcsSystem(c, pose, autodiff);
     EXPECT_LT(Relative(ra.H, rd.H), 1e-8);
     EXPECT_LT(Relative(ra.g, rd.g), 1e-8);
+    // The summed losses the systems carry give eq. 2 as EvaluateCost does.
+    EXPECT_NEAR(ga.rho_sum, gd.rho_sum, 1e-9 * ga.rho_sum);
+    EXPECT_NEAR(ra.rho_sum, rd.rho_sum, 1e-9 * ra.rho_sum);
+    const double f = 0.75 / double(ga.residuals) * ga.rho_sum + 0.25 / double(ra.residuals) * ra.rho_sum;
+    EXPECT_NEAR(f, EvaluateCost(c, pose, analytic), 1e-12 * f);
   }
 }
 
@@ -386,6 +391,55 @@ TEST(ScanMatchingOptionsTest, Validation) {
   hypotheses.starts = 14;
   EXPECT_THROW(HypothesisOffsets(hypotheses), std::invalid_argument);
   EXPECT_THROW(MakeScanMatcher("lm", ScanMatchingOptions{}), std::invalid_argument);
+  ScanMatchingOptions lazy;
+  lazy.reassociation_translation = -0.01;
+  EXPECT_THROW(GaussNewtonSolver{lazy}, std::invalid_argument);
+}
+
+// Lazy re-association on the exact map: the solver keeps the association
+// while the pose stays within the thresholds of where it was made. With the
+// thresholds at 0 it re-associates after every step (the textbook loop);
+// both end at the same optimum to well within the association's own
+// resolution, the lazy one with fewer associations (fewer iterations here,
+// as small steps no longer make points swap Gaussians back and forth).
+TEST(LazyReassociation, SameOptimumFewerIterations) {
+  const World& world = SimulatedWorld();
+  const MatchingMap exact(world.map, {});
+  double eager_iterations = 0.0, lazy_iterations = 0.0;
+  for (const int scan : {20, 40, 60}) {
+    const SE3d truth = world.simulated.ground_truth[scan].pose;
+    const SE3d initial = Perturbed(truth, 0.05, 0.2, std::uint32_t(scan));
+    ScanMatchingOptions eager;
+    eager.reassociation_translation = eager.reassociation_rotation = 0.0;
+    const ScanMatchingOptions lazy;
+    const ScanMatchingResult a = GaussNewtonSolver(eager).Match(world.simulated.scans[scan], exact, initial);
+    const ScanMatchingResult b = GaussNewtonSolver(lazy).Match(world.simulated.scans[scan], exact, initial);
+    double dt = 0.0, dr = 0.0;
+    PoseError(a.pose, b.pose, dt, dr);
+    EXPECT_LT(dt, 0.02) << "scan " << scan;
+    EXPECT_LT(dr, 0.1) << "scan " << scan;
+    EXPECT_TRUE(b.converged) << b.reason;
+    eager_iterations += a.iterations;
+    lazy_iterations += b.iterations;
+  }
+  std::printf("iterations over 3 scans: eager %.0f, lazy %.0f\n", eager_iterations, lazy_iterations);
+  EXPECT_LT(lazy_iterations, eager_iterations);
+}
+
+// coarse_points subsamples the coarse levels only: a limit above the scan
+// size changes nothing, a small one changes the path.
+TEST(CoarsePoints, SubsamplesCoarseLevelsOnly) {
+  const World& world = SimulatedWorld();
+  const RadarScan& scan = world.simulated.scans[kTestScan];
+  const SE3d initial = Perturbed(world.simulated.ground_truth[kTestScan].pose, 2.0, 5.0, 1);
+  ScanMatchingOptions all, above, few;
+  above.coarse_points = scan.points.size() + 1;
+  few.coarse_points = 20;
+  const SE3d a = GaussNewtonSolver(all).Match(scan, *world.matching, initial).pose;
+  const SE3d b = GaussNewtonSolver(above).Match(scan, *world.matching, initial).pose;
+  const SE3d c = GaussNewtonSolver(few).Match(scan, *world.matching, initial).pose;
+  EXPECT_EQ(a.translation(), b.translation());
+  EXPECT_NE(a.translation(), c.translation());
 }
 
 }  // namespace

@@ -90,6 +90,13 @@ class GaussianIndex {
   std::vector<Eigen::Vector3d> means_;
   std::vector<Eigen::Matrix3d> information_;
   std::vector<Eigen::Matrix3d> sqrt_information_t_;
+  // Mean and upper-triangular information (xx xy xz yy yz zz) side by side:
+  // what Associate reads per candidate, in one place.
+  struct PackedGaussian {
+    double mean[3];
+    double information[6];
+  };
+  std::vector<PackedGaussian> packed_;
   std::vector<std::uint32_t> cell_entries_;  // Gaussian ids grouped by cell
   std::unordered_map<std::int64_t, std::pair<std::uint32_t, std::uint32_t>> cells_;  // key -> [begin, end)
 };
