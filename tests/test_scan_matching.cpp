@@ -9,6 +9,7 @@
 #include "radargauss/map/builder.hpp"
 #include "radargauss/map/map_cloud.hpp"
 #include "radargauss/map/rcs_model.hpp"
+#include "radargauss/sh.hpp"
 #include "radargauss/simulator.hpp"
 #include "residuals/geometric_residual.hpp"
 #include "residuals/loss.hpp"
@@ -322,11 +323,12 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
   }
 }
 
-// w = 1 with rotation-only RCS: the translation does not move. Whether the
-// RCS term alone reduces a pure rotation error is measured and printed, not
-// asserted: on the simulated world it does not (a 1 deg error ends at 1.2 to
-// 2.8 deg with either incidence model; RCS is a weak rotation signal next to
-// its 1 dB noise), which is reported in the closing note of issue 5.
+// w = 1 with rotation-only RCS: the translation does not move. On the
+// simulated world's fitted models the RCS term alone does not reduce a pure
+// rotation error (1 deg ends at 1.2 to 2.8 deg with either incidence model:
+// the fits' RMSE, 0.35 to 0.45 normalised, swamps the signal); that is
+// measured and printed here, and the planted-model test below shows the
+// reduction where the models are right.
 TEST(RotationOnlyRcs, TranslationFixedAtWeightOne) {
   const World& world = SimulatedWorld();
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
@@ -350,6 +352,88 @@ TEST(RotationOnlyRcs, TranslationFixedAtWeightOne) {
                   ToString(map->incidence).c_str(), dr);
       EXPECT_TRUE(std::isfinite(dr));
       EXPECT_LT(dr, 10.0) << name;  // bounded, even where it does not help
+    }
+  }
+}
+
+// A pure rotation error reduced by the RCS term alone, on planted
+// parameters: Gaussians 6 to 12 m around the radar whose RCS models are
+// planted degree-2 SH patterns, and a scan whose RCS values are those
+// patterns evaluated at the true pose with the incidence law of DESIGN.md
+// section 4, written out here independently of the residual code. With
+// w = 1 and rotation-only the geometric term has no weight, so whatever
+// corrects the rotation is the RCS term.
+struct PlantedRcsWorld {
+  GaussianMap map;
+  RadarScan scan;
+  SE3d truth;
+};
+
+PlantedRcsWorld MakePlantedRcsWorld(IncidenceModel incidence, double rcs_noise) {
+  PlantedRcsWorld world;
+  world.map.incidence = incidence;
+  world.truth = SE3d(SO3d::Exp(Eigen::Vector3d(0.05, -0.03, 0.4)), Eigen::Vector3d(3.0, -1.0, 0.5));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coefficient(-0.35, 0.35), offset(-0.12, 0.12);
+  std::normal_distribution<double> noise(0.0, rcs_noise);
+  world.scan.has_rcs = true;
+  for (int azimuth = -60; azimuth <= 60; azimuth += 10) {
+    for (const int elevation : {-8, 0, 8}) {
+      const double range = 6.0 + 3.0 * ((azimuth / 10 + elevation / 8 + 9) % 3);
+      const double a = azimuth * M_PI / 180.0, e = elevation * M_PI / 180.0;
+      const Eigen::Vector3d mean_radar = range * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+      Gaussian g;
+      g.mean = world.truth * mean_radar;
+      g.covariance = 0.15 * 0.15 * Eigen::Matrix3d::Identity();
+      g.rcs.degree = 2;
+      g.rcs.median = 0.0;
+      g.rcs.scale = 1.0;
+      for (int i = 1; i < ShCoefficientCount(2); ++i) g.rcs.coefficients[i] = coefficient(rng);
+      for (int k = 0; k < 12; ++k) {
+        RadarPoint point;
+        point.position = world.truth.Inverse() * (g.mean + Eigen::Vector3d(offset(rng), offset(rng), offset(rng)));
+        // u in the radar frame at the true pose; d faces the radar (d.x <= 0).
+        const Eigen::Vector3d u = incidence == IncidenceModel::kOffset ? Eigen::Vector3d(point.position - mean_radar)
+                                                                       : Eigen::Vector3d(-mean_radar);
+        Eigen::Vector3d d = u.normalized();
+        if (d.x() > 0.0) d = -d;
+        const Eigen::Matrix<double, 9, 1> basis = ShBasis<2, double>(d);
+        point.rcs = basis.dot(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(g.rcs.coefficients.data())) + noise(rng);
+        world.scan.points.push_back(point);
+      }
+      world.map.gaussians.push_back(g);
+    }
+  }
+  return world;
+}
+
+TEST(RotationOnlyRcs, RcsAloneReducesAPureRotationErrorOnPlantedModels) {
+  // Exact patterns: both incidence models recover the truth. With RCS noise
+  // of 0.1 (normalised units, a twentieth of the range) the paper's offset
+  // incidence still does, to < 0.1 deg: mu_r moves by range x angle against
+  // the fixed p_r, so d turns much faster than the pose. The view incidence
+  // turns d only by the pose's own angle; its signal over 1 deg is ~100x
+  // below that noise, and it ends at 1.2 deg there (measured, not asserted).
+  for (const auto& [incidence, rcs_noise] : std::vector<std::pair<IncidenceModel, double>>{
+           {IncidenceModel::kView, 0.0}, {IncidenceModel::kOffset, 0.0}, {IncidenceModel::kOffset, 0.1}}) {
+    const PlantedRcsWorld world = MakePlantedRcsWorld(incidence, rcs_noise);
+    const MatchingMap single(world.map, {});
+    ScanMatchingOptions options;
+    options.w_rcs = 1.0;
+    options.max_iterations = 50;
+    for (const std::string name : {"gn", "gn-autodiff", "ceres"}) {
+      const auto solver = MakeSolver(name, options);
+      for (const Eigen::Vector3d axis : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, 2, -2).normalized()}) {
+        const SE3d rotated(world.truth.rotation() * SO3d::Exp(M_PI / 180.0 * axis), world.truth.translation());
+        const ScanMatchingResult result = solver->Match(world.scan, single, rotated);
+        double dt = 0.0, dr = 0.0;
+        PoseError(result.pose, world.truth, dt, dr);
+        std::printf("%s, %s incidence, planted RCS, noise %.1f, w = 1: rotation error 1.000 -> %.4f deg (N_rcs %zu)\n",
+                    name.c_str(), ToString(incidence).c_str(), rcs_noise, dr, result.n_rcs);
+        EXPECT_EQ(dt, 0.0) << name;
+        EXPECT_GT(result.n_rcs, world.scan.points.size() / 2) << name;
+        EXPECT_LT(dr, rcs_noise == 0.0 ? 1e-6 : 0.1) << name << ", " << ToString(incidence) << " incidence";
+      }
     }
   }
 }
