@@ -6,6 +6,7 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <type_traits>
@@ -131,6 +132,13 @@ std::vector<SE3d> InitialPoses(const SimulatedSequence& sequence) {
   return initial;
 }
 
+// The median of the per-scan times the solvers report (the goal is a median).
+double MedianMs(std::vector<double> times) {
+  if (times.empty()) return 0.0;
+  std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
+  return times[times.size() / 2];
+}
+
 std::unique_ptr<ScanMatcher> Solver(int kind, const ScanMatchingOptions& options) {
   static const char* names[] = {"gn", "gn-autodiff", "ceres", "mh-gn"};
   return MakeScanMatcher(names[kind], options);
@@ -147,8 +155,10 @@ void BM_MatchScan(benchmark::State& state) {
   const auto solver = Solver(int(state.range(1)), options);
   std::size_t k = 0, points = 0, converged = 0, runs = 0, iterations = 0, within = 0;
   double translation_error = 0.0, rotation_error = 0.0;
+  std::vector<double> times;
   for (auto _ : state) {
     const ScanMatchingResult result = solver->Match(scans.scans[k], *world.matching, initial[k]);
+    times.push_back(result.time_ms);
     points += scans.scans[k].points.size();
     converged += result.converged;
     const double t_err = (result.pose.translation() - scans.ground_truth[k].pose.translation()).norm();
@@ -164,6 +174,7 @@ void BM_MatchScan(benchmark::State& state) {
   state.counters["points"] = double(points) / double(runs);
   state.counters["iterations"] = double(iterations) / double(runs);
   state.counters["within_10cm_0.5deg"] = double(within) / double(runs);
+  state.counters["median_ms"] = MedianMs(times);
   state.counters["converged"] = double(converged) / double(runs);
   state.counters["t_err_m"] = translation_error / double(runs);
   state.counters["r_err_deg"] = rotation_error / double(runs) * 180.0 / M_PI;
@@ -190,8 +201,10 @@ void BM_RefineScan(benchmark::State& state) {
   const auto solver = Solver(int(state.range(0)), options);
   std::size_t k = 0, iterations = 0, runs = 0;
   double translation_error = 0.0, rotation_error = 0.0;
+  std::vector<double> times;
   for (auto _ : state) {
     const ScanMatchingResult result = solver->Match(scans.scans[k], exact, initial[k]);
+    times.push_back(result.time_ms);
     iterations += result.iterations;
     translation_error += (result.pose.translation() - scans.ground_truth[k].pose.translation()).norm();
     rotation_error += (scans.ground_truth[k].pose.rotation().Inverse() * result.pose.rotation()).Log().norm();
@@ -202,6 +215,7 @@ void BM_RefineScan(benchmark::State& state) {
   state.counters["iterations"] = double(iterations) / double(runs);
   state.counters["t_err_m"] = translation_error / double(runs);
   state.counters["r_err_deg"] = rotation_error / double(runs) * 180.0 / M_PI;
+  state.counters["median_ms"] = MedianMs(times);
 }
 BENCHMARK(BM_RefineScan)->ArgsProduct({{0, 1, 2}, {0, 25}})->Unit(benchmark::kMillisecond);
 

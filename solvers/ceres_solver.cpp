@@ -4,6 +4,8 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include <memory>
+
 
 #include "radargauss/lie/manifold.hpp"
 #include "residuals/geometric_residual.hpp"
@@ -35,35 +37,38 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
   solver_options.max_num_iterations = ceres_options_.max_inner_iterations;
   solver_options.num_threads = ceres_options_.threads;
   solver_options.logging_type = ceres::SILENT;
-  solver_options.function_tolerance = 1e-12;
-  solver_options.gradient_tolerance = 1e-12;
-  solver_options.parameter_tolerance = 1e-10;
+  solver_options.function_tolerance = ceres_options_.function_tolerance;
+  solver_options.gradient_tolerance = ceres_options_.gradient_tolerance;
+  solver_options.parameter_tolerance = ceres_options_.parameter_tolerance;
 
   return RunCoarseToFine(scan, map, initial, options_, [&](const LevelStep& level, ScanMatchingResult& result) {
     const Correspondences& c = level.correspondences;
     const double w = level.options.w_rcs;
     ceres::Problem::Options problem_options;
     problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    problem_options.disable_all_safety_checks = true;  // blocks are built here, not by users
+    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // one loss per term, shared
+    std::unique_ptr<ceres::LossFunction> geometric_loss, rcs_loss;
     ceres::Problem problem(problem_options);
     problem.AddParameterBlock(rotation.data(), 4, &so3);
     if (w < 1.0) {
-      const double weight = (1.0 - w) / double(c.geometric.size());
+      geometric_loss = std::make_unique<ceres::ScaledLoss>(MakeLoss(options_.geometric_loss),
+                                                           (1.0 - w) / double(c.geometric.size()),
+                                                           ceres::TAKE_OWNERSHIP);
       for (const GeometricTerm& term : c.geometric) {
         const Eigen::Vector3d& mean = c.index->Mean(term.gaussian);
         const Eigen::Matrix3d& LT = c.index->SqrtInformationT(term.gaussian);
         ceres::CostFunction* cost = analytic ? static_cast<ceres::CostFunction*>(
                                                    new GeometricCostFunction(term.point_radar, mean, LT))
                                              : GeometricResidual::Create(term.point_radar, mean, LT);
-        problem.AddResidualBlock(cost, new ceres::ScaledLoss(MakeLoss(options_.geometric_loss), weight,
-                                                             ceres::TAKE_OWNERSHIP),
-                                 rotation.data(), translation.data());
+        problem.AddResidualBlock(cost, geometric_loss.get(), rotation.data(), translation.data());
       }
     }
     if (w > 0.0) {
-      const double weight = w / double(c.rcs.size());
+      rcs_loss = std::make_unique<ceres::ScaledLoss>(MakeLoss(options_.rcs_loss), w / double(c.rcs.size()),
+                                                     ceres::TAKE_OWNERSHIP);
+      ceres::LossFunction* loss = rcs_loss.get();
       for (const RcsTerm& term : c.rcs) {
-        ceres::LossFunction* loss =
-            new ceres::ScaledLoss(MakeLoss(options_.rcs_loss), weight, ceres::TAKE_OWNERSHIP);
         if (rotation_only) {
           ceres::CostFunction* cost =
               analytic ? static_cast<ceres::CostFunction*>(new RcsRotationCostFunction(term, c.pose.translation()))

@@ -14,6 +14,11 @@ struct CeresSolverOptions {
   bool dogleg = false;           // Levenberg-Marquardt (default) or dogleg
   int max_inner_iterations = 10; // Ceres iterations per association
   int threads = 1;
+  // Ceres's stopping rules per association (Ceres's defaults; the outer
+  // loop's step tolerances decide convergence of the match).
+  double function_tolerance = 1e-6;
+  double gradient_tolerance = 1e-10;
+  double parameter_tolerance = 1e-8;
 };
 
 class CeresSolver final : public ScanMatcher {

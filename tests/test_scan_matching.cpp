@@ -302,6 +302,9 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
     options.rotation_tolerance = 1e-10;
     CeresSolverOptions ceres_options;
     ceres_options.max_inner_iterations = 200;
+    ceres_options.function_tolerance = 1e-12;
+    ceres_options.gradient_tolerance = 1e-12;
+    ceres_options.parameter_tolerance = 1e-10;
     const SE3d initial = Perturbed(truth, 0.05, 0.3, 4);
     const ScanMatchingResult gn = GaussNewtonSolver(options).Match(world.simulated.scans[kTestScan], single, initial);
     const ScanMatchingResult lm =
