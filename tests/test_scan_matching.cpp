@@ -426,7 +426,7 @@ TEST(RotationOnlyRcs, RcsAloneReducesAPureRotationErrorOnPlantedModels) {
     options.max_iterations = 50;
     for (const std::string name : {"gn", "gn-autodiff", "ceres"}) {
       const auto solver = MakeSolver(name, options);
-      for (const Eigen::Vector3d axis : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, 2, -2).normalized()}) {
+      for (const Eigen::Vector3d& axis : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, 2, -2).normalized()}) {
         const SE3d rotated(world.truth.rotation() * SO3d::Exp(M_PI / 180.0 * axis), world.truth.translation());
         const ScanMatchingResult result = solver->Match(world.scan, single, rotated);
         double dt = 0.0, dr = 0.0;
