@@ -144,33 +144,29 @@ std::unique_ptr<ScanMatcher> Solver(int kind, const ScanMatchingOptions& options
   return MakeScanMatcher(names[kind], options);
 }
 
-// Args: points per scan, solver (0 gn, 1 gn-autodiff, 2 ceres, 3 mh8-gn), w_rcs x 100.
-void BM_MatchScan(benchmark::State& state) {
-  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
-  const MatchingWorld& world = World();
-  const SimulatedSequence& scans = world.scans.at(int(state.range(0)));
-  const std::vector<SE3d> initial = InitialPoses(scans);
-  ScanMatchingOptions options;
-  options.w_rcs = double(state.range(2)) / 100.0;
-  const auto solver = Solver(int(state.range(1)), options);
+// Matches the scans in turn from `initial` and reports the median time the
+// solver measured, iterations, convergence and the mean final errors.
+void MatchScans(benchmark::State& state, const ScanMatcher& solver, const MatchingMap& map,
+                const SimulatedSequence& scans, const std::vector<SE3d>& initial, double w_rcs) {
   std::size_t k = 0, points = 0, converged = 0, runs = 0, iterations = 0, within = 0;
   double translation_error = 0.0, rotation_error = 0.0;
   std::vector<double> times;
   for (auto _ : state) {
-    const ScanMatchingResult result = solver->Match(scans.scans[k], *world.matching, initial[k]);
+    const ScanMatchingResult result = solver.Match(scans.scans[k], map, initial[k]);
+    const SE3d& truth = scans.ground_truth[k].pose;
+    const double t_err = (result.pose.translation() - truth.translation()).norm();
+    const double r_err = (truth.rotation().Inverse() * result.pose.rotation()).Log().norm();
     times.push_back(result.time_ms);
     points += scans.scans[k].points.size();
     converged += result.converged;
-    const double t_err = (result.pose.translation() - scans.ground_truth[k].pose.translation()).norm();
-    translation_error += t_err;
-    const double r_err = (scans.ground_truth[k].pose.rotation().Inverse() * result.pose.rotation()).Log().norm();
-    rotation_error += r_err;
     iterations += result.iterations;
+    translation_error += t_err;
+    rotation_error += r_err;
     within += t_err < 0.1 && r_err < 0.5 * M_PI / 180.0;
     ++runs;
     k = (k + 1) % scans.scans.size();
   }
-  state.SetLabel(solver->Name() + " w=" + std::to_string(options.w_rcs).substr(0, 4));
+  state.SetLabel(solver.Name() + " w=" + std::to_string(w_rcs).substr(0, 4));
   state.counters["points"] = double(points) / double(runs);
   state.counters["iterations"] = double(iterations) / double(runs);
   state.counters["within_10cm_0.5deg"] = double(within) / double(runs);
@@ -179,13 +175,24 @@ void BM_MatchScan(benchmark::State& state) {
   state.counters["t_err_m"] = translation_error / double(runs);
   state.counters["r_err_deg"] = rotation_error / double(runs) * 180.0 / M_PI;
 }
+
+// Args: points per scan, solver (0 gn, 1 gn-autodiff, 2 ceres, 3 mh8-gn), w_rcs x 100.
+void BM_MatchScan(benchmark::State& state) {
+  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const MatchingWorld& world = World();
+  const SimulatedSequence& scans = world.scans.at(int(state.range(0)));
+  ScanMatchingOptions options;
+  options.w_rcs = double(state.range(2)) / 100.0;
+  MatchScans(state, *Solver(int(state.range(1)), options), *world.matching, scans, InitialPoses(scans),
+             options.w_rcs);
+}
 BENCHMARK(BM_MatchScan)
     ->ArgsProduct({{150, 800, 4000}, {0, 1, 2}, {0, 25}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MatchScan)->Args({800, 3, 0})->Args({800, 3, 25})->Unit(benchmark::kMillisecond);
 
-// Refinement only (the exact map, from 5 cm / 0.2 deg): the per-iteration
-// cost of tracking, where the coarse levels are not needed.
+// Refinement only (the exact map, from 5 cm / 0.2 deg): the per-scan latency
+// of tracking, where the coarse levels are not needed.
 void BM_RefineScan(benchmark::State& state) {
   const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const MatchingWorld& world = World();
@@ -198,30 +205,13 @@ void BM_RefineScan(benchmark::State& state) {
   }
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(1)) / 100.0;
-  const auto solver = Solver(int(state.range(0)), options);
-  std::size_t k = 0, iterations = 0, runs = 0;
-  double translation_error = 0.0, rotation_error = 0.0;
-  std::vector<double> times;
-  for (auto _ : state) {
-    const ScanMatchingResult result = solver->Match(scans.scans[k], exact, initial[k]);
-    times.push_back(result.time_ms);
-    iterations += result.iterations;
-    translation_error += (result.pose.translation() - scans.ground_truth[k].pose.translation()).norm();
-    rotation_error += (scans.ground_truth[k].pose.rotation().Inverse() * result.pose.rotation()).Log().norm();
-    ++runs;
-    k = (k + 1) % scans.scans.size();
-  }
-  state.SetLabel(solver->Name() + " w=" + std::to_string(options.w_rcs).substr(0, 4));
-  state.counters["iterations"] = double(iterations) / double(runs);
-  state.counters["t_err_m"] = translation_error / double(runs);
-  state.counters["r_err_deg"] = rotation_error / double(runs) * 180.0 / M_PI;
-  state.counters["median_ms"] = MedianMs(times);
+  MatchScans(state, *Solver(int(state.range(0)), options), exact, scans, initial, options.w_rcs);
 }
 BENCHMARK(BM_RefineScan)->ArgsProduct({{0, 1, 2}, {0, 25}})->Unit(benchmark::kMillisecond);
 
-// The two parts of one outer iteration on the exact map, 800 points at the
-// reference pose: association (FindCorrespondences) and the geometric normal
-// equations (BuildGeometricSystem, analytic).
+// The parts of one outer iteration on the exact map, 800 points at the
+// reference pose: association (FindCorrespondences) and the normal equations
+// (BuildGeometricSystem, BuildRcsSystem; analytic and autodiff).
 void BM_AssociateScan(benchmark::State& state) {
   const MatchingWorld& world = World();
   const SimulatedSequence& scans = world.scans.at(800);

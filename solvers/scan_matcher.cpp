@@ -38,7 +38,6 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
   Correspondences out;
   out.index = &map.level(level);
   out.pose = pose;
-  out.with_rcs = with_rcs;
   out.geometric.reserve(scan.points.size());
   const bool rcs = with_rcs && scan.has_rcs;
   const Eigen::Matrix3d R = pose.rotation().Matrix();
@@ -124,11 +123,12 @@ bool CheckCorrespondences(const RadarScan& scan, const Correspondences& c,
 
 namespace {
 
-// At most `count` points of `scan`, evenly strided (all when count is 0).
+// `count` points of `scan`, evenly strided (count < scan size).
 RadarScan Subsample(const RadarScan& scan, std::size_t count) {
-  if (count == 0 || scan.points.size() <= count) return scan;
-  RadarScan subsampled = scan;
-  subsampled.points.clear();
+  RadarScan subsampled;
+  subsampled.timestamp = scan.timestamp;
+  subsampled.has_doppler = scan.has_doppler;
+  subsampled.has_rcs = scan.has_rcs;
   subsampled.points.reserve(count);
   for (std::size_t k = 0; k < count; ++k) subsampled.points.push_back(scan.points[k * scan.points.size() / count]);
   return subsampled;
@@ -150,7 +150,10 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
   const double w = options.w_rcs;
   Correspondences c;
   bool failed = false;
-  const RadarScan coarse_scan = w < 1.0 && map.levels() > 1 ? Subsample(scan, options.coarse_points) : RadarScan();
+  const bool subsample = w < 1.0 && map.levels() > 1 && options.coarse_points > 0 &&
+                         scan.points.size() > options.coarse_points;
+  const RadarScan subsampled = subsample ? Subsample(scan, options.coarse_points) : RadarScan();
+  const RadarScan& coarse_scan = subsample ? subsampled : scan;
   for (std::size_t level = w < 1.0 ? 0 : map.levels() - 1; level < map.levels() && !failed; ++level) {
     const bool finest = level + 1 == map.levels();
     ScanMatchingOptions level_options = options;
@@ -183,8 +186,8 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     // The final association: the last one, when it was made on the exact map
     // within the re-association thresholds of the final pose (or when not
     // re-associating); otherwise a new one at the final pose.
-    const bool last_is_final = !options.reassociate || (c.index == &map.index() && c.with_rcs == (w > 0.0) &&
-                                                        !MovedSince(c.pose, result.pose, options));
+    const bool last_is_final =
+        !options.reassociate || (c.index == &map.index() && !MovedSince(c.pose, result.pose, options));
     const Correspondences final_c =
         last_is_final ? c : FindCorrespondences(scan, map, map.levels() - 1, result.pose, options.gate, w > 0.0);
     result.n_geo = final_c.geometric.size();

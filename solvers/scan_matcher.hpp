@@ -94,8 +94,7 @@ struct Correspondences {
   const GaussianIndex* index = nullptr;  // the level they were made with
   std::vector<GeometricTerm> geometric;
   std::vector<RcsTerm> rcs;
-  SE3d pose;              // the pose they were made at
-  bool with_rcs = false;  // whether RCS terms were asked for
+  SE3d pose;  // the pose they were made at
 };
 
 // Associates every point at `pose` with the Gaussians of `level`

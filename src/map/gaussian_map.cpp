@@ -61,19 +61,14 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
     : cell_size_(cell_size) {
   if (!(cell_size > 0.0)) throw std::invalid_argument("index cell size must be > 0");
   const std::size_t n = gaussians.size();
-  means_.resize(n);
-  information_.resize(n);
-  sqrt_information_t_.resize(n);
-  packed_.resize(n);
+  gaussians_.resize(n);
   std::vector<std::pair<std::int64_t, std::uint32_t>> entries;
   for (std::size_t i = 0; i < n; ++i) {
     const Gaussian& g = gaussians[i];
-    means_[i] = g.mean;
-    information_[i] = g.covariance.inverse();
-    const Eigen::Matrix3d& I = information_[i];
-    packed_[i] = {{g.mean.x(), g.mean.y(), g.mean.z()}, {I(0, 0), I(0, 1), I(0, 2), I(1, 1), I(1, 2), I(2, 2)}};
-    const Eigen::LLT<Eigen::Matrix3d> llt(information_[i]);
-    sqrt_information_t_[i] = llt.matrixL().transpose();
+    IndexedGaussian& entry = gaussians_[i];
+    entry.mean = g.mean;
+    entry.information = g.covariance.inverse();
+    entry.sqrt_information_t = Eigen::LLT<Eigen::Matrix3d>(entry.information).matrixL().transpose();
     const Eigen::Vector3d half = extent_sigmas * g.covariance.diagonal().cwiseSqrt();
     const Eigen::Vector3d lo = ((g.mean - half) / cell_size).array().floor();
     const Eigen::Vector3d hi = ((g.mean + half) / cell_size).array().floor();
@@ -117,10 +112,9 @@ int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
   double best_d2 = gate_sq;
   for (std::size_t k = 0; k < count; ++k) {
     const std::uint32_t i = candidates[k];
-    const PackedGaussian& g = packed_[i];
-    const double ex = point.x() - g.mean[0], ey = point.y() - g.mean[1], ez = point.z() - g.mean[2];
-    const double d2 = g.information[0] * ex * ex + g.information[3] * ey * ey + g.information[5] * ez * ez +
-                      2.0 * (g.information[1] * ex * ey + g.information[2] * ex * ez + g.information[4] * ey * ez);
+    const IndexedGaussian& entry = gaussians_[i];
+    const Eigen::Vector3d e = point - entry.mean;
+    const double d2 = e.dot(entry.information * e);
     // Candidates come sorted by id, so ties go to the smallest id.
     if (d2 < best_d2 || (best < 0 && d2 <= gate_sq)) {
       best_d2 = d2;
@@ -132,7 +126,7 @@ int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
 }
 
 std::size_t GaussianIndex::MemoryBytes() const {
-  return means_.size() * (sizeof(Eigen::Vector3d) + 2 * sizeof(Eigen::Matrix3d) + sizeof(PackedGaussian)) +
+  return gaussians_.size() * sizeof(IndexedGaussian) +
          cell_entries_.size() * sizeof(std::uint32_t) +
          cells_.size() * (sizeof(std::int64_t) + 2 * sizeof(std::uint32_t) + 2 * sizeof(void*));
 }

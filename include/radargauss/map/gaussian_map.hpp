@@ -76,27 +76,24 @@ class GaussianIndex {
   // Gaussians whose box contains the cell of `point`.
   const std::uint32_t* Candidates(const Eigen::Vector3d& point, std::size_t& count) const;
 
-  const Eigen::Matrix3d& Information(std::size_t i) const { return information_[i]; }
+  const Eigen::Matrix3d& Information(std::size_t i) const { return gaussians_[i].information; }
   // L^T with Sigma^-1 = L L^T (Cholesky), so ||L^T (x - mu)||^2 is the Mahalanobis^2.
-  const Eigen::Matrix3d& SqrtInformationT(std::size_t i) const { return sqrt_information_t_[i]; }
-  const Eigen::Vector3d& Mean(std::size_t i) const { return means_[i]; }
-  std::size_t size() const { return means_.size(); }
+  const Eigen::Matrix3d& SqrtInformationT(std::size_t i) const { return gaussians_[i].sqrt_information_t; }
+  const Eigen::Vector3d& Mean(std::size_t i) const { return gaussians_[i].mean; }
+  std::size_t size() const { return gaussians_.size(); }
   std::size_t MemoryBytes() const;
 
  private:
   std::int64_t Key(const Eigen::Vector3d& p) const;
 
   double cell_size_ = 1.0;
-  std::vector<Eigen::Vector3d> means_;
-  std::vector<Eigen::Matrix3d> information_;
-  std::vector<Eigen::Matrix3d> sqrt_information_t_;
-  // Mean and upper-triangular information (xx xy xz yy yz zz) side by side:
-  // what Associate reads per candidate, in one place.
-  struct PackedGaussian {
-    double mean[3];
-    double information[6];
+  // What a query reads per candidate, side by side in one entry.
+  struct IndexedGaussian {
+    Eigen::Vector3d mean;
+    Eigen::Matrix3d information;
+    Eigen::Matrix3d sqrt_information_t;
   };
-  std::vector<PackedGaussian> packed_;
+  std::vector<IndexedGaussian> gaussians_;
   std::vector<std::uint32_t> cell_entries_;  // Gaussian ids grouped by cell
   std::unordered_map<std::int64_t, std::pair<std::uint32_t, std::uint32_t>> cells_;  // key -> [begin, end)
 };
