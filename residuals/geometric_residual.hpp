@@ -32,16 +32,22 @@ class GeometricResidual {
     return true;
   }
 
+  // Re-targets the residual at another term (problems kept across associations).
+  void Reset(const Eigen::Vector3d& point_radar, const Eigen::Vector3d& mean,
+             const Eigen::Matrix3d& sqrt_information_t) {
+    *this = GeometricResidual(point_radar, mean, sqrt_information_t);
+  }
+
+  using AutoDiff = ceres::AutoDiffCostFunction<GeometricResidual, 3, 4, 3>;
   static ceres::CostFunction* Create(const Eigen::Vector3d& point_radar, const Eigen::Vector3d& mean,
                                      const Eigen::Matrix3d& sqrt_information_t) {
-    return new ceres::AutoDiffCostFunction<GeometricResidual, 3, 4, 3>(
-        new GeometricResidual(point_radar, mean, sqrt_information_t));
+    return new AutoDiff(new GeometricResidual(point_radar, mean, sqrt_information_t));
   }
 
  private:
-  const Eigen::Vector3d point_radar_;
-  const Eigen::Vector3d mean_;
-  const Eigen::Matrix3d sqrt_information_t_;
+  Eigen::Vector3d point_radar_;
+  Eigen::Vector3d mean_;
+  Eigen::Matrix3d sqrt_information_t_;
 };
 
 // The analytic twin: same residual, Jacobians in closed form
@@ -69,10 +75,17 @@ class GeometricCostFunction final : public ceres::SizedCostFunction<3, 4, 3> {
     return true;
   }
 
+  void Reset(const Eigen::Vector3d& point_radar, const Eigen::Vector3d& mean,
+             const Eigen::Matrix3d& sqrt_information_t) {
+    point_radar_ = point_radar;
+    mean_ = mean;
+    sqrt_information_t_ = sqrt_information_t;
+  }
+
  private:
-  const Eigen::Vector3d point_radar_;
-  const Eigen::Vector3d mean_;
-  const Eigen::Matrix3d sqrt_information_t_;
+  Eigen::Vector3d point_radar_;
+  Eigen::Vector3d mean_;
+  Eigen::Matrix3d sqrt_information_t_;
 };
 
 }  // namespace radargauss

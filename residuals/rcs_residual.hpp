@@ -65,12 +65,14 @@ class RcsResidual {
     return true;
   }
 
-  static ceres::CostFunction* Create(const RcsTerm& term) {
-    return new ceres::AutoDiffCostFunction<RcsResidual, 1, 4, 3>(new RcsResidual(term));
-  }
+  // Re-targets the residual at another term (problems kept across associations).
+  void Reset(const RcsTerm& term) { term_ = term; }
+
+  using AutoDiff = ceres::AutoDiffCostFunction<RcsResidual, 1, 4, 3>;
+  static ceres::CostFunction* Create(const RcsTerm& term) { return new AutoDiff(new RcsResidual(term)); }
 
  private:
-  const RcsTerm term_;
+  RcsTerm term_;
 };
 
 class RcsRotationResidual {
@@ -84,14 +86,19 @@ class RcsRotationResidual {
     return true;
   }
 
+  void Reset(const RcsTerm& term, const Eigen::Vector3d& translation) {
+    term_ = term;
+    translation_ = translation;
+  }
+
+  using AutoDiff = ceres::AutoDiffCostFunction<RcsRotationResidual, 1, 4>;
   static ceres::CostFunction* Create(const RcsTerm& term, const Eigen::Vector3d& translation) {
-    return new ceres::AutoDiffCostFunction<RcsRotationResidual, 1, 4>(
-        new RcsRotationResidual(term, translation));
+    return new AutoDiff(new RcsRotationResidual(term, translation));
   }
 
  private:
-  const RcsTerm term_;
-  const Eigen::Vector3d translation_;
+  RcsTerm term_;
+  Eigen::Vector3d translation_;
 };
 
 // Analytic linearisation shared by the analytic twins: the residual, its
@@ -153,8 +160,10 @@ class RcsCostFunction final : public ceres::SizedCostFunction<1, 4, 3> {
     return true;
   }
 
+  void Reset(const RcsTerm& term) { term_ = term; }
+
  private:
-  const RcsTerm term_;
+  RcsTerm term_;
 };
 
 // The analytic twin of RcsRotationResidual.
@@ -174,9 +183,14 @@ class RcsRotationCostFunction final : public ceres::SizedCostFunction<1, 4> {
     return true;
   }
 
+  void Reset(const RcsTerm& term, const Eigen::Vector3d& translation) {
+    term_ = term;
+    translation_ = translation;
+  }
+
  private:
-  const RcsTerm term_;
-  const Eigen::Vector3d translation_;
+  RcsTerm term_;
+  Eigen::Vector3d translation_;
 };
 
 }  // namespace radargauss

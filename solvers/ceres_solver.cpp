@@ -5,13 +5,146 @@
 #include <ceres/solver.h>
 
 #include <memory>
-
+#include <vector>
 
 #include "radargauss/lie/manifold.hpp"
 #include "residuals/geometric_residual.hpp"
 #include "residuals/rcs_residual.hpp"
 
 namespace radargauss {
+
+namespace {
+
+// The residual blocks of one kind of term, kept across associations: block k
+// holds term k of the current association. A new association re-targets the
+// blocks it keeps (Reset on the functor or the analytic twin) and adds or
+// removes blocks only for the change in count, so that Ceres's per-block
+// set-up is paid about once per match instead of once per association.
+template <typename Functor, typename AnalyticCost>
+class TermBlocks {
+ public:
+  TermBlocks(ceres::Problem& problem, ceres::LossFunction* loss, bool analytic, std::vector<double*> parameters)
+      : problem_(problem), loss_(loss), analytic_(analytic), parameters_(std::move(parameters)) {}
+
+  // Block k holds the term made from `args` and is in the problem.
+  template <typename... Args>
+  void Set(std::size_t k, const Args&... args) {
+    if (k == blocks_.size()) {
+      Block block;
+      if (analytic_) {
+        block.analytic = new AnalyticCost(args...);
+        block.cost.reset(block.analytic);
+      } else {
+        block.functor = new Functor(args...);
+        block.cost = std::make_unique<typename Functor::AutoDiff>(block.functor);
+      }
+      blocks_.push_back(std::move(block));
+    } else if (analytic_) {
+      blocks_[k].analytic->Reset(args...);
+    } else {
+      blocks_[k].functor->Reset(args...);
+    }
+    Block& block = blocks_[k];
+    if (block.id == nullptr) {
+      block.id = problem_.AddResidualBlock(block.cost.get(), loss_, parameters_.data(), int(parameters_.size()));
+    }
+  }
+
+  // Takes blocks k >= count out of the problem (kept for later associations).
+  void Truncate(std::size_t count) {
+    for (std::size_t k = count; k < blocks_.size(); ++k) {
+      if (blocks_[k].id == nullptr) continue;
+      problem_.RemoveResidualBlock(blocks_[k].id);
+      blocks_[k].id = nullptr;
+    }
+  }
+
+ private:
+  struct Block {
+    std::unique_ptr<ceres::CostFunction> cost;
+    Functor* functor = nullptr;         // autodiff: the functor `cost` owns
+    AnalyticCost* analytic = nullptr;   // analytic: `cost` itself
+    ceres::ResidualBlockId id = nullptr;  // null while not in the problem
+  };
+  ceres::Problem& problem_;
+  ceres::LossFunction* loss_;
+  bool analytic_;
+  std::vector<double*> parameters_;
+  std::vector<Block> blocks_;
+};
+
+}  // namespace
+
+struct CeresScanProblem::Impl {
+  Impl(const ScanMatchingOptions& options, double* rotation, double* translation)
+      : options_(options),
+        geometric_(problem_, &geometric_loss_, options.jacobians == JacobianMode::kAnalytic,
+                   {rotation, translation}),
+        rcs_full_(problem_, &rcs_loss_, options.jacobians == JacobianMode::kAnalytic, {rotation, translation}),
+        rcs_rotation_(problem_, &rcs_loss_, options.jacobians == JacobianMode::kAnalytic, {rotation}),
+        problem_(ProblemOptions()) {
+    problem_.AddParameterBlock(rotation, 4, &so3_);
+    problem_.AddParameterBlock(translation, 3);
+  }
+
+  void Update(const Correspondences& c, double w) {
+    const std::size_t n_geometric = w < 1.0 ? c.geometric.size() : 0;
+    if (n_geometric > 0) {
+      geometric_loss_.Reset(new ceres::ScaledLoss(MakeLoss(options_.geometric_loss), (1.0 - w) / double(n_geometric),
+                                                  ceres::TAKE_OWNERSHIP),
+                            ceres::TAKE_OWNERSHIP);
+    }
+    for (std::size_t k = 0; k < n_geometric; ++k) {
+      const GeometricTerm& term = c.geometric[k];
+      geometric_.Set(k, term.point_radar, c.index->Mean(term.gaussian), c.index->SqrtInformationT(term.gaussian));
+    }
+    geometric_.Truncate(n_geometric);
+
+    const std::size_t n_rcs = w > 0.0 ? c.rcs.size() : 0;
+    if (n_rcs > 0) {
+      rcs_loss_.Reset(new ceres::ScaledLoss(MakeLoss(options_.rcs_loss), w / double(n_rcs), ceres::TAKE_OWNERSHIP),
+                      ceres::TAKE_OWNERSHIP);
+    }
+    // Rotation-only: the RCS residuals take the rotation block only, the
+    // translation a constant of the association.
+    const bool rotation_only = options_.rcs_translation == RcsTranslation::kRotationOnly;
+    for (std::size_t k = 0; k < n_rcs; ++k) {
+      if (rotation_only) {
+        rcs_rotation_.Set(k, c.rcs[k], c.pose.translation());
+      } else {
+        rcs_full_.Set(k, c.rcs[k]);
+      }
+    }
+    rcs_rotation_.Truncate(rotation_only ? n_rcs : 0);
+    rcs_full_.Truncate(rotation_only ? 0 : n_rcs);
+  }
+
+  static ceres::Problem::Options ProblemOptions() {
+    ceres::Problem::Options options;
+    options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // the term blocks own them
+    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // one wrapper per term, members
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    options.disable_all_safety_checks = true;  // blocks are built here, not by users
+    return options;
+  }
+
+  ScanMatchingOptions options_;
+  SO3Manifold so3_;
+  ceres::LossFunctionWrapper geometric_loss_{nullptr, ceres::TAKE_OWNERSHIP};
+  ceres::LossFunctionWrapper rcs_loss_{nullptr, ceres::TAKE_OWNERSHIP};
+  TermBlocks<GeometricResidual, GeometricCostFunction> geometric_;
+  TermBlocks<RcsResidual, RcsCostFunction> rcs_full_;
+  TermBlocks<RcsRotationResidual, RcsRotationCostFunction> rcs_rotation_;
+  ceres::Problem problem_;  // last: destroyed before what it refers to
+};
+
+CeresScanProblem::CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation)
+    : impl_(std::make_unique<Impl>(options, rotation, translation)) {}
+CeresScanProblem::~CeresScanProblem() = default;
+void CeresScanProblem::Update(const Correspondences& correspondences, double w_rcs) {
+  impl_->Update(correspondences, w_rcs);
+}
+ceres::Problem& CeresScanProblem::problem() { return impl_->problem_; }
 
 CeresSolver::CeresSolver(const ScanMatchingOptions& options, const CeresSolverOptions& ceres_options)
     : options_(options), ceres_options_(ceres_options) {
@@ -26,64 +159,25 @@ std::string CeresSolver::Name() const {
 
 ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& map,
                                       const SE3d& initial) const {
-  const bool analytic = options_.jacobians == JacobianMode::kAnalytic;
-  const bool rotation_only = options_.rcs_translation == RcsTranslation::kRotationOnly;
   Eigen::Vector4d rotation = initial.rotation().quaternion().coeffs();
   Eigen::Vector3d translation = initial.translation();
-  SO3Manifold so3;
   ceres::Solver::Options solver_options;
   solver_options.trust_region_strategy_type = ceres_options_.dogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // 6 unknowns, ~10^3 residuals
   solver_options.max_num_iterations = ceres_options_.max_inner_iterations;
   solver_options.num_threads = ceres_options_.threads;
   solver_options.logging_type = ceres::SILENT;
   solver_options.function_tolerance = ceres_options_.function_tolerance;
   solver_options.gradient_tolerance = ceres_options_.gradient_tolerance;
   solver_options.parameter_tolerance = ceres_options_.parameter_tolerance;
+  CeresScanProblem problem(options_, rotation.data(), translation.data());
 
   return RunCoarseToFine(scan, map, initial, options_, [&](const LevelStep& level, ScanMatchingResult& result) {
     const Correspondences& c = level.correspondences;
-    const double w = level.options.w_rcs;
-    ceres::Problem::Options problem_options;
-    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    problem_options.disable_all_safety_checks = true;  // blocks are built here, not by users
-    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // one loss per term, shared
-    std::unique_ptr<ceres::LossFunction> geometric_loss, rcs_loss;
-    ceres::Problem problem(problem_options);
-    problem.AddParameterBlock(rotation.data(), 4, &so3);
-    if (w < 1.0) {
-      geometric_loss = std::make_unique<ceres::ScaledLoss>(MakeLoss(options_.geometric_loss),
-                                                           (1.0 - w) / double(c.geometric.size()),
-                                                           ceres::TAKE_OWNERSHIP);
-      for (const GeometricTerm& term : c.geometric) {
-        const Eigen::Vector3d& mean = c.index->Mean(term.gaussian);
-        const Eigen::Matrix3d& LT = c.index->SqrtInformationT(term.gaussian);
-        ceres::CostFunction* cost = analytic ? static_cast<ceres::CostFunction*>(
-                                                   new GeometricCostFunction(term.point_radar, mean, LT))
-                                             : GeometricResidual::Create(term.point_radar, mean, LT);
-        problem.AddResidualBlock(cost, geometric_loss.get(), rotation.data(), translation.data());
-      }
-    }
-    if (w > 0.0) {
-      rcs_loss = std::make_unique<ceres::ScaledLoss>(MakeLoss(options_.rcs_loss), w / double(c.rcs.size()),
-                                                     ceres::TAKE_OWNERSHIP);
-      ceres::LossFunction* loss = rcs_loss.get();
-      for (const RcsTerm& term : c.rcs) {
-        if (rotation_only) {
-          ceres::CostFunction* cost =
-              analytic ? static_cast<ceres::CostFunction*>(new RcsRotationCostFunction(term, c.pose.translation()))
-                       : RcsRotationResidual::Create(term, c.pose.translation());
-          problem.AddResidualBlock(cost, loss, rotation.data());
-        } else {
-          ceres::CostFunction* cost = analytic ? static_cast<ceres::CostFunction*>(new RcsCostFunction(term))
-                                               : RcsResidual::Create(term);
-          problem.AddResidualBlock(cost, loss, rotation.data(), translation.data());
-        }
-      }
-    }
+    problem.Update(c, level.options.w_rcs);
     ceres::Solver::Summary summary;
     const SE3d before = result.pose;
-    ceres::Solve(solver_options, &problem, &summary);
+    ceres::Solve(solver_options, &problem.problem(), &summary);
     if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
       result.reason = "Ceres: " + summary.message;
       rotation = before.rotation().quaternion().coeffs();
@@ -95,8 +189,13 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
     const bool small =
         (result.pose.translation() - before.translation()).norm() < level.looseness * options_.translation_tolerance &&
         step.rotation().Log().norm() < level.looseness * options_.rotation_tolerance;
-    // Converged when the pose settled, or, on a fixed association, when Ceres did.
-    if (small || (!options_.reassociate && summary.termination_type == ceres::CONVERGENCE)) {
+    // Converged when the pose settled, or when Ceres converged on an
+    // association the outer loop would keep (a fixed one, or on the exact map
+    // one the pose has not moved past the re-association thresholds from):
+    // the next solve would be the same problem from its own solution.
+    const bool association_kept =
+        !options_.reassociate || (level.finest && !MovedPastReassociation(c.pose, result.pose, options_));
+    if (small || (association_kept && summary.termination_type == ceres::CONVERGENCE)) {
       return StepOutcome::kConverged;
     }
     return StepOutcome::kContinue;

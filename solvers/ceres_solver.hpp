@@ -6,6 +6,10 @@
 // translation a constant of the current association.
 #pragma once
 
+#include <ceres/problem.h>
+
+#include <memory>
+
 #include "solvers/scan_matcher.hpp"
 
 namespace radargauss {
@@ -19,6 +23,31 @@ struct CeresSolverOptions {
   double function_tolerance = 1e-6;
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;
+};
+
+// The ceres::Problem of one match, kept across associations: the pose blocks
+// (rotation with SO3Manifold, translation), one residual block per term of
+// the current association, eq. 2's weights as ScaledLoss around each term's
+// loss. Update re-targets the blocks it keeps at the new terms and adds or
+// removes blocks only for the change in count, so Ceres's per-block set-up
+// is paid about once per match instead of once per association.
+class CeresScanProblem {
+ public:
+  // `rotation` (quaternion x y z w) and `translation` are the parameter
+  // blocks; they must outlive the problem.
+  CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation);
+  ~CeresScanProblem();
+  CeresScanProblem(const CeresScanProblem&) = delete;
+  CeresScanProblem& operator=(const CeresScanProblem&) = delete;
+
+  // Makes the problem hold exactly the terms of `correspondences` weighted
+  // for `w_rcs` (the geometric terms when w_rcs < 1, the RCS terms when > 0).
+  void Update(const Correspondences& correspondences, double w_rcs);
+  ceres::Problem& problem();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 class CeresSolver final : public ScanMatcher {

@@ -121,6 +121,11 @@ bool CheckCorrespondences(const RadarScan& scan, const Correspondences& c,
   return true;
 }
 
+bool MovedPastReassociation(const SE3d& associated_at, const SE3d& pose, const ScanMatchingOptions& options) {
+  return (pose.translation() - associated_at.translation()).norm() > options.reassociation_translation ||
+         (associated_at.rotation().Inverse() * pose.rotation()).Log().norm() > options.reassociation_rotation;
+}
+
 namespace {
 
 // `count` points of `scan`, evenly strided (count < scan size).
@@ -132,12 +137,6 @@ RadarScan Subsample(const RadarScan& scan, std::size_t count) {
   subsampled.points.reserve(count);
   for (std::size_t k = 0; k < count; ++k) subsampled.points.push_back(scan.points[k * scan.points.size() / count]);
   return subsampled;
-}
-
-// Whether the pose has moved far enough from `associated_at` to associate again.
-bool MovedSince(const SE3d& associated_at, const SE3d& pose, const ScanMatchingOptions& options) {
-  return (pose.translation() - associated_at.translation()).norm() > options.reassociation_translation ||
-         (associated_at.rotation().Inverse() * pose.rotation()).Log().norm() > options.reassociation_rotation;
 }
 
 }  // namespace
@@ -164,7 +163,7 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     const RadarScan& level_scan = finest ? scan : coarse_scan;
     c = FindCorrespondences(level_scan, map, level, result.pose, options.gate, with_rcs);
     for (int iteration = 1; iteration <= max_iterations; ++iteration) {
-      if (options.reassociate && iteration > 1 && (!finest || MovedSince(c.pose, result.pose, options))) {
+      if (options.reassociate && iteration > 1 && (!finest || MovedPastReassociation(c.pose, result.pose, options))) {
         c = FindCorrespondences(level_scan, map, level, result.pose, options.gate, with_rcs);
       }
       if (!CheckCorrespondences(level_scan, c, level_options, result.reason)) {
@@ -187,7 +186,7 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     // within the re-association thresholds of the final pose (or when not
     // re-associating); otherwise a new one at the final pose.
     const bool last_is_final =
-        !options.reassociate || (c.index == &map.index() && !MovedSince(c.pose, result.pose, options));
+        !options.reassociate || (c.index == &map.index() && !MovedPastReassociation(c.pose, result.pose, options));
     const Correspondences final_c =
         last_is_final ? c : FindCorrespondences(scan, map, map.levels() - 1, result.pose, options.gate, w > 0.0);
     result.n_geo = final_c.geometric.size();

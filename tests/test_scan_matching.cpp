@@ -326,6 +326,55 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
   }
 }
 
+// The Ceres problem kept across associations holds exactly the latest
+// association: after updates that grow and shrink the term counts, change
+// level and weight, its cost (Ceres: 1/2 sum) is eq. 2 as EvaluateCost gives
+// it, its block count is the latest term count, for analytic and autodiff
+// blocks and both RCS translation modes.
+TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
+  const World& world = SimulatedWorld();
+  const MatchingMap& map = *world.matching;
+  const RadarScan& full_scan = world.simulated.scans[kTestScan];
+  RadarScan half_scan = full_scan;
+  half_scan.points.resize(full_scan.points.size() / 2);
+  const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
+  for (const JacobianMode jacobians : {JacobianMode::kAnalytic, JacobianMode::kAutoDiff}) {
+    for (const RcsTranslation mode : {RcsTranslation::kRotationOnly, RcsTranslation::kFull}) {
+      ScanMatchingOptions options;
+      options.jacobians = jacobians;
+      options.rcs_translation = mode;
+      options.geometric_loss = {LossType::kHuber, 0.5};
+      const SE3d pose = Perturbed(truth, 0.1, 0.5, 3);
+      Eigen::Vector4d rotation = pose.rotation().quaternion().coeffs();
+      Eigen::Vector3d translation = pose.translation();
+      CeresScanProblem problem(options, rotation.data(), translation.data());
+      struct Update {
+        const RadarScan* scan;
+        std::size_t level;
+        double w;
+      };
+      for (const Update& update : {Update{&full_scan, map.levels() - 1, 0.25}, Update{&half_scan, 0, 0.0},
+                                   Update{&full_scan, map.levels() - 1, 0.0}, Update{&half_scan, map.levels() - 1, 0.5},
+                                   Update{&full_scan, map.levels() - 1, 1.0}, Update{&full_scan, map.levels() - 1, 0.25}}) {
+        const Correspondences c = FindCorrespondences(*update.scan, map, update.level, pose, 3.0, update.w > 0.0);
+        ASSERT_GT(c.geometric.size(), 100u);
+        if (update.w > 0.0) {
+          ASSERT_GT(c.rcs.size(), 10u);
+        }
+        problem.Update(c, update.w);
+        ScanMatchingOptions weighted = options;
+        weighted.w_rcs = update.w;
+        const std::size_t blocks = (update.w < 1.0 ? c.geometric.size() : 0) + (update.w > 0.0 ? c.rcs.size() : 0);
+        EXPECT_EQ(problem.problem().NumResidualBlocks(), int(blocks)) << "w " << update.w;
+        double cost = 0.0;
+        ASSERT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr));
+        const double f = EvaluateCost(c, pose, weighted);
+        EXPECT_NEAR(2.0 * cost, f, 1e-12 * f) << "w " << update.w << " level " << update.level;
+      }
+    }
+  }
+}
+
 // w = 1 with rotation-only RCS: the translation does not move. On the
 // simulated world's fitted models the RCS term alone does not reduce a pure
 // rotation error (1 deg ends at 1.2 to 2.8 deg with either incidence model:
