@@ -94,7 +94,8 @@ BENCHMARK_TEMPLATE(BM_RcsResidualRotationOnly, AutoDiff)->Arg(0)->Arg(1);
 
 struct MatchingWorld {
   GaussianMap map;
-  std::unique_ptr<MatchingMap> matching;
+  std::unique_ptr<MatchingMap> matching;         // inflated coarse levels (the default)
+  std::unique_ptr<MatchingMap> merged_matching;  // merged coarse levels
   std::map<int, SimulatedSequence> scans;  // by detections per scan
   SimulatedSequence drive;                 // the 1000-scan drive of the map
 };
@@ -111,6 +112,9 @@ const MatchingWorld& World() {
     w->map.gaussians = BuildGaussians(cloud.points, options, {}, &association);
     FitRcsModels(w->map, cloud, association);
     w->matching = std::make_unique<MatchingMap>(w->map);
+    MatchingMapOptions merged;
+    merged.coarse = CoarseLevels::kMerged;
+    w->merged_matching = std::make_unique<MatchingMap>(w->map, merged);
     for (const int n : {150, 800, 4000}) {
       SimulationConfig scan_config;  // same seed: the same world and drive
       scan_config.scans = 20;
@@ -191,12 +195,26 @@ BENCHMARK(BM_MatchScan)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MatchScan)->Args({800, 3, 0})->Args({800, 3, 25})->Unit(benchmark::kMillisecond);
 
+// Merged coarse levels (CoarseLevels::kMerged), 800 points, from the paper's
+// errors. Args: solver (0 gn, 2 ceres), w_rcs x 100, coarse_points.
+void BM_MatchScanMerged(benchmark::State& state) {
+  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const MatchingWorld& world = World();
+  const SimulatedSequence& scans = world.scans.at(800);
+  ScanMatchingOptions options;
+  options.w_rcs = double(state.range(1)) / 100.0;
+  options.coarse_points = std::size_t(state.range(2));
+  MatchScans(state, *Solver(int(state.range(0)), options), *world.merged_matching, scans, InitialPoses(scans),
+             options.w_rcs);
+}
+BENCHMARK(BM_MatchScanMerged)->ArgsProduct({{0, 2}, {0, 25}, {0, 400}})->Unit(benchmark::kMillisecond);
+
 // Refinement only (the exact map, from 5 cm / 0.2 deg): the per-scan latency
 // of tracking, where the coarse levels are not needed.
 void BM_RefineScan(benchmark::State& state) {
   const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const MatchingWorld& world = World();
-  const MatchingMap exact(world.map, {});
+  const MatchingMap exact(world.map, ExactMapOnly());
   const SimulatedSequence& scans = world.scans.at(800);
   std::vector<SE3d> initial;
   for (const auto& sample : scans.ground_truth) {

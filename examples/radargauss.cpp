@@ -264,6 +264,8 @@ struct LocalizeSettings {
   double max_rotation = 5.0;
   std::uint32_t seed = 42;
   int stride = 1;
+  std::string coarse_levels = "inflated";
+  std::size_t coarse_points = 0;
 };
 
 // Our solvers, plus the PCL peers when built with RADARGAUSS_WITH_PCL.
@@ -320,6 +322,13 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--stride", s.stride, "Match every n-th scan (the map uses all)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app->add_option("--coarse-levels", s.coarse_levels,
+                  "Coarse-to-fine levels: inflated (every Gaussian blurred) or merged (voxel merges, faster)")
+      ->check(CLI::IsMember({"inflated", "merged"}))
+      ->capture_default_str();
+  app->add_option("--coarse-points", s.coarse_points, "Points used on the coarse levels (0: all)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
 }
 
 std::string FormatWeight(double w) {
@@ -364,7 +373,9 @@ int RunLocalize(LocalizeSettings s) {
   std::size_t total = 0, done = 0;
   for (std::size_t m = 0; m < maps.size(); ++m) total += s.solvers.size() * s.losses.size() * s.w_rcs.size();
   for (std::size_t m = 0; m < maps.size(); ++m) {
-    const MatchingMap matching(maps[m]);
+    MatchingMapOptions matching_options;
+    matching_options.coarse = CoarseLevelsFromString(s.coarse_levels);
+    const MatchingMap matching(maps[m], matching_options);
     const int degree = s.map_path.empty() ? s.degrees[m % s.degrees.size()] : s.degrees[0];
     for (const std::string& solver : s.solvers) {
       if (solver.rfind("pcl-", 0) == 0) {
@@ -385,6 +396,7 @@ int RunLocalize(LocalizeSettings s) {
           options.w_rcs = w;
           options.geometric_loss = {LossTypeFromString(loss), s.loss_scale};
           options.rcs_loss = {LossTypeFromString(s.rcs_loss), s.rcs_loss_scale};
+          options.coarse_points = s.coarse_points;
           const auto matcher = MakeScanMatcher(solver, options);
           const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" +
                                    ToString(maps[m].incidence) + "-L" + std::to_string(degree);

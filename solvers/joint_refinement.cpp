@@ -62,7 +62,7 @@ class RelativePoseResidual {
 
 double RcsResidualRms(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
                       const GaussianMap& map, double gate) {
-  const MatchingMap matching(map, {});
+  const MatchingMap matching(map, ExactMapOnly());
   double sum = 0.0;
   std::size_t n = 0;
   for (std::size_t k = 0; k < scans.size(); ++k) {
@@ -106,7 +106,7 @@ JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
       coefficients[g].assign(model.coefficients.begin(), model.coefficients.begin() + ShCoefficientCount(model.degree));
     }
   }
-  const MatchingMap matching(result.map, {});
+  const MatchingMap matching(result.map, ExactMapOnly());
   SO3Manifold so3;
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = options.schur ? ceres::SPARSE_SCHUR : ceres::SPARSE_NORMAL_CHOLESKY;

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
+#include <array>
+#include <map>
 
 namespace radargauss {
 
@@ -21,16 +23,62 @@ void ValidateOptions(const ScanMatchingOptions& o) {
           "re-association thresholds must be >= 0");
 }
 
-MatchingMap::MatchingMap(const GaussianMap& map, const std::vector<double>& inflation,
-                         double index_cell)
-    : map_(map) {
-  for (const double sigma : inflation) {
-    if (!(sigma > 0.0)) throw std::invalid_argument("coarse-to-fine inflation must be > 0");
-    std::vector<Gaussian> inflated = map.gaussians;
-    for (Gaussian& g : inflated) g.covariance += sigma * sigma * Eigen::Matrix3d::Identity();
-    levels_.emplace_back(inflated, std::max(index_cell, sigma));
+namespace {
+
+// One Gaussian per voxel of side `cell` (the voxel of its mean): the
+// moment-matched mixture of the Gaussians whose means fall in it, weighted by
+// their member counts.
+std::vector<Gaussian> MergedGaussians(const std::vector<Gaussian>& gaussians, double cell) {
+  struct Moments {
+    double weight = 0.0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d second = Eigen::Matrix3d::Zero();  // sum w (Sigma + mu mu^T)
+    std::uint32_t points = 0;
+  };
+  std::map<std::array<std::int64_t, 3>, Moments> voxels;  // exact keys: no two voxels share one
+  for (const Gaussian& g : gaussians) {
+    const Eigen::Vector3d v = (g.mean / cell).array().floor();
+    Moments& m = voxels[{std::int64_t(v.x()), std::int64_t(v.y()), std::int64_t(v.z())}];
+    const double w = std::max<std::uint32_t>(g.point_count, 1);
+    m.weight += w;
+    m.sum += w * g.mean;
+    m.second += w * (g.covariance + g.mean * g.mean.transpose());
+    m.points += g.point_count;
   }
-  levels_.emplace_back(map.gaussians, index_cell);
+  std::vector<Gaussian> merged;
+  merged.reserve(voxels.size());
+  for (const auto& [key, m] : voxels) {
+    Gaussian g;
+    g.mean = m.sum / m.weight;
+    const Eigen::Matrix3d covariance = m.second / m.weight - g.mean * g.mean.transpose();
+    g.covariance = 0.5 * (covariance + covariance.transpose());
+    g.point_count = m.points;
+    merged.push_back(g);
+  }
+  return merged;
+}
+
+}  // namespace
+
+std::string ToString(CoarseLevels coarse) { return coarse == CoarseLevels::kMerged ? "merged" : "inflated"; }
+
+CoarseLevels CoarseLevelsFromString(const std::string& name) {
+  if (name == "inflated") return CoarseLevels::kInflated;
+  if (name == "merged") return CoarseLevels::kMerged;
+  throw std::invalid_argument("unknown coarse levels '" + name + "' (inflated, merged)");
+}
+
+MatchingMap::MatchingMap(const GaussianMap& map, const MatchingMapOptions& options) : map_(map) {
+  if (!(options.index_cell > 0.0)) throw std::invalid_argument("index cell must be > 0");
+  for (const double sigma : options.inflation) {
+    if (!(sigma > 0.0)) throw std::invalid_argument("coarse-to-fine inflation must be > 0");
+    std::vector<Gaussian> level = options.coarse == CoarseLevels::kMerged
+                                      ? MergedGaussians(map.gaussians, kMergeCellPerSigma * sigma)
+                                      : map.gaussians;
+    for (Gaussian& g : level) g.covariance += sigma * sigma * Eigen::Matrix3d::Identity();
+    levels_.emplace_back(level, std::max(options.index_cell, sigma));
+  }
+  levels_.emplace_back(map.gaussians, options.index_cell);
 }
 
 Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level,
@@ -149,9 +197,10 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
   const double w = options.w_rcs;
   Correspondences c;
   bool failed = false;
-  const bool subsample = w < 1.0 && map.levels() > 1 && options.coarse_points > 0 &&
-                         scan.points.size() > options.coarse_points;
-  const RadarScan subsampled = subsample ? Subsample(scan, options.coarse_points) : RadarScan();
+  const std::size_t coarse_points = options.coarse_points;
+  const bool subsample = w < 1.0 && map.levels() > 1 && coarse_points > 0 &&
+                         scan.points.size() > coarse_points;
+  const RadarScan subsampled = subsample ? Subsample(scan, coarse_points) : RadarScan();
   const RadarScan& coarse_scan = subsample ? subsampled : scan;
   for (std::size_t level = w < 1.0 ? 0 : map.levels() - 1; level < map.levels() && !failed; ++level) {
     const bool finest = level + 1 == map.levels();

@@ -20,7 +20,7 @@ TEST(PclPeers, LowerTheErrorsOnAShortSequence) {
   const Sequence sequence = AsSequence(simulated);
   const MapCloud cloud = BuildMapCloud(sequence);
   const GaussianMap unused;
-  const MatchingMap matching(unused, {});
+  const MatchingMap matching(unused, ExactMapOnly());
   const std::vector<SE3d> errors = InitialErrors(sequence.scans.size(), 1.0, 3.0, 42);
   for (const PclMethod method : {PclMethod::kNdt, PclMethod::kGicp}) {
     const PclPeerMatcher peer(method, cloud.points);
