@@ -63,6 +63,12 @@ expect_ok "localize" "configurations" -- \
 for f in per_scan.csv summary.json table.md reference.tum trajectories/gn-w0-trivial-offset-L3.tum; do
   if [ -s "$work/results/$f" ]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: missing $f"; fi
 done
+expect_ok "localize with merged coarse levels" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0 --coarse-levels merged --coarse-points 100 --out "$work/results_merged"
+expect_fail "localize with unknown coarse levels" "coarse-levels" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --coarse-levels blurred --out "$work/r5"
 expect_fail "localize with a bad weight" "w-rcs" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --w-rcs 1.5 --out "$work/r2"
 expect_fail "localize with a map of another version" "map version" -- \
