@@ -1,11 +1,10 @@
 #include "solvers/scan_matcher.hpp"
 
-#include <cmath>
 #include <algorithm>
 #include <chrono>
-#include <stdexcept>
-#include <array>
+#include <cmath>
 #include <map>
+#include <stdexcept>
 
 namespace radargauss {
 
@@ -35,10 +34,9 @@ std::vector<Gaussian> MergedGaussians(const std::vector<Gaussian>& gaussians, do
     Eigen::Matrix3d second = Eigen::Matrix3d::Zero();  // sum w (Sigma + mu mu^T)
     std::uint32_t points = 0;
   };
-  std::map<std::array<std::int64_t, 3>, Moments> voxels;  // exact keys: no two voxels share one
+  std::map<VoxelKey, Moments> voxels;
   for (const Gaussian& g : gaussians) {
-    const Eigen::Vector3d v = (g.mean / cell).array().floor();
-    Moments& m = voxels[{std::int64_t(v.x()), std::int64_t(v.y()), std::int64_t(v.z())}];
+    Moments& m = voxels[VoxelOf(g.mean, cell)];
     const double w = std::max<std::uint32_t>(g.point_count, 1);
     m.weight += w;
     m.sum += w * g.mean;
@@ -197,10 +195,9 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
   const double w = options.w_rcs;
   Correspondences c;
   bool failed = false;
-  const std::size_t coarse_points = options.coarse_points;
-  const bool subsample = w < 1.0 && map.levels() > 1 && coarse_points > 0 &&
-                         scan.points.size() > coarse_points;
-  const RadarScan subsampled = subsample ? Subsample(scan, coarse_points) : RadarScan();
+  const bool subsample = w < 1.0 && map.levels() > 1 && options.coarse_points > 0 &&
+                         scan.points.size() > options.coarse_points;
+  const RadarScan subsampled = subsample ? Subsample(scan, options.coarse_points) : RadarScan();
   const RadarScan& coarse_scan = subsample ? subsampled : scan;
   for (std::size_t level = w < 1.0 ? 0 : map.levels() - 1; level < map.levels() && !failed; ++level) {
     const bool finest = level + 1 == map.levels();

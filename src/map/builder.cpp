@@ -20,26 +20,12 @@ MapBuilder MapBuilderFromString(const std::string& name) {
 
 namespace {
 
-struct VoxelKey {
-  std::int64_t x, y, z;
-  bool operator<(const VoxelKey& o) const {
-    return x != o.x ? x < o.x : (y != o.y ? y < o.y : z < o.z);
-  }
-  bool operator==(const VoxelKey& o) const { return x == o.x && y == o.y && z == o.z; }
-};
-
-VoxelKey KeyOf(const Eigen::Vector3d& p, double voxel) {
-  return {static_cast<std::int64_t>(std::floor(p.x() / voxel)),
-          static_cast<std::int64_t>(std::floor(p.y() / voxel)),
-          static_cast<std::int64_t>(std::floor(p.z() / voxel))};
-}
-
 // Points grouped by voxel: (key, point index) sorted.
 std::vector<std::pair<VoxelKey, std::uint32_t>> SortedByVoxel(
     const std::vector<Eigen::Vector3d>& points, double voxel) {
   std::vector<std::pair<VoxelKey, std::uint32_t>> keyed(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
-    keyed[i] = {KeyOf(points[i], voxel), static_cast<std::uint32_t>(i)};
+    keyed[i] = {VoxelOf(points[i], voxel), static_cast<std::uint32_t>(i)};
   }
   std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) {
     return a.first < b.first || (a.first == b.first && a.second < b.second);

@@ -50,10 +50,14 @@ std::int64_t PackKey(std::int64_t x, std::int64_t y, std::int64_t z) {
 
 }  // namespace
 
+VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel) {
+  return {static_cast<std::int64_t>(std::floor(p.x() / voxel)), static_cast<std::int64_t>(std::floor(p.y() / voxel)),
+          static_cast<std::int64_t>(std::floor(p.z() / voxel))};
+}
+
 std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
-  return PackKey(static_cast<std::int64_t>(std::floor(p.x() / cell_size_)),
-                 static_cast<std::int64_t>(std::floor(p.y() / cell_size_)),
-                 static_cast<std::int64_t>(std::floor(p.z() / cell_size_)));
+  const VoxelKey v = VoxelOf(p, cell_size_);
+  return PackKey(v.x, v.y, v.z);
 }
 
 GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size,

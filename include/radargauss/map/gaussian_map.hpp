@@ -60,6 +60,15 @@ void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs,
 // Clamps every principal std to at least `min_std` (DESIGN.md section 4).
 Eigen::Matrix3d ClampCovariance(const Eigen::Matrix3d& covariance, double min_std);
 
+// The integer voxel of a point in a grid of side `voxel` (floor(p / voxel)),
+// ordered so that it can key sorted containers.
+struct VoxelKey {
+  std::int64_t x, y, z;
+  bool operator<(const VoxelKey& o) const { return x != o.x ? x < o.x : (y != o.y ? y < o.y : z < o.z); }
+  bool operator==(const VoxelKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel);
+
 // Spatial index: a voxel hash over each Gaussian's box of +/- `extent_sigmas`
 // standard deviations, so a query point has a few candidates; association is
 // the candidate of smallest Mahalanobis^2, gated by tau^2.
