@@ -16,7 +16,12 @@ namespace radargauss {
 
 struct CeresSolverOptions {
   bool dogleg = false;           // Levenberg-Marquardt (default) or dogleg
-  int max_inner_iterations = 10; // Ceres iterations per association
+  // Ceres iterations per solve, i.e. per association. Few: the outer loop
+  // re-associates after each solve, and iterating a fresh association to
+  // full convergence pays Jacobian evaluations for terms about to change; a
+  // match ends only once Ceres converged on an association the loop keeps
+  // (more solves on it when this limit cuts one short).
+  int max_inner_iterations = 3;
   int threads = 1;
   // Ceres's stopping rules per association (Ceres's defaults; the outer
   // loop's step tolerances decide convergence of the match).
