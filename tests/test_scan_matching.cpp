@@ -326,6 +326,44 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
   }
 }
 
+// Ceres's iteration limit per association only chunks the solve: on one
+// fixed association, 1 or 3 LM iterations per solve end where 100 do, because
+// a match ends only once Ceres converged on an association the loop keeps.
+TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
+  const World& world = SimulatedWorld();
+  const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
+  const MatchingMap single(world.view_map, ExactMapOnly());  // view incidence: a smooth cost
+  for (const double w : {0.0, 0.25}) {
+    ScanMatchingOptions options;
+    options.w_rcs = w;
+    options.reassociate = false;
+    options.max_iterations = 200;
+    options.translation_tolerance = 1e-12;  // the outer loop stops on Ceres's convergence
+    options.rotation_tolerance = 1e-12;
+    CeresSolverOptions ceres_options;
+    ceres_options.function_tolerance = 1e-12;
+    ceres_options.parameter_tolerance = 1e-12;
+    const SE3d initial = Perturbed(truth, 0.1, 0.5, 6);
+    const RadarScan& scan = world.simulated.scans[kTestScan];
+    ceres_options.max_inner_iterations = 100;
+    const ScanMatchingResult reference = CeresSolver(options, ceres_options).Match(scan, single, initial);
+    ASSERT_TRUE(reference.converged) << reference.reason;
+    EXPECT_EQ(reference.iterations, 1) << "w " << w;  // one solve on the one association
+    for (const int limit : {1, 3}) {
+      ceres_options.max_inner_iterations = limit;
+      const ScanMatchingResult chunked = CeresSolver(options, ceres_options).Match(scan, single, initial);
+      ASSERT_TRUE(chunked.converged) << chunked.reason;
+      double dt = 0.0, dr = 0.0;
+      PoseError(chunked.pose, reference.pose, dt, dr);
+      EXPECT_LT(dt, 1e-6) << "w " << w << ", limit " << limit;
+      EXPECT_LT(dr, 1e-5) << "w " << w << ", limit " << limit;
+      if (limit == 1) {
+        EXPECT_GT(chunked.iterations, 1) << "w " << w;  // the limit did cut the solve
+      }
+    }
+  }
+}
+
 // The Ceres problem kept across associations holds exactly the latest
 // association: after updates that grow and shrink the term counts, change
 // level and weight, its cost (Ceres: 1/2 sum) is eq. 2 as EvaluateCost gives
