@@ -157,16 +157,15 @@ void MatchScans(benchmark::State& state, const ScanMatcher& solver, const Matchi
   std::vector<double> times;
   for (auto _ : state) {
     const ScanMatchingResult result = solver.Match(scans.scans[k], map, initial[k]);
-    const SE3d& truth = scans.ground_truth[k].pose;
-    const double t_err = (result.pose.translation() - truth.translation()).norm();
-    const double r_err = (truth.rotation().Inverse() * result.pose.rotation()).Log().norm();
+    double t_err = 0.0, r_err_deg = 0.0;
+    PoseErrors(result.pose, scans.ground_truth[k].pose, t_err, r_err_deg);
     times.push_back(result.time_ms);
     points += scans.scans[k].points.size();
     converged += result.converged;
     iterations += result.iterations;
     translation_error += t_err;
-    rotation_error += r_err;
-    within += t_err < 0.1 && r_err < 0.5 * M_PI / 180.0;
+    rotation_error += r_err_deg;
+    within += t_err < 0.1 && r_err_deg < 0.5;
     ++runs;
     k = (k + 1) % scans.scans.size();
   }
@@ -177,7 +176,7 @@ void MatchScans(benchmark::State& state, const ScanMatcher& solver, const Matchi
   state.counters["median_ms"] = MedianMs(times);
   state.counters["converged"] = double(converged) / double(runs);
   state.counters["t_err_m"] = translation_error / double(runs);
-  state.counters["r_err_deg"] = rotation_error / double(runs) * 180.0 / M_PI;
+  state.counters["r_err_deg"] = rotation_error / double(runs);
 }
 
 // Args: points per scan, solver (0 gn, 1 gn-autodiff, 2 ceres, 3 mh8-gn), w_rcs x 100.

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <random>
 
+#include "radargauss/experiment.hpp"
 #include "radargauss/map/builder.hpp"
 #include "radargauss/map/map_cloud.hpp"
 #include "radargauss/map/rcs_model.hpp"
@@ -202,11 +203,6 @@ SE3d Perturbed(const SE3d& pose, double translation, double angle_deg, std::uint
               pose.translation() + translation * RandomUnitVector(rng));
 }
 
-void PoseError(const SE3d& estimate, const SE3d& truth, double& translation, double& rotation_deg) {
-  translation = (estimate.translation() - truth.translation()).norm();
-  rotation_deg = (truth.rotation().Inverse() * estimate.rotation()).Log().norm() * 180.0 / M_PI;
-}
-
 struct SolverCase {
   std::string name;
   double w_rcs;
@@ -229,7 +225,7 @@ TEST_P(SolverTest, ConvergesFromTwoMetresFiveDegrees) {
   for (const std::uint32_t seed : {1u, 2u, 3u}) {
     const ScanMatchingResult result = solver->Match(scan, *world.matching, Perturbed(truth, 2.0, 5.0, seed));
     double dt = 0.0, dr = 0.0;
-    PoseError(result.pose, truth, dt, dr);
+    PoseErrors(result.pose, truth, dt, dr);
     EXPECT_TRUE(result.converged) << result.reason;
     EXPECT_LT(dt, 0.05) << GetParam().name << " seed " << seed;
     EXPECT_LT(dr, 0.2) << GetParam().name << " seed " << seed;
@@ -310,7 +306,7 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
     const ScanMatchingResult lm =
         CeresSolver(options, ceres_options).Match(world.simulated.scans[kTestScan], single, initial);
     double dt = 0.0, dr = 0.0;
-    PoseError(gn.pose, lm.pose, dt, dr);
+    PoseErrors(gn.pose, lm.pose, dt, dr);
     const bool smooth = w == 0.0 || map->incidence == IncidenceModel::kView;
     std::printf("w %.2f, %s incidence: GN cost %.10f (%d it), LM cost %.10f; pose difference %.2e m, %.2e rad\n",
                 w, ToString(map->incidence).c_str(), gn.final_cost, gn.iterations, lm.final_cost, dt,
@@ -354,7 +350,7 @@ TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
       const ScanMatchingResult chunked = CeresSolver(options, ceres_options).Match(scan, single, initial);
       ASSERT_TRUE(chunked.converged) << chunked.reason;
       double dt = 0.0, dr = 0.0;
-      PoseError(chunked.pose, reference.pose, dt, dr);
+      PoseErrors(chunked.pose, reference.pose, dt, dr);
       EXPECT_LT(dt, 1e-6) << "w " << w << ", limit " << limit;
       EXPECT_LT(dr, 1e-5) << "w " << w << ", limit " << limit;
       if (limit == 1) {
@@ -436,7 +432,7 @@ TEST(RotationOnlyRcs, TranslationFixedAtWeightOne) {
       const SE3d rotated(truth.rotation() * SO3d::Exp(Eigen::Vector3d(0, 0, M_PI / 180.0)), truth.translation());
       const ScanMatchingResult result = solver->Match(world.simulated.scans[kTestScan], single, rotated);
       double dt = 0.0, dr = 0.0;
-      PoseError(result.pose, truth, dt, dr);
+      PoseErrors(result.pose, truth, dt, dr);
       EXPECT_EQ(dt, 0.0) << name;
       std::printf("%s, w = 1, %s incidence, RCS alone: rotation error 1.000 -> %.3f deg\n", name.c_str(),
                   ToString(map->incidence).c_str(), dr);
@@ -517,7 +513,7 @@ TEST(RotationOnlyRcs, RcsAloneReducesAPureRotationErrorOnPlantedModels) {
         const SE3d rotated(world.truth.rotation() * SO3d::Exp(M_PI / 180.0 * axis), world.truth.translation());
         const ScanMatchingResult result = solver->Match(world.scan, single, rotated);
         double dt = 0.0, dr = 0.0;
-        PoseError(result.pose, world.truth, dt, dr);
+        PoseErrors(result.pose, world.truth, dt, dr);
         std::printf("%s, %s incidence, planted RCS, noise %.1f, w = 1: rotation error 1.000 -> %.4f deg (N_rcs %zu)\n",
                     name.c_str(), ToString(incidence).c_str(), rcs_noise, dr, result.n_rcs);
         EXPECT_EQ(dt, 0.0) << name;
@@ -589,7 +585,7 @@ TEST(LazyReassociation, SameOptimumFewerIterations) {
     const ScanMatchingResult a = GaussNewtonSolver(eager).Match(world.simulated.scans[scan], exact, initial);
     const ScanMatchingResult b = GaussNewtonSolver(lazy).Match(world.simulated.scans[scan], exact, initial);
     double dt = 0.0, dr = 0.0;
-    PoseError(a.pose, b.pose, dt, dr);
+    PoseErrors(a.pose, b.pose, dt, dr);
     EXPECT_LT(dt, 0.02) << "scan " << scan;
     EXPECT_LT(dr, 0.1) << "scan " << scan;
     EXPECT_TRUE(b.converged) << b.reason;
@@ -678,7 +674,7 @@ TEST(MergedCoarseLevels, ConvergesFromTwoMetresFiveDegrees) {
         for (const std::uint32_t seed : {1u, 2u, 3u}) {
           const ScanMatchingResult result = solver->Match(scan, merged, Perturbed(truth, 2.0, 5.0, seed));
           double dt = 0.0, dr = 0.0;
-          PoseError(result.pose, truth, dt, dr);
+          PoseErrors(result.pose, truth, dt, dr);
           EXPECT_TRUE(result.converged) << result.reason;
           EXPECT_LT(dt, 0.05) << name << " w " << w << " coarse points " << coarse_points << " seed " << seed;
           EXPECT_LT(dr, 0.2) << name << " w " << w << " coarse points " << coarse_points << " seed " << seed;
@@ -711,7 +707,7 @@ TEST(JointRefinement, LowersPoseErrorAndRcsResidual) {
     translation = rotation_deg = 0.0;
     for (std::size_t k = 0; k < poses.size(); ++k) {
       double dt = 0.0, dr = 0.0;
-      PoseError(poses[k], truth[k], dt, dr);
+      PoseErrors(poses[k], truth[k], dt, dr);
       translation += dt / poses.size();
       rotation_deg += dr / poses.size();
     }
