@@ -190,12 +190,10 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
         (result.pose.translation() - before.translation()).norm() < level.looseness * options_.translation_tolerance &&
         step.rotation().Log().norm() < level.looseness * options_.rotation_tolerance;
     // Converged when the pose settled, or when Ceres converged on an
-    // association the outer loop would keep (a fixed one, or on the exact map
-    // one the pose has not moved past the re-association thresholds from):
-    // the next solve would be the same problem from its own solution.
-    const bool association_kept =
-        !options_.reassociate || (level.finest && !MovedPastReassociation(c.pose, result.pose, options_));
-    if (small || (association_kept && summary.termination_type == ceres::CONVERGENCE)) {
+    // association the outer loop keeps: the next solve would be the same
+    // problem from its own solution.
+    if (small || (KeepsAssociation(level.finest, c.pose, result.pose, options_) &&
+                  summary.termination_type == ceres::CONVERGENCE)) {
       return StepOutcome::kConverged;
     }
     return StepOutcome::kContinue;

@@ -167,9 +167,12 @@ bool CheckCorrespondences(const RadarScan& scan, const Correspondences& c,
   return true;
 }
 
-bool MovedPastReassociation(const SE3d& associated_at, const SE3d& pose, const ScanMatchingOptions& options) {
-  return (pose.translation() - associated_at.translation()).norm() > options.reassociation_translation ||
-         (associated_at.rotation().Inverse() * pose.rotation()).Log().norm() > options.reassociation_rotation;
+bool KeepsAssociation(bool exact_level, const SE3d& associated_at, const SE3d& pose,
+                      const ScanMatchingOptions& options) {
+  if (!options.reassociate) return true;
+  return exact_level &&
+         (pose.translation() - associated_at.translation()).norm() <= options.reassociation_translation &&
+         (associated_at.rotation().Inverse() * pose.rotation()).Log().norm() <= options.reassociation_rotation;
 }
 
 namespace {
@@ -209,7 +212,7 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     const RadarScan& level_scan = finest ? scan : coarse_scan;
     c = FindCorrespondences(level_scan, map, level, result.pose, options.gate, with_rcs);
     for (int iteration = 1; iteration <= max_iterations; ++iteration) {
-      if (options.reassociate && iteration > 1 && (!finest || MovedPastReassociation(c.pose, result.pose, options))) {
+      if (iteration > 1 && !KeepsAssociation(finest, c.pose, result.pose, options)) {
         c = FindCorrespondences(level_scan, map, level, result.pose, options.gate, with_rcs);
       }
       if (!CheckCorrespondences(level_scan, c, level_options, result.reason)) {
@@ -231,8 +234,7 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     // The final association: the last one, when it was made on the exact map
     // within the re-association thresholds of the final pose (or when not
     // re-associating); otherwise a new one at the final pose.
-    const bool last_is_final =
-        !options.reassociate || (c.index == &map.index() && !MovedPastReassociation(c.pose, result.pose, options));
+    const bool last_is_final = KeepsAssociation(c.index == &map.index(), c.pose, result.pose, options);
     const Correspondences final_c =
         last_is_final ? c : FindCorrespondences(scan, map, map.levels() - 1, result.pose, options.gate, w > 0.0);
     result.n_geo = final_c.geometric.size();

@@ -130,9 +130,12 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
 double EvaluateCost(const Correspondences& correspondences, const SE3d& pose,
                     const ScanMatchingOptions& options);
 
-// Whether the pose has moved past the re-association thresholds since
-// `associated_at` (the lazy rule of the exact map; see ScanMatchingOptions).
-bool MovedPastReassociation(const SE3d& associated_at, const SE3d& pose, const ScanMatchingOptions& options);
+// Whether the outer loop keeps correspondences made at `associated_at` once
+// the pose is `pose`: always when not re-associating; on the exact map (the
+// lazy rule, see ScanMatchingOptions) until the pose has moved past the
+// re-association thresholds; never on a coarse level.
+bool KeepsAssociation(bool exact_level, const SE3d& associated_at, const SE3d& pose,
+                      const ScanMatchingOptions& options);
 
 // Checks the inputs every solver shares; false with a reason for an empty
 // scan or a term that has no residuals although its weight is not zero.
