@@ -2,9 +2,13 @@
 // 5), for a radar point p_r whose normalised RCS y (with the associated
 // Gaussian's median and scale) lies in [-1, 1]:
 //
-//   r_rcs = y - c . Y(d),   d = IncidenceDirection(model, p_r, mu_r),
+//   r_rcs = y - c . Y(d),   d = s u / |u|,   u = IncidenceVector(model, p_r, mu_r),
 //   mu_r  = R^T (mu - t)    (the Gaussian centre in the radar frame),
 //
+// with the facing sign s (d.x <= 0) taken at the pose of the association and
+// held, like the associated Gaussian, until the next association: the
+// paper's flip of d at u.x = 0 would make eq. 2 jump (odd SH bands) wherever
+// a point crosses its Gaussian's y-z plane, and solvers need a smooth cost.
 // with the Gaussian's SH coefficients c up to its degree (runtime). Two forms:
 //   RcsResidual          rotation and translation blocks ("full");
 //   RcsRotationResidual  the rotation block only, the translation a constant
@@ -35,6 +39,7 @@ struct RcsTerm {
   int degree = 0;
   std::array<double, ShCoefficientCount(kMaxShDegree)> coefficients{};
   IncidenceModel incidence = IncidenceModel::kOffset;
+  double facing = 1.0;          // s: FacingSign(u) at the association's pose
   std::uint32_t gaussian = 0;   // index in the map (for joint refinement)
 };
 
@@ -45,8 +50,9 @@ T RcsResidualValue(const RcsTerm& term, const T* rotation, const Eigen::Matrix<T
                    const CoefficientT* coefficients) {
   const Eigen::Map<const Eigen::Quaternion<T>> q(rotation);
   const Eigen::Matrix<T, 3, 1> mean_radar = q.conjugate() * (term.mean.cast<T>() - translation);
-  const Eigen::Matrix<T, 3, 1> d =
-      IncidenceDirection<T>(term.incidence, term.point_radar.cast<T>(), mean_radar);
+  const Eigen::Matrix<T, 3, 1> u = IncidenceVector<T>(term.incidence, term.point_radar.cast<T>(), mean_radar);
+  using std::sqrt;
+  const Eigen::Matrix<T, 3, 1> d = u * (T(term.facing) / sqrt(u.squaredNorm()));
   return T(term.measurement) - EvaluateSh<T>(term.degree, coefficients, d);
 }
 
@@ -103,7 +109,7 @@ class RcsRotationResidual {
 
 // Analytic linearisation shared by the analytic twins: the residual, its
 // derivative with respect to u (the un-normalised incidence vector) and u's
-// derivatives. With d = s u / |u| (s = -1 when u.x > 0):
+// derivatives. With d = s u / |u| (s the term's facing sign):
 //   dr/du = -(c^T dY/dd) s (I - d d^T) / |u|,
 //   u = p_r - mu_r (offset) or -mu_r (view), so du/dq = -d(R^T a)/dq and
 //   du/dt = R^T, with a = mu - t.
@@ -117,11 +123,9 @@ inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Quaternio
                                      const Eigen::Vector3d& translation) {
   RcsLinearisation out;
   out.mean_radar = q.conjugate() * (term.mean - translation);
-  const Eigen::Vector3d u = term.incidence == IncidenceModel::kOffset
-                                ? Eigen::Vector3d(term.point_radar - out.mean_radar)
-                                : Eigen::Vector3d(-out.mean_radar);
+  const Eigen::Vector3d u = IncidenceVector(term.incidence, term.point_radar, out.mean_radar);
   const double norm = u.norm();
-  const double sign = u.x() > 0.0 ? -1.0 : 1.0;
+  const double sign = term.facing;
   const Eigen::Vector3d d = sign * u / norm;
   double basis[ShCoefficientCount(kMaxShDegree)];
   double gradient[3 * ShCoefficientCount(kMaxShDegree)];

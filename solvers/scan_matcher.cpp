@@ -99,9 +99,7 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
     const double y = gaussian.rcs.Normalise(point.rcs);
     if (!(std::abs(y) <= 1.0)) continue;  // RCS outlier: no residual (eq. 2)
     const Eigen::Vector3d mean_radar = Rt * (gaussian.mean - pose.translation());
-    const Eigen::Vector3d u = map.map().incidence == IncidenceModel::kOffset
-                                  ? Eigen::Vector3d(point.position - mean_radar)
-                                  : Eigen::Vector3d(-mean_radar);
+    const Eigen::Vector3d u = IncidenceVector(map.map().incidence, point.position, mean_radar);
     if (u.squaredNorm() < 1e-12) continue;  // no incidence direction
     RcsTerm term;
     term.point_radar = point.position;
@@ -110,6 +108,7 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
     term.degree = gaussian.rcs.degree;
     term.coefficients = gaussian.rcs.coefficients;
     term.incidence = map.map().incidence;
+    term.facing = FacingSign(u);
     term.gaussian = std::uint32_t(g);
     out.rcs.push_back(term);
   }

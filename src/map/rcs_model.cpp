@@ -92,11 +92,9 @@ RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud,
       const SE3d world_to_radar = pose.Inverse();
       const Eigen::Vector3d point_radar = world_to_radar * cloud.points[i];
       const Eigen::Vector3d mean_radar = world_to_radar * gaussian.mean;
-      const Eigen::Vector3d v = options.incidence == IncidenceModel::kOffset
-                                    ? Eigen::Vector3d(point_radar - mean_radar)
-                                    : Eigen::Vector3d(-mean_radar);
-      if (v.squaredNorm() < 1e-18) continue;  // no direction: skip the member
-      directions.push_back(IncidenceDirection(options.incidence, point_radar, mean_radar));
+      const Eigen::Vector3d u = IncidenceVector(options.incidence, point_radar, mean_radar);
+      if (u.squaredNorm() < 1e-18) continue;  // no direction: skip the member
+      directions.push_back(FacingSign(u) * u.normalized());
       rcs.push_back(cloud.rcs[i]);
     }
     gaussian.rcs = cloud.has_rcs ? FitRcsModel(directions, rcs, options) : RcsModel{};

@@ -31,20 +31,19 @@ struct RcsNormalisation {
 
 RcsNormalisation NormaliseRcs(std::vector<double> rcs);
 
-// The incidence vector d (unit, radar frame, facing the radar: d.x <= 0) of a
-// point p_r for a Gaussian centred at mu_r, both in the radar frame.
-// Templated so that residuals can differentiate it. Requires a non-zero vector.
+// The incidence vector of a point p_r for a Gaussian centred at mu_r, both in
+// the radar frame, before normalising and facing: u = p_r - mu_r (offset) or
+// u = -mu_r (view). Templated so that residuals can differentiate it.
 template <typename T>
-Eigen::Matrix<T, 3, 1> IncidenceDirection(IncidenceModel model,
-                                          const Eigen::Matrix<T, 3, 1>& point_radar,
-                                          const Eigen::Matrix<T, 3, 1>& mean_radar) {
-  Eigen::Matrix<T, 3, 1> d = model == IncidenceModel::kOffset ? Eigen::Matrix<T, 3, 1>(point_radar - mean_radar)
-                                                              : Eigen::Matrix<T, 3, 1>(-mean_radar);
-  using std::sqrt;
-  d /= sqrt(d.squaredNorm());
-  if (d.x() > T(0.0)) d = -d;
-  return d;
+Eigen::Matrix<T, 3, 1> IncidenceVector(IncidenceModel model, const Eigen::Matrix<T, 3, 1>& point_radar,
+                                       const Eigen::Matrix<T, 3, 1>& mean_radar) {
+  return model == IncidenceModel::kOffset ? Eigen::Matrix<T, 3, 1>(point_radar - mean_radar)
+                                          : Eigen::Matrix<T, 3, 1>(-mean_radar);
 }
+
+// The sign s that makes s u face the radar ((s u).x <= 0): the incidence
+// direction is d = s u / |u| (DESIGN.md section 4, item 3).
+inline double FacingSign(const Eigen::Vector3d& u) { return u.x() > 0.0 ? -1.0 : 1.0; }
 
 struct RcsFitOptions {
   int max_degree = kMaxShDegree;
