@@ -5,11 +5,11 @@
 //   r_rcs = y - c . Y(d),   d = s u / |u|,   u = IncidenceVector(model, p_r, mu_r),
 //   mu_r  = R^T (mu - t)    (the Gaussian centre in the radar frame),
 //
-// with the facing sign s (d.x <= 0) taken at the pose of the association and
-// held, like the associated Gaussian, until the next association: the
-// paper's flip of d at u.x = 0 would make eq. 2 jump (odd SH bands) wherever
-// a point crosses its Gaussian's y-z plane, and solvers need a smooth cost.
-// with the Gaussian's SH coefficients c up to its degree (runtime). Two forms:
+// with the Gaussian's SH coefficients c up to its degree (runtime), and the
+// facing sign s (d.x <= 0) taken at the pose of the association and held,
+// like the associated Gaussian, until the next association: the paper's flip
+// of d at u.x = 0 would make eq. 2 jump (odd SH bands) wherever a point
+// crosses its Gaussian's y-z plane, and solvers need a smooth cost. Two forms:
 //   RcsResidual          rotation and translation blocks ("full");
 //   RcsRotationResidual  the rotation block only, the translation a constant
 //                        of the current association (the paper's choice).
@@ -125,8 +125,7 @@ inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Quaternio
   out.mean_radar = q.conjugate() * (term.mean - translation);
   const Eigen::Vector3d u = IncidenceVector(term.incidence, term.point_radar, out.mean_radar);
   const double norm = u.norm();
-  const double sign = term.facing;
-  const Eigen::Vector3d d = sign * u / norm;
+  const Eigen::Vector3d d = term.facing * u / norm;
   double basis[ShCoefficientCount(kMaxShDegree)];
   double gradient[3 * ShCoefficientCount(kMaxShDegree)];
   EvaluateShBasis(term.degree, d, basis);
@@ -138,7 +137,7 @@ inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Quaternio
     c_dY += term.coefficients[i] * Eigen::Map<const Eigen::RowVector3d>(gradient + 3 * i);
   }
   out.residual = term.measurement - prediction;
-  out.dr_du = -c_dY * (sign / norm) * (Eigen::Matrix3d::Identity() - d * d.transpose());
+  out.dr_du = -c_dY * (term.facing / norm) * (Eigen::Matrix3d::Identity() - d * d.transpose());
   return out;
 }
 
@@ -150,9 +149,12 @@ class RcsCostFunction final : public ceres::SizedCostFunction<1, 4, 3> {
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
     const Eigen::Map<const Eigen::Vector3d> t(parameters[1]);
+    if (jacobians == nullptr) {  // the cost alone (Ceres's step evaluations)
+      residuals[0] = RcsResidualValue<double>(term_, parameters[0], t);
+      return true;
+    }
     const RcsLinearisation lin = LineariseRcs(term_, q, t);
     residuals[0] = lin.residual;
-    if (jacobians == nullptr) return true;
     if (jacobians[0] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
       J = -lin.dr_du * InverseRotatePointJacobian(parameters[0], term_.mean - t);
@@ -177,10 +179,14 @@ class RcsRotationCostFunction final : public ceres::SizedCostFunction<1, 4> {
       : term_(term), translation_(translation) {}
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    if (jacobians == nullptr) {  // the cost alone (Ceres's step evaluations)
+      residuals[0] = RcsResidualValue<double>(term_, parameters[0], translation_);
+      return true;
+    }
     const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
     const RcsLinearisation lin = LineariseRcs(term_, q, translation_);
     residuals[0] = lin.residual;
-    if (jacobians != nullptr && jacobians[0] != nullptr) {
+    if (jacobians[0] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
       J = -lin.dr_du * InverseRotatePointJacobian(parameters[0], term_.mean - translation_);
     }

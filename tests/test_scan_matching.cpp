@@ -125,6 +125,9 @@ TEST_P(JacobianTest, RcsAnalyticAutodiffNumeric) {
     const Eigen::VectorXd ra = EvaluateWithJacobians(analytic, blocks, ja);
     const Eigen::VectorXd rd = EvaluateWithJacobians(*autodiff, blocks, jd);
     EXPECT_NEAR(ra[0], rd[0], 1e-12);
+    double cost_only = 0.0;  // the residual-only path (no Jacobians requested)
+    ASSERT_TRUE(analytic.Evaluate(blocks.data(), &cost_only, nullptr));
+    EXPECT_NEAR(cost_only, ra[0], 1e-14);
     for (int b = 0; b < 2; ++b) {
       EXPECT_LT(Relative(ja[b], jd[b]), 1e-8) << "block " << b;
       EXPECT_LT(Relative(ja[b], NumericBlockJacobian(analytic, blocks, b)), 1e-5) << "block " << b;
@@ -133,8 +136,10 @@ TEST_P(JacobianTest, RcsAnalyticAutodiffNumeric) {
     const RcsRotationCostFunction analytic_rotation(term, t);
     const std::unique_ptr<ceres::CostFunction> autodiff_rotation(RcsRotationResidual::Create(term, t));
     const std::vector<double*> rotation_block = {q.data()};
-    EvaluateWithJacobians(analytic_rotation, rotation_block, ja);
+    const Eigen::VectorXd rotation_residual = EvaluateWithJacobians(analytic_rotation, rotation_block, ja);
     EvaluateWithJacobians(*autodiff_rotation, rotation_block, jd);
+    ASSERT_TRUE(analytic_rotation.Evaluate(rotation_block.data(), &cost_only, nullptr));
+    EXPECT_NEAR(cost_only, rotation_residual[0], 1e-14);
     EXPECT_LT(Relative(ja[0], jd[0]), 1e-8);
     EXPECT_LT(Relative(ja[0], NumericBlockJacobian(analytic_rotation, rotation_block, 0)), 1e-5);
   }
