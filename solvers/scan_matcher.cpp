@@ -86,6 +86,7 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
   out.pose = pose;
   out.geometric.reserve(scan.points.size());
   const bool rcs = with_rcs && scan.has_rcs;
+  if (rcs) out.rcs.reserve(scan.points.size());
   const Eigen::Matrix3d R = pose.rotation().Matrix();
   const Eigen::Matrix3d Rt = R.transpose();
   for (const RadarPoint& point : scan.points) {
