@@ -208,6 +208,17 @@ void BM_MatchScanMerged(benchmark::State& state) {
 }
 BENCHMARK(BM_MatchScanMerged)->ArgsProduct({{0, 2}, {0, 25}, {0, 400}})->Unit(benchmark::kMillisecond);
 
+// Tracking's initial poses: 5 cm and 0.2 deg (yaw) off the truth, as a
+// motion model would give them.
+std::vector<SE3d> TrackingPoses(const SimulatedSequence& sequence) {
+  std::vector<SE3d> initial;
+  for (const auto& sample : sequence.ground_truth) {
+    initial.emplace_back(sample.pose.rotation() * SO3d::Exp(Eigen::Vector3d(0, 0, 0.2 * M_PI / 180.0)),
+                         sample.pose.translation() + Eigen::Vector3d(0.05, 0.0, 0.0));
+  }
+  return initial;
+}
+
 // Refinement only (the exact map, from 5 cm / 0.2 deg): the per-scan latency
 // of tracking, where the coarse levels are not needed.
 void BM_RefineScan(benchmark::State& state) {
@@ -215,16 +226,41 @@ void BM_RefineScan(benchmark::State& state) {
   const MatchingWorld& world = World();
   const MatchingMap exact(world.map, ExactMapOnly());
   const SimulatedSequence& scans = world.scans.at(800);
-  std::vector<SE3d> initial;
-  for (const auto& sample : scans.ground_truth) {
-    initial.emplace_back(sample.pose.rotation() * SO3d::Exp(Eigen::Vector3d(0, 0, 0.2 * M_PI / 180.0)),
-                         sample.pose.translation() + Eigen::Vector3d(0.05, 0.0, 0.0));
-  }
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(1)) / 100.0;
-  MatchScans(state, *Solver(int(state.range(0)), options), exact, scans, initial, options.w_rcs);
+  MatchScans(state, *Solver(int(state.range(0)), options), exact, scans, TrackingPoses(scans), options.w_rcs);
 }
 BENCHMARK(BM_RefineScan)->ArgsProduct({{0, 1, 2}, {0, 25}})->Unit(benchmark::kMillisecond);
+
+// Ceres LM against the own GN when tracking, the two interleaved scan by
+// scan so that this shared machine's load drifts over both alike: the medians
+// of their per-scan times and the ratio of the medians (the goal: <= 5x).
+// Arg: w_rcs x 100.
+void BM_RefineScanCeresOverGn(benchmark::State& state) {
+  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const MatchingWorld& world = World();
+  const MatchingMap exact(world.map, ExactMapOnly());
+  const SimulatedSequence& scans = world.scans.at(800);
+  const std::vector<SE3d> initial = TrackingPoses(scans);
+  ScanMatchingOptions options;
+  options.w_rcs = double(state.range(0)) / 100.0;
+  const std::unique_ptr<ScanMatcher> gn = Solver(0, options);
+  const std::unique_ptr<ScanMatcher> ceres = Solver(2, options);
+  std::vector<double> gn_times, ceres_times;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    gn_times.push_back(gn->Match(scans.scans[k], exact, initial[k]).time_ms);
+    ceres_times.push_back(ceres->Match(scans.scans[k], exact, initial[k]).time_ms);
+    k = (k + 1) % scans.scans.size();
+  }
+  const double gn_median = MedianMs(gn_times);
+  const double ceres_median = MedianMs(ceres_times);
+  state.SetLabel("ceres / gn, w=" + std::to_string(options.w_rcs).substr(0, 4));
+  state.counters["gn_median_ms"] = gn_median;
+  state.counters["ceres_median_ms"] = ceres_median;
+  state.counters["ratio"] = ceres_median / gn_median;
+}
+BENCHMARK(BM_RefineScanCeresOverGn)->Arg(0)->Arg(25)->Unit(benchmark::kMillisecond);
 
 // The parts of one outer iteration on the exact map, 800 points at the
 // reference pose: association (FindCorrespondences) and the normal equations
