@@ -147,12 +147,12 @@ class RcsCostFunction final : public ceres::SizedCostFunction<1, 4, 3> {
   explicit RcsCostFunction(const RcsTerm& term) : term_(term) {}
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
     const Eigen::Map<const Eigen::Vector3d> t(parameters[1]);
     if (jacobians == nullptr) {  // the cost alone (Ceres's step evaluations)
       residuals[0] = RcsResidualValue<double>(term_, parameters[0], t);
       return true;
     }
+    const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
     const RcsLinearisation lin = LineariseRcs(term_, q, t);
     residuals[0] = lin.residual;
     if (jacobians[0] != nullptr) {

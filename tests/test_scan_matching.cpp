@@ -286,13 +286,22 @@ TEST(GaussNewton, AnalyticAndAutodiffSystemsAgree) {
   }
 }
 
-// The paper's RCS residual, written out: d = normalize(u), flipped when d.x > 0.
-double PaperRcsResidual(const RcsTerm& term, const SE3d& pose) {
-  const Eigen::Vector3d mean_radar = pose.rotation().Inverse() * (term.mean - pose.translation());
-  Eigen::Vector3d d = term.incidence == IncidenceModel::kOffset ? Eigen::Vector3d(term.point_radar - mean_radar)
-                                                                : Eigen::Vector3d(-mean_radar);
+// The paper's incidence direction, written out (the reference the library's
+// IncidenceVector and FacingSign are tested against): d = normalize(u),
+// u = p_r - mu_r (offset) or -mu_r (view), flipped when d.x > 0.
+Eigen::Vector3d PaperIncidenceDirection(IncidenceModel incidence, const Eigen::Vector3d& point_radar,
+                                        const Eigen::Vector3d& mean_radar) {
+  Eigen::Vector3d d = incidence == IncidenceModel::kOffset ? Eigen::Vector3d(point_radar - mean_radar)
+                                                           : Eigen::Vector3d(-mean_radar);
   d.normalize();
   if (d.x() > 0.0) d = -d;
+  return d;
+}
+
+// The paper's RCS residual, with the direction re-evaluated at `pose`.
+double PaperRcsResidual(const RcsTerm& term, const SE3d& pose) {
+  const Eigen::Vector3d mean_radar = pose.rotation().Inverse() * (term.mean - pose.translation());
+  const Eigen::Vector3d d = PaperIncidenceDirection(term.incidence, term.point_radar, mean_radar);
   return term.measurement - EvaluateSh<double>(term.degree, term.coefficients.data(), d);
 }
 
@@ -526,11 +535,8 @@ PlantedRcsWorld MakePlantedRcsWorld(IncidenceModel incidence, double rcs_noise) 
       for (int k = 0; k < 12; ++k) {
         RadarPoint point;
         point.position = world.truth.Inverse() * (g.mean + Eigen::Vector3d(offset(rng), offset(rng), offset(rng)));
-        // u in the radar frame at the true pose; d faces the radar (d.x <= 0).
-        const Eigen::Vector3d u = incidence == IncidenceModel::kOffset ? Eigen::Vector3d(point.position - mean_radar)
-                                                                       : Eigen::Vector3d(-mean_radar);
-        Eigen::Vector3d d = u.normalized();
-        if (d.x() > 0.0) d = -d;
+        // d in the radar frame at the true pose.
+        const Eigen::Vector3d d = PaperIncidenceDirection(incidence, point.position, mean_radar);
         const Eigen::Matrix<double, 9, 1> basis = ShBasis<2, double>(d);
         point.rcs = basis.dot(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(g.rcs.coefficients.data())) + noise(rng);
         world.scan.points.push_back(point);
