@@ -149,6 +149,15 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
   EXPECT_GT(associated, 50);
 }
 
+TEST(GaussianIndexTest, EmptyIndexAssociatesNothing) {
+  const Eigen::Vector3d p(0.1, -0.2, 0.3);
+  std::size_t count = 1;
+  EXPECT_EQ(GaussianIndex().Associate(p, 9.0), -1);
+  EXPECT_EQ(GaussianIndex().Candidates(p, count), nullptr);
+  EXPECT_EQ(count, 0u);
+  EXPECT_EQ(GaussianIndex({}, 0.5).Associate(p, 9.0), -1);
+}
+
 // ---------------------------------------------------------------------------
 // RCS models.
 

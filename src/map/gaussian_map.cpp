@@ -86,26 +86,41 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
   }
   std::sort(entries.begin(), entries.end());
   cell_entries_.resize(entries.size());
-  cells_.reserve(entries.size() / 2 + 1);
+  std::size_t cell_count = 0;
+  for (std::size_t k = 0; k < entries.size(); ++k) cell_count += k == 0 || entries[k].first != entries[k - 1].first;
+  std::size_t slots = 2;
+  for (slot_shift_ = 63; slots < 2 * cell_count; --slot_shift_) slots *= 2;
+  cells_.assign(slots, Cell());
   for (std::size_t begin = 0; begin < entries.size();) {
     std::size_t end = begin;
     while (end < entries.size() && entries[end].first == entries[begin].first) {
       cell_entries_[end] = entries[end].second;
       ++end;
     }
-    cells_.emplace(entries[begin].first, std::make_pair(std::uint32_t(begin), std::uint32_t(end)));
+    Cell& cell = cells_[Slot(entries[begin].first)];
+    cell.key = entries[begin].first;
+    cell.begin = std::uint32_t(begin);
+    cell.end = std::uint32_t(end);
     begin = end;
   }
 }
 
+std::size_t GaussianIndex::Slot(std::int64_t key) const {
+  const std::size_t mask = cells_.size() - 1;
+  // Fibonacci hashing: the product's top bits mix all of the key's bits.
+  std::size_t slot = std::size_t((std::uint64_t(key) * 0x9E3779B97F4A7C15ull) >> slot_shift_);
+  while (cells_[slot].key != key && cells_[slot].key != kEmptyCell) slot = (slot + 1) & mask;
+  return slot;
+}
+
 const std::uint32_t* GaussianIndex::Candidates(const Eigen::Vector3d& point, std::size_t& count) const {
-  const auto it = cells_.find(Key(point));
-  if (it == cells_.end()) {
+  if (cells_.empty()) {  // a default-constructed index
     count = 0;
     return nullptr;
   }
-  count = it->second.second - it->second.first;
-  return cell_entries_.data() + it->second.first;
+  const Cell& cell = cells_[Slot(Key(point))];
+  count = cell.end - cell.begin;  // 0 for an empty slot
+  return cell_entries_.data() + cell.begin;
 }
 
 int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
@@ -132,7 +147,7 @@ int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
 std::size_t GaussianIndex::MemoryBytes() const {
   return gaussians_.size() * sizeof(IndexedGaussian) +
          cell_entries_.size() * sizeof(std::uint32_t) +
-         cells_.size() * (sizeof(std::int64_t) + 2 * sizeof(std::uint32_t) + 2 * sizeof(void*));
+         cells_.size() * sizeof(Cell);
 }
 
 }  // namespace radargauss

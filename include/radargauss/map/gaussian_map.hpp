@@ -6,7 +6,6 @@
 #include <array>
 #include <cstdint>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -104,7 +103,18 @@ class GaussianIndex {
   };
   std::vector<IndexedGaussian> gaussians_;
   std::vector<std::uint32_t> cell_entries_;  // Gaussian ids grouped by cell
-  std::unordered_map<std::int64_t, std::pair<std::uint32_t, std::uint32_t>> cells_;  // key -> [begin, end)
+  // The cells: an open-addressing hash table (linear probing, power-of-two
+  // size, at most half full), so that a query reads one or two adjacent
+  // slots instead of chasing a node-based map's pointers.
+  struct Cell {
+    std::int64_t key = kEmptyCell;
+    std::uint32_t begin = 0, end = 0;  // [begin, end) in cell_entries_
+  };
+  static constexpr std::int64_t kEmptyCell = -1;  // packed keys are >= 0
+  std::vector<Cell> cells_;
+  int slot_shift_ = 64;  // 64 - log2(cells_.size())
+  // The slot holding `key`, or the empty slot where it would go.
+  std::size_t Slot(std::int64_t key) const;
 };
 
 }  // namespace radargauss
