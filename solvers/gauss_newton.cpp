@@ -30,15 +30,17 @@ void SeedJets(const SE3d& pose, const Eigen::Vector3d& translation, Jet7 rotatio
   for (int i = 0; i < 3; ++i) t[i] = Jet7(translation[i], 4 + i);
 }
 
-// Fixed sizes throughout: this is the inner loop of every iteration.
-template <int Rows>
-void Accumulate(LinearSystem& system, const Eigen::Matrix<double, Rows, 6>& J,
+// Fixed sizes throughout: this is the inner loop of every iteration. J holds
+// the columns of the tangent block starting at `offset` (all six, or the
+// rotation's three).
+template <int Rows, int Cols>
+void Accumulate(LinearSystem& system, int offset, const Eigen::Matrix<double, Rows, Cols>& J,
                 const Eigen::Matrix<double, Rows, 1>& r, const RobustLoss& loss) {
   double rho = 0.0, weight = 0.0;
   loss.Evaluate(r.squaredNorm(), rho, weight);
-  const Eigen::Matrix<double, Rows, 6> weighted_J = weight * J;
-  system.H.noalias() += weighted_J.transpose() * J;
-  system.g.noalias() += weighted_J.transpose() * r;
+  const Eigen::Matrix<double, Rows, Cols> weighted_J = weight * J;
+  system.H.block<Cols, Cols>(offset, offset).noalias() += weighted_J.transpose() * J;
+  system.g.segment<Cols>(offset).noalias() += weighted_J.transpose() * r;
   system.rho_sum += rho;
   ++system.residuals;
 }
@@ -109,7 +111,7 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     Matrix3x6 J;
     J.block<3, 3>(0, kTranslationOffset) = ambient.rightCols<3>();
     J.block<3, 3>(0, kRotationOffset) = ambient.leftCols<4>() * P;
-    Accumulate(system, J, r, loss);
+    Accumulate(system, 0, J, r, loss);
   }
   return system;
 }
@@ -119,8 +121,8 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
   LinearSystem system;
   const RobustLoss loss(options.rcs_loss);
   // Rotation-only: the translation is the association's constant.
-  const Eigen::Vector3d translation =
-      options.rcs_translation == RcsTranslation::kRotationOnly ? c.pose.translation() : pose.translation();
+  const bool rotation_only = options.rcs_translation == RcsTranslation::kRotationOnly;
+  const Eigen::Vector3d translation = rotation_only ? c.pose.translation() : pose.translation();
   const Eigen::Matrix3d Rt = pose.rotation().Matrix().transpose();
   const Eigen::Matrix<double, 4, 3> P = QuaternionTangent(pose.rotation());
   for (const RcsTerm& term : c.rcs) {
@@ -130,8 +132,8 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
       // du/ddt = R^T, du/ddphi = -[mu_r]x (conventions.hpp: right perturbation).
       const RcsLinearisation lin = LineariseRcs(term, pose.rotation().quaternion(), translation);
       r[0] = lin.residual;
-      J.block<1, 3>(0, kTranslationOffset) = lin.dr_du * Rt;
       J.block<1, 3>(0, kRotationOffset) = -lin.dr_du * SO3d::Hat(lin.mean_radar);
+      if (!rotation_only) J.block<1, 3>(0, kTranslationOffset) = lin.dr_du * Rt;
     } else {
       Jet7 rotation[4], t[3], residual[1];
       SeedJets(pose, translation, rotation, t);
@@ -141,15 +143,16 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
       J.block<1, 3>(0, kTranslationOffset) = residual[0].v.tail<3>().transpose();
       J.block<1, 3>(0, kRotationOffset) = residual[0].v.head<4>().transpose() * P;
     }
-    Accumulate(system, J, r, loss);
+    if (rotation_only) {
+      Accumulate(system, kRotationOffset, Eigen::Matrix<double, 1, 3>(J.block<1, 3>(0, kRotationOffset)), r, loss);
+    } else {
+      Accumulate(system, 0, J, r, loss);
+    }
   }
-  if (options.rcs_translation == RcsTranslation::kRotationOnly) {
+  if (rotation_only) {
     // The paper: translation rows/columns of the RCS Hessian -> identity,
-    // translation gradient -> zero.
+    // translation gradient -> zero (only the rotation block was accumulated).
     system.H.block<3, 3>(kTranslationOffset, kTranslationOffset).setIdentity();
-    system.H.block<3, 3>(kTranslationOffset, kRotationOffset).setZero();
-    system.H.block<3, 3>(kRotationOffset, kTranslationOffset).setZero();
-    system.g.segment<3>(kTranslationOffset).setZero();
   }
   return system;
 }

@@ -283,6 +283,26 @@ TEST(GaussNewton, AnalyticAndAutodiffSystemsAgree) {
     EXPECT_NEAR(ra.rho_sum, rd.rho_sum, 1e-9 * ra.rho_sum);
     const double f = 0.75 / double(ga.residuals) * ga.rho_sum + 0.25 / double(ra.residuals) * ra.rho_sum;
     EXPECT_NEAR(f, EvaluateCost(c, pose, analytic), 1e-12 * f);
+    if (mode == RcsTranslation::kRotationOnly) {
+      // The paper's rotation-only system: the translation rows/columns are
+      // the identity, the translation gradient zero, and the rotation block
+      // that of the full system (at the association's pose, where the two
+      // residuals coincide).
+      ScanMatchingOptions full = analytic;
+      full.rcs_translation = RcsTranslation::kFull;
+      const LinearSystem rf = BuildRcsSystem(c, pose, full);
+      const auto block = [](const LinearSystem& system, int row, int col) {
+        return Eigen::Matrix3d(system.H.block<3, 3>(row, col));
+      };
+      EXPECT_EQ(block(ra, kTranslationOffset, kTranslationOffset), Eigen::Matrix3d::Identity());
+      EXPECT_TRUE(block(ra, kTranslationOffset, kRotationOffset).isZero(0.0));
+      EXPECT_TRUE(block(ra, kRotationOffset, kTranslationOffset).isZero(0.0));
+      EXPECT_TRUE(ra.g.segment<3>(kTranslationOffset).isZero(0.0));
+      EXPECT_LT(Relative(block(ra, kRotationOffset, kRotationOffset), block(rf, kRotationOffset, kRotationOffset)),
+                1e-12);
+      EXPECT_LT(Relative(ra.g.segment<3>(kRotationOffset), rf.g.segment<3>(kRotationOffset)), 1e-12);
+      EXPECT_GT(block(rf, kTranslationOffset, kTranslationOffset).norm(), 0.0);
+    }
   }
 }
 
