@@ -165,11 +165,50 @@ std::string GaussNewtonSolver::Name() const {
   return options_.jacobians == JacobianMode::kAnalytic ? "gn" : "gn-autodiff";
 }
 
+namespace {
+
+// Whether two correspondences are the same association (made at the same
+// pose on the same level).
+bool SameAssociation(const Correspondences& c, const GaussianIndex* index, const SE3d& pose) {
+  return c.index == index && c.pose.translation() == pose.translation() &&
+         c.pose.rotation().quaternion().coeffs() == pose.rotation().quaternion().coeffs();
+}
+
+}  // namespace
+
 ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const MatchingMap& map,
                                             const SE3d& initial) const {
-  return RunCoarseToFine(scan, map, initial, options_, [this](const LevelStep& level, ScanMatchingResult& result) {
+  // The step check on the exact map: a step must not raise eq. 2 for its
+  // association. When the next iteration keeps that association, its system
+  // carries the cost at the new pose, so the check waits for it (no extra
+  // pass over the residuals); otherwise the cost is evaluated at once.
+  struct Unchecked {
+    bool pending = false;
+    SE3d from;                               // the pose the step was taken from
+    Eigen::Matrix<double, 6, 1> dx;          // the full step
+    double cost = 0.0;                       // eq. 2 at `from`
+    const GaussianIndex* index = nullptr;    // the association it was taken on
+    SE3d associated_at;
+  } unchecked;
+  return RunCoarseToFine(scan, map, initial, options_, [&, this](const LevelStep& level, ScanMatchingResult& result) {
     const Correspondences& c = level.correspondences;
     const double w = level.options.w_rcs;
+    const auto small = [&](const Eigen::Matrix<double, 6, 1>& step) {
+      return step.segment<3>(kTranslationOffset).norm() < level.looseness * options_.translation_tolerance &&
+             step.segment<3>(kRotationOffset).norm() < level.looseness * options_.rotation_tolerance;
+    };
+    // Halves dx from `from` (first by `scale`) while eq. 2 exceeds `cost`;
+    // sets result.pose and returns the step taken.
+    const auto backtrack = [&](const SE3d& from, const Eigen::Matrix<double, 6, 1>& dx, double cost, double scale,
+                               int halvings) {
+      SE3d next = Step(from, scale * dx);
+      for (; halvings < options_.max_step_halvings && EvaluateCost(c, next, level.options) > cost; ++halvings) {
+        scale *= 0.5;
+        next = Step(from, scale * dx);
+      }
+      result.pose = next;
+      return Eigen::Matrix<double, 6, 1>(scale * dx);
+    };
     // Eq. 2: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs (likewise g).
     Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
@@ -188,6 +227,14 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
       g += weight * rcs.g;
       cost += weight * rcs.rho_sum;
     }
+    if (unchecked.pending) {
+      unchecked.pending = false;
+      if (SameAssociation(c, unchecked.index, unchecked.associated_at) && cost > unchecked.cost) {
+        // The last step raised eq. 2: take it back and halve it.
+        const Eigen::Matrix<double, 6, 1> step = backtrack(unchecked.from, unchecked.dx, unchecked.cost, 0.5, 1);
+        return small(step) ? StepOutcome::kConverged : StepOutcome::kContinue;
+      }
+    }
     const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
     const Eigen::Matrix<double, 6, 1> pivots = ldlt.vectorD();
     if (ldlt.info() != Eigen::Success || !(pivots.minCoeff() > 1e-10 * std::max(1e-300, pivots.maxCoeff()))) {
@@ -199,21 +246,19 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
       result.reason = "non-finite update";
       return StepOutcome::kFailed;
     }
-    // Backtracking on the exact map: halve the step while eq. 2 grows for
-    // this association (coarse levels only steer into the basin).
-    double scale = 1.0;
-    SE3d next = Step(result.pose, dx);
-    for (int halving = 0; level.finest && halving < options_.max_step_halvings &&
-                          EvaluateCost(c, next, level.options) > cost;
-         ++halving) {
-      scale *= 0.5;
-      next = Step(result.pose, scale * dx);
+    if (!level.finest || options_.max_step_halvings == 0) {  // plain steps (coarse levels only steer into the basin)
+      result.pose = Step(result.pose, dx);
+      return small(dx) ? StepOutcome::kConverged : StepOutcome::kContinue;
     }
+    const SE3d next = Step(result.pose, dx);
+    if (small(dx) || level.last_iteration || !KeepsAssociation(true, c.pose, next, options_)) {
+      // Checked now: a converging step, the last one allowed, or one after
+      // which the loop re-associates.
+      return small(backtrack(result.pose, dx, cost, 1.0, 0)) ? StepOutcome::kConverged : StepOutcome::kContinue;
+    }
+    unchecked = {true, result.pose, dx, cost, c.index, c.pose};
     result.pose = next;
-    const Eigen::Matrix<double, 6, 1> step = scale * dx;
-    const bool small = step.segment<3>(kTranslationOffset).norm() < level.looseness * options_.translation_tolerance &&
-                       step.segment<3>(kRotationOffset).norm() < level.looseness * options_.rotation_tolerance;
-    return small ? StepOutcome::kConverged : StepOutcome::kContinue;
+    return StepOutcome::kContinue;
   });
 }
 

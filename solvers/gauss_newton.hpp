@@ -5,8 +5,11 @@
 // H dx = -g by LDLT, update t += dt, R = R Exp(dphi); stop on a small update
 // or at the iteration limit. On the exact map the step is halved (at most
 // max_step_halvings times) while it increases eq. 2 for the current
-// association, so that the steep RCS term cannot make the iteration oscillate.
-// Coarse levels of the MatchingMap take plain steps.
+// association, so that the steep RCS term cannot make the iteration oscillate;
+// when the next iteration keeps the association, the check uses the cost its
+// system carries (the step is taken back and halved there if it raised eq. 2),
+// otherwise eq. 2 is evaluated at once. Coarse levels of the MatchingMap take
+// plain steps.
 //
 // Rotation-only RCS (the paper): the rows and columns of the RCS Hessian
 // that belong to translation become the identity and its translation

@@ -220,7 +220,8 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
         break;
       }
       ++result.iterations;
-      const StepOutcome outcome = step({c, level_options, finest, finest ? 1.0 : 100.0}, result);
+      const StepOutcome outcome =
+          step({c, level_options, finest, finest ? 1.0 : 100.0, iteration == max_iterations}, result);
       if (outcome == StepOutcome::kFailed) failed = true;
       if (outcome != StepOutcome::kContinue) {
         result.converged = outcome == StepOutcome::kConverged;

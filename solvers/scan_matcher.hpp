@@ -155,6 +155,7 @@ struct LevelStep {
   const ScanMatchingOptions& options;  // with this level's w_rcs
   bool finest = false;
   double looseness = 1.0;              // tolerance multiplier (100 on coarse levels)
+  bool last_iteration = false;         // the level's iteration limit is reached with this step
 };
 enum class StepOutcome { kContinue, kConverged, kFailed };
 using SolverStep = std::function<StepOutcome(const LevelStep&, ScanMatchingResult&)>;
