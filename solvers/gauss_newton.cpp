@@ -189,6 +189,7 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
     double cost = 0.0;                       // eq. 2 at `from`
     const GaussianIndex* index = nullptr;    // the association it was taken on
     SE3d associated_at;
+    bool taken_back = false;                 // a step on that association was taken back
   } unchecked;
   return RunCoarseToFine(scan, map, initial, options_, [&, this](const LevelStep& level, ScanMatchingResult& result) {
     const Correspondences& c = level.correspondences;
@@ -227,10 +228,13 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
       g += weight * rcs.g;
       cost += weight * rcs.rho_sum;
     }
+    const bool same_association = SameAssociation(c, unchecked.index, unchecked.associated_at);
     if (unchecked.pending) {
       unchecked.pending = false;
-      if (SameAssociation(c, unchecked.index, unchecked.associated_at) && cost > unchecked.cost) {
-        // The last step raised eq. 2: take it back and halve it.
+      if (same_association && cost > unchecked.cost) {
+        // The last step raised eq. 2: take it back and halve it; the
+        // association's further steps are checked at once.
+        unchecked.taken_back = true;
         const Eigen::Matrix<double, 6, 1> step = backtrack(unchecked.from, unchecked.dx, unchecked.cost, 0.5, 1);
         return small(step) ? StepOutcome::kConverged : StepOutcome::kContinue;
       }
@@ -251,12 +255,14 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
       return small(dx) ? StepOutcome::kConverged : StepOutcome::kContinue;
     }
     const SE3d next = Step(result.pose, dx);
-    if (small(dx) || level.last_iteration || !KeepsAssociation(true, c.pose, next, options_)) {
-      // Checked now: a converging step, the last one allowed, or one after
-      // which the loop re-associates.
+    if (small(dx) || level.last_iteration || (same_association && unchecked.taken_back) ||
+        !KeepsAssociation(true, c.pose, next, options_)) {
+      // Checked now: a converging step, the last one allowed, one on an
+      // association that had a step taken back, or one after which the loop
+      // re-associates.
       return small(backtrack(result.pose, dx, cost, 1.0, 0)) ? StepOutcome::kConverged : StepOutcome::kContinue;
     }
-    unchecked = {true, result.pose, dx, cost, c.index, c.pose};
+    unchecked = {true, result.pose, dx, cost, c.index, c.pose, same_association && unchecked.taken_back};
     result.pose = next;
     return StepOutcome::kContinue;
   });

@@ -816,5 +816,35 @@ TEST(JointRefinement, LowersPoseErrorAndRcsResidual) {
   EXPECT_THROW(RefineJointly(scans, {}, world.map, JointRefinementOptions{}), std::invalid_argument);
 }
 
+// The own GN's step check: on one association (no re-association) a step
+// never raises eq. 2, whether it is checked at once or by the next
+// iteration's system, so the cost after k iterations does not grow with k.
+// The planted RCS world 20 deg off, with w = 1: plain GN steps
+// (max_step_halvings = 0) overshoot there, and the cost rises above the
+// initial one.
+TEST(GaussNewton, StepCheckKeepsTheCostFalling) {
+  const PlantedRcsWorld world = MakePlantedRcsWorld(IncidenceModel::kOffset, 0.1);
+  const MatchingMap single(world.map, ExactMapOnly());
+  const SE3d initial(world.truth.rotation() * SO3d::Exp(20.0 * M_PI / 180.0 * Eigen::Vector3d(1, 2, -2).normalized()),
+                     world.truth.translation());
+  ScanMatchingOptions options;
+  options.w_rcs = 1.0;
+  options.reassociate = false;
+  const double initial_cost =
+      EvaluateCost(FindCorrespondences(world.scan, single, 0, initial, options.gate, true), initial, options);
+  double checked = initial_cost, plain_highest = 0.0;
+  for (int k = 1; k <= 12; ++k) {
+    options.max_iterations = k;
+    options.max_step_halvings = 8;
+    const ScanMatchingResult result = MakeSolver("gn", options)->Match(world.scan, single, initial);
+    EXPECT_LE(result.final_cost, checked * (1.0 + 1e-12)) << k << " iterations";
+    checked = result.final_cost;
+    options.max_step_halvings = 0;
+    plain_highest = std::max(plain_highest, MakeSolver("gn", options)->Match(world.scan, single, initial).final_cost);
+  }
+  EXPECT_LT(checked, 0.75 * initial_cost);
+  EXPECT_GT(plain_highest, initial_cost);
+}
+
 }  // namespace
 }  // namespace radargauss
