@@ -232,6 +232,20 @@ void BM_RefineScan(benchmark::State& state) {
 }
 BENCHMARK(BM_RefineScan)->ArgsProduct({{0, 1, 2}, {0, 25}})->Unit(benchmark::kMillisecond);
 
+// The own GN with the losses' curvature in its Hessian
+// (ScanMatchingOptions::loss_curvature), tracking. Arg: w_rcs x 100.
+void BM_RefineScanLossCurvature(benchmark::State& state) {
+  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const MatchingWorld& world = World();
+  const MatchingMap exact(world.map, ExactMapOnly());
+  const SimulatedSequence& scans = world.scans.at(800);
+  ScanMatchingOptions options;
+  options.w_rcs = double(state.range(0)) / 100.0;
+  options.loss_curvature = true;
+  MatchScans(state, *Solver(0, options), exact, scans, TrackingPoses(scans), options.w_rcs);
+}
+BENCHMARK(BM_RefineScanLossCurvature)->Arg(0)->Arg(25)->Unit(benchmark::kMillisecond);
+
 // Ceres LM against the own GN when tracking, the two interleaved scan by
 // scan so that this shared machine's load drifts over both alike: the medians
 // of their per-scan times and the ratio of the medians (the goal: <= 5x).

@@ -266,6 +266,7 @@ struct LocalizeSettings {
   int stride = 1;
   std::string coarse_levels = "inflated";
   std::size_t coarse_points = 0;
+  bool loss_curvature = false;
 };
 
 // Our solvers, plus the PCL peers when built with RADARGAUSS_WITH_PCL.
@@ -329,6 +330,8 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--coarse-points", s.coarse_points, "Points used on the coarse levels (0: all)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app->add_flag("--loss-curvature", s.loss_curvature,
+                "Own GN: the robust losses' curvature in the Hessian instead of IRLS weights alone");
 }
 
 std::string FormatWeight(double w) {
@@ -397,6 +400,7 @@ int RunLocalize(LocalizeSettings s) {
           options.geometric_loss = {LossTypeFromString(loss), s.loss_scale};
           options.rcs_loss = {LossTypeFromString(s.rcs_loss), s.rcs_loss_scale};
           options.coarse_points = s.coarse_points;
+          options.loss_curvature = s.loss_curvature;
           const auto matcher = MakeScanMatcher(solver, options);
           const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" +
                                    ToString(maps[m].incidence) + "-L" + std::to_string(degree);

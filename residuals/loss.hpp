@@ -42,21 +42,23 @@ class GemanMcClureLoss final : public ceres::LossFunction {
 // A new loss (nullptr for trivial: Ceres's convention); the caller owns it.
 ceres::LossFunction* MakeLoss(const LossConfig& config);
 
-// A loss owned for evaluation by the own solvers: rho(s) and rho'(s), the
-// IRLS weight.
+// A loss owned for evaluation by the own solvers: rho(s), rho'(s) (the IRLS
+// weight) and, when asked, rho''(s).
 class RobustLoss {
  public:
   explicit RobustLoss(const LossConfig& config) : loss_(MakeLoss(config)) {}
-  void Evaluate(double s, double& rho, double& weight) const {
+  void Evaluate(double s, double& rho, double& weight, double* second = nullptr) const {
     if (!loss_) {
       rho = s;
       weight = 1.0;
+      if (second) *second = 0.0;
       return;
     }
     double values[3];
     loss_->Evaluate(s, values);
     rho = values[0];
     weight = values[1];
+    if (second) *second = values[2];
   }
 
  private:

@@ -33,14 +33,26 @@ void SeedJets(const SE3d& pose, const Eigen::Vector3d& translation, Jet7 rotatio
 // Fixed sizes throughout: this is the inner loop of every iteration. J holds
 // the columns of the tangent block starting at `offset` (all six, or the
 // rotation's three).
+// The loss's curvature along r (ScanMatchingOptions::loss_curvature): the
+// coefficient c of (J^T r)(J^T r)^T, 2 rho'' clamped so that rho' + c s >= 0.
+double CurvatureAlongResidual(double s, double weight, double second) {
+  return s > 0.0 ? std::max(2.0 * second, -weight / s) : 0.0;
+}
+
 template <int Rows, int Cols>
 void Accumulate(LinearSystem& system, int offset, const Eigen::Matrix<double, Rows, Cols>& J,
-                const Eigen::Matrix<double, Rows, 1>& r, const RobustLoss& loss) {
-  double rho = 0.0, weight = 0.0;
-  loss.Evaluate(r.squaredNorm(), rho, weight);
+                const Eigen::Matrix<double, Rows, 1>& r, const RobustLoss& loss, bool loss_curvature) {
+  double rho = 0.0, weight = 0.0, second = 0.0;
+  const double s = r.squaredNorm();
+  loss.Evaluate(s, rho, weight, &second);
   const Eigen::Matrix<double, Rows, Cols> weighted_J = weight * J;
   system.H.block<Cols, Cols>(offset, offset).noalias() += weighted_J.transpose() * J;
   system.g.segment<Cols>(offset).noalias() += weighted_J.transpose() * r;
+  if (loss_curvature && second != 0.0) {
+    const Eigen::Matrix<double, Cols, 1> Jt_r = J.transpose() * r;
+    system.loss_curvature.block<Cols, Cols>(offset, offset).noalias() +=
+        CurvatureAlongResidual(s, weight, second) * Jt_r * Jt_r.transpose();
+  }
   system.rho_sum += rho;
   ++system.residuals;
 }
@@ -68,14 +80,23 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     Eigen::Matrix3d A_tt = Eigen::Matrix3d::Zero(), A_tr = Eigen::Matrix3d::Zero(),
                     A_rr = Eigen::Matrix3d::Zero();
     Eigen::Vector3d b_t = Eigen::Vector3d::Zero(), b_r = Eigen::Vector3d::Zero();
-    double rho = 0.0, weight = 0.0;
+    // Loss curvature (options.loss_curvature), with J^T r = [I_e; R^T (q x I_e)]
+    // (I_e = Sigma^-1 e): summed without R as well.
+    Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
+    double rho = 0.0, weight = 0.0, second = 0.0;
     for (const GeometricTerm& term : c.geometric) {
       const Eigen::Matrix3d& information = c.index->Information(term.gaussian);
       const Eigen::Vector3d q = R * term.point_radar;
       const Eigen::Vector3d e = q + pose.translation() - c.index->Mean(term.gaussian);
       const Eigen::Vector3d information_e = information * e;
-      loss.Evaluate(e.dot(information_e), rho, weight);
+      const double s = e.dot(information_e);
+      loss.Evaluate(s, rho, weight, &second);
       system.rho_sum += rho;
+      if (options.loss_curvature && second != 0.0) {
+        Eigen::Matrix<double, 6, 1> Jt_r;
+        Jt_r << information_e, q.cross(information_e);
+        C.noalias() += CurvatureAlongResidual(s, weight, second) * Jt_r * Jt_r.transpose();
+      }
       const Eigen::Matrix3d q_hat = SO3d::Hat(q);
       const Eigen::Matrix3d information_q_hat = information * q_hat;
       A_tt.noalias() += weight * information;
@@ -90,6 +111,11 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     system.H.block<3, 3>(kRotationOffset, kRotationOffset) = R.transpose() * A_rr * R;
     system.g.segment<3>(kTranslationOffset) = b_t;
     system.g.segment<3>(kRotationOffset) = R.transpose() * b_r;
+    if (options.loss_curvature) {
+      Eigen::Matrix<double, 6, 6> rotate = Eigen::Matrix<double, 6, 6>::Identity();
+      rotate.block<3, 3>(kRotationOffset, kRotationOffset) = R;
+      system.loss_curvature = rotate.transpose() * C * rotate;
+    }
     system.residuals = c.geometric.size();
     return system;
   }
@@ -111,7 +137,7 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     Matrix3x6 J;
     J.block<3, 3>(0, kTranslationOffset) = ambient.rightCols<3>();
     J.block<3, 3>(0, kRotationOffset) = ambient.leftCols<4>() * P;
-    Accumulate(system, 0, J, r, loss);
+    Accumulate(system, 0, J, r, loss, options.loss_curvature);
   }
   return system;
 }
@@ -144,9 +170,10 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
       J.block<1, 3>(0, kRotationOffset) = residual[0].v.head<4>().transpose() * P;
     }
     if (rotation_only) {
-      Accumulate(system, kRotationOffset, Eigen::Matrix<double, 1, 3>(J.block<1, 3>(0, kRotationOffset)), r, loss);
+      Accumulate(system, kRotationOffset, Eigen::Matrix<double, 1, 3>(J.block<1, 3>(0, kRotationOffset)), r, loss,
+                 options.loss_curvature);
     } else {
-      Accumulate(system, 0, J, r, loss);
+      Accumulate(system, 0, J, r, loss, options.loss_curvature);
     }
   }
   if (rotation_only) {
@@ -212,12 +239,14 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
     };
     // Eq. 2: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs (likewise g).
     Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 6> loss_curvature = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
     double cost = 0.0;  // eq. 2 at the current pose, as EvaluateCost
     if (w < 1.0) {
       const LinearSystem geometric = BuildGeometricSystem(c, result.pose, level.options);
       const double weight = (1.0 - w) / double(geometric.residuals);
       H += weight * geometric.H;
+      loss_curvature += weight * geometric.loss_curvature;
       g += weight * geometric.g;
       cost += weight * geometric.rho_sum;
     }
@@ -225,6 +254,7 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
       const LinearSystem rcs = BuildRcsSystem(c, result.pose, level.options);
       const double weight = w / double(rcs.residuals);
       H += weight * rcs.H;
+      loss_curvature += weight * rcs.loss_curvature;
       g += weight * rcs.g;
       cost += weight * rcs.rho_sum;
     }
@@ -239,11 +269,17 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
         return small(step) ? StepOutcome::kConverged : StepOutcome::kContinue;
       }
     }
-    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
-    const Eigen::Matrix<double, 6, 1> pivots = ldlt.vectorD();
-    if (ldlt.info() != Eigen::Success || !(pivots.minCoeff() > 1e-10 * std::max(1e-300, pivots.maxCoeff()))) {
-      result.reason = "degenerate normal equations (too few or ill-placed residuals)";
-      return StepOutcome::kFailed;
+    const auto positive_definite = [](const Eigen::LDLT<Eigen::Matrix<double, 6, 6>>& ldlt) {
+      const Eigen::Matrix<double, 6, 1> pivots = ldlt.vectorD();
+      return ldlt.info() == Eigen::Success && pivots.minCoeff() > 1e-10 * std::max(1e-300, pivots.maxCoeff());
+    };
+    Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt;
+    // With the losses' curvature when asked and positive definite, else IRLS.
+    if (!options_.loss_curvature || !positive_definite(ldlt.compute(H + loss_curvature))) {
+      if (!positive_definite(ldlt.compute(H))) {
+        result.reason = "degenerate normal equations (too few or ill-placed residuals)";
+        return StepOutcome::kFailed;
+      }
     }
     const Eigen::Matrix<double, 6, 1> dx = ldlt.solve(-g);
     if (!dx.allFinite()) {

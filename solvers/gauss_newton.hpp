@@ -29,6 +29,9 @@ struct LinearSystem {
   Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
   std::size_t residuals = 0;
   double rho_sum = 0.0;  // sum of rho(s) over the residuals: the term's cost before eq. 2's weight
+  // With ScanMatchingOptions::loss_curvature: what the losses' curvature adds
+  // to H (sum of c (J^T r)(J^T r)^T, c = max(2 rho'', -rho'/s)); else zero.
+  Eigen::Matrix<double, 6, 6> loss_curvature = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
 // The geometric and RCS systems at `pose` for fixed correspondences (public

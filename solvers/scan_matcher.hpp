@@ -45,6 +45,14 @@ struct ScanMatchingOptions {
   // keeps steps of a few mm going. 0 re-associates after every step.
   double reassociation_translation = 0.01;  // m
   double reassociation_rotation = 0.002;    // rad
+  // Own GN: the robust losses' curvature in the Hessian. Per term
+  // J^T (rho' I + 2 rho'' r r^T) J, the curvature along r clamped at 0, where
+  // IRLS takes J^T rho' J (the gradient is the same). For concave losses
+  // (Cauchy: rho'' < 0) IRLS overestimates the curvature and its steps come
+  // out short; this takes fewer iterations (RESULTS.md). When the system is
+  // not positive definite the step falls back to IRLS. Off: IRLS, as the
+  // paper and Ceres (whose Corrector ignores rho'' < 0).
+  bool loss_curvature = false;
   double translation_tolerance = 1e-4;  // m: stop when the update is smaller ...
   double rotation_tolerance = 1e-5;     // rad ... in both parts (100x looser on coarse levels)
 };

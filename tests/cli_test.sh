@@ -66,6 +66,9 @@ done
 expect_ok "localize with merged coarse levels" "configurations" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --w-rcs 0 --coarse-levels merged --coarse-points 100 --out "$work/results_merged"
+expect_ok "localize with the losses' curvature" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0.25 --solver gn --loss-curvature --out "$work/results_curvature"
 expect_fail "localize with unknown coarse levels" "coarse-levels" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --coarse-levels blurred --out "$work/r5"

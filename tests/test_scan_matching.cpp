@@ -303,7 +303,68 @@ TEST(GaussNewton, AnalyticAndAutodiffSystemsAgree) {
       EXPECT_LT(Relative(ra.g.segment<3>(kRotationOffset), rf.g.segment<3>(kRotationOffset)), 1e-12);
       EXPECT_GT(block(rf, kTranslationOffset, kTranslationOffset).norm(), 0.0);
     }
+    // The losses' curvature: the same from both paths, added beside the IRLS
+    // system (which it leaves as it was), zero unless asked.
+    EXPECT_TRUE(ga.loss_curvature.isZero(0.0));
+    EXPECT_TRUE(ra.loss_curvature.isZero(0.0));
+    ScanMatchingOptions curved = analytic;
+    curved.loss_curvature = true;
+    ScanMatchingOptions curved_autodiff = autodiff;
+    curved_autodiff.loss_curvature = true;
+    const LinearSystem gc = BuildGeometricSystem(c, pose, curved);
+    const LinearSystem rc = BuildRcsSystem(c, pose, curved);
+    EXPECT_GT(gc.loss_curvature.norm(), 1e-3 * gc.H.norm());  // Huber terms beyond a = 1
+    EXPECT_GT(rc.loss_curvature.norm(), 1e-3 * rc.H.norm());  // Cauchy
+    EXPECT_LT(Relative(gc.loss_curvature, BuildGeometricSystem(c, pose, curved_autodiff).loss_curvature), 1e-8);
+    EXPECT_LT(Relative(rc.loss_curvature, BuildRcsSystem(c, pose, curved_autodiff).loss_curvature), 1e-8);
+    EXPECT_EQ(gc.H, ga.H);
+    EXPECT_EQ(rc.H, ra.H);
   }
+}
+
+// The losses' curvature of one term against the losses written out here:
+// with g = rho' J^T r, the term adds c (J^T r)(J^T r)^T = c / rho'^2 g g^T,
+// c = max(2 rho'', -rho'/s). Huber (a = 1) beyond a: rho' = s^-1/2,
+// rho'' = -s^-3/2 / 2; Cauchy (a = 1): rho' = 1/(1+s), rho'' = -1/(1+s)^2.
+TEST(GaussNewton, LossCurvatureOfOneTerm) {
+  const World& world = SimulatedWorld();
+  const SE3d pose = Perturbed(world.simulated.ground_truth[kTestScan].pose, 0.1, 0.5, 9);
+  const MatchingMap& map = *world.matching;
+  ScanMatchingOptions options;
+  options.geometric_loss = {LossType::kHuber, 1.0};
+  options.rcs_loss = {LossType::kCauchy, 1.0};
+  options.loss_curvature = true;
+  const Correspondences all =
+      FindCorrespondences(world.simulated.scans[kTestScan], map, map.levels() - 1, pose, 3.0, true);
+  int geometric_checked = 0, rcs_checked = 0;
+  for (std::size_t k = 0; k < std::min<std::size_t>(all.geometric.size(), 40); ++k) {
+    Correspondences one = all;
+    one.geometric = {all.geometric[k]};
+    const LinearSystem system = BuildGeometricSystem(one, pose, options);
+    const Eigen::Vector3d r = map.index().SqrtInformationT(all.geometric[k].gaussian) *
+                              (pose * all.geometric[k].point_radar - map.index().Mean(all.geometric[k].gaussian));
+    const double s = r.squaredNorm();
+    const double rho1 = s <= 1.0 ? 1.0 : 1.0 / std::sqrt(s);
+    const double rho2 = s <= 1.0 ? 0.0 : -0.5 / (s * std::sqrt(s));
+    const double curvature = std::max(2.0 * rho2, -rho1 / s);
+    const Eigen::Matrix<double, 6, 6> expected = curvature / (rho1 * rho1) * system.g * system.g.transpose();
+    EXPECT_LT((system.loss_curvature - expected).norm(), 1e-9 * std::max(1.0, expected.norm())) << k;
+    geometric_checked += s > 1.0;
+  }
+  for (std::size_t k = 0; k < std::min<std::size_t>(all.rcs.size(), 40); ++k) {
+    Correspondences one = all;
+    one.rcs = {all.rcs[k]};
+    const LinearSystem system = BuildRcsSystem(one, pose, options);
+    const double r = RcsResidualValue<double>(all.rcs[k], pose.rotation().data(), all.pose.translation());
+    const double s = r * r;
+    const double rho1 = 1.0 / (1.0 + s), rho2 = -1.0 / ((1.0 + s) * (1.0 + s));
+    const double curvature = std::max(2.0 * rho2, -rho1 / s);
+    const Eigen::Matrix<double, 6, 6> expected = curvature / (rho1 * rho1) * system.g * system.g.transpose();
+    EXPECT_LT((system.loss_curvature - expected).norm(), 1e-9 * std::max(1.0, expected.norm())) << k;
+    ++rcs_checked;
+  }
+  EXPECT_GT(geometric_checked, 3);
+  EXPECT_GT(rcs_checked, 10);
 }
 
 // The paper's incidence direction, written out (the reference the library's
@@ -387,7 +448,16 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
     const ScanMatchingResult gn = GaussNewtonSolver(options).Match(world.simulated.scans[kTestScan], single, initial);
     const ScanMatchingResult lm =
         CeresSolver(options, ceres_options).Match(world.simulated.scans[kTestScan], single, initial);
+    // The losses' curvature in the own GN's Hessian changes its path, not its optimum.
+    ScanMatchingOptions curved = options;
+    curved.loss_curvature = true;
+    const ScanMatchingResult gn_curved =
+        GaussNewtonSolver(curved).Match(world.simulated.scans[kTestScan], single, initial);
     double dt = 0.0, dr = 0.0;
+    PoseErrors(gn_curved.pose, lm.pose, dt, dr);
+    ASSERT_TRUE(gn_curved.converged) << gn_curved.reason;
+    EXPECT_LT(dt, 1e-4) << "w " << w << ", loss curvature";
+    EXPECT_LT(dr * M_PI / 180.0, 1e-4) << "w " << w << ", loss curvature";
     PoseErrors(gn.pose, lm.pose, dt, dr);
     std::printf("w %.2f, %s incidence: GN cost %.10f (%d it), LM cost %.10f; pose difference %.2e m, %.2e rad\n",
                 w, ToString(map->incidence).c_str(), gn.final_cost, gn.iterations, lm.final_cost, dt,
