@@ -220,29 +220,30 @@ std::vector<SE3d> TrackingPoses(const SimulatedSequence& sequence) {
 }
 
 // Refinement only (the exact map, from 5 cm / 0.2 deg): the per-scan latency
-// of tracking, where the coarse levels are not needed.
-void BM_RefineScan(benchmark::State& state) {
+// of tracking, where the coarse levels are not needed. 800 points, one thread.
+void RefineScans(benchmark::State& state, int solver, const ScanMatchingOptions& options) {
   const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const MatchingWorld& world = World();
   const MatchingMap exact(world.map, ExactMapOnly());
   const SimulatedSequence& scans = world.scans.at(800);
+  MatchScans(state, *Solver(solver, options), exact, scans, TrackingPoses(scans), options.w_rcs);
+}
+
+// Args: solver, w_rcs x 100.
+void BM_RefineScan(benchmark::State& state) {
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(1)) / 100.0;
-  MatchScans(state, *Solver(int(state.range(0)), options), exact, scans, TrackingPoses(scans), options.w_rcs);
+  RefineScans(state, int(state.range(0)), options);
 }
 BENCHMARK(BM_RefineScan)->ArgsProduct({{0, 1, 2}, {0, 25}})->Unit(benchmark::kMillisecond);
 
 // The own GN with the losses' curvature in its Hessian
 // (ScanMatchingOptions::loss_curvature), tracking. Arg: w_rcs x 100.
 void BM_RefineScanLossCurvature(benchmark::State& state) {
-  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
-  const MatchingWorld& world = World();
-  const MatchingMap exact(world.map, ExactMapOnly());
-  const SimulatedSequence& scans = world.scans.at(800);
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(0)) / 100.0;
   options.loss_curvature = true;
-  MatchScans(state, *Solver(0, options), exact, scans, TrackingPoses(scans), options.w_rcs);
+  RefineScans(state, 0, options);
 }
 BENCHMARK(BM_RefineScanLossCurvature)->Arg(0)->Arg(25)->Unit(benchmark::kMillisecond);
 

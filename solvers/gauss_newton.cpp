@@ -30,15 +30,15 @@ void SeedJets(const SE3d& pose, const Eigen::Vector3d& translation, Jet7 rotatio
   for (int i = 0; i < 3; ++i) t[i] = Jet7(translation[i], 4 + i);
 }
 
-// Fixed sizes throughout: this is the inner loop of every iteration. J holds
-// the columns of the tangent block starting at `offset` (all six, or the
-// rotation's three).
 // The loss's curvature along r (ScanMatchingOptions::loss_curvature): the
 // coefficient c of (J^T r)(J^T r)^T, 2 rho'' clamped so that rho' + c s >= 0.
 double CurvatureAlongResidual(double s, double weight, double second) {
   return s > 0.0 ? std::max(2.0 * second, -weight / s) : 0.0;
 }
 
+// Fixed sizes throughout: this is the inner loop of every iteration. J holds
+// the columns of the tangent block starting at `offset` (all six, or the
+// rotation's three).
 template <int Rows, int Cols>
 void Accumulate(LinearSystem& system, int offset, const Eigen::Matrix<double, Rows, Cols>& J,
                 const Eigen::Matrix<double, Rows, 1>& r, const RobustLoss& loss, bool loss_curvature) {
@@ -259,11 +259,12 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
       cost += weight * rcs.rho_sum;
     }
     const bool same_association = SameAssociation(c, unchecked.index, unchecked.associated_at);
+    // An association that had a step taken back has its further steps checked at once.
+    const bool check_at_once = same_association && unchecked.taken_back;
     if (unchecked.pending) {
       unchecked.pending = false;
       if (same_association && cost > unchecked.cost) {
-        // The last step raised eq. 2: take it back and halve it; the
-        // association's further steps are checked at once.
+        // The last step raised eq. 2: take it back and halve it.
         unchecked.taken_back = true;
         const Eigen::Matrix<double, 6, 1> step = backtrack(unchecked.from, unchecked.dx, unchecked.cost, 0.5, 1);
         return small(step) ? StepOutcome::kConverged : StepOutcome::kContinue;
@@ -291,14 +292,13 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
       return small(dx) ? StepOutcome::kConverged : StepOutcome::kContinue;
     }
     const SE3d next = Step(result.pose, dx);
-    if (small(dx) || level.last_iteration || (same_association && unchecked.taken_back) ||
-        !KeepsAssociation(true, c.pose, next, options_)) {
+    if (small(dx) || level.last_iteration || check_at_once || !KeepsAssociation(true, c.pose, next, options_)) {
       // Checked now: a converging step, the last one allowed, one on an
       // association that had a step taken back, or one after which the loop
       // re-associates.
       return small(backtrack(result.pose, dx, cost, 1.0, 0)) ? StepOutcome::kConverged : StepOutcome::kContinue;
     }
-    unchecked = {true, result.pose, dx, cost, c.index, c.pose, same_association && unchecked.taken_back};
+    unchecked = {true, result.pose, dx, cost, c.index, c.pose, check_at_once};
     result.pose = next;
     return StepOutcome::kContinue;
   });
