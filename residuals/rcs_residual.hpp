@@ -107,37 +107,27 @@ class RcsRotationResidual {
   Eigen::Vector3d translation_;
 };
 
-// Analytic linearisation shared by the analytic twins: the residual, its
-// derivative with respect to u (the un-normalised incidence vector) and u's
-// derivatives. With d = s u / |u| (s the term's facing sign):
+// Analytic linearisation shared by the analytic twins and the own GN: the
+// residual and its derivative with respect to u (the un-normalised incidence
+// vector), given the Gaussian centre in the radar frame mu_r = R^T (mu - t).
+// With d = s u / |u| (s the term's facing sign):
 //   dr/du = -(c^T dY/dd) s (I - d d^T) / |u|,
 //   u = p_r - mu_r (offset) or -mu_r (view), so du/dq = -d(R^T a)/dq and
 //   du/dt = R^T, with a = mu - t.
 struct RcsLinearisation {
   double residual = 0.0;
   Eigen::RowVector3d dr_du = Eigen::RowVector3d::Zero();
-  Eigen::Vector3d mean_radar = Eigen::Vector3d::Zero();
 };
 
-inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Quaterniond& q,
-                                     const Eigen::Vector3d& translation) {
-  RcsLinearisation out;
-  out.mean_radar = q.conjugate() * (term.mean - translation);
-  const Eigen::Vector3d u = IncidenceVector(term.incidence, term.point_radar, out.mean_radar);
+inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d& mean_radar) {
+  const Eigen::Vector3d u = IncidenceVector(term.incidence, term.point_radar, mean_radar);
   const double norm = u.norm();
   const Eigen::Vector3d d = term.facing * u / norm;
-  double basis[ShCoefficientCount(kMaxShDegree)];
-  double gradient[3 * ShCoefficientCount(kMaxShDegree)];
-  EvaluateShBasis(term.degree, d, basis);
-  EvaluateShBasisGradient(term.degree, d, gradient);
-  double prediction = 0.0;
-  Eigen::RowVector3d c_dY = Eigen::RowVector3d::Zero();
-  for (int i = 0; i < ShCoefficientCount(term.degree); ++i) {
-    prediction += term.coefficients[i] * basis[i];
-    c_dY += term.coefficients[i] * Eigen::Map<const Eigen::RowVector3d>(gradient + 3 * i);
-  }
+  Eigen::Vector3d c_dY;
+  const double prediction = EvaluateShWithGradient(term.degree, term.coefficients.data(), d, c_dY);
+  RcsLinearisation out;
   out.residual = term.measurement - prediction;
-  out.dr_du = -c_dY * (term.facing / norm) * (Eigen::Matrix3d::Identity() - d * d.transpose());
+  out.dr_du = -(term.facing / norm) * (c_dY - c_dY.dot(d) * d).transpose();  // c_dY^T (I - d d^T)
   return out;
 }
 
@@ -153,7 +143,7 @@ class RcsCostFunction final : public ceres::SizedCostFunction<1, 4, 3> {
       return true;
     }
     const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
-    const RcsLinearisation lin = LineariseRcs(term_, q, t);
+    const RcsLinearisation lin = LineariseRcs(term_, q.conjugate() * (term_.mean - t));
     residuals[0] = lin.residual;
     if (jacobians[0] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
@@ -161,7 +151,7 @@ class RcsCostFunction final : public ceres::SizedCostFunction<1, 4, 3> {
     }
     if (jacobians[1] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 1, 3>> J(jacobians[1]);
-      J = lin.dr_du * q.conjugate().toRotationMatrix();
+      J = (q * lin.dr_du.transpose()).transpose();  // dr/du R^T
     }
     return true;
   }
@@ -184,7 +174,7 @@ class RcsRotationCostFunction final : public ceres::SizedCostFunction<1, 4> {
       return true;
     }
     const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
-    const RcsLinearisation lin = LineariseRcs(term_, q, translation_);
+    const RcsLinearisation lin = LineariseRcs(term_, q.conjugate() * (term_.mean - translation_));
     residuals[0] = lin.residual;
     if (jacobians[0] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);

@@ -156,9 +156,10 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
     Eigen::Matrix<double, 1, 6> J;
     if (options.jacobians == JacobianMode::kAnalytic) {
       // du/ddt = R^T, du/ddphi = -[mu_r]x (conventions.hpp: right perturbation).
-      const RcsLinearisation lin = LineariseRcs(term, pose.rotation().quaternion(), translation);
+      const Eigen::Vector3d mean_radar = Rt * (term.mean - translation);
+      const RcsLinearisation lin = LineariseRcs(term, mean_radar);
       r[0] = lin.residual;
-      J.block<1, 3>(0, kRotationOffset) = -lin.dr_du * SO3d::Hat(lin.mean_radar);
+      J.block<1, 3>(0, kRotationOffset) = -lin.dr_du * SO3d::Hat(mean_radar);
       if (!rotation_only) J.block<1, 3>(0, kTranslationOffset) = lin.dr_du * Rt;
     } else {
       Jet7 rotation[4], t[3], residual[1];

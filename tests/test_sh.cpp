@@ -3,6 +3,7 @@
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -166,6 +167,35 @@ TEST(SphericalHarmonics, AnalyticGradientMatchesJets) {
       for (int k = 0; k < 3; ++k) ASSERT_NEAR(gradient[3 * i + k], y_jet[i].v[k], 1e-12) << i << " " << k;
     }
   }
+}
+
+// c . Y(d) and its gradient in one pass, for every degree, against the
+// dot product with the basis and a central-difference gradient of it.
+TEST(SphericalHarmonics, ValueWithGradientMatchesDotProductAndNumeric) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal;
+  for (int degree = 0; degree <= kMaxShDegree; ++degree) {
+    for (int sample = 0; sample < 20; ++sample) {
+      Eigen::Matrix<double, kCount, 1> c;
+      for (int i = 0; i < kCount; ++i) c[i] = normal(rng);
+      const Eigen::Vector3d d = RandomUnitVector(rng);
+      Eigen::Vector3d gradient;
+      const double value = EvaluateShWithGradient(degree, c.data(), d, gradient);
+      EXPECT_NEAR(value, EvaluateSh(degree, c.data(), d), 1e-13) << degree;
+      const Eigen::MatrixXd numeric = NumericJacobian(
+          [&](const Eigen::VectorXd& x) {
+            return Eigen::VectorXd::Constant(1, EvaluateSh(degree, c.data(), Eigen::Vector3d(x)));
+          },
+          d);
+      EXPECT_LT((gradient.transpose() - numeric).norm(), 1e-7) << degree;
+      if (degree == 0) {
+        EXPECT_EQ(gradient, Eigen::Vector3d::Zero());
+      }
+    }
+  }
+  Eigen::Vector3d gradient;
+  EXPECT_THROW(EvaluateShWithGradient(4, std::array<double, kCount>{}.data(), Eigen::Vector3d(1, 0, 0), gradient),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -122,15 +122,23 @@ void EvaluateShBasisGradient(const Eigen::Vector3d& d, double* gradient) {
   }
 }
 
-inline void EvaluateShBasisGradient(int degree, const Eigen::Vector3d& d, double* gradient) {
-  switch (degree) {
-    case 0: return EvaluateShBasisGradient<0>(d, gradient);
-    case 1: return EvaluateShBasisGradient<1>(d, gradient);
-    case 2: return EvaluateShBasisGradient<2>(d, gradient);
-    case 3: return EvaluateShBasisGradient<3>(d, gradient);
-    default:
-      throw std::invalid_argument("SH degree must be in 0..3, got " + std::to_string(degree));
+// c . Y(d) and its gradient c . dY/dd (polynomial forms, d not renormalised)
+// in one pass: the inner loop of the analytic RCS residual. With the degree
+// fixed, the basis and its gradient stay in registers.
+template <int Degree>
+double EvaluateShWithGradient(const double* coefficients, const Eigen::Vector3d& d, Eigen::Vector3d& gradient) {
+  constexpr int kCount = ShCoefficientCount(Degree);
+  double basis[kCount];
+  double basis_gradient[3 * kCount];
+  EvaluateShBasis<Degree>(d, basis);
+  EvaluateShBasisGradient<Degree>(d, basis_gradient);
+  double value = 0.0;
+  gradient.setZero();
+  for (int i = 0; i < kCount; ++i) {
+    value += coefficients[i] * basis[i];
+    gradient += coefficients[i] * Eigen::Map<const Eigen::Vector3d>(basis_gradient + 3 * i);
   }
+  return value;
 }
 
 // Runtime-degree versions; throw std::invalid_argument for a degree outside 0..3.
@@ -153,6 +161,18 @@ T EvaluateSh(int degree, const CoefficientT* coefficients, const Eigen::Matrix<T
   T value = T(0.0);
   for (int i = 0; i < ShCoefficientCount(degree); ++i) value += T(coefficients[i]) * basis[i];
   return value;
+}
+
+inline double EvaluateShWithGradient(int degree, const double* coefficients, const Eigen::Vector3d& d,
+                                     Eigen::Vector3d& gradient) {
+  switch (degree) {
+    case 0: return EvaluateShWithGradient<0>(coefficients, d, gradient);
+    case 1: return EvaluateShWithGradient<1>(coefficients, d, gradient);
+    case 2: return EvaluateShWithGradient<2>(coefficients, d, gradient);
+    case 3: return EvaluateShWithGradient<3>(coefficients, d, gradient);
+    default:
+      throw std::invalid_argument("SH degree must be in 0..3, got " + std::to_string(degree));
+  }
 }
 
 }  // namespace radargauss
