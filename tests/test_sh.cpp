@@ -132,6 +132,8 @@ TEST(SphericalHarmonics, RejectsUnknownDegree) {
   double basis[kCount];
   EXPECT_THROW(EvaluateShBasis(4, Eigen::Vector3d(1, 0, 0), basis), std::invalid_argument);
   EXPECT_THROW(EvaluateShBasis(-1, Eigen::Vector3d(1, 0, 0), basis), std::invalid_argument);
+  const double coefficients[kCount] = {};
+  EXPECT_THROW(EvaluateSh(4, coefficients, Eigen::Vector3d(1, 0, 0)), std::invalid_argument);
 }
 
 TEST(SphericalHarmonics, JetDerivativesMatchNumeric) {

@@ -156,11 +156,14 @@ void EvaluateShBasis(int degree, const Eigen::Matrix<T, 3, 1>& d, T* basis) {
 
 template <typename T, typename CoefficientT>
 T EvaluateSh(int degree, const CoefficientT* coefficients, const Eigen::Matrix<T, 3, 1>& d) {
-  T basis[ShCoefficientCount(kMaxShDegree)];
-  EvaluateShBasis(degree, d, basis);
-  T value = T(0.0);
-  for (int i = 0; i < ShCoefficientCount(degree); ++i) value += T(coefficients[i]) * basis[i];
-  return value;
+  switch (degree) {
+    case 0: return EvaluateSh<0, T>(coefficients, d);
+    case 1: return EvaluateSh<1, T>(coefficients, d);
+    case 2: return EvaluateSh<2, T>(coefficients, d);
+    case 3: return EvaluateSh<3, T>(coefficients, d);
+    default:
+      throw std::invalid_argument("SH degree must be in 0..3, got " + std::to_string(degree));
+  }
 }
 
 inline double EvaluateShWithGradient(int degree, const double* coefficients, const Eigen::Vector3d& d,
