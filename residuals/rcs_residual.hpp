@@ -9,16 +9,21 @@
 // facing sign s (d.x <= 0) taken at the pose of the association and held,
 // like the associated Gaussian, until the next association: the paper's flip
 // of d at u.x = 0 would make eq. 2 jump (odd SH bands) wherever a point
-// crosses its Gaussian's y-z plane, and solvers need a smooth cost. Two forms:
-//   RcsResidual          rotation and translation blocks ("full");
-//   RcsRotationResidual  the rotation block only, the translation a constant
-//                        of the current association (the paper's choice).
+// crosses its Gaussian's y-z plane, and solvers need a smooth cost. Forms:
+//   RcsResidual             rotation and translation blocks ("full");
+//   RcsRotationResidual     the rotation block only, the translation a constant
+//                           of the current association (the paper's choice);
+//   RcsCoefficientResidual  either of these plus the Gaussian's coefficients
+//                           as a block (joint refinement).
+// Each has an analytic twin (ceres::CostFunction) sharing LineariseRcs.
 #pragma once
 
 #include <array>
 #include <cstdint>
 
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/cost_function.h>
+#include <ceres/dynamic_autodiff_cost_function.h>
 #include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
@@ -119,16 +124,28 @@ struct RcsLinearisation {
   Eigen::RowVector3d dr_du = Eigen::RowVector3d::Zero();
 };
 
-inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d& mean_radar) {
+// d = s u / |u| for the Gaussian centre mu_r in the radar frame; writes |u|.
+inline Eigen::Vector3d RcsDirection(const RcsTerm& term, const Eigen::Vector3d& mean_radar, double& norm) {
   const Eigen::Vector3d u = IncidenceVector(term.incidence, term.point_radar, mean_radar);
-  const double norm = u.norm();
-  const Eigen::Vector3d d = term.facing * u / norm;
+  norm = u.norm();
+  return term.facing * u / norm;
+}
+
+// With coefficients c from a parameter block (joint refinement), else the term's.
+inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d& mean_radar,
+                                     const double* coefficients) {
+  double norm = 0.0;
+  const Eigen::Vector3d d = RcsDirection(term, mean_radar, norm);
   Eigen::Vector3d c_dY;
-  const double prediction = EvaluateShWithGradient(term.degree, term.coefficients.data(), d, c_dY);
+  const double prediction = EvaluateShWithGradient(term.degree, coefficients, d, c_dY);
   RcsLinearisation out;
   out.residual = term.measurement - prediction;
   out.dr_du = -(term.facing / norm) * (c_dY - c_dY.dot(d) * d).transpose();  // c_dY^T (I - d d^T)
   return out;
+}
+
+inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d& mean_radar) {
+  return LineariseRcs(term, mean_radar, term.coefficients.data());
 }
 
 // The analytic twin of RcsResidual ("full": rotation and translation).
@@ -191,6 +208,83 @@ class RcsRotationCostFunction final : public ceres::SizedCostFunction<1, 4> {
  private:
   RcsTerm term_;
   Eigen::Vector3d translation_;
+};
+
+// Joint refinement (DESIGN.md section 5): the same residual with the
+// Gaussian's coefficients c as a parameter block, so that scans tie their
+// poses to the map. Blocks: rotation (4), coefficients ((degree + 1)^2) and,
+// with `full`, translation (3); rotation-only takes the translation as a
+// constant of the association. dr/dc = -Y(d).
+class RcsCoefficientResidual {
+ public:
+  RcsCoefficientResidual(const RcsTerm& term, const Eigen::Vector3d& translation, bool full)
+      : term_(term), translation_(translation), full_(full) {}
+
+  template <typename T>
+  bool operator()(T const* const* parameters, T* residual) const {
+    const Eigen::Matrix<T, 3, 1> t = full_ ? Eigen::Matrix<T, 3, 1>(parameters[2][0], parameters[2][1], parameters[2][2])
+                                           : Eigen::Matrix<T, 3, 1>(translation_.cast<T>());
+    residual[0] = RcsResidualValue<T, T>(term_, parameters[0], t, parameters[1]);
+    return true;
+  }
+
+  using AutoDiff = ceres::DynamicAutoDiffCostFunction<RcsCoefficientResidual, 4>;
+  static ceres::CostFunction* Create(const RcsTerm& term, const Eigen::Vector3d& translation, bool full) {
+    auto* cost = new AutoDiff(new RcsCoefficientResidual(term, translation, full));
+    cost->AddParameterBlock(4);
+    cost->AddParameterBlock(ShCoefficientCount(term.degree));
+    if (full) cost->AddParameterBlock(3);
+    cost->SetNumResiduals(1);
+    return cost;
+  }
+
+ private:
+  const RcsTerm term_;
+  const Eigen::Vector3d translation_;
+  const bool full_;
+};
+
+// The analytic twin of RcsCoefficientResidual (same blocks).
+class RcsCoefficientCostFunction final : public ceres::CostFunction {
+ public:
+  RcsCoefficientCostFunction(const RcsTerm& term, const Eigen::Vector3d& translation, bool full)
+      : term_(term), translation_(translation), full_(full) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(4);
+    mutable_parameter_block_sizes()->push_back(ShCoefficientCount(term.degree));
+    if (full) mutable_parameter_block_sizes()->push_back(3);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const Eigen::Vector3d t = full_ ? Eigen::Vector3d(parameters[2][0], parameters[2][1], parameters[2][2]) : translation_;
+    if (jacobians == nullptr) {  // the cost alone (Ceres's step evaluations)
+      residuals[0] = RcsResidualValue<double>(term_, parameters[0], t, parameters[1]);
+      return true;
+    }
+    const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
+    const Eigen::Vector3d mean_radar = q.conjugate() * (term_.mean - t);
+    const RcsLinearisation lin = LineariseRcs(term_, mean_radar, parameters[1]);
+    residuals[0] = lin.residual;
+    if (jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
+      J = -lin.dr_du * InverseRotatePointJacobian(parameters[0], term_.mean - t);
+    }
+    if (jacobians[1] != nullptr) {
+      double norm = 0.0;
+      EvaluateShBasis(term_.degree, RcsDirection(term_, mean_radar, norm), jacobians[1]);
+      for (int i = 0; i < ShCoefficientCount(term_.degree); ++i) jacobians[1][i] = -jacobians[1][i];
+    }
+    if (full_ && jacobians[2] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 1, 3>> J(jacobians[2]);
+      J = (q * lin.dr_du.transpose()).transpose();  // dr/du R^T
+    }
+    return true;
+  }
+
+ private:
+  const RcsTerm term_;
+  const Eigen::Vector3d translation_;
+  const bool full_;
 };
 
 }  // namespace radargauss

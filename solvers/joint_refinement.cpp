@@ -1,6 +1,5 @@
 #include "solvers/joint_refinement.hpp"
 
-#include <ceres/dynamic_autodiff_cost_function.h>
 #include <ceres/normal_prior.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
@@ -16,28 +15,6 @@
 namespace radargauss {
 
 namespace {
-
-// r = y - c . Y(d(R, t)) with c a parameter block: blocks are rotation (4),
-// coefficients (count) and, with `full`, translation (3); else the
-// translation is the association's constant.
-class RcsCoefficientResidual {
- public:
-  RcsCoefficientResidual(const RcsTerm& term, const Eigen::Vector3d& translation, bool full)
-      : term_(term), translation_(translation), full_(full) {}
-
-  template <typename T>
-  bool operator()(T const* const* parameters, T* residual) const {
-    const Eigen::Matrix<T, 3, 1> t = full_ ? Eigen::Matrix<T, 3, 1>(parameters[2][0], parameters[2][1], parameters[2][2])
-                                           : Eigen::Matrix<T, 3, 1>(translation_.cast<T>());
-    residual[0] = RcsResidualValue<T, T>(term_, parameters[0], t, parameters[1]);
-    return true;
-  }
-
- private:
-  const RcsTerm term_;
-  const Eigen::Vector3d translation_;
-  const bool full_;
-};
 
 // r = weight * Log((T_i0^-1 T_j0)^-1 T_i^-1 T_j), blocks R_i, t_i, R_j, t_j.
 class RelativePoseResidual {
@@ -144,16 +121,12 @@ JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
         const double weight = w / double(c.rcs.size());
         for (const RcsTerm& term : c.rcs) {
           const std::uint32_t g = term.gaussian;
-          auto* cost = new ceres::DynamicAutoDiffCostFunction<RcsCoefficientResidual, 4>(
-              new RcsCoefficientResidual(term, c.pose.translation(), full));
-          cost->AddParameterBlock(4);
-          cost->AddParameterBlock(int(coefficients[g].size()));
+          ceres::CostFunction* cost =
+              options.matching.jacobians == JacobianMode::kAnalytic
+                  ? static_cast<ceres::CostFunction*>(new RcsCoefficientCostFunction(term, c.pose.translation(), full))
+                  : RcsCoefficientResidual::Create(term, c.pose.translation(), full);
           std::vector<double*> blocks = {rotations[k].data(), coefficients[g].data()};
-          if (full) {
-            cost->AddParameterBlock(3);
-            blocks.push_back(translations[k].data());
-          }
-          cost->SetNumResiduals(1);
+          if (full) blocks.push_back(translations[k].data());
           problem.AddResidualBlock(
               cost, new ceres::ScaledLoss(MakeLoss(options.matching.rcs_loss), weight, ceres::TAKE_OWNERSHIP),
               blocks);

@@ -6,6 +6,8 @@
 // consecutive relative poses and the coefficients near their initial values.
 // Solved with SPARSE_SCHUR (SH blocks eliminated first) or
 // SPARSE_NORMAL_CHOLESKY (SuiteSparse); associations are redone between rounds.
+// The RCS blocks are RcsCoefficientCostFunction (analytic) or
+// RcsCoefficientResidual's Jets, as matching.jacobians says.
 #pragma once
 
 #include <string>
@@ -16,7 +18,7 @@
 namespace radargauss {
 
 struct JointRefinementOptions {
-  ScanMatchingOptions matching;       // w_rcs, losses, gate, RCS translation mode
+  ScanMatchingOptions matching;       // w_rcs, losses, gate, RCS translation mode, Jacobians
   int rounds = 3;                     // association rounds
   int max_iterations_per_round = 20;  // Ceres iterations per round
   double relative_pose_prior = 0.0;   // weight of Log(dT0^-1 dT) between consecutive scans; 0: off

@@ -145,6 +145,45 @@ TEST_P(JacobianTest, RcsAnalyticAutodiffNumeric) {
   }
 }
 
+// Joint refinement's RCS residual with the coefficients as a parameter block:
+// analytic vs autodiff vs numeric, rotation-only and full, every SH degree.
+TEST_P(JacobianTest, RcsCoefficientBlocksAnalyticAutodiffNumeric) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 20; ++trial) {
+    RcsTerm term = RandomRcsTerm(rng, GetParam());
+    term.degree = trial % (kMaxShDegree + 1);
+    Eigen::Vector4d q = SO3d::Exp(0.5 * RandomUnitVector(rng)).quaternion().coeffs();
+    Eigen::Vector3d t = RandomUnitVector(rng);
+    const Eigen::Vector3d mean_radar = Eigen::Map<const Eigen::Quaterniond>(q.data()).conjugate() * (term.mean - t);
+    term.facing = FacingSign(IncidenceVector(term.incidence, term.point_radar, mean_radar));
+    Eigen::VectorXd c(ShCoefficientCount(term.degree));
+    for (int i = 0; i < c.size(); ++i) c[i] = 0.5 * normal(rng);  // not the term's own
+    for (const bool full : {false, true}) {
+      const RcsCoefficientCostFunction analytic(term, t, full);
+      const std::unique_ptr<ceres::CostFunction> autodiff(RcsCoefficientResidual::Create(term, t, full));
+      ASSERT_EQ(analytic.parameter_block_sizes(), autodiff->parameter_block_sizes());
+      std::vector<double*> blocks = {q.data(), c.data()};
+      if (full) blocks.push_back(t.data());
+      std::vector<Eigen::MatrixXd> ja, jd;
+      const Eigen::VectorXd ra = EvaluateWithJacobians(analytic, blocks, ja);
+      const Eigen::VectorXd rd = EvaluateWithJacobians(*autodiff, blocks, jd);
+      EXPECT_NEAR(ra[0], rd[0], 1e-12);
+      // The coefficients of the block, not the term's, predict the RCS.
+      double d_norm = 0.0;
+      const Eigen::Vector3d d = RcsDirection(term, mean_radar, d_norm);
+      EXPECT_NEAR(ra[0], term.measurement - EvaluateSh(term.degree, c.data(), d), 1e-12);
+      double cost_only = 0.0;
+      ASSERT_TRUE(analytic.Evaluate(blocks.data(), &cost_only, nullptr));
+      EXPECT_NEAR(cost_only, ra[0], 1e-14);
+      for (std::size_t b = 0; b < blocks.size(); ++b) {
+        EXPECT_LT(Relative(ja[b], jd[b]), 1e-8) << "block " << b << " degree " << term.degree;
+        EXPECT_LT(Relative(ja[b], NumericBlockJacobian(analytic, blocks, int(b))), 1e-5) << "block " << b;
+      }
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(BothIncidenceModels, JacobianTest,
                          ::testing::Values(IncidenceModel::kOffset, IncidenceModel::kView));
 
@@ -861,13 +900,15 @@ TEST(JointRefinement, LowersPoseErrorAndRcsResidual) {
       rotation_deg += dr / poses.size();
     }
   };
+  JointRefinementOptions options;
+  options.matching.w_rcs = 0.25;
+  options.coefficient_prior = 1.0;  // coefficients seen by few residuals stay put
+  options.threads = 2;
+  JointRefinementResult schur_result;
   for (const bool schur : {true, false}) {
-    JointRefinementOptions options;
-    options.matching.w_rcs = 0.25;
-    options.coefficient_prior = 1.0;  // coefficients seen by few residuals stay put
     options.schur = schur;
-    options.threads = 2;
     const JointRefinementResult result = RefineJointly(scans, perturbed, world.map, options);
+    if (schur) schur_result = result;
     double t0 = 0.0, r0 = 0.0, t1 = 0.0, r1 = 0.0;
     mean_error(perturbed, t0, r0);
     mean_error(result.poses, t1, r1);
@@ -883,6 +924,29 @@ TEST(JointRefinement, LowersPoseErrorAndRcsResidual) {
     EXPECT_EQ(result.poses[0].translation(), perturbed[0].translation());  // gauge
     EXPECT_LT(result.final_cost, result.initial_cost);
   }
+  // The autodiff RCS blocks (Jets through RcsCoefficientResidual) reach the
+  // analytic twin's poses and coefficients.
+  options.schur = true;
+  options.matching.jacobians = JacobianMode::kAutoDiff;
+  const JointRefinementResult autodiff = RefineJointly(scans, perturbed, world.map, options);
+  EXPECT_EQ(autodiff.iterations, schur_result.iterations);
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    double dt = 0.0, dr = 0.0;
+    PoseErrors(autodiff.poses[k], schur_result.poses[k], dt, dr);
+    EXPECT_LT(dt, 1e-6) << k;
+    EXPECT_LT(dr, 1e-5) << k;  // deg
+  }
+  double largest_coefficient_change = 0.0, largest_difference = 0.0;
+  for (std::size_t g = 0; g < world.map.gaussians.size(); ++g) {
+    for (int i = 0; i < ShCoefficientCount(kMaxShDegree); ++i) {
+      const double analytic = schur_result.map.gaussians[g].rcs.coefficients[i];
+      largest_coefficient_change =
+          std::max(largest_coefficient_change, std::abs(analytic - world.map.gaussians[g].rcs.coefficients[i]));
+      largest_difference = std::max(largest_difference, std::abs(autodiff.map.gaussians[g].rcs.coefficients[i] - analytic));
+    }
+  }
+  EXPECT_GT(largest_coefficient_change, 1e-3);  // the coefficients did move
+  EXPECT_LT(largest_difference, 1e-6);
   EXPECT_THROW(RefineJointly(scans, {}, world.map, JointRefinementOptions{}), std::invalid_argument);
 }
 
