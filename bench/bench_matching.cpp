@@ -89,6 +89,30 @@ void BM_RcsResidualRotationOnly(benchmark::State& state) {
 BENCHMARK_TEMPLATE(BM_RcsResidualRotationOnly, Analytic)->Arg(0)->Arg(1);
 BENCHMARK_TEMPLATE(BM_RcsResidualRotationOnly, AutoDiff)->Arg(0)->Arg(1);
 
+// Joint refinement's RCS block: rotation-only, the 16 coefficients a block.
+template <typename Kind>
+void BM_RcsResidualWithCoefficients(benchmark::State& state) {
+  const RcsTerm term = BenchmarkTerm(IncidenceModel::kOffset);
+  const Eigen::Vector3d t(1.0, 2.0, 0.5);
+  std::unique_ptr<ceres::CostFunction> cost;
+  if constexpr (std::is_same_v<Kind, Analytic>) {
+    cost = std::make_unique<RcsCoefficientCostFunction>(term, t, false);
+  } else {
+    cost.reset(RcsCoefficientResidual::Create(term, t, false));
+  }
+  Eigen::Vector4d q = SO3d::Exp(Eigen::Vector3d(0.1, -0.2, 0.3)).quaternion().coeffs();
+  const double* parameters[2] = {q.data(), term.coefficients.data()};
+  double residual, j0[4], j1[16];
+  double* jacobians[2] = {j0, j1};
+  for (auto _ : state) {
+    cost->Evaluate(parameters, &residual, jacobians);
+    benchmark::DoNotOptimize(j1[0]);
+  }
+  state.SetLabel("offset, degree 3");
+}
+BENCHMARK_TEMPLATE(BM_RcsResidualWithCoefficients, Analytic);
+BENCHMARK_TEMPLATE(BM_RcsResidualWithCoefficients, AutoDiff);
+
 // ---------------------------------------------------------------------------
 // Per-scan matching.
 
