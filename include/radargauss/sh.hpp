@@ -9,6 +9,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include <Eigen/Core>
 
@@ -141,41 +142,36 @@ double EvaluateShWithGradient(const double* coefficients, const Eigen::Vector3d&
   return value;
 }
 
-// Runtime-degree versions; throw std::invalid_argument for a degree outside 0..3.
-template <typename T>
-void EvaluateShBasis(int degree, const Eigen::Matrix<T, 3, 1>& d, T* basis) {
+// Calls f(std::integral_constant<int, degree>{}) for a degree read from data;
+// throws std::invalid_argument for a degree outside 0..3.
+template <typename F>
+decltype(auto) WithShDegree(int degree, F&& f) {
   switch (degree) {
-    case 0: return EvaluateShBasis<0>(d, basis);
-    case 1: return EvaluateShBasis<1>(d, basis);
-    case 2: return EvaluateShBasis<2>(d, basis);
-    case 3: return EvaluateShBasis<3>(d, basis);
+    case 0: return f(std::integral_constant<int, 0>{});
+    case 1: return f(std::integral_constant<int, 1>{});
+    case 2: return f(std::integral_constant<int, 2>{});
+    case 3: return f(std::integral_constant<int, 3>{});
     default:
       throw std::invalid_argument("SH degree must be in 0..3, got " + std::to_string(degree));
   }
+}
+
+// Runtime-degree versions of the above.
+template <typename T>
+void EvaluateShBasis(int degree, const Eigen::Matrix<T, 3, 1>& d, T* basis) {
+  WithShDegree(degree, [&](auto D) { EvaluateShBasis<decltype(D)::value>(d, basis); });
 }
 
 template <typename T, typename CoefficientT>
 T EvaluateSh(int degree, const CoefficientT* coefficients, const Eigen::Matrix<T, 3, 1>& d) {
-  switch (degree) {
-    case 0: return EvaluateSh<0, T>(coefficients, d);
-    case 1: return EvaluateSh<1, T>(coefficients, d);
-    case 2: return EvaluateSh<2, T>(coefficients, d);
-    case 3: return EvaluateSh<3, T>(coefficients, d);
-    default:
-      throw std::invalid_argument("SH degree must be in 0..3, got " + std::to_string(degree));
-  }
+  return WithShDegree(degree, [&](auto D) { return EvaluateSh<decltype(D)::value, T>(coefficients, d); });
 }
 
 inline double EvaluateShWithGradient(int degree, const double* coefficients, const Eigen::Vector3d& d,
                                      Eigen::Vector3d& gradient) {
-  switch (degree) {
-    case 0: return EvaluateShWithGradient<0>(coefficients, d, gradient);
-    case 1: return EvaluateShWithGradient<1>(coefficients, d, gradient);
-    case 2: return EvaluateShWithGradient<2>(coefficients, d, gradient);
-    case 3: return EvaluateShWithGradient<3>(coefficients, d, gradient);
-    default:
-      throw std::invalid_argument("SH degree must be in 0..3, got " + std::to_string(degree));
-  }
+  return WithShDegree(degree, [&](auto D) {
+    return EvaluateShWithGradient<decltype(D)::value>(coefficients, d, gradient);
+  });
 }
 
 }  // namespace radargauss
