@@ -32,16 +32,21 @@ namespace {
 struct Analytic {};
 struct AutoDiff {};
 
+// The analytic twin or the autodiff functor's cost function, from the same arguments.
+template <typename Kind, typename AnalyticCost, typename Functor, typename... Args>
+std::unique_ptr<ceres::CostFunction> MakeCost(const Args&... args) {
+  if constexpr (std::is_same_v<Kind, Analytic>) {
+    return std::make_unique<AnalyticCost>(args...);
+  } else {
+    return std::unique_ptr<ceres::CostFunction>(Functor::Create(args...));
+  }
+}
+
 template <typename Kind>
 void BM_GeometricResidual(benchmark::State& state) {
   const Eigen::Vector3d p(12.0, -3.0, 1.0), mean(11.5, -2.5, 1.2);
   const Eigen::Matrix3d LT = 10.0 * Eigen::Matrix3d::Identity();
-  std::unique_ptr<ceres::CostFunction> cost;
-  if constexpr (std::is_same_v<Kind, Analytic>) {
-    cost = std::make_unique<GeometricCostFunction>(p, mean, LT);
-  } else {
-    cost.reset(GeometricResidual::Create(p, mean, LT));
-  }
+  const auto cost = MakeCost<Kind, GeometricCostFunction, GeometricResidual>(p, mean, LT);
   Eigen::Vector4d q = SO3d::Exp(Eigen::Vector3d(0.1, -0.2, 0.3)).quaternion().coeffs();
   Eigen::Vector3d t(1.0, 2.0, 0.5);
   const double* parameters[2] = {q.data(), t.data()};
@@ -70,12 +75,7 @@ template <typename Kind>
 void BM_RcsResidualRotationOnly(benchmark::State& state) {
   const RcsTerm term = BenchmarkTerm(IncidenceModel(state.range(0)));
   const Eigen::Vector3d t(1.0, 2.0, 0.5);
-  std::unique_ptr<ceres::CostFunction> cost;
-  if constexpr (std::is_same_v<Kind, Analytic>) {
-    cost = std::make_unique<RcsRotationCostFunction>(term, t);
-  } else {
-    cost.reset(RcsRotationResidual::Create(term, t));
-  }
+  const auto cost = MakeCost<Kind, RcsRotationCostFunction, RcsRotationResidual>(term, t);
   Eigen::Vector4d q = SO3d::Exp(Eigen::Vector3d(0.1, -0.2, 0.3)).quaternion().coeffs();
   const double* parameters[1] = {q.data()};
   double residual, j0[4];
@@ -94,12 +94,7 @@ template <typename Kind>
 void BM_RcsResidualWithCoefficients(benchmark::State& state) {
   const RcsTerm term = BenchmarkTerm(IncidenceModel::kOffset);
   const Eigen::Vector3d t(1.0, 2.0, 0.5);
-  std::unique_ptr<ceres::CostFunction> cost;
-  if constexpr (std::is_same_v<Kind, Analytic>) {
-    cost = std::make_unique<RcsCoefficientCostFunction>(term, t, false);
-  } else {
-    cost.reset(RcsCoefficientResidual::Create(term, t, false));
-  }
+  const auto cost = MakeCost<Kind, RcsCoefficientCostFunction, RcsCoefficientResidual>(term, t, false);
   Eigen::Vector4d q = SO3d::Exp(Eigen::Vector3d(0.1, -0.2, 0.3)).quaternion().coeffs();
   const double* parameters[2] = {q.data(), term.coefficients.data()};
   double residual, j0[4], j1[16];
