@@ -266,6 +266,68 @@ void BM_RefineScanLossCurvature(benchmark::State& state) {
 }
 BENCHMARK(BM_RefineScanLossCurvature)->Arg(0)->Arg(25)->Unit(benchmark::kMillisecond);
 
+// The own GN when tracking under other stopping and re-association settings
+// than the defaults: what they buy in latency and what they cost against the
+// defaults' answer. Counters t_dev_m / r_dev_deg: mean distance of each
+// scan's result from the default settings' result on the same scan.
+// Args: w_rcs x 100, setting (0 defaults; 1 eager re-association, after
+// every step; 2 small_gicp's step tolerances, 1 mm and 0.1 deg; 3
+// re-association after 2 cm instead of 1 cm; 4 both; 5 both with
+// re-association after 3 cm / 0.006 rad, i.e. beyond this benchmark's
+// initial error: one association per match).
+void BM_RefineScanSettings(benchmark::State& state) {
+  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const MatchingWorld& world = World();
+  const MatchingMap exact(world.map, ExactMapOnly());
+  const SimulatedSequence& scans = world.scans.at(800);
+  const std::vector<SE3d> initial = TrackingPoses(scans);
+  ScanMatchingOptions defaults;
+  defaults.w_rcs = double(state.range(0)) / 100.0;
+  ScanMatchingOptions options = defaults;
+  const int setting = int(state.range(1));
+  if (setting == 1) options.reassociation_translation = options.reassociation_rotation = 0.0;
+  if (setting == 2 || setting >= 4) {
+    options.translation_tolerance = 1e-3;
+    options.rotation_tolerance = 0.1 * M_PI / 180.0;
+  }
+  if (setting >= 3) options.reassociation_translation = 0.02;
+  if (setting == 5) {
+    options.reassociation_translation = 0.03;
+    options.reassociation_rotation = 0.006;
+  }
+  std::vector<SE3d> reference;
+  const GaussNewtonSolver default_solver(defaults);
+  for (std::size_t k = 0; k < scans.scans.size(); ++k) {
+    reference.push_back(default_solver.Match(scans.scans[k], exact, initial[k]).pose);
+  }
+  const GaussNewtonSolver solver(options);
+  std::vector<double> times;
+  double t_dev = 0.0, r_dev = 0.0, t_err = 0.0, r_err = 0.0, iterations = 0.0;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const ScanMatchingResult result = solver.Match(scans.scans[k], exact, initial[k]);
+    times.push_back(result.time_ms);
+    double dt = 0.0, dr = 0.0;
+    PoseErrors(result.pose, reference[k], dt, dr);
+    t_dev += dt;
+    r_dev += dr;
+    PoseErrors(result.pose, scans.ground_truth[k].pose, dt, dr);
+    t_err += dt;
+    r_err += dr;
+    iterations += result.iterations;
+    k = (k + 1) % scans.scans.size();
+  }
+  const double runs = double(times.size());
+  state.SetLabel("gn setting " + std::to_string(setting) + " w=" + std::to_string(defaults.w_rcs).substr(0, 4));
+  state.counters["median_ms"] = MedianMs(times);
+  state.counters["iterations"] = iterations / runs;
+  state.counters["t_dev_m"] = t_dev / runs;
+  state.counters["r_dev_deg"] = r_dev / runs;
+  state.counters["t_err_m"] = t_err / runs;
+  state.counters["r_err_deg"] = r_err / runs;
+}
+BENCHMARK(BM_RefineScanSettings)->ArgsProduct({{0, 25}, {0, 1, 2, 3, 4, 5}})->Unit(benchmark::kMillisecond);
+
 // Ceres LM against the own GN when tracking, the two interleaved scan by
 // scan so that this shared machine's load drifts over both alike: the medians
 // of their per-scan times and the ratio of the medians (the goal: <= 5x).

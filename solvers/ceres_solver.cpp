@@ -186,9 +186,7 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
     }
     result.pose = SE3d(SO3d(Eigen::Quaterniond(rotation[3], rotation[0], rotation[1], rotation[2])), translation);
     const SE3d step = before.Inverse() * result.pose;
-    const bool small =
-        (result.pose.translation() - before.translation()).norm() < level.looseness * options_.translation_tolerance &&
-        step.rotation().Log().norm() < level.looseness * options_.rotation_tolerance;
+    const bool small = level.SmallStep(step.translation().norm(), step.rotation().Log().norm());
     // Converged when the pose settled, or when Ceres converged on an
     // association the outer loop keeps: the next solve would be the same
     // problem from its own solution.

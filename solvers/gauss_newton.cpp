@@ -223,8 +223,7 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
     const Correspondences& c = level.correspondences;
     const double w = level.options.w_rcs;
     const auto small = [&](const Eigen::Matrix<double, 6, 1>& step) {
-      return step.segment<3>(kTranslationOffset).norm() < level.looseness * options_.translation_tolerance &&
-             step.segment<3>(kRotationOffset).norm() < level.looseness * options_.rotation_tolerance;
+      return level.SmallStep(step.segment<3>(kTranslationOffset).norm(), step.segment<3>(kRotationOffset).norm());
     };
     // Halves dx from `from` (first by `scale`) while eq. 2 exceeds `cost`;
     // sets result.pose and returns the step taken.

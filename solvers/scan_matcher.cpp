@@ -17,7 +17,9 @@ void ValidateOptions(const ScanMatchingOptions& o) {
   require(o.gate > 0.0, "association gate must be > 0");
   require(o.max_iterations >= 1 && o.coarse_iterations >= 1, "iteration limits must be >= 1");
   require(o.max_step_halvings >= 0, "max step halvings must be >= 0");
-  require(o.translation_tolerance > 0.0 && o.rotation_tolerance > 0.0, "tolerances must be > 0");
+  require(o.translation_tolerance > 0.0 && o.rotation_tolerance > 0.0 && o.coarse_translation_tolerance > 0.0 &&
+              o.coarse_rotation_tolerance > 0.0,
+          "tolerances must be > 0");
   require(o.reassociation_translation >= 0.0 && o.reassociation_rotation >= 0.0,
           "re-association thresholds must be >= 0");
 }
@@ -221,7 +223,11 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
       }
       ++result.iterations;
       const StepOutcome outcome =
-          step({c, level_options, finest, finest ? 1.0 : 100.0, iteration == max_iterations}, result);
+          step({c, level_options, finest,
+                finest ? options.translation_tolerance : options.coarse_translation_tolerance,
+                finest ? options.rotation_tolerance : options.coarse_rotation_tolerance,
+                iteration == max_iterations},
+               result);
       if (outcome == StepOutcome::kFailed) failed = true;
       if (outcome != StepOutcome::kContinue) {
         result.converged = outcome == StepOutcome::kConverged;

@@ -54,7 +54,9 @@ struct ScanMatchingOptions {
   // paper and Ceres (whose Corrector ignores rho'' < 0).
   bool loss_curvature = false;
   double translation_tolerance = 1e-4;  // m: stop when the update is smaller ...
-  double rotation_tolerance = 1e-5;     // rad ... in both parts (100x looser on coarse levels)
+  double rotation_tolerance = 1e-5;     // rad ... in both parts, on the exact map
+  double coarse_translation_tolerance = 1e-2;  // m: the same on coarse levels, which
+  double coarse_rotation_tolerance = 1e-3;     // rad only steer into the exact map's basin
 };
 
 // Throws std::invalid_argument naming the bad option.
@@ -162,8 +164,13 @@ struct LevelStep {
   const Correspondences& correspondences;
   const ScanMatchingOptions& options;  // with this level's w_rcs
   bool finest = false;
-  double looseness = 1.0;              // tolerance multiplier (100 on coarse levels)
+  double translation_tolerance = 0.0;  // m: this level's step tolerances
+  double rotation_tolerance = 0.0;     // rad
   bool last_iteration = false;         // the level's iteration limit is reached with this step
+  // Whether a step (translation norm, rotation angle) ends the level.
+  bool SmallStep(double translation, double rotation) const {
+    return translation < translation_tolerance && rotation < rotation_tolerance;
+  }
 };
 enum class StepOutcome { kContinue, kConverged, kFailed };
 using SolverStep = std::function<StepOutcome(const LevelStep&, ScanMatchingResult&)>;
