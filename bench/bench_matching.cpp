@@ -271,10 +271,10 @@ BENCHMARK(BM_RefineScanLossCurvature)->Arg(0)->Arg(25)->Unit(benchmark::kMillise
 // defaults' answer. Counters t_dev_m / r_dev_deg: mean distance of each
 // scan's result from the default settings' result on the same scan.
 // Args: w_rcs x 100, setting (0 defaults; 1 eager re-association, after
-// every step; 2 small_gicp's step tolerances, 1 mm and 0.1 deg; 3
-// re-association after 2 cm instead of 1 cm; 4 both; 5 both with
-// re-association after 3 cm / 0.006 rad, i.e. beyond this benchmark's
-// initial error: one association per match).
+// every step; 2 steps to 0.1 mm / 1e-5 rad, the defaults before the eighth
+// session; 3 re-association after 2 cm instead of 1 cm; 4 small_gicp's step
+// tolerances, 1 mm / 0.1 deg; 5 re-association after 3 cm / 0.006 rad,
+// beyond this benchmark's initial error: one association per match).
 void BM_RefineScanSettings(benchmark::State& state) {
   const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const MatchingWorld& world = World();
@@ -286,11 +286,12 @@ void BM_RefineScanSettings(benchmark::State& state) {
   ScanMatchingOptions options = defaults;
   const int setting = int(state.range(1));
   if (setting == 1) options.reassociation_translation = options.reassociation_rotation = 0.0;
-  if (setting == 2 || setting >= 4) {
-    options.translation_tolerance = 1e-3;
-    options.rotation_tolerance = 0.1 * M_PI / 180.0;
+  if (setting == 2) {
+    options.translation_tolerance = 1e-4;
+    options.rotation_tolerance = 1e-5;
   }
-  if (setting >= 3) options.reassociation_translation = 0.02;
+  if (setting == 3) options.reassociation_translation = 0.02;
+  if (setting == 4) options.rotation_tolerance = 0.1 * M_PI / 180.0;
   if (setting == 5) {
     options.reassociation_translation = 0.03;
     options.reassociation_rotation = 0.006;
