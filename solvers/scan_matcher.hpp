@@ -53,8 +53,8 @@ struct ScanMatchingOptions {
   // not positive definite the step falls back to IRLS. Off: IRLS, as the
   // paper and Ceres (whose Corrector ignores rho'' < 0).
   bool loss_curvature = false;
-  double translation_tolerance = 1e-3;                // m: stop when the update is smaller ...
-  double rotation_tolerance = 1e-4;                   // rad ... in both parts, on the exact map
+  double translation_tolerance = 1e-3;         // m: stop when the update is smaller ...
+  double rotation_tolerance = 1e-4;            // rad ... in both parts, on the exact map
   double coarse_translation_tolerance = 1e-2;  // m: the same on coarse levels, which
   double coarse_rotation_tolerance = 1e-3;     // rad only steer into the exact map's basin
 };

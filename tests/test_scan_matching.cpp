@@ -800,6 +800,31 @@ TEST(CoarsePoints, SubsamplesCoarseLevelsOnly) {
   EXPECT_NE(a.translation(), c.translation());
 }
 
+// The coarse levels stop on their own tolerances, the exact map on its own:
+// coarse tolerances so large that every first step is small end each coarse
+// level after one iteration (the exact map's iterations unchanged in kind),
+// and invalid ones are rejected.
+TEST(CoarseTolerances, EndCoarseLevelsOnly) {
+  const World& world = SimulatedWorld();
+  const RadarScan& scan = world.simulated.scans[kTestScan];
+  const SE3d initial = Perturbed(world.simulated.ground_truth[kTestScan].pose, 2.0, 5.0, 1);
+  ScanMatchingOptions loose;
+  loose.coarse_translation_tolerance = 1e3;
+  loose.coarse_rotation_tolerance = 1e3;
+  const ScanMatchingResult defaults = GaussNewtonSolver(ScanMatchingOptions{}).Match(scan, *world.matching, initial);
+  ScanMatchingOptions exact_only = loose;
+  exact_only.max_iterations = 1;  // one iteration on the exact map: the coarse levels' count is what remains
+  const ScanMatchingResult one = GaussNewtonSolver(exact_only).Match(scan, *world.matching, initial);
+  EXPECT_EQ(one.iterations, int(world.matching->levels()));
+  EXPECT_GT(defaults.iterations, int(world.matching->levels()) + 1);
+  ScanMatchingOptions bad;
+  bad.coarse_translation_tolerance = 0.0;
+  EXPECT_THROW(GaussNewtonSolver{bad}, std::invalid_argument);
+  bad = ScanMatchingOptions{};
+  bad.coarse_rotation_tolerance = -1.0;
+  EXPECT_THROW(CeresSolver{bad}, std::invalid_argument);
+}
+
 // Merged coarse levels: the Gaussians whose means share a voxel of side
 // kMergeCellPerSigma * sigma become their moment-matched mixture (weights:
 // member counts), blurred by sigma^2 I. Reference by hand: two Gaussians
