@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <map>
 #include <memory>
+#include <tuple>
 #include <type_traits>
 #include <random>
 
@@ -238,14 +239,20 @@ std::vector<SE3d> TrackingPoses(const SimulatedSequence& sequence) {
   return initial;
 }
 
-// Refinement only (the exact map, from 5 cm / 0.2 deg): the per-scan latency
-// of tracking, where the coarse levels are not needed. 800 points, one thread.
-void RefineScans(benchmark::State& state, int solver, const ScanMatchingOptions& options) {
-  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+// What every tracking benchmark matches: 800-point scans on the exact map
+// (no coarse levels) from 5 cm / 0.2 deg, one thread.
+struct Tracking {
+  const tbb::global_control one_thread{tbb::global_control::max_allowed_parallelism, 1};
   const MatchingWorld& world = World();
-  const MatchingMap exact(world.map, ExactMapOnly());
+  const MatchingMap exact{world.map, ExactMapOnly()};
   const SimulatedSequence& scans = world.scans.at(800);
-  MatchScans(state, *Solver(solver, options), exact, scans, TrackingPoses(scans), options.w_rcs);
+  const std::vector<SE3d> initial = TrackingPoses(scans);
+};
+
+// Refinement only: the per-scan latency of tracking.
+void RefineScans(benchmark::State& state, int solver, const ScanMatchingOptions& options) {
+  const Tracking tracking;
+  MatchScans(state, *Solver(solver, options), tracking.exact, tracking.scans, tracking.initial, options.w_rcs);
 }
 
 // Args: solver, w_rcs x 100.
@@ -276,11 +283,8 @@ BENCHMARK(BM_RefineScanLossCurvature)->Arg(0)->Arg(25)->Unit(benchmark::kMillise
 // tolerances, 1 mm / 0.1 deg; 5 re-association after 3 cm / 0.006 rad,
 // beyond this benchmark's initial error: one association per match).
 void BM_RefineScanSettings(benchmark::State& state) {
-  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
-  const MatchingWorld& world = World();
-  const MatchingMap exact(world.map, ExactMapOnly());
-  const SimulatedSequence& scans = world.scans.at(800);
-  const std::vector<SE3d> initial = TrackingPoses(scans);
+  const Tracking tracking;
+  const auto& [exact, scans, initial] = std::tie(tracking.exact, tracking.scans, tracking.initial);
   ScanMatchingOptions defaults;
   defaults.w_rcs = double(state.range(0)) / 100.0;
   ScanMatchingOptions options = defaults;
@@ -334,11 +338,8 @@ BENCHMARK(BM_RefineScanSettings)->ArgsProduct({{0, 25}, {0, 1, 2, 3, 4, 5}})->Un
 // of their per-scan times and the ratio of the medians (the goal: <= 5x).
 // Arg: w_rcs x 100.
 void BM_RefineScanCeresOverGn(benchmark::State& state) {
-  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
-  const MatchingWorld& world = World();
-  const MatchingMap exact(world.map, ExactMapOnly());
-  const SimulatedSequence& scans = world.scans.at(800);
-  const std::vector<SE3d> initial = TrackingPoses(scans);
+  const Tracking tracking;
+  const auto& [exact, scans, initial] = std::tie(tracking.exact, tracking.scans, tracking.initial);
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(0)) / 100.0;
   const std::unique_ptr<ScanMatcher> gn = Solver(0, options);

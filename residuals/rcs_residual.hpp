@@ -122,7 +122,6 @@ class RcsRotationResidual {
 struct RcsLinearisation {
   double residual = 0.0;
   Eigen::RowVector3d dr_du = Eigen::RowVector3d::Zero();
-  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // d, where Y is evaluated (dr/dc = -Y(d))
 };
 
 // d = s u / |u| for the Gaussian centre mu_r in the radar frame; writes |u|.
@@ -132,15 +131,15 @@ inline Eigen::Vector3d RcsDirection(const RcsTerm& term, const Eigen::Vector3d& 
   return term.facing * u / norm;
 }
 
-// With coefficients c from a parameter block (joint refinement), else the term's.
+// With coefficients c from a parameter block (joint refinement), else the
+// term's; writes Y(d) = -dr/dc to `basis_out` when given.
 inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d& mean_radar,
-                                     const double* coefficients) {
+                                     const double* coefficients, double* basis_out = nullptr) {
   double norm = 0.0;
   RcsLinearisation out;
-  out.direction = RcsDirection(term, mean_radar, norm);
-  const Eigen::Vector3d& d = out.direction;
+  const Eigen::Vector3d d = RcsDirection(term, mean_radar, norm);
   Eigen::Vector3d c_dY;
-  const double prediction = EvaluateShWithGradient(term.degree, coefficients, d, c_dY);
+  const double prediction = EvaluateShWithGradient(term.degree, coefficients, d, c_dY, basis_out);
   out.residual = term.measurement - prediction;
   out.dr_du = -(term.facing / norm) * (c_dY - c_dY.dot(d) * d).transpose();  // c_dY^T (I - d d^T)
   return out;
@@ -264,14 +263,14 @@ class RcsCoefficientCostFunction final : public ceres::CostFunction {
       return true;
     }
     const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
-    const RcsLinearisation lin = LineariseRcs(term_, q.conjugate() * (term_.mean - t), parameters[1]);
+    // jacobians[1], when asked for, receives Y(d); dr/dc = -Y(d).
+    const RcsLinearisation lin = LineariseRcs(term_, q.conjugate() * (term_.mean - t), parameters[1], jacobians[1]);
     residuals[0] = lin.residual;
     if (jacobians[0] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
       J = -lin.dr_du * InverseRotatePointJacobian(parameters[0], term_.mean - t);
     }
     if (jacobians[1] != nullptr) {
-      EvaluateShBasis(term_.degree, lin.direction, jacobians[1]);
       for (int i = 0; i < ShCoefficientCount(term_.degree); ++i) jacobians[1][i] = -jacobians[1][i];
     }
     if (full_ && jacobians[2] != nullptr) {

@@ -193,6 +193,11 @@ TEST(SphericalHarmonics, ValueWithGradientMatchesDotProductAndNumeric) {
       if (degree == 0) {
         EXPECT_EQ(gradient, Eigen::Vector3d::Zero());
       }
+      // The basis it can hand out on the way (joint refinement's dr/dc).
+      double basis_out[kCount], basis[kCount];
+      EvaluateShWithGradient(degree, c.data(), d, gradient, basis_out);
+      EvaluateShBasis(degree, d, basis);
+      for (int i = 0; i < ShCoefficientCount(degree); ++i) EXPECT_EQ(basis_out[i], basis[i]) << degree << " " << i;
     }
   }
   Eigen::Vector3d gradient;

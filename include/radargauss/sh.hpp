@@ -7,6 +7,7 @@
 // data. Directions must be unit vectors (the paper's incidence vector d).
 #pragma once
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -125,9 +126,11 @@ void EvaluateShBasisGradient(const Eigen::Vector3d& d, double* gradient) {
 
 // c . Y(d) and its gradient c . dY/dd (polynomial forms, d not renormalised)
 // in one pass: the inner loop of the analytic RCS residual. With the degree
-// fixed, the basis and its gradient stay in registers.
+// fixed, the basis and its gradient stay in registers. Writes the basis
+// Y(d) to `basis_out` when given.
 template <int Degree>
-double EvaluateShWithGradient(const double* coefficients, const Eigen::Vector3d& d, Eigen::Vector3d& gradient) {
+double EvaluateShWithGradient(const double* coefficients, const Eigen::Vector3d& d, Eigen::Vector3d& gradient,
+                              double* basis_out = nullptr) {
   constexpr int kCount = ShCoefficientCount(Degree);
   double basis[kCount];
   double basis_gradient[3 * kCount];
@@ -139,6 +142,7 @@ double EvaluateShWithGradient(const double* coefficients, const Eigen::Vector3d&
     value += coefficients[i] * basis[i];
     gradient += coefficients[i] * Eigen::Map<const Eigen::Vector3d>(basis_gradient + 3 * i);
   }
+  if (basis_out != nullptr) std::copy(basis, basis + kCount, basis_out);
   return value;
 }
 
@@ -168,9 +172,9 @@ T EvaluateSh(int degree, const CoefficientT* coefficients, const Eigen::Matrix<T
 }
 
 inline double EvaluateShWithGradient(int degree, const double* coefficients, const Eigen::Vector3d& d,
-                                     Eigen::Vector3d& gradient) {
+                                     Eigen::Vector3d& gradient, double* basis_out = nullptr) {
   return WithShDegree(degree, [&](auto D) {
-    return EvaluateShWithGradient<decltype(D)::value>(coefficients, d, gradient);
+    return EvaluateShWithGradient<decltype(D)::value>(coefficients, d, gradient, basis_out);
   });
 }
 
