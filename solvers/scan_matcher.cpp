@@ -91,13 +91,23 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
   if (rcs) out.rcs.reserve(scan.points.size());
   const Eigen::Matrix3d R = pose.rotation().Matrix();
   const Eigen::Matrix3d Rt = R.transpose();
-  for (const RadarPoint& point : scan.points) {
-    const Eigen::Vector3d world = R * point.position + pose.translation();
-    const int g = out.index->Associate(world, gate * gate);
+  const std::size_t n = scan.points.size();
+  std::vector<Eigen::Vector3d> world(n);
+  for (std::size_t k = 0; k < n; ++k) world[k] = R * scan.points[k].position + pose.translation();
+  std::vector<int> associations(n);
+  out.index->AssociateAll(world.data(), n, gate * gate, associations.data());
+  const std::vector<Gaussian>& gaussians = map.map().gaussians;
+  constexpr std::size_t kAhead = 8;  // RCS terms read the Gaussian's model: fetch it early
+  for (std::size_t k = 0; k < n; ++k) {
+    if (rcs && k + kAhead < n && associations[k + kAhead] >= 0) {
+      __builtin_prefetch(&gaussians[associations[k + kAhead]].rcs);
+    }
+    const RadarPoint& point = scan.points[k];
+    const int g = associations[k];
     if (g < 0) continue;
     out.geometric.push_back({point.position, std::uint32_t(g)});
     if (!rcs) continue;
-    const Gaussian& gaussian = map.map().gaussians[g];
+    const Gaussian& gaussian = gaussians[g];
     if (!gaussian.rcs.valid()) continue;
     const double y = gaussian.rcs.Normalise(point.rcs);
     if (!(std::abs(y) <= 1.0)) continue;  // RCS outlier: no residual (eq. 2)
@@ -122,18 +132,22 @@ double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchi
   const RobustLoss geometric_loss(options.geometric_loss);
   const RobustLoss rcs_loss(options.rcs_loss);
   double rho = 0.0, weight = 0.0;
+  // One rotation matrix for all terms (the functors rotate by the quaternion per term).
+  const Eigen::Matrix3d R = pose.rotation().Matrix();
+  const Eigen::Matrix3d Rt = R.transpose();
   double geometric = 0.0;
   for (const GeometricTerm& term : c.geometric) {
-    const Eigen::Vector3d r = c.index->SqrtInformationT(term.gaussian) *
-                              (pose * term.point_radar - c.index->Mean(term.gaussian));
-    geometric_loss.Evaluate(r.squaredNorm(), rho, weight);
+    const Eigen::Vector3d e = R * term.point_radar + pose.translation() - c.index->Mean(term.gaussian);
+    geometric_loss.Evaluate(e.dot(c.index->Information(term.gaussian) * e), rho, weight);  // ||L^T e||^2
     geometric += rho;
   }
   double rcs = 0.0;
   const Eigen::Vector3d rcs_translation =
       options.rcs_translation == RcsTranslation::kRotationOnly ? c.pose.translation() : pose.translation();
   for (const RcsTerm& term : c.rcs) {
-    const double r = RcsResidualValue<double>(term, pose.rotation().data(), rcs_translation);
+    double norm = 0.0;
+    const Eigen::Vector3d d = RcsDirection(term, Rt * (term.mean - rcs_translation), norm);
+    const double r = term.measurement - EvaluateSh<double>(term.degree, term.coefficients.data(), d);
     rcs_loss.Evaluate(r * r, rho, weight);
     rcs += rho;
   }

@@ -117,13 +117,16 @@ TEST(GaussianBuilder, ClampsStdAndVoxelBaseline) {
 }
 
 // The index gives the brute-force answer: every point within tau <= 3 of a
-// Gaussian lies in its 3-sigma box.
+// Gaussian lies in its 3-sigma box. So does the batched query (AssociateAll),
+// which fetches ahead and must not change an answer.
 TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
   const Planted planted = PlantGaussians(10, 3);
   const GaussianIndex index(planted.gaussians, 0.7);
   std::mt19937 rng(4);
   std::uniform_real_distribution<double> uniform(-2.0, 20.0);
   int associated = 0;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> expected_all;
   for (int trial = 0; trial < 20000; ++trial) {
     const Eigen::Vector3d p(uniform(rng), uniform(rng), 0.2 * uniform(rng));
     int expected = -1;
@@ -136,6 +139,8 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
         expected = int(g);
       }
     }
+    points.push_back(p);
+    expected_all.push_back(expected);
     double d2 = 0.0;
     ASSERT_EQ(index.Associate(p, 9.0, &d2), expected) << p.transpose();
     if (expected >= 0) {
@@ -147,6 +152,13 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
     }
   }
   EXPECT_GT(associated, 50);
+  std::vector<int> batched(points.size(), -2);
+  index.AssociateAll(points.data(), points.size(), 9.0, batched.data());
+  EXPECT_EQ(batched, expected_all);
+  // Fewer points than the batch looks ahead.
+  index.AssociateAll(points.data(), 3, 9.0, batched.data());
+  EXPECT_EQ(std::vector<int>(batched.begin(), batched.begin() + 3),
+            std::vector<int>(expected_all.begin(), expected_all.begin() + 3));
 }
 
 TEST(GaussianIndexTest, EmptyIndexAssociatesNothing) {
@@ -156,6 +168,13 @@ TEST(GaussianIndexTest, EmptyIndexAssociatesNothing) {
   EXPECT_EQ(GaussianIndex().Candidates(p, count), nullptr);
   EXPECT_EQ(count, 0u);
   EXPECT_EQ(GaussianIndex({}, 0.5).Associate(p, 9.0), -1);
+  const std::vector<Eigen::Vector3d> points(20, p);
+  std::vector<int> associations(points.size(), 7);
+  GaussianIndex().AssociateAll(points.data(), points.size(), 9.0, associations.data());
+  EXPECT_EQ(associations, std::vector<int>(points.size(), -1));
+  associations.assign(points.size(), 7);
+  GaussianIndex({}, 0.5).AssociateAll(points.data(), points.size(), 9.0, associations.data());
+  EXPECT_EQ(associations, std::vector<int>(points.size(), -1));
 }
 
 // ---------------------------------------------------------------------------

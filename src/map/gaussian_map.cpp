@@ -50,9 +50,14 @@ std::int64_t PackKey(std::int64_t x, std::int64_t y, std::int64_t z) {
 
 }  // namespace
 
+// floor(x) as an integer, inline (std::floor is a library call without SSE4.1).
+std::int64_t FloorToInt(double x) {
+  const auto truncated = static_cast<std::int64_t>(x);
+  return truncated - (static_cast<double>(truncated) > x);
+}
+
 VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel) {
-  return {static_cast<std::int64_t>(std::floor(p.x() / voxel)), static_cast<std::int64_t>(std::floor(p.y() / voxel)),
-          static_cast<std::int64_t>(std::floor(p.z() / voxel))};
+  return {FloorToInt(p.x() / voxel), FloorToInt(p.y() / voxel), FloorToInt(p.z() / voxel)};
 }
 
 std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
@@ -105,10 +110,14 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
   }
 }
 
+std::size_t GaussianIndex::HomeSlot(std::int64_t key) const {
+  // Fibonacci hashing: the product's top bits mix all of the key's bits.
+  return std::size_t((std::uint64_t(key) * 0x9E3779B97F4A7C15ull) >> slot_shift_);
+}
+
 std::size_t GaussianIndex::Slot(std::int64_t key) const {
   const std::size_t mask = cells_.size() - 1;
-  // Fibonacci hashing: the product's top bits mix all of the key's bits.
-  std::size_t slot = std::size_t((std::uint64_t(key) * 0x9E3779B97F4A7C15ull) >> slot_shift_);
+  std::size_t slot = HomeSlot(key);
   while (cells_[slot].key != key && cells_[slot].key != kEmptyCell) slot = (slot + 1) & mask;
   return slot;
 }
@@ -123,10 +132,8 @@ const std::uint32_t* GaussianIndex::Candidates(const Eigen::Vector3d& point, std
   return cell_entries_.data() + cell.begin;
 }
 
-int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
-                             double* mahalanobis_sq) const {
-  std::size_t count = 0;
-  const std::uint32_t* candidates = Candidates(point, count);
+int GaussianIndex::Nearest(const Eigen::Vector3d& point, const std::uint32_t* candidates, std::size_t count,
+                           double gate_sq, double* mahalanobis_sq) const {
   int best = -1;
   double best_d2 = gate_sq;
   for (std::size_t k = 0; k < count; ++k) {
@@ -142,6 +149,46 @@ int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
   }
   if (mahalanobis_sq && best >= 0) *mahalanobis_sq = best_d2;
   return best;
+}
+
+int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
+                             double* mahalanobis_sq) const {
+  std::size_t count = 0;
+  const std::uint32_t* candidates = Candidates(point, count);
+  return Nearest(point, candidates, count, gate_sq, mahalanobis_sq);
+}
+
+void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t count, double gate_sq,
+                                 int* associations) const {
+  if (cells_.empty()) {  // a default-constructed index
+    std::fill(associations, associations + count, -1);
+    return;
+  }
+  // Three stages kAhead points apart: fetch the cell's home slot; find the
+  // cell and fetch its candidates' entries; score.
+  constexpr std::size_t kAhead = 8;
+  std::vector<std::int64_t> keys(count);
+  std::vector<const Cell*> cells(count);
+  const auto fetch_cell = [&](std::size_t k) {
+    keys[k] = Key(points[k]);
+    __builtin_prefetch(&cells_[HomeSlot(keys[k])]);
+  };
+  const auto fetch_candidates = [&](std::size_t k) {
+    cells[k] = &cells_[Slot(keys[k])];
+    for (std::uint32_t e = cells[k]->begin; e < cells[k]->end; ++e) {
+      const char* entry = reinterpret_cast<const char*>(&gaussians_[cell_entries_[e]]);
+      __builtin_prefetch(entry);  // mean and information: the entry's first two cache lines
+      __builtin_prefetch(entry + 64);
+    }
+  };
+  for (std::size_t k = 0; k < std::min(count, 2 * kAhead); ++k) fetch_cell(k);
+  for (std::size_t k = 0; k < std::min(count, kAhead); ++k) fetch_candidates(k);
+  for (std::size_t k = 0; k < count; ++k) {
+    if (k + 2 * kAhead < count) fetch_cell(k + 2 * kAhead);
+    if (k + kAhead < count) fetch_candidates(k + kAhead);
+    const Cell& cell = *cells[k];
+    associations[k] = Nearest(points[k], cell_entries_.data() + cell.begin, cell.end - cell.begin, gate_sq, nullptr);
+  }
 }
 
 std::size_t GaussianIndex::MemoryBytes() const {

@@ -81,6 +81,12 @@ class GaussianIndex {
   // Mahalanobis^2 <= gate_sq. Writes the Mahalanobis^2 when asked.
   int Associate(const Eigen::Vector3d& point, double gate_sq, double* mahalanobis_sq = nullptr) const;
 
+  // Associate for points[0, count), written to associations[0, count): the
+  // same answers, with the memory of later points (their cell, then their
+  // candidates) fetched while earlier ones are scored. A query is bound by
+  // cache misses on maps larger than the cache; this overlaps them.
+  void AssociateAll(const Eigen::Vector3d* points, std::size_t count, double gate_sq, int* associations) const;
+
   // Gaussians whose box contains the cell of `point`.
   const std::uint32_t* Candidates(const Eigen::Vector3d& point, std::size_t& count) const;
 
@@ -95,8 +101,9 @@ class GaussianIndex {
   std::int64_t Key(const Eigen::Vector3d& p) const;
 
   double cell_size_ = 1.0;
-  // What a query reads per candidate, side by side in one entry.
-  struct IndexedGaussian {
+  // What a query reads per candidate, side by side in one entry; aligned so
+  // that the mean and information a query scores fill two cache lines.
+  struct alignas(64) IndexedGaussian {
     Eigen::Vector3d mean;
     Eigen::Matrix3d information;
     Eigen::Matrix3d sqrt_information_t;
@@ -113,8 +120,13 @@ class GaussianIndex {
   static constexpr std::int64_t kEmptyCell = -1;  // packed keys are >= 0
   std::vector<Cell> cells_;
   int slot_shift_ = 64;  // 64 - log2(cells_.size())
+  // The slot where the probe for `key` starts.
+  std::size_t HomeSlot(std::int64_t key) const;
   // The slot holding `key`, or the empty slot where it would go.
   std::size_t Slot(std::int64_t key) const;
+  // The best candidate of `point` among `count` (-1 if none within the gate).
+  int Nearest(const Eigen::Vector3d& point, const std::uint32_t* candidates, std::size_t count, double gate_sq,
+              double* mahalanobis_sq) const;
 };
 
 }  // namespace radargauss
