@@ -198,8 +198,7 @@ namespace {
 // Whether two correspondences are the same association (made at the same
 // pose on the same level).
 bool SameAssociation(const Correspondences& c, const GaussianIndex* index, const SE3d& pose) {
-  return c.index == index && c.pose.translation() == pose.translation() &&
-         c.pose.rotation().quaternion().coeffs() == pose.rotation().quaternion().coeffs();
+  return c.index == index && SamePose(c.pose, pose);
 }
 
 }  // namespace
@@ -227,12 +226,18 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
     };
     // Halves dx from `from` (first by `scale`) while eq. 2 exceeds `cost`;
     // sets result.pose and returns the step taken.
+    // Records the cost at the pose it ends on, when it evaluated it there.
     const auto backtrack = [&](const SE3d& from, const Eigen::Matrix<double, 6, 1>& dx, double cost, double scale,
                                int halvings) {
       SE3d next = Step(from, scale * dx);
-      for (; halvings < options_.max_step_halvings && EvaluateCost(c, next, level.options) > cost; ++halvings) {
+      level.evaluated->known = false;
+      for (; halvings < options_.max_step_halvings; ++halvings) {
+        const double next_cost = EvaluateCost(c, next, level.options);
+        *level.evaluated = {true, next, next_cost};
+        if (next_cost <= cost) break;
         scale *= 0.5;
         next = Step(from, scale * dx);
+        level.evaluated->known = false;
       }
       result.pose = next;
       return Eigen::Matrix<double, 6, 1>(scale * dx);

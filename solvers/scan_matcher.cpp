@@ -213,6 +213,7 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
   result.pose = initial;
   const double w = options.w_rcs;
   Correspondences c;
+  EvaluatedCost evaluated;  // on c
   bool failed = false;
   const bool subsample = w < 1.0 && map.levels() > 1 && options.coarse_points > 0 &&
                          scan.points.size() > options.coarse_points;
@@ -227,9 +228,11 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     result.converged = false;
     const RadarScan& level_scan = finest ? scan : coarse_scan;
     c = FindCorrespondences(level_scan, map, level, result.pose, options.gate, with_rcs);
+    evaluated.known = false;
     for (int iteration = 1; iteration <= max_iterations; ++iteration) {
       if (iteration > 1 && !KeepsAssociation(finest, c.pose, result.pose, options)) {
         c = FindCorrespondences(level_scan, map, level, result.pose, options.gate, with_rcs);
+        evaluated.known = false;
       }
       if (!CheckCorrespondences(level_scan, c, level_options, result.reason)) {
         failed = true;
@@ -240,7 +243,7 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
           step({c, level_options, finest,
                 finest ? options.translation_tolerance : options.coarse_translation_tolerance,
                 finest ? options.rotation_tolerance : options.coarse_rotation_tolerance,
-                iteration == max_iterations},
+                iteration == max_iterations, &evaluated},
                result);
       if (outcome == StepOutcome::kFailed) failed = true;
       if (outcome != StepOutcome::kContinue) {
@@ -260,7 +263,10 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
         last_is_final ? c : FindCorrespondences(scan, map, map.levels() - 1, result.pose, options.gate, w > 0.0);
     result.n_geo = final_c.geometric.size();
     result.n_rcs = final_c.rcs.size();
-    result.final_cost = EvaluateCost(final_c, result.pose, options);
+    // On the exact map the steps' options are these (w_rcs is the requested w there).
+    const bool known = last_is_final && c.index == &map.index() && evaluated.known &&
+                       SamePose(evaluated.pose, result.pose);
+    result.final_cost = known ? evaluated.cost : EvaluateCost(final_c, result.pose, options);
   } else {
     result.pose = initial;
   }

@@ -160,6 +160,22 @@ bool CheckCorrespondences(const RadarScan& scan, const Correspondences& correspo
 // `step` update result.pose. At the end: the final association (the last
 // one when it is within the thresholds of the final pose), N_geo, N_rcs,
 // the cost of eq. 2 and the time.
+// Whether two poses are bit for bit the same (the same association, the
+// same evaluated cost).
+inline bool SamePose(const SE3d& a, const SE3d& b) {
+  return a.translation() == b.translation() &&
+         a.rotation().quaternion().coeffs() == b.rotation().quaternion().coeffs();
+}
+
+// The cost of eq. 2 on the current correspondences at a pose, when a step
+// evaluated it there: the loop reuses it as the final cost instead of
+// evaluating it again.
+struct EvaluatedCost {
+  bool known = false;
+  SE3d pose;
+  double cost = 0.0;
+};
+
 struct LevelStep {
   const Correspondences& correspondences;
   const ScanMatchingOptions& options;  // with this level's w_rcs
@@ -167,6 +183,7 @@ struct LevelStep {
   double translation_tolerance = 0.0;  // m: this level's step tolerances
   double rotation_tolerance = 0.0;     // rad
   bool last_iteration = false;         // the level's iteration limit is reached with this step
+  EvaluatedCost* evaluated = nullptr;  // a step may record EvaluateCost at the pose it leaves
   // Whether a step (translation norm, rotation angle) ends the level.
   bool SmallStep(double translation, double rotation) const {
     return translation < translation_tolerance && rotation < rotation_tolerance;

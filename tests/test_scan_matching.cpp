@@ -294,6 +294,31 @@ INSTANTIATE_TEST_SUITE_P(
       return name;
     });
 
+// The reported final cost is eq. 2 at the final pose on the final
+// association. Associating once (no re-association) on the exact map makes
+// that association the one at the initial pose, so it can be rebuilt here.
+// The own GN hands the loop the cost it evaluated while checking its last
+// step; this checks that it is the cost at the pose it ended on.
+TEST(GaussNewton, FinalCostIsEq2AtTheFinalPose) {
+  const World& world = SimulatedWorld();
+  const RadarScan& scan = world.simulated.scans[kTestScan];
+  const MatchingMap exact(world.map, ExactMapOnly());
+  const SE3d initial = Perturbed(world.simulated.ground_truth[kTestScan].pose, 0.1, 0.5, 4);
+  for (const double w : {0.0, 0.25}) {
+    ScanMatchingOptions options;
+    options.w_rcs = w;
+    options.reassociate = false;
+    const ScanMatchingResult result = GaussNewtonSolver(options).Match(scan, exact, initial);
+    ASSERT_TRUE(result.converged) << result.reason;
+    ASSERT_GT(result.iterations, 1);
+    const Correspondences c = FindCorrespondences(scan, exact, 0, initial, options.gate, w > 0.0);
+    const double expected = EvaluateCost(c, result.pose, options);
+    EXPECT_NEAR(result.final_cost, expected, 1e-12 * expected) << "w = " << w;
+    EXPECT_EQ(result.n_geo, c.geometric.size());
+    EXPECT_EQ(result.n_rcs, c.rcs.size());
+  }
+}
+
 // The analytic and autodiff linear systems of the own GN are the same.
 TEST(GaussNewton, AnalyticAndAutodiffSystemsAgree) {
   const World& world = SimulatedWorld();
