@@ -164,8 +164,8 @@ void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t coun
     std::fill(associations, associations + count, -1);
     return;
   }
-  // Three stages kAhead points apart: fetch the cell's home slot; find the
-  // cell and fetch its candidates' entries; score.
+  // Four stages kAhead points apart: fetch the cell's home slot; find the
+  // cell and fetch its list of candidates; fetch the candidates' entries; score.
   constexpr std::size_t kAhead = 8;
   std::vector<std::int64_t> keys(count);
   std::vector<const Cell*> cells(count);
@@ -173,18 +173,23 @@ void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t coun
     keys[k] = Key(points[k]);
     __builtin_prefetch(&cells_[HomeSlot(keys[k])]);
   };
-  const auto fetch_candidates = [&](std::size_t k) {
+  const auto fetch_list = [&](std::size_t k) {
     cells[k] = &cells_[Slot(keys[k])];
+    __builtin_prefetch(cell_entries_.data() + cells[k]->begin);
+  };
+  const auto fetch_candidates = [&](std::size_t k) {
     for (std::uint32_t e = cells[k]->begin; e < cells[k]->end; ++e) {
       const char* entry = reinterpret_cast<const char*>(&gaussians_[cell_entries_[e]]);
       __builtin_prefetch(entry);  // mean and information: the entry's first two cache lines
       __builtin_prefetch(entry + 64);
     }
   };
-  for (std::size_t k = 0; k < std::min(count, 2 * kAhead); ++k) fetch_cell(k);
+  for (std::size_t k = 0; k < std::min(count, 3 * kAhead); ++k) fetch_cell(k);
+  for (std::size_t k = 0; k < std::min(count, 2 * kAhead); ++k) fetch_list(k);
   for (std::size_t k = 0; k < std::min(count, kAhead); ++k) fetch_candidates(k);
   for (std::size_t k = 0; k < count; ++k) {
-    if (k + 2 * kAhead < count) fetch_cell(k + 2 * kAhead);
+    if (k + 3 * kAhead < count) fetch_cell(k + 3 * kAhead);
+    if (k + 2 * kAhead < count) fetch_list(k + 2 * kAhead);
     if (k + kAhead < count) fetch_candidates(k + kAhead);
     const Cell& cell = *cells[k];
     associations[k] = Nearest(points[k], cell_entries_.data() + cell.begin, cell.end - cell.begin, gate_sq, nullptr);
