@@ -97,11 +97,18 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
         Jt_r << information_e, q.cross(information_e);
         C.noalias() += CurvatureAlongResidual(s, weight, second) * Jt_r * Jt_r.transpose();
       }
-      const Eigen::Matrix3d q_hat = SO3d::Hat(q);
-      const Eigen::Matrix3d information_q_hat = information * q_hat;
+      // Sigma^-1 [q]x column by column (column k is Sigma^-1 (e_k x q)), then
+      // [q]x (Sigma^-1 [q]x) column by column as cross products: the zeros of
+      // [q]x never enter a product.
+      Eigen::Matrix3d information_q_hat;
+      information_q_hat.col(0) = q.z() * information.col(1) - q.y() * information.col(2);
+      information_q_hat.col(1) = q.x() * information.col(2) - q.z() * information.col(0);
+      information_q_hat.col(2) = q.y() * information.col(0) - q.x() * information.col(1);
+      Eigen::Matrix3d q_hat_information_q_hat;
+      for (int k = 0; k < 3; ++k) q_hat_information_q_hat.col(k) = q.cross(information_q_hat.col(k));
       A_tt.noalias() += weight * information;
       A_tr.noalias() -= weight * information_q_hat;
-      A_rr.noalias() -= weight * q_hat * information_q_hat;  // [q]x^T = -[q]x
+      A_rr.noalias() -= weight * q_hat_information_q_hat;  // [q]x^T = -[q]x
       b_t.noalias() += weight * information_e;
       b_r.noalias() += weight * q.cross(information_e);
     }
