@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <stdexcept>
+#include <vector>
 
 namespace radargauss {
 
@@ -34,13 +35,15 @@ namespace {
 double Score(const RadarScan& scan, const MatchingMap& map, const SE3d& pose, double gate) {
   if (scan.points.empty()) return INFINITY;
   const double gate_sq = gate * gate;
+  const std::size_t n = scan.points.size();
+  std::vector<Eigen::Vector3d> world(n);
+  for (std::size_t k = 0; k < n; ++k) world[k] = pose * scan.points[k].position;
+  std::vector<int> associations(n);
+  std::vector<double> d2(n);
+  map.index().AssociateAll(world.data(), n, gate_sq, associations.data(), d2.data());
   double sum = 0.0;
-  for (const RadarPoint& point : scan.points) {
-    double d2 = gate_sq;
-    if (map.index().Associate(pose * point.position, gate_sq, &d2) < 0) d2 = gate_sq;
-    sum += d2;
-  }
-  return sum / double(scan.points.size());
+  for (std::size_t k = 0; k < n; ++k) sum += associations[k] < 0 ? gate_sq : d2[k];
+  return sum / double(n);
 }
 
 }  // namespace

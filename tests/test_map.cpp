@@ -127,6 +127,7 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
   int associated = 0;
   std::vector<Eigen::Vector3d> points;
   std::vector<int> expected_all;
+  std::vector<double> expected_d2;
   for (int trial = 0; trial < 20000; ++trial) {
     const Eigen::Vector3d p(uniform(rng), uniform(rng), 0.2 * uniform(rng));
     int expected = -1;
@@ -141,6 +142,7 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
     }
     points.push_back(p);
     expected_all.push_back(expected);
+    expected_d2.push_back(best);
     double d2 = 0.0;
     ASSERT_EQ(index.Associate(p, 9.0, &d2), expected) << p.transpose();
     if (expected >= 0) {
@@ -153,8 +155,14 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
   }
   EXPECT_GT(associated, 50);
   std::vector<int> batched(points.size(), -2);
-  index.AssociateAll(points.data(), points.size(), 9.0, batched.data());
+  std::vector<double> batched_d2(points.size(), -1.0);
+  index.AssociateAll(points.data(), points.size(), 9.0, batched.data(), batched_d2.data());
   EXPECT_EQ(batched, expected_all);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (expected_all[k] >= 0) {
+      ASSERT_NEAR(batched_d2[k], expected_d2[k], 1e-9) << k;
+    }
+  }
   // Fewer points than the batch looks ahead.
   index.AssociateAll(points.data(), 3, 9.0, batched.data());
   EXPECT_EQ(std::vector<int>(batched.begin(), batched.begin() + 3),

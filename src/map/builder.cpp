@@ -1,5 +1,6 @@
 #include "radargauss/map/builder.hpp"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -255,8 +256,8 @@ std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>&
 std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points,
                                  const GaussianIndex& index, double gate) {
   std::vector<int> association(points.size());
-  tbb::parallel_for(std::size_t(0), points.size(), [&](std::size_t i) {
-    association[i] = index.Associate(points[i], gate * gate);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 4096), [&](const auto& range) {
+    index.AssociateAll(points.data() + range.begin(), range.size(), gate * gate, association.data() + range.begin());
   });
   return association;
 }

@@ -159,7 +159,7 @@ int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
 }
 
 void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t count, double gate_sq,
-                                 int* associations) const {
+                                 int* associations, double* mahalanobis_sq) const {
   if (cells_.empty()) {  // a default-constructed index
     std::fill(associations, associations + count, -1);
     return;
@@ -192,7 +192,8 @@ void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t coun
     if (k + 2 * kAhead < count) fetch_list(k + 2 * kAhead);
     if (k + kAhead < count) fetch_candidates(k + kAhead);
     const Cell& cell = *cells[k];
-    associations[k] = Nearest(points[k], cell_entries_.data() + cell.begin, cell.end - cell.begin, gate_sq, nullptr);
+    associations[k] = Nearest(points[k], cell_entries_.data() + cell.begin, cell.end - cell.begin, gate_sq,
+                              mahalanobis_sq ? mahalanobis_sq + k : nullptr);
   }
 }
 

@@ -81,11 +81,14 @@ class GaussianIndex {
   // Mahalanobis^2 <= gate_sq. Writes the Mahalanobis^2 when asked.
   int Associate(const Eigen::Vector3d& point, double gate_sq, double* mahalanobis_sq = nullptr) const;
 
-  // Associate for points[0, count), written to associations[0, count): the
-  // same answers, with the memory of later points (their cell, then their
-  // candidates) fetched while earlier ones are scored. A query is bound by
-  // cache misses on maps larger than the cache; this overlaps them.
-  void AssociateAll(const Eigen::Vector3d* points, std::size_t count, double gate_sq, int* associations) const;
+  // Associate for points[0, count), written to associations[0, count) (and
+  // the Mahalanobis^2 of the associated ones to mahalanobis_sq[0, count) when
+  // asked): the same answers, with the memory of later points (their cell,
+  // its list, their candidates) fetched while earlier ones are scored. A
+  // query is bound by cache misses on maps larger than the cache; this
+  // overlaps them.
+  void AssociateAll(const Eigen::Vector3d* points, std::size_t count, double gate_sq, int* associations,
+                    double* mahalanobis_sq = nullptr) const;
 
   // Gaussians whose box contains the cell of `point`.
   const std::uint32_t* Candidates(const Eigen::Vector3d& point, std::size_t& count) const;
