@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include <random>
+#include <vector>
 
 #include "radargauss/map/builder.hpp"
 #include "radargauss/map/map_cloud.hpp"
@@ -84,6 +85,26 @@ void BM_AssociatePoint(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_AssociatePoint);
+
+// The same queries batched (GaussianIndex::AssociateAll, memory fetched
+// ahead), 800 at a time as a scan: time per point.
+void BM_AssociatePointsBatched(benchmark::State& state) {
+  const BuiltMap& b = Built();
+  constexpr std::size_t kBatch = 800;
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t k = 0, i = 0; k < 100 * kBatch; ++k, i = (i + 7919) % b.cloud.points.size()) {
+    points.push_back(b.cloud.points[i]);
+  }
+  std::vector<int> associations(kBatch);
+  std::size_t batch = 0;
+  for (auto _ : state) {
+    b.index.AssociateAll(points.data() + batch * kBatch, kBatch, 9.0, associations.data());
+    benchmark::DoNotOptimize(associations.data());
+    batch = (batch + 1) % 100;
+  }
+  state.SetItemsProcessed(state.iterations() * kBatch);
+}
+BENCHMARK(BM_AssociatePointsBatched);
 
 void BM_FitRcsModelDegree3(benchmark::State& state) {
   std::mt19937 rng(3);
