@@ -232,8 +232,8 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
       return level.SmallStep(step.segment<3>(kTranslationOffset).norm(), step.segment<3>(kRotationOffset).norm());
     };
     // Halves dx from `from` (first by `scale`) while eq. 2 exceeds `cost`;
-    // sets result.pose and returns the step taken.
-    // Records the cost at the pose it ends on, when it evaluated it there.
+    // sets result.pose, records eq. 2 there when it evaluated it, and
+    // returns the step taken.
     const auto backtrack = [&](const SE3d& from, const Eigen::Matrix<double, 6, 1>& dx, double cost, double scale,
                                int halvings) {
       SE3d next = Step(from, scale * dx);

@@ -152,14 +152,6 @@ bool KeepsAssociation(bool exact_level, const SE3d& associated_at, const SE3d& p
 bool CheckCorrespondences(const RadarScan& scan, const Correspondences& correspondences,
                           const ScanMatchingOptions& options, std::string& reason);
 
-// The outer loop every single-scan solver shares (kiss-icp style): map level
-// by map level, coarse to fine (coarse levels with the geometric term only
-// and at most coarse_points points, w = 1 without them), associate (again
-// each iteration on coarse levels; on the exact map once the pose has moved
-// past the re-association thresholds), check the correspondences, and let
-// `step` update result.pose. At the end: the final association (the last
-// one when it is within the thresholds of the final pose), N_geo, N_rcs,
-// the cost of eq. 2 and the time.
 // Whether two poses are bit for bit the same (the same association, the
 // same evaluated cost).
 inline bool SamePose(const SE3d& a, const SE3d& b) {
@@ -176,6 +168,15 @@ struct EvaluatedCost {
   double cost = 0.0;
 };
 
+// The outer loop every single-scan solver shares (kiss-icp style): map level
+// by map level, coarse to fine (coarse levels with the geometric term only
+// and at most coarse_points points, w = 1 without them), associate (again
+// each iteration on coarse levels; on the exact map once the pose has moved
+// past the re-association thresholds), check the correspondences, and let
+// `step` update result.pose. At the end: the final association (the last
+// one when it is within the thresholds of the final pose), N_geo, N_rcs,
+// the cost of eq. 2 (the one a step recorded at the final pose on that
+// association, if any; EvaluatedCost) and the time.
 struct LevelStep {
   const Correspondences& correspondences;
   const ScanMatchingOptions& options;  // with this level's w_rcs

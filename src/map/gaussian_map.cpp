@@ -48,13 +48,13 @@ std::int64_t PackKey(std::int64_t x, std::int64_t y, std::int64_t z) {
          (((z + kKeyOffset) & kKeyMask) << (2 * kKeyBits));
 }
 
-}  // namespace
-
 // floor(x) as an integer, inline (std::floor is a library call without SSE4.1).
 std::int64_t FloorToInt(double x) {
   const auto truncated = static_cast<std::int64_t>(x);
   return truncated - (static_cast<double>(truncated) > x);
 }
+
+}  // namespace
 
 VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel) {
   return {FloorToInt(p.x() / voxel), FloorToInt(p.y() / voxel), FloorToInt(p.z() / voxel)};
