@@ -1,9 +1,11 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <random>
 
 #include "radargauss/error.hpp"
@@ -162,6 +164,19 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
     if (expected_all[k] >= 0) {
       ASSERT_NEAR(batched_d2[k], expected_d2[k], 1e-9) << k;
     }
+  }
+  // A non-finite point has no association, and the points around it keep theirs.
+  const Eigen::Vector3d nan_point(std::nan(""), 1.0, 0.0);
+  const Eigen::Vector3d inf_point(1.0, std::numeric_limits<double>::infinity(), 0.0);
+  EXPECT_EQ(index.Associate(nan_point, 9.0), -1);
+  EXPECT_EQ(index.Associate(inf_point, 9.0), -1);
+  std::vector<Eigen::Vector3d> with_bad(points.begin(), points.begin() + 40);
+  with_bad[10] = nan_point;
+  with_bad[20] = inf_point;
+  std::vector<int> with_bad_out(with_bad.size(), -2);
+  index.AssociateAll(with_bad.data(), with_bad.size(), 9.0, with_bad_out.data());
+  for (std::size_t k = 0; k < with_bad.size(); ++k) {
+    EXPECT_EQ(with_bad_out[k], k == 10 || k == 20 ? -1 : expected_all[k]) << k;
   }
   // Fewer points than the batch looks ahead.
   index.AssociateAll(points.data(), 3, 9.0, batched.data());

@@ -61,6 +61,8 @@ VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel) {
 }
 
 std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
+  // A non-finite point has no voxel: the empty key finds an empty slot (no candidates).
+  if (!p.allFinite()) return kEmptyCell;
   const VoxelKey v = VoxelOf(p, cell_size_);
   return PackKey(v.x, v.y, v.z);
 }

@@ -78,7 +78,8 @@ class GaussianIndex {
                 double extent_sigmas = 3.0);
 
   // Index of the associated Gaussian, or -1 if no candidate has
-  // Mahalanobis^2 <= gate_sq. Writes the Mahalanobis^2 when asked.
+  // Mahalanobis^2 <= gate_sq (or the point is not finite). Writes the
+  // Mahalanobis^2 when asked.
   int Associate(const Eigen::Vector3d& point, double gate_sq, double* mahalanobis_sq = nullptr) const;
 
   // Associate for points[0, count), written to associations[0, count) (and
