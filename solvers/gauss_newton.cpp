@@ -240,11 +240,12 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
       level.evaluated->known = false;
       for (; halvings < options_.max_step_halvings; ++halvings) {
         const double next_cost = EvaluateCost(c, next, level.options);
-        *level.evaluated = {true, next, next_cost};
-        if (next_cost <= cost) break;
+        if (next_cost <= cost) {
+          *level.evaluated = {true, next, next_cost};
+          break;
+        }
         scale *= 0.5;
         next = Step(from, scale * dx);
-        level.evaluated->known = false;
       }
       result.pose = next;
       return Eigen::Matrix<double, 6, 1>(scale * dx);

@@ -34,16 +34,11 @@ namespace {
 
 double Score(const RadarScan& scan, const MatchingMap& map, const SE3d& pose, double gate) {
   if (scan.points.empty()) return INFINITY;
-  const double gate_sq = gate * gate;
-  const std::size_t n = scan.points.size();
-  std::vector<Eigen::Vector3d> world(n);
-  for (std::size_t k = 0; k < n; ++k) world[k] = pose * scan.points[k].position;
-  std::vector<int> associations(n);
-  std::vector<double> d2(n);
-  map.index().AssociateAll(world.data(), n, gate_sq, associations.data(), d2.data());
+  std::vector<double> d2;
+  const std::vector<int> associations = AssociateScan(scan, map.index(), pose, gate, &d2);
   double sum = 0.0;
-  for (std::size_t k = 0; k < n; ++k) sum += associations[k] < 0 ? gate_sq : d2[k];
-  return sum / double(n);
+  for (std::size_t k = 0; k < associations.size(); ++k) sum += associations[k] < 0 ? gate * gate : d2[k];
+  return sum / double(associations.size());
 }
 
 }  // namespace

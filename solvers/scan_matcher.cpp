@@ -81,6 +81,19 @@ MatchingMap::MatchingMap(const GaussianMap& map, const MatchingMapOptions& optio
   levels_.emplace_back(map.gaussians, options.index_cell);
 }
 
+std::vector<int> AssociateScan(const RadarScan& scan, const GaussianIndex& index, const SE3d& pose, double gate,
+                               std::vector<double>* mahalanobis_sq) {
+  const Eigen::Matrix3d R = pose.rotation().Matrix();
+  const std::size_t n = scan.points.size();
+  std::vector<Eigen::Vector3d> world(n);
+  for (std::size_t k = 0; k < n; ++k) world[k] = R * scan.points[k].position + pose.translation();
+  std::vector<int> associations(n);
+  if (mahalanobis_sq) mahalanobis_sq->assign(n, 0.0);
+  index.AssociateAll(world.data(), n, gate * gate, associations.data(),
+                     mahalanobis_sq ? mahalanobis_sq->data() : nullptr);
+  return associations;
+}
+
 Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level,
                                     const SE3d& pose, double gate, bool with_rcs) {
   Correspondences out;
@@ -89,13 +102,9 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
   out.geometric.reserve(scan.points.size());
   const bool rcs = with_rcs && scan.has_rcs;
   if (rcs) out.rcs.reserve(scan.points.size());
-  const Eigen::Matrix3d R = pose.rotation().Matrix();
-  const Eigen::Matrix3d Rt = R.transpose();
+  const Eigen::Matrix3d Rt = pose.rotation().Matrix().transpose();
   const std::size_t n = scan.points.size();
-  std::vector<Eigen::Vector3d> world(n);
-  for (std::size_t k = 0; k < n; ++k) world[k] = R * scan.points[k].position + pose.translation();
-  std::vector<int> associations(n);
-  out.index->AssociateAll(world.data(), n, gate * gate, associations.data());
+  const std::vector<int> associations = AssociateScan(scan, *out.index, pose, gate);
   const std::vector<Gaussian>& gaussians = map.map().gaussians;
   constexpr std::size_t kAhead = 8;  // RCS terms read the Gaussian's model: fetch it early
   for (std::size_t k = 0; k < n; ++k) {

@@ -129,6 +129,12 @@ struct Correspondences {
   SE3d pose;  // the pose they were made at
 };
 
+// The Gaussian of `index` each point of the scan goes to at `pose` (-1:
+// none within the gate), batched (GaussianIndex::AssociateAll); writes each
+// associated point's Mahalanobis^2 too when asked.
+std::vector<int> AssociateScan(const RadarScan& scan, const GaussianIndex& index, const SE3d& pose, double gate,
+                               std::vector<double>* mahalanobis_sq = nullptr);
+
 // Associates every point at `pose` with the Gaussians of `level`
 // (smallest Mahalanobis^2 within the gate); RCS terms too when `with_rcs`
 // (and the scan has RCS).
