@@ -4,6 +4,8 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -15,18 +17,64 @@ namespace radargauss {
 
 namespace {
 
-// The residual blocks of one kind of term, kept across associations: block k
-// holds term k of the current association. A new association re-targets the
-// blocks it keeps (Reset on the functor or the analytic twin) and adds or
-// removes blocks only for the change in count, so that Ceres's per-block
-// set-up is paid about once per match instead of once per association.
+// Terms [begin, end) of one kind as one residual block: term k's residuals
+// and Jacobian rows sit at k times one term's (Ceres's Jacobians are
+// row-major), so the block evaluates the terms' own cost functions side by
+// side. Ceres applies a block's loss to the block's squared norm, which is
+// the sum of the terms' losses only for a (scaled) trivial loss: used there
+// alone (TermBlocks), where it pays Ceres's per-block work (evaluator loop,
+// manifold product, loss correction, checks) once per block of terms.
+class TermRangeCost final : public ceres::CostFunction {
+ public:
+  explicit TermRangeCost(const ceres::CostFunction& term) : term_residuals_(term.num_residuals()) {
+    *mutable_parameter_block_sizes() = term.parameter_block_sizes();
+  }
+
+  void Reset(std::vector<const ceres::CostFunction*> terms) {
+    terms_ = std::move(terms);
+    set_num_residuals(term_residuals_ * int(terms_.size()));
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const std::vector<std::int32_t>& sizes = parameter_block_sizes();
+    double* term_jacobians[2];  // at most two parameter blocks (rotation, translation)
+    for (std::size_t k = 0; k < terms_.size(); ++k) {
+      for (std::size_t b = 0; b < sizes.size(); ++b) {
+        term_jacobians[b] = jacobians != nullptr && jacobians[b] != nullptr
+                                ? jacobians[b] + k * std::size_t(term_residuals_ * sizes[b])
+                                : nullptr;
+      }
+      if (!terms_[k]->Evaluate(parameters, residuals + k * term_residuals_, jacobians ? term_jacobians : nullptr)) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+ private:
+  int term_residuals_;
+  std::vector<const ceres::CostFunction*> terms_;
+};
+
+// The residual blocks of one kind of term, kept across associations: cost
+// function k holds term k of the current association. A new association
+// re-targets the cost functions it keeps (Reset on the functor or the
+// analytic twin) and adds or removes blocks only for the change in count,
+// so that Ceres's per-block set-up is paid about once per match instead of
+// once per association. With `ranged` (analytic terms under a trivial loss)
+// the terms sit in residual blocks of kTermsPerBlock (TermRangeCost).
 template <typename Functor, typename AnalyticCost>
 class TermBlocks {
  public:
-  TermBlocks(ceres::Problem& problem, ceres::LossFunction* loss, bool analytic, std::vector<double*> parameters)
-      : problem_(problem), loss_(loss), analytic_(analytic), parameters_(std::move(parameters)) {}
+  TermBlocks(ceres::Problem& problem, ceres::LossFunction* loss, bool analytic, bool ranged,
+             std::vector<double*> parameters)
+      : problem_(problem),
+        loss_(loss),
+        analytic_(analytic),
+        ranged_(analytic && ranged),
+        parameters_(std::move(parameters)) {}
 
-  // Block k holds the term made from `args` and is in the problem.
+  // Term k is the one made from `args` (and, unless ranged, its block is in the problem).
   template <typename... Args>
   void Set(std::size_t k, const Args&... args) {
     if (k == blocks_.size()) {
@@ -45,13 +93,18 @@ class TermBlocks {
       blocks_[k].functor->Reset(args...);
     }
     Block& block = blocks_[k];
-    if (block.id == nullptr) {
+    if (!ranged_ && block.id == nullptr) {
       block.id = problem_.AddResidualBlock(block.cost.get(), loss_, parameters_.data(), int(parameters_.size()));
     }
   }
 
-  // Takes blocks k >= count out of the problem (kept for later associations).
+  // Makes terms [0, count) the problem's terms of this kind (blocks of
+  // terms k >= count are taken out and kept for later associations).
   void Truncate(std::size_t count) {
+    if (ranged_) {
+      Range(count);
+      return;
+    }
     for (std::size_t k = count; k < blocks_.size(); ++k) {
       if (blocks_[k].id == nullptr) continue;
       problem_.RemoveResidualBlock(blocks_[k].id);
@@ -60,17 +113,36 @@ class TermBlocks {
   }
 
  private:
+  // The range blocks over terms [0, count), made afresh (a handful per match).
+  void Range(std::size_t count) {
+    for (const ceres::ResidualBlockId id : range_ids_) problem_.RemoveResidualBlock(id);
+    range_ids_.clear();
+    for (std::size_t begin = 0, r = 0; begin < count; begin += CeresScanProblem::kTermsPerBlock, ++r) {
+      const std::size_t end = std::min(count, begin + CeresScanProblem::kTermsPerBlock);
+      if (r == ranges_.size()) ranges_.push_back(std::make_unique<TermRangeCost>(*blocks_[0].cost));
+      std::vector<const ceres::CostFunction*> terms;
+      terms.reserve(end - begin);
+      for (std::size_t k = begin; k < end; ++k) terms.push_back(blocks_[k].cost.get());
+      ranges_[r]->Reset(std::move(terms));
+      range_ids_.push_back(
+          problem_.AddResidualBlock(ranges_[r].get(), loss_, parameters_.data(), int(parameters_.size())));
+    }
+  }
+
   struct Block {
     std::unique_ptr<ceres::CostFunction> cost;
     Functor* functor = nullptr;         // autodiff: the functor `cost` owns
     AnalyticCost* analytic = nullptr;   // analytic: `cost` itself
-    ceres::ResidualBlockId id = nullptr;  // null while not in the problem
+    ceres::ResidualBlockId id = nullptr;  // null while not in the problem (always when ranged)
   };
   ceres::Problem& problem_;
   ceres::LossFunction* loss_;
   bool analytic_;
+  bool ranged_;
   std::vector<double*> parameters_;
   std::vector<Block> blocks_;
+  std::vector<std::unique_ptr<TermRangeCost>> ranges_;
+  std::vector<ceres::ResidualBlockId> range_ids_;
 };
 
 }  // namespace
@@ -79,9 +151,11 @@ struct CeresScanProblem::Impl {
   Impl(const ScanMatchingOptions& options, double* rotation, double* translation)
       : options_(options),
         geometric_(problem_, &geometric_loss_, options.jacobians == JacobianMode::kAnalytic,
-                   {rotation, translation}),
-        rcs_full_(problem_, &rcs_loss_, options.jacobians == JacobianMode::kAnalytic, {rotation, translation}),
-        rcs_rotation_(problem_, &rcs_loss_, options.jacobians == JacobianMode::kAnalytic, {rotation}),
+                   options.geometric_loss.type == LossType::kTrivial, {rotation, translation}),
+        rcs_full_(problem_, &rcs_loss_, options.jacobians == JacobianMode::kAnalytic,
+                  options.rcs_loss.type == LossType::kTrivial, {rotation, translation}),
+        rcs_rotation_(problem_, &rcs_loss_, options.jacobians == JacobianMode::kAnalytic,
+                      options.rcs_loss.type == LossType::kTrivial, {rotation}),
         problem_(ProblemOptions()) {
     problem_.AddParameterBlock(rotation, 4, &so3_);
     problem_.AddParameterBlock(translation, 3);

@@ -38,6 +38,11 @@ struct CeresSolverOptions {
 // is paid about once per match instead of once per association.
 class CeresScanProblem {
  public:
+  // Analytic terms under a trivial loss share residual blocks of this many
+  // terms (the sum of their squared norms is the sum of their losses); Ceres's
+  // per-block work is then paid per block of terms. Other terms: one block each.
+  static constexpr std::size_t kTermsPerBlock = 64;
+
   // `rotation` (quaternion x y z w) and `translation` are the parameter
   // blocks; they must outlive the problem.
   CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation);

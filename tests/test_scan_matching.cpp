@@ -574,8 +574,12 @@ TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
 // The Ceres problem kept across associations holds exactly the latest
 // association: after updates that grow and shrink the term counts, change
 // level and weight, its cost (Ceres: 1/2 sum) is eq. 2 as EvaluateCost gives
-// it, its block count is the latest term count, for analytic and autodiff
-// blocks and both RCS translation modes.
+// it, it holds one residual per residual of the latest terms, in one block
+// per term, or, for analytic terms under a trivial loss, in blocks of
+// kTermsPerBlock terms; for analytic and autodiff blocks, both RCS
+// translation modes, robust and trivial losses. Its gradient is the same
+// whether the terms are blocks of their own (autodiff) or share blocks
+// (analytic, trivial losses): the shared blocks place each term's Jacobian rows.
 TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
   const World& world = SimulatedWorld();
   const MatchingMap& map = *world.matching;
@@ -583,38 +587,59 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
   RadarScan half_scan = full_scan;
   half_scan.points.resize(full_scan.points.size() / 2);
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
-  for (const JacobianMode jacobians : {JacobianMode::kAnalytic, JacobianMode::kAutoDiff}) {
+  const auto blocks_of = [](std::size_t terms, bool shared) {
+    return shared ? (terms + CeresScanProblem::kTermsPerBlock - 1) / CeresScanProblem::kTermsPerBlock : terms;
+  };
+  for (const bool trivial : {false, true}) {
     for (const RcsTranslation mode : {RcsTranslation::kRotationOnly, RcsTranslation::kFull}) {
-      ScanMatchingOptions options;
-      options.jacobians = jacobians;
-      options.rcs_translation = mode;
-      options.geometric_loss = {LossType::kHuber, 0.5};
-      const SE3d pose = Perturbed(truth, 0.1, 0.5, 3);
-      Eigen::Vector4d rotation = pose.rotation().quaternion().coeffs();
-      Eigen::Vector3d translation = pose.translation();
-      CeresScanProblem problem(options, rotation.data(), translation.data());
-      struct Update {
-        const RadarScan* scan;
-        std::size_t level;
-        double w;
-      };
-      for (const Update& update : {Update{&full_scan, map.levels() - 1, 0.25}, Update{&half_scan, 0, 0.0},
-                                   Update{&full_scan, map.levels() - 1, 0.0}, Update{&half_scan, map.levels() - 1, 0.5},
-                                   Update{&full_scan, map.levels() - 1, 1.0}, Update{&full_scan, map.levels() - 1, 0.25}}) {
-        const Correspondences c = FindCorrespondences(*update.scan, map, update.level, pose, 3.0, update.w > 0.0);
-        ASSERT_GT(c.geometric.size(), 100u);
-        if (update.w > 0.0) {
-          ASSERT_GT(c.rcs.size(), 10u);
+      std::vector<double> gradients[2];  // per Jacobian mode, all updates in a row
+      for (const JacobianMode jacobians : {JacobianMode::kAnalytic, JacobianMode::kAutoDiff}) {
+        ScanMatchingOptions options;
+        options.jacobians = jacobians;
+        options.rcs_translation = mode;
+        options.geometric_loss = trivial ? LossConfig{LossType::kTrivial, 1.0} : LossConfig{LossType::kHuber, 0.5};
+        if (trivial) options.rcs_loss = {LossType::kTrivial, 1.0};
+        const bool shared = trivial && jacobians == JacobianMode::kAnalytic;
+        const SE3d pose = Perturbed(truth, 0.1, 0.5, 3);
+        Eigen::Vector4d rotation = pose.rotation().quaternion().coeffs();
+        Eigen::Vector3d translation = pose.translation();
+        CeresScanProblem problem(options, rotation.data(), translation.data());
+        struct Update {
+          const RadarScan* scan;
+          std::size_t level;
+          double w;
+        };
+        for (const Update& update :
+             {Update{&full_scan, map.levels() - 1, 0.25}, Update{&half_scan, 0, 0.0},
+              Update{&full_scan, map.levels() - 1, 0.0}, Update{&half_scan, map.levels() - 1, 0.5},
+              Update{&full_scan, map.levels() - 1, 1.0}, Update{&full_scan, map.levels() - 1, 0.25}}) {
+          const Correspondences c = FindCorrespondences(*update.scan, map, update.level, pose, 3.0, update.w > 0.0);
+          ASSERT_GT(c.geometric.size(), 2 * CeresScanProblem::kTermsPerBlock);
+          if (update.w > 0.0) {
+            ASSERT_GT(c.rcs.size(), CeresScanProblem::kTermsPerBlock);
+          }
+          problem.Update(c, update.w);
+          ScanMatchingOptions weighted = options;
+          weighted.w_rcs = update.w;
+          const std::size_t n_geo = update.w < 1.0 ? c.geometric.size() : 0;
+          const std::size_t n_rcs = update.w > 0.0 ? c.rcs.size() : 0;
+          EXPECT_EQ(problem.problem().NumResidualBlocks(), int(blocks_of(n_geo, shared) + blocks_of(n_rcs, shared)))
+              << "w " << update.w;
+          EXPECT_EQ(problem.problem().NumResiduals(), int(3 * n_geo + n_rcs)) << "w " << update.w;
+          double cost = 0.0;
+          std::vector<double> gradient;
+          ASSERT_TRUE(
+              problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient, nullptr));
+          const double f = EvaluateCost(c, pose, weighted);
+          EXPECT_NEAR(2.0 * cost, f, 1e-12 * f) << "w " << update.w << " level " << update.level;
+          gradients[jacobians == JacobianMode::kAnalytic ? 0 : 1].insert(
+              gradients[jacobians == JacobianMode::kAnalytic ? 0 : 1].end(), gradient.begin(), gradient.end());
         }
-        problem.Update(c, update.w);
-        ScanMatchingOptions weighted = options;
-        weighted.w_rcs = update.w;
-        const std::size_t blocks = (update.w < 1.0 ? c.geometric.size() : 0) + (update.w > 0.0 ? c.rcs.size() : 0);
-        EXPECT_EQ(problem.problem().NumResidualBlocks(), int(blocks)) << "w " << update.w;
-        double cost = 0.0;
-        ASSERT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr));
-        const double f = EvaluateCost(c, pose, weighted);
-        EXPECT_NEAR(2.0 * cost, f, 1e-12 * f) << "w " << update.w << " level " << update.level;
+      }
+      ASSERT_EQ(gradients[0].size(), gradients[1].size());
+      for (std::size_t i = 0; i < gradients[0].size(); ++i) {
+        EXPECT_NEAR(gradients[0][i], gradients[1][i], 1e-8 * (1.0 + std::abs(gradients[1][i])))
+            << "gradient entry " << i << (trivial ? ", trivial losses" : ", robust losses");
       }
     }
   }
