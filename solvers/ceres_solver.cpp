@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "radargauss/lie/manifold.hpp"
@@ -27,6 +28,9 @@ namespace {
 class TermRangeCost final : public ceres::CostFunction {
  public:
   explicit TermRangeCost(const ceres::CostFunction& term) : term_residuals_(term.num_residuals()) {
+    if (term.parameter_block_sizes().size() > kMaxParameterBlocks) {
+      throw std::logic_error("TermRangeCost: a term with more than two parameter blocks");
+    }
     *mutable_parameter_block_sizes() = term.parameter_block_sizes();
   }
 
@@ -37,7 +41,7 @@ class TermRangeCost final : public ceres::CostFunction {
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const std::vector<std::int32_t>& sizes = parameter_block_sizes();
-    double* term_jacobians[2];  // at most two parameter blocks (rotation, translation)
+    double* term_jacobians[kMaxParameterBlocks];
     for (std::size_t k = 0; k < terms_.size(); ++k) {
       for (std::size_t b = 0; b < sizes.size(); ++b) {
         term_jacobians[b] = jacobians != nullptr && jacobians[b] != nullptr
@@ -52,6 +56,7 @@ class TermRangeCost final : public ceres::CostFunction {
   }
 
  private:
+  static constexpr std::size_t kMaxParameterBlocks = 2;  // rotation, translation
   int term_residuals_;
   std::vector<const ceres::CostFunction*> terms_;
 };

@@ -31,11 +31,13 @@ struct CeresSolverOptions {
 };
 
 // The ceres::Problem of one match, kept across associations: the pose blocks
-// (rotation with SO3Manifold, translation), one residual block per term of
-// the current association, eq. 2's weights as ScaledLoss around each term's
-// loss. Update re-targets the blocks it keeps at the new terms and adds or
-// removes blocks only for the change in count, so Ceres's per-block set-up
-// is paid about once per match instead of once per association.
+// (rotation with SO3Manifold, translation), the terms of the current
+// association (a residual block per term, or per kTermsPerBlock terms for
+// analytic terms under a trivial loss), eq. 2's weights as ScaledLoss
+// around each term's loss. Update re-targets the blocks it keeps at the new
+// terms and adds or removes blocks only for the change in count, so Ceres's
+// per-block set-up is paid about once per match instead of once per
+// association.
 class CeresScanProblem {
  public:
   // Analytic terms under a trivial loss share residual blocks of this many
