@@ -131,6 +131,15 @@ inline Eigen::Vector3d RcsDirection(const RcsTerm& term, const Eigen::Vector3d& 
   return term.facing * u / norm;
 }
 
+// y - c . Y(d) (the term's coefficients) for the Gaussian centre mu_r in the
+// radar frame: RcsResidualValue with the rotation already applied, for
+// passes that rotate every term by one matrix.
+inline double RcsResidualAt(const RcsTerm& term, const Eigen::Vector3d& mean_radar) {
+  double norm = 0.0;
+  return term.measurement -
+         EvaluateSh<double>(term.degree, term.coefficients.data(), RcsDirection(term, mean_radar, norm));
+}
+
 // With coefficients c from a parameter block (joint refinement), else the
 // term's; writes Y(d) = -dr/dc to `basis_out` when given.
 inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d& mean_radar,

@@ -66,17 +66,17 @@ class TermRangeCost final : public ceres::CostFunction {
 // re-targets the cost functions it keeps (Reset on the functor or the
 // analytic twin) and adds or removes blocks only for the change in count,
 // so that Ceres's per-block set-up is paid about once per match instead of
-// once per association. With `ranged` (analytic terms under a trivial loss)
-// the terms sit in residual blocks of kTermsPerBlock (TermRangeCost).
+// once per association. Analytic terms under a trivial loss sit in residual
+// blocks of kTermsPerBlock (TermRangeCost).
 template <typename Functor, typename AnalyticCost>
 class TermBlocks {
  public:
-  TermBlocks(ceres::Problem& problem, ceres::LossFunction* loss, bool analytic, bool ranged,
+  TermBlocks(ceres::Problem& problem, ceres::LossFunction* loss, bool analytic, bool trivial_loss,
              std::vector<double*> parameters)
       : problem_(problem),
         loss_(loss),
         analytic_(analytic),
-        ranged_(analytic && ranged),
+        ranged_(analytic && trivial_loss),
         parameters_(std::move(parameters)) {}
 
   // Term k is the one made from `args` (and, unless ranged, its block is in the problem).

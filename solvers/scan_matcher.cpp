@@ -154,9 +154,7 @@ double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchi
   const Eigen::Vector3d rcs_translation =
       options.rcs_translation == RcsTranslation::kRotationOnly ? c.pose.translation() : pose.translation();
   for (const RcsTerm& term : c.rcs) {
-    double norm = 0.0;
-    const Eigen::Vector3d d = RcsDirection(term, Rt * (term.mean - rcs_translation), norm);
-    const double r = term.measurement - EvaluateSh<double>(term.degree, term.coefficients.data(), d);
+    const double r = RcsResidualAt(term, Rt * (term.mean - rcs_translation));
     rcs_loss.Evaluate(r * r, rho, weight);
     rcs += rho;
   }

@@ -632,8 +632,8 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
               problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient, nullptr));
           const double f = EvaluateCost(c, pose, weighted);
           EXPECT_NEAR(2.0 * cost, f, 1e-12 * f) << "w " << update.w << " level " << update.level;
-          gradients[jacobians == JacobianMode::kAnalytic ? 0 : 1].insert(
-              gradients[jacobians == JacobianMode::kAnalytic ? 0 : 1].end(), gradient.begin(), gradient.end());
+          std::vector<double>& all = gradients[jacobians == JacobianMode::kAnalytic ? 0 : 1];
+          all.insert(all.end(), gradient.begin(), gradient.end());
         }
       }
       ASSERT_EQ(gradients[0].size(), gradients[1].size());
