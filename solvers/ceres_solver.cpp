@@ -5,6 +5,7 @@
 #include <ceres/solver.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -18,68 +19,122 @@ namespace radargauss {
 
 namespace {
 
-// Terms [begin, end) of one kind as one residual block: term k's residuals
-// and Jacobian rows sit at k times one term's (Ceres's Jacobians are
-// row-major), so the block evaluates the terms' own cost functions side by
-// side. Ceres applies a block's loss to the block's squared norm, which is
-// the sum of the terms' losses only for a (scaled) trivial loss: used there
-// alone (TermBlocks), where it pays Ceres's per-block work (evaluator loop,
-// manifold product, loss correction, checks) once per block of terms.
+// The sizes of a ceres::SizedCostFunction, at compile time.
+template <int Residuals, int... BlockSizes>
+struct SizedDims {
+  static constexpr int kResiduals = Residuals;
+  static constexpr int kBlocks = sizeof...(BlockSizes);
+  static constexpr int kBlockSizes[kBlocks] = {BlockSizes...};
+};
+template <int Residuals, int... BlockSizes>
+SizedDims<Residuals, BlockSizes...> DimsOf(const ceres::SizedCostFunction<Residuals, BlockSizes...>*);
+
+// Terms [begin, end) of one kind (analytic cost functions `Term`) as one
+// residual block: term k's residuals and Jacobian rows sit at k times one
+// term's (Ceres's Jacobians are row-major), so the block evaluates the
+// terms' own cost functions side by side, and Ceres's per-block work
+// (evaluator loop, manifold product, loss correction, checks) is paid once
+// per block of terms. Ceres applies a block's loss to the block's squared
+// norm, so each term's own robust loss is applied here, in its residual:
+// r -> f r with f = sqrt(rho(s) / s), s = |r|^2, whose squared norm is
+// rho(s); the Jacobian is that residual's exact one,
+// f (J + (rho'/rho - 1/s) r r^T J) (f = sqrt(rho'(0)) at s = 0). Cost and
+// gradient are those of eq. 2; the Gauss-Newton model is that of the
+// rescaled residual, where Ceres's own loss correction (Corrector) would
+// take sqrt(rho') J (IRLS) for the losses here.
+template <typename Term>
 class TermRangeCost final : public ceres::CostFunction {
- public:
-  explicit TermRangeCost(const ceres::CostFunction& term) : term_residuals_(term.num_residuals()) {
-    if (term.parameter_block_sizes().size() > kMaxParameterBlocks) {
-      throw std::logic_error("TermRangeCost: a term with more than two parameter blocks");
+  using Dims = decltype(DimsOf(static_cast<const Term*>(nullptr)));
+  static constexpr int kRows = Dims::kResiduals;
+  static constexpr int kMaxBlockSize = 4;  // the quaternion
+  static constexpr bool BlocksFit() {
+    for (int b = 0; b < Dims::kBlocks; ++b) {
+      if (Dims::kBlockSizes[b] > kMaxBlockSize) return false;
     }
-    *mutable_parameter_block_sizes() = term.parameter_block_sizes();
+    return true;
+  }
+  static_assert(BlocksFit(), "parameter blocks of at most four coordinates");
+
+ public:
+  // `loss`: each term's robust loss (nullptr: trivial); it must outlive this.
+  explicit TermRangeCost(const ceres::LossFunction* loss) : loss_(loss) {
+    *mutable_parameter_block_sizes() = std::vector<std::int32_t>(Dims::kBlockSizes, Dims::kBlockSizes + Dims::kBlocks);
   }
 
-  void Reset(std::vector<const ceres::CostFunction*> terms) {
+  void Reset(std::vector<const Term*> terms) {
     terms_ = std::move(terms);
-    set_num_residuals(term_residuals_ * int(terms_.size()));
+    set_num_residuals(kRows * int(terms_.size()));
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const std::vector<std::int32_t>& sizes = parameter_block_sizes();
-    double* term_jacobians[kMaxParameterBlocks];
+    double* term_jacobians[Dims::kBlocks];
     for (std::size_t k = 0; k < terms_.size(); ++k) {
-      for (std::size_t b = 0; b < sizes.size(); ++b) {
-        term_jacobians[b] = jacobians != nullptr && jacobians[b] != nullptr
-                                ? jacobians[b] + k * std::size_t(term_residuals_ * sizes[b])
-                                : nullptr;
+      double* r = residuals + k * kRows;
+      if (jacobians != nullptr) {
+        for (int b = 0; b < Dims::kBlocks; ++b) {
+          term_jacobians[b] = jacobians[b] != nullptr ? jacobians[b] + k * kRows * Dims::kBlockSizes[b] : nullptr;
+        }
       }
-      if (!terms_[k]->Evaluate(parameters, residuals + k * term_residuals_, jacobians ? term_jacobians : nullptr)) {
-        return false;
-      }
+      if (!terms_[k]->Term::Evaluate(parameters, r, jacobians != nullptr ? term_jacobians : nullptr)) return false;
+      if (loss_ != nullptr) ApplyLoss(r, jacobians != nullptr ? term_jacobians : nullptr);
     }
     return true;
   }
 
  private:
-  static constexpr std::size_t kMaxParameterBlocks = 2;  // rotation, translation
-  int term_residuals_;
-  std::vector<const ceres::CostFunction*> terms_;
+  void ApplyLoss(double* r, double* const* J) const {
+    double s = 0.0;
+    for (int i = 0; i < kRows; ++i) s += r[i] * r[i];
+    double rho[3];
+    loss_->Evaluate(s, rho);
+    const bool at_zero = !(s > 0.0) || !(rho[0] > 0.0);
+    const double f = at_zero ? std::sqrt(rho[1]) : std::sqrt(rho[0] / s);
+    const double c = at_zero ? 0.0 : rho[1] / rho[0] - 1.0 / s;
+    for (int b = 0; J != nullptr && b < Dims::kBlocks; ++b) {
+      if (J[b] == nullptr) continue;
+      const int n = Dims::kBlockSizes[b];
+      double rt_J[kMaxBlockSize] = {};  // r^T J
+      for (int i = 0; i < kRows; ++i)
+        for (int j = 0; j < n; ++j) rt_J[j] += r[i] * J[b][i * n + j];
+      for (int i = 0; i < kRows; ++i)
+        for (int j = 0; j < n; ++j) J[b][i * n + j] = f * (J[b][i * n + j] + c * r[i] * rt_J[j]);
+    }
+    for (int i = 0; i < kRows; ++i) r[i] *= f;
+  }
+
+  const ceres::LossFunction* loss_;
+  std::vector<const Term*> terms_;
 };
 
 // The residual blocks of one kind of term, kept across associations: cost
 // function k holds term k of the current association. A new association
 // re-targets the cost functions it keeps (Reset on the functor or the
-// analytic twin) and adds or removes blocks only for the change in count,
-// so that Ceres's per-block set-up is paid about once per match instead of
-// once per association. Analytic terms under a trivial loss sit in residual
-// blocks of kTermsPerBlock (TermRangeCost).
+// analytic twin). Shared (analytic terms, by default): the terms sit in
+// residual blocks of kTermsPerBlock (TermRangeCost), made afresh for each
+// association (a handful per match), with their loss inside and eq. 2's
+// weight as the blocks' ScaledLoss. Otherwise a block per term under the
+// ScaledLoss of its loss (Ceres's own loss handling), added or removed only
+// for the change in count, so that Ceres's per-block set-up is paid about
+// once per match instead of once per association.
 template <typename Functor, typename AnalyticCost>
 class TermBlocks {
  public:
-  TermBlocks(ceres::Problem& problem, ceres::LossFunction* loss, bool analytic, bool trivial_loss,
+  TermBlocks(ceres::Problem& problem, const LossConfig& loss, bool analytic, bool shared,
              std::vector<double*> parameters)
       : problem_(problem),
-        loss_(loss),
+        loss_config_(loss),
         analytic_(analytic),
-        ranged_(analytic && trivial_loss),
+        shared_(analytic && shared),
+        term_loss_(shared_ ? MakeLoss(loss) : nullptr),
         parameters_(std::move(parameters)) {}
 
-  // Term k is the one made from `args` (and, unless ranged, its block is in the problem).
+  // Eq. 2's weight of every term of this kind (for the next Truncate).
+  void SetWeight(double weight) {
+    loss_.Reset(new ceres::ScaledLoss(shared_ ? nullptr : MakeLoss(loss_config_), weight, ceres::TAKE_OWNERSHIP),
+                ceres::TAKE_OWNERSHIP);
+  }
+
+  // Term k is the one made from `args` (and, unless shared, its block is in the problem).
   template <typename... Args>
   void Set(std::size_t k, const Args&... args) {
     if (k == blocks_.size()) {
@@ -98,16 +153,16 @@ class TermBlocks {
       blocks_[k].functor->Reset(args...);
     }
     Block& block = blocks_[k];
-    if (!ranged_ && block.id == nullptr) {
-      block.id = problem_.AddResidualBlock(block.cost.get(), loss_, parameters_.data(), int(parameters_.size()));
+    if (!shared_ && block.id == nullptr) {
+      block.id = problem_.AddResidualBlock(block.cost.get(), &loss_, parameters_.data(), int(parameters_.size()));
     }
   }
 
   // Makes terms [0, count) the problem's terms of this kind (blocks of
   // terms k >= count are taken out and kept for later associations).
   void Truncate(std::size_t count) {
-    if (ranged_) {
-      Range(count);
+    if (shared_) {
+      Share(count);
       return;
     }
     for (std::size_t k = count; k < blocks_.size(); ++k) {
@@ -118,19 +173,19 @@ class TermBlocks {
   }
 
  private:
-  // The range blocks over terms [0, count), made afresh (a handful per match).
-  void Range(std::size_t count) {
+  // The shared blocks over terms [0, count), made afresh.
+  void Share(std::size_t count) {
     for (const ceres::ResidualBlockId id : range_ids_) problem_.RemoveResidualBlock(id);
     range_ids_.clear();
     for (std::size_t begin = 0, r = 0; begin < count; begin += CeresScanProblem::kTermsPerBlock, ++r) {
       const std::size_t end = std::min(count, begin + CeresScanProblem::kTermsPerBlock);
-      if (r == ranges_.size()) ranges_.push_back(std::make_unique<TermRangeCost>(*blocks_[0].cost));
-      std::vector<const ceres::CostFunction*> terms;
+      if (r == ranges_.size()) ranges_.push_back(std::make_unique<TermRangeCost<AnalyticCost>>(term_loss_.get()));
+      std::vector<const AnalyticCost*> terms;
       terms.reserve(end - begin);
-      for (std::size_t k = begin; k < end; ++k) terms.push_back(blocks_[k].cost.get());
+      for (std::size_t k = begin; k < end; ++k) terms.push_back(blocks_[k].analytic);
       ranges_[r]->Reset(std::move(terms));
       range_ids_.push_back(
-          problem_.AddResidualBlock(ranges_[r].get(), loss_, parameters_.data(), int(parameters_.size())));
+          problem_.AddResidualBlock(ranges_[r].get(), &loss_, parameters_.data(), int(parameters_.size())));
     }
   }
 
@@ -138,29 +193,31 @@ class TermBlocks {
     std::unique_ptr<ceres::CostFunction> cost;
     Functor* functor = nullptr;         // autodiff: the functor `cost` owns
     AnalyticCost* analytic = nullptr;   // analytic: `cost` itself
-    ceres::ResidualBlockId id = nullptr;  // null while not in the problem (always when ranged)
+    ceres::ResidualBlockId id = nullptr;  // null while not in the problem (always when shared)
   };
   ceres::Problem& problem_;
-  ceres::LossFunction* loss_;
+  LossConfig loss_config_;
   bool analytic_;
-  bool ranged_;
+  bool shared_;
+  std::unique_ptr<ceres::LossFunction> term_loss_;  // shared: in each term's residual (null: trivial)
+  ceres::LossFunctionWrapper loss_{nullptr, ceres::TAKE_OWNERSHIP};  // the blocks' loss
   std::vector<double*> parameters_;
   std::vector<Block> blocks_;
-  std::vector<std::unique_ptr<TermRangeCost>> ranges_;
+  std::vector<std::unique_ptr<TermRangeCost<AnalyticCost>>> ranges_;
   std::vector<ceres::ResidualBlockId> range_ids_;
 };
 
 }  // namespace
 
 struct CeresScanProblem::Impl {
-  Impl(const ScanMatchingOptions& options, double* rotation, double* translation)
+  Impl(const ScanMatchingOptions& options, double* rotation, double* translation, bool shared_blocks)
       : options_(options),
-        geometric_(problem_, &geometric_loss_, options.jacobians == JacobianMode::kAnalytic,
-                   options.geometric_loss.type == LossType::kTrivial, {rotation, translation}),
-        rcs_full_(problem_, &rcs_loss_, options.jacobians == JacobianMode::kAnalytic,
-                  options.rcs_loss.type == LossType::kTrivial, {rotation, translation}),
-        rcs_rotation_(problem_, &rcs_loss_, options.jacobians == JacobianMode::kAnalytic,
-                      options.rcs_loss.type == LossType::kTrivial, {rotation}),
+        geometric_(problem_, options.geometric_loss, options.jacobians == JacobianMode::kAnalytic, shared_blocks,
+                   {rotation, translation}),
+        rcs_full_(problem_, options.rcs_loss, options.jacobians == JacobianMode::kAnalytic, shared_blocks,
+                  {rotation, translation}),
+        rcs_rotation_(problem_, options.rcs_loss, options.jacobians == JacobianMode::kAnalytic, shared_blocks,
+                      {rotation}),
         problem_(ProblemOptions()) {
     problem_.AddParameterBlock(rotation, 4, &so3_);
     problem_.AddParameterBlock(translation, 3);
@@ -168,11 +225,7 @@ struct CeresScanProblem::Impl {
 
   void Update(const Correspondences& c, double w) {
     const std::size_t n_geometric = w < 1.0 ? c.geometric.size() : 0;
-    if (n_geometric > 0) {
-      geometric_loss_.Reset(new ceres::ScaledLoss(MakeLoss(options_.geometric_loss), (1.0 - w) / double(n_geometric),
-                                                  ceres::TAKE_OWNERSHIP),
-                            ceres::TAKE_OWNERSHIP);
-    }
+    if (n_geometric > 0) geometric_.SetWeight((1.0 - w) / double(n_geometric));
     for (std::size_t k = 0; k < n_geometric; ++k) {
       const GeometricTerm& term = c.geometric[k];
       geometric_.Set(k, term.point_radar, c.index->Mean(term.gaussian), c.index->SqrtInformationT(term.gaussian));
@@ -181,8 +234,8 @@ struct CeresScanProblem::Impl {
 
     const std::size_t n_rcs = w > 0.0 ? c.rcs.size() : 0;
     if (n_rcs > 0) {
-      rcs_loss_.Reset(new ceres::ScaledLoss(MakeLoss(options_.rcs_loss), w / double(n_rcs), ceres::TAKE_OWNERSHIP),
-                      ceres::TAKE_OWNERSHIP);
+      rcs_full_.SetWeight(w / double(n_rcs));
+      rcs_rotation_.SetWeight(w / double(n_rcs));
     }
     // Rotation-only: the RCS residuals take the rotation block only, the
     // translation a constant of the association.
@@ -201,7 +254,7 @@ struct CeresScanProblem::Impl {
   static ceres::Problem::Options ProblemOptions() {
     ceres::Problem::Options options;
     options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // the term blocks own them
-    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // one wrapper per term, members
+    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // one wrapper per kind of term, members
     options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     options.disable_all_safety_checks = true;  // blocks are built here, not by users
     return options;
@@ -209,16 +262,15 @@ struct CeresScanProblem::Impl {
 
   ScanMatchingOptions options_;
   SO3Manifold so3_;
-  ceres::LossFunctionWrapper geometric_loss_{nullptr, ceres::TAKE_OWNERSHIP};
-  ceres::LossFunctionWrapper rcs_loss_{nullptr, ceres::TAKE_OWNERSHIP};
   TermBlocks<GeometricResidual, GeometricCostFunction> geometric_;
   TermBlocks<RcsResidual, RcsCostFunction> rcs_full_;
   TermBlocks<RcsRotationResidual, RcsRotationCostFunction> rcs_rotation_;
   ceres::Problem problem_;  // last: destroyed before what it refers to
 };
 
-CeresScanProblem::CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation)
-    : impl_(std::make_unique<Impl>(options, rotation, translation)) {}
+CeresScanProblem::CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation,
+                                   bool shared_blocks)
+    : impl_(std::make_unique<Impl>(options, rotation, translation, shared_blocks)) {}
 CeresScanProblem::~CeresScanProblem() = default;
 void CeresScanProblem::Update(const Correspondences& correspondences, double w_rcs) {
   impl_->Update(correspondences, w_rcs);
@@ -249,7 +301,7 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
   solver_options.function_tolerance = ceres_options_.function_tolerance;
   solver_options.gradient_tolerance = ceres_options_.gradient_tolerance;
   solver_options.parameter_tolerance = ceres_options_.parameter_tolerance;
-  CeresScanProblem problem(options_, rotation.data(), translation.data());
+  CeresScanProblem problem(options_, rotation.data(), translation.data(), ceres_options_.shared_blocks);
 
   return RunCoarseToFine(scan, map, initial, options_, [&](const LevelStep& level, ScanMatchingResult& result) {
     const Correspondences& c = level.correspondences;

@@ -1,7 +1,7 @@
 // Scan matching with Ceres (DESIGN.md section 5): the same residual functors
 // in a ceres::Problem with a rotation block (SO3Manifold) and a translation
-// block, eq. 2's weights as ScaledLoss around each term's robust loss, a
-// dense linear solver; an outer loop re-associates between solves.
+// block, eq. 2's weights as ScaledLoss, a dense linear solver; an outer loop
+// re-associates between solves.
 // Rotation-only RCS: the RCS residuals take the rotation block only, the
 // translation a constant of the current association.
 #pragma once
@@ -20,8 +20,13 @@ struct CeresSolverOptions {
   // re-associates after each solve, and iterating a fresh association to
   // full convergence pays Jacobian evaluations for terms about to change; a
   // match ends only once Ceres converged on an association the loop keeps
-  // (more solves on it when this limit cuts one short).
-  int max_inner_iterations = 3;
+  // (more solves on it when this limit cuts one short). RESULTS.md has 1-5.
+  int max_inner_iterations = 2;
+  // Analytic terms share residual blocks of CeresScanProblem::kTermsPerBlock
+  // terms, each term's robust loss applied in its own residual (the cost and
+  // gradient of eq. 2; see CeresScanProblem). False: a residual block per
+  // term under Ceres's own loss handling, as autodiff terms always have.
+  bool shared_blocks = true;
   int threads = 1;
   // Ceres's stopping rules per association (Ceres's defaults; the outer
   // loop's step tolerances decide convergence of the match).
@@ -31,23 +36,32 @@ struct CeresSolverOptions {
 };
 
 // The ceres::Problem of one match, kept across associations: the pose blocks
-// (rotation with SO3Manifold, translation), the terms of the current
-// association (a residual block per term, or per kTermsPerBlock terms for
-// analytic terms under a trivial loss), eq. 2's weights as ScaledLoss
-// around each term's loss. Update re-targets the blocks it keeps at the new
+// (rotation with SO3Manifold, translation) and the terms of the current
+// association, with eq. 2's weights as ScaledLoss.
+//
+// Shared blocks (analytic terms, `shared_blocks`): kTermsPerBlock terms of a
+// kind per residual block, so that Ceres's per-block work (evaluator loop,
+// manifold product, loss correction, checks, preprocessing) is paid per
+// block of terms. Ceres applies a block's loss to the block's squared norm,
+// so each term's robust loss rho goes into its own residual instead:
+// r -> sqrt(rho(s)/s) r with s = |r|^2, whose squared norm is rho(s), and that
+// residual's exact Jacobian. Cost and gradient are eq. 2's, as with a block
+// per term; the Gauss-Newton model is that of the rescaled residual, where
+// Ceres's loss correction would take sqrt(rho') J (IRLS, for every loss here).
+//
+// Otherwise (autodiff terms, or shared_blocks = false) a block per term under
+// ScaledLoss(its loss); Update re-targets the blocks it keeps at the new
 // terms and adds or removes blocks only for the change in count, so Ceres's
 // per-block set-up is paid about once per match instead of once per
 // association.
 class CeresScanProblem {
  public:
-  // Analytic terms under a trivial loss share residual blocks of this many
-  // terms (the sum of their squared norms is the sum of their losses); Ceres's
-  // per-block work is then paid per block of terms. Other terms: one block each.
   static constexpr std::size_t kTermsPerBlock = 64;
 
   // `rotation` (quaternion x y z w) and `translation` are the parameter
   // blocks; they must outlive the problem.
-  CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation);
+  CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation,
+                   bool shared_blocks = true);
   ~CeresScanProblem();
   CeresScanProblem(const CeresScanProblem&) = delete;
   CeresScanProblem& operator=(const CeresScanProblem&) = delete;

@@ -1,4 +1,5 @@
 #include <ceres/cost_function.h>
+#include <ceres/crs_matrix.h>
 #include <Eigen/Cholesky>
 #include <gtest/gtest.h>
 
@@ -7,6 +8,7 @@
 #include <random>
 
 #include "radargauss/experiment.hpp"
+#include "radargauss/lie/manifold.hpp"
 #include "radargauss/map/builder.hpp"
 #include "radargauss/map/map_cloud.hpp"
 #include "radargauss/map/rcs_model.hpp"
@@ -574,12 +576,14 @@ TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
 // The Ceres problem kept across associations holds exactly the latest
 // association: after updates that grow and shrink the term counts, change
 // level and weight, its cost (Ceres: 1/2 sum) is eq. 2 as EvaluateCost gives
-// it, it holds one residual per residual of the latest terms, in one block
-// per term, or, for analytic terms under a trivial loss, in blocks of
-// kTermsPerBlock terms; for analytic and autodiff blocks, both RCS
+// it, and it holds one residual per residual of the latest terms, in one
+// block per term or, shared, in blocks of kTermsPerBlock terms; for both RCS
 // translation modes, robust and trivial losses. Its gradient is the same
-// whether the terms are blocks of their own (autodiff) or share blocks
-// (analytic, trivial losses): the shared blocks place each term's Jacobian rows.
+// whether the terms are blocks of their own under Ceres's loss handling
+// (autodiff, and analytic unshared) or share blocks with their loss in the
+// residual (analytic): the shared blocks place each term's rows and apply its
+// loss consistently. The shared blocks' Jacobian is their residuals'
+// derivative (central differences on the manifold).
 TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
   const World& world = SimulatedWorld();
   const MatchingMap& map = *world.matching;
@@ -590,20 +594,29 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
   const auto blocks_of = [](std::size_t terms, bool shared) {
     return shared ? (terms + CeresScanProblem::kTermsPerBlock - 1) / CeresScanProblem::kTermsPerBlock : terms;
   };
+  struct Layout {
+    JacobianMode jacobians;
+    bool shared_blocks;  // asked for; autodiff terms never share
+    const char* name;
+  };
+  const Layout layouts[] = {{JacobianMode::kAutoDiff, true, "autodiff"},
+                            {JacobianMode::kAnalytic, true, "analytic, shared"},
+                            {JacobianMode::kAnalytic, false, "analytic, a block per term"}};
   for (const bool trivial : {false, true}) {
     for (const RcsTranslation mode : {RcsTranslation::kRotationOnly, RcsTranslation::kFull}) {
-      std::vector<double> gradients[2];  // per Jacobian mode, all updates in a row
-      for (const JacobianMode jacobians : {JacobianMode::kAnalytic, JacobianMode::kAutoDiff}) {
+      std::vector<double> gradients[3];  // per layout, all updates in a row
+      for (int l = 0; l < 3; ++l) {
+        const Layout& layout = layouts[l];
         ScanMatchingOptions options;
-        options.jacobians = jacobians;
+        options.jacobians = layout.jacobians;
         options.rcs_translation = mode;
         options.geometric_loss = trivial ? LossConfig{LossType::kTrivial, 1.0} : LossConfig{LossType::kHuber, 0.5};
         if (trivial) options.rcs_loss = {LossType::kTrivial, 1.0};
-        const bool shared = trivial && jacobians == JacobianMode::kAnalytic;
+        const bool shared = layout.shared_blocks && layout.jacobians == JacobianMode::kAnalytic;
         const SE3d pose = Perturbed(truth, 0.1, 0.5, 3);
         Eigen::Vector4d rotation = pose.rotation().quaternion().coeffs();
         Eigen::Vector3d translation = pose.translation();
-        CeresScanProblem problem(options, rotation.data(), translation.data());
+        CeresScanProblem problem(options, rotation.data(), translation.data(), layout.shared_blocks);
         struct Update {
           const RadarScan* scan;
           std::size_t level;
@@ -624,22 +637,64 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
           const std::size_t n_geo = update.w < 1.0 ? c.geometric.size() : 0;
           const std::size_t n_rcs = update.w > 0.0 ? c.rcs.size() : 0;
           EXPECT_EQ(problem.problem().NumResidualBlocks(), int(blocks_of(n_geo, shared) + blocks_of(n_rcs, shared)))
-              << "w " << update.w;
+              << "w " << update.w << ", " << layout.name;
           EXPECT_EQ(problem.problem().NumResiduals(), int(3 * n_geo + n_rcs)) << "w " << update.w;
           double cost = 0.0;
-          std::vector<double> gradient;
-          ASSERT_TRUE(
-              problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient, nullptr));
+          std::vector<double> residuals, gradient;
+          ceres::CRSMatrix jacobian;
+          ASSERT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, &residuals, &gradient,
+                                                 shared ? &jacobian : nullptr));
           const double f = EvaluateCost(c, pose, weighted);
-          EXPECT_NEAR(2.0 * cost, f, 1e-12 * f) << "w " << update.w << " level " << update.level;
-          std::vector<double>& all = gradients[jacobians == JacobianMode::kAnalytic ? 0 : 1];
-          all.insert(all.end(), gradient.begin(), gradient.end());
+          EXPECT_NEAR(2.0 * cost, f, 1e-12 * f) << "w " << update.w << " level " << update.level << ", " << layout.name;
+          gradients[l].insert(gradients[l].end(), gradient.begin(), gradient.end());
+          if (!shared) continue;
+          // Central differences of the residuals along the tangent coordinates
+          // (Ceres's Jacobian columns: rotation dphi, then translation dt).
+          const Eigen::Vector4d rotation0 = rotation;
+          const Eigen::Vector3d translation0 = translation;
+          const auto residuals_at = [&](int column, double h) {
+            rotation = rotation0;
+            translation = translation0;
+            if (column < 3) {
+              Eigen::Vector3d delta = Eigen::Vector3d::Zero();
+              delta[column] = h;
+              SO3Manifold().Plus(rotation0.data(), delta.data(), rotation.data());
+            } else {
+              translation[column - 3] += h;
+            }
+            std::vector<double> values;
+            EXPECT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), nullptr, &values, nullptr,
+                                                   nullptr));
+            return values;
+          };
+          const int columns = jacobian.num_cols;
+          ASSERT_EQ(columns, 6);
+          Eigen::MatrixXd analytic = Eigen::MatrixXd::Zero(jacobian.num_rows, columns);
+          for (int row = 0; row < jacobian.num_rows; ++row) {
+            for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) analytic(row, jacobian.cols[k]) = jacobian.values[k];
+          }
+          constexpr double h = 1e-6;
+          double worst = 0.0;
+          for (int column = 0; column < columns; ++column) {
+            const std::vector<double> plus = residuals_at(column, h), minus = residuals_at(column, -h);
+            for (int row = 0; row < jacobian.num_rows; ++row) {
+              const double numeric = (plus[row] - minus[row]) / (2.0 * h);
+              worst = std::max(worst, std::abs(numeric - analytic(row, column)) /
+                                          (1e-6 + std::abs(numeric) + std::abs(analytic(row, column))));
+            }
+          }
+          rotation = rotation0;
+          translation = translation0;
+          EXPECT_LT(worst, 1e-5) << "w " << update.w << (trivial ? ", trivial losses" : ", robust losses");
         }
       }
-      ASSERT_EQ(gradients[0].size(), gradients[1].size());
-      for (std::size_t i = 0; i < gradients[0].size(); ++i) {
-        EXPECT_NEAR(gradients[0][i], gradients[1][i], 1e-8 * (1.0 + std::abs(gradients[1][i])))
-            << "gradient entry " << i << (trivial ? ", trivial losses" : ", robust losses");
+      for (int l = 0; l < 2; ++l) {
+        ASSERT_EQ(gradients[l].size(), gradients[0].size());
+        for (std::size_t i = 0; i < gradients[0].size(); ++i) {
+          EXPECT_NEAR(gradients[l + 1][i], gradients[0][i], 1e-8 * (1.0 + std::abs(gradients[0][i])))
+              << "gradient entry " << i << ", " << layouts[l + 1].name
+              << (trivial ? ", trivial losses" : ", robust losses");
+        }
       }
     }
   }
