@@ -30,18 +30,9 @@ template <int Residuals, int... BlockSizes>
 SizedDims<Residuals, BlockSizes...> DimsOf(const ceres::SizedCostFunction<Residuals, BlockSizes...>*);
 
 // Terms [begin, end) of one kind (analytic cost functions `Term`) as one
-// residual block: term k's residuals and Jacobian rows sit at k times one
-// term's (Ceres's Jacobians are row-major), so the block evaluates the
-// terms' own cost functions side by side, and Ceres's per-block work
-// (evaluator loop, manifold product, loss correction, checks) is paid once
-// per block of terms. Ceres applies a block's loss to the block's squared
-// norm, so each term's own robust loss is applied here, in its residual:
-// r -> f r with f = sqrt(rho(s) / s), s = |r|^2, whose squared norm is
-// rho(s); the Jacobian is that residual's exact one,
-// f (J + (rho'/rho - 1/s) r r^T J) (f = sqrt(rho'(0)) at s = 0). Cost and
-// gradient are those of eq. 2; the Gauss-Newton model is that of the
-// rescaled residual, where Ceres's own loss correction (Corrector) would
-// take sqrt(rho') J (IRLS) for the losses here.
+// shared residual block (CeresScanProblem): term k's residuals and Jacobian
+// rows sit at k times one term's (Ceres's Jacobians are row-major), each with
+// the term's robust loss applied in it (ApplyLoss).
 template <typename Term>
 class TermRangeCost final : public ceres::CostFunction {
   using Dims = decltype(DimsOf(static_cast<const Term*>(nullptr)));
@@ -82,6 +73,9 @@ class TermRangeCost final : public ceres::CostFunction {
   }
 
  private:
+  // r -> f r with f = sqrt(rho(s) / s), s = |r|^2, so that |f r|^2 = rho(s),
+  // and J -> its exact Jacobian f (J + (rho'/rho - 1/s) r r^T J);
+  // f = sqrt(rho'(0)) at s = 0.
   void ApplyLoss(double* r, double* const* J) const {
     double s = 0.0;
     for (int i = 0; i < kRows; ++i) s += r[i] * r[i];
