@@ -169,17 +169,19 @@ class TermBlocks {
  private:
   // The shared blocks over terms [0, count), made afresh.
   void Share(std::size_t count) {
-    for (const ceres::ResidualBlockId id : range_ids_) problem_.RemoveResidualBlock(id);
-    range_ids_.clear();
+    for (const ceres::ResidualBlockId id : shared_ids_) problem_.RemoveResidualBlock(id);
+    shared_ids_.clear();
     for (std::size_t begin = 0, r = 0; begin < count; begin += CeresScanProblem::kTermsPerBlock, ++r) {
       const std::size_t end = std::min(count, begin + CeresScanProblem::kTermsPerBlock);
-      if (r == ranges_.size()) ranges_.push_back(std::make_unique<TermRangeCost<AnalyticCost>>(term_loss_.get()));
+      if (r == shared_costs_.size()) {
+        shared_costs_.push_back(std::make_unique<TermRangeCost<AnalyticCost>>(term_loss_.get()));
+      }
       std::vector<const AnalyticCost*> terms;
       terms.reserve(end - begin);
       for (std::size_t k = begin; k < end; ++k) terms.push_back(blocks_[k].analytic);
-      ranges_[r]->Reset(std::move(terms));
-      range_ids_.push_back(
-          problem_.AddResidualBlock(ranges_[r].get(), &loss_, parameters_.data(), int(parameters_.size())));
+      shared_costs_[r]->Reset(std::move(terms));
+      shared_ids_.push_back(
+          problem_.AddResidualBlock(shared_costs_[r].get(), &loss_, parameters_.data(), int(parameters_.size())));
     }
   }
 
@@ -197,8 +199,8 @@ class TermBlocks {
   ceres::LossFunctionWrapper loss_{nullptr, ceres::TAKE_OWNERSHIP};  // the blocks' loss
   std::vector<double*> parameters_;
   std::vector<Block> blocks_;
-  std::vector<std::unique_ptr<TermRangeCost<AnalyticCost>>> ranges_;
-  std::vector<ceres::ResidualBlockId> range_ids_;
+  std::vector<std::unique_ptr<TermRangeCost<AnalyticCost>>> shared_costs_;
+  std::vector<ceres::ResidualBlockId> shared_ids_;
 };
 
 }  // namespace

@@ -492,7 +492,8 @@ TEST(RcsFacing, HeldFromTheAssociationPose) {
 
 // Own GN and Ceres LM reach the same optimum on the same association, for
 // both incidence models (the association holds each RCS term's facing sign,
-// so the cost they minimise is smooth).
+// so the cost they minimise is smooth); so do Ceres with shared blocks and
+// with a block per term, and the own GN with the losses' curvature.
 TEST(SolverAgreement, SameOptimumOnSameAssociation) {
   const World& world = SimulatedWorld();
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
@@ -514,12 +515,21 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
     const ScanMatchingResult gn = GaussNewtonSolver(options).Match(world.simulated.scans[kTestScan], single, initial);
     const ScanMatchingResult lm =
         CeresSolver(options, ceres_options).Match(world.simulated.scans[kTestScan], single, initial);
+    // A residual block per term under Ceres's own loss handling: another path, the same optimum.
+    CeresSolverOptions unshared = ceres_options;
+    unshared.shared_blocks = false;
+    const ScanMatchingResult lm_unshared =
+        CeresSolver(options, unshared).Match(world.simulated.scans[kTestScan], single, initial);
     // The losses' curvature in the own GN's Hessian changes its path, not its optimum.
     ScanMatchingOptions curved = options;
     curved.loss_curvature = true;
     const ScanMatchingResult gn_curved =
         GaussNewtonSolver(curved).Match(world.simulated.scans[kTestScan], single, initial);
     double dt = 0.0, dr = 0.0;
+    PoseErrors(lm_unshared.pose, lm.pose, dt, dr);
+    ASSERT_TRUE(lm_unshared.converged) << lm_unshared.reason;
+    EXPECT_LT(dt, 1e-4) << "w " << w << ", a block per term";
+    EXPECT_LT(dr * M_PI / 180.0, 1e-4) << "w " << w << ", a block per term";
     PoseErrors(gn_curved.pose, lm.pose, dt, dr);
     ASSERT_TRUE(gn_curved.converged) << gn_curved.reason;
     EXPECT_LT(dt, 1e-4) << "w " << w << ", loss curvature";
@@ -671,7 +681,9 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
           ASSERT_EQ(columns, 6);
           Eigen::MatrixXd analytic = Eigen::MatrixXd::Zero(jacobian.num_rows, columns);
           for (int row = 0; row < jacobian.num_rows; ++row) {
-            for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) analytic(row, jacobian.cols[k]) = jacobian.values[k];
+            for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
+              analytic(row, jacobian.cols[k]) = jacobian.values[k];
+            }
           }
           constexpr double h = 1e-6;
           double worst = 0.0;
