@@ -116,16 +116,17 @@ class TermBlocks {
   TermBlocks(ceres::Problem& problem, const LossConfig& loss, bool analytic, bool shared,
              std::vector<double*> parameters)
       : problem_(problem),
-        loss_config_(loss),
         analytic_(analytic),
         shared_(analytic && shared),
-        term_loss_(shared_ ? MakeLoss(loss) : nullptr),
+        robust_loss_(MakeLoss(loss)),
         parameters_(std::move(parameters)) {}
 
-  // Eq. 2's weight of every term of this kind (for the next Truncate).
+  // Eq. 2's weight of every term of this kind (for the next Truncate); the
+  // robust loss is inside the shared blocks, else under the weight.
   void SetWeight(double weight) {
-    loss_.Reset(new ceres::ScaledLoss(shared_ ? nullptr : MakeLoss(loss_config_), weight, ceres::TAKE_OWNERSHIP),
-                ceres::TAKE_OWNERSHIP);
+    loss_.Reset(
+        new ceres::ScaledLoss(shared_ ? nullptr : robust_loss_.get(), weight, ceres::DO_NOT_TAKE_OWNERSHIP),
+        ceres::TAKE_OWNERSHIP);
   }
 
   // Term k is the one made from `args` (and, unless shared, its block is in the problem).
@@ -174,7 +175,7 @@ class TermBlocks {
     for (std::size_t begin = 0, r = 0; begin < count; begin += CeresScanProblem::kTermsPerBlock, ++r) {
       const std::size_t end = std::min(count, begin + CeresScanProblem::kTermsPerBlock);
       if (r == shared_costs_.size()) {
-        shared_costs_.push_back(std::make_unique<TermRangeCost<AnalyticCost>>(term_loss_.get()));
+        shared_costs_.push_back(std::make_unique<TermRangeCost<AnalyticCost>>(robust_loss_.get()));
       }
       std::vector<const AnalyticCost*> terms;
       terms.reserve(end - begin);
@@ -192,10 +193,9 @@ class TermBlocks {
     ceres::ResidualBlockId id = nullptr;  // null while not in the problem (always when shared)
   };
   ceres::Problem& problem_;
-  LossConfig loss_config_;
   bool analytic_;
   bool shared_;
-  std::unique_ptr<ceres::LossFunction> term_loss_;  // shared: in each term's residual (null: trivial)
+  std::unique_ptr<ceres::LossFunction> robust_loss_;  // null: trivial
   ceres::LossFunctionWrapper loss_{nullptr, ceres::TAKE_OWNERSHIP};  // the blocks' loss
   std::vector<double*> parameters_;
   std::vector<Block> blocks_;

@@ -650,58 +650,47 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
               << "w " << update.w << ", " << layout.name;
           EXPECT_EQ(problem.problem().NumResiduals(), int(3 * n_geo + n_rcs)) << "w " << update.w;
           double cost = 0.0;
-          std::vector<double> residuals, gradient;
+          std::vector<double> gradient;
           ceres::CRSMatrix jacobian;
-          ASSERT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, &residuals, &gradient,
+          ASSERT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient,
                                                  shared ? &jacobian : nullptr));
           const double f = EvaluateCost(c, pose, weighted);
           EXPECT_NEAR(2.0 * cost, f, 1e-12 * f) << "w " << update.w << " level " << update.level << ", " << layout.name;
           gradients[l].insert(gradients[l].end(), gradient.begin(), gradient.end());
           if (!shared) continue;
           // Central differences of the residuals along the tangent coordinates
-          // (Ceres's Jacobian columns: rotation dphi, then translation dt).
+          // x = [dphi; dt] (Ceres's Jacobian columns: rotation, then translation).
           const Eigen::Vector4d rotation0 = rotation;
           const Eigen::Vector3d translation0 = translation;
-          const auto residuals_at = [&](int column, double h) {
-            rotation = rotation0;
-            translation = translation0;
-            if (column < 3) {
-              Eigen::Vector3d delta = Eigen::Vector3d::Zero();
-              delta[column] = h;
-              SO3Manifold().Plus(rotation0.data(), delta.data(), rotation.data());
-            } else {
-              translation[column - 3] += h;
-            }
-            std::vector<double> values;
-            EXPECT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), nullptr, &values, nullptr,
-                                                   nullptr));
-            return values;
-          };
-          const int columns = jacobian.num_cols;
-          ASSERT_EQ(columns, 6);
-          Eigen::MatrixXd analytic = Eigen::MatrixXd::Zero(jacobian.num_rows, columns);
-          for (int row = 0; row < jacobian.num_rows; ++row) {
-            for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
-              analytic(row, jacobian.cols[k]) = jacobian.values[k];
-            }
-          }
-          constexpr double h = 1e-6;
-          double worst = 0.0;
-          for (int column = 0; column < columns; ++column) {
-            const std::vector<double> plus = residuals_at(column, h), minus = residuals_at(column, -h);
-            for (int row = 0; row < jacobian.num_rows; ++row) {
-              const double numeric = (plus[row] - minus[row]) / (2.0 * h);
-              worst = std::max(worst, std::abs(numeric - analytic(row, column)) /
-                                          (1e-6 + std::abs(numeric) + std::abs(analytic(row, column))));
-            }
-          }
+          const Eigen::MatrixXd numeric = NumericJacobian(
+              [&](const Eigen::VectorXd& x) {
+                SO3Manifold().Plus(rotation0.data(), x.data(), rotation.data());
+                translation = translation0 + x.tail<3>();
+                std::vector<double> values;
+                EXPECT_TRUE(
+                    problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), nullptr, &values, nullptr, nullptr));
+                return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(values.data(), Eigen::Index(values.size())));
+              },
+              Eigen::VectorXd::Zero(6));
           rotation = rotation0;
           translation = translation0;
+          ASSERT_EQ(jacobian.num_cols, 6);
+          ASSERT_EQ(jacobian.num_rows, numeric.rows());
+          double worst = 0.0;  // entry by entry
+          for (int row = 0; row < jacobian.num_rows; ++row) {
+            Eigen::Matrix<double, 1, 6> analytic = Eigen::Matrix<double, 1, 6>::Zero();
+            for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
+              analytic[jacobian.cols[k]] = jacobian.values[k];
+            }
+            const Eigen::Matrix<double, 1, 6> difference = analytic - numeric.row(row);
+            const Eigen::Matrix<double, 1, 6> scale = analytic.cwiseAbs() + numeric.row(row).cwiseAbs();
+            worst = std::max(worst, (difference.cwiseAbs().array() / (1e-6 + scale.array())).maxCoeff());
+          }
           EXPECT_LT(worst, 1e-5) << "w " << update.w << (trivial ? ", trivial losses" : ", robust losses");
         }
       }
       for (int l = 0; l < 2; ++l) {
-        ASSERT_EQ(gradients[l].size(), gradients[0].size());
+        ASSERT_EQ(gradients[l + 1].size(), gradients[0].size());
         for (std::size_t i = 0; i < gradients[0].size(); ++i) {
           EXPECT_NEAR(gradients[l + 1][i], gradients[0][i], 1e-8 * (1.0 + std::abs(gradients[0][i])))
               << "gradient entry " << i << ", " << layouts[l + 1].name
