@@ -184,6 +184,35 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
             std::vector<int>(expected_all.begin(), expected_all.begin() + 3));
 }
 
+// A point exactly on the gate is associated, one just beyond it is not, and
+// of two equally close Gaussians the one with the smaller id wins (the
+// branch-free selection keeps both rules).
+TEST(GaussianIndexTest, GateIsInclusiveAndTiesGoToTheSmallestId) {
+  Gaussian unit;
+  unit.mean.setZero();
+  unit.covariance.setIdentity();  // information I: Mahalanobis^2 = |p|^2, exactly
+  Gaussian far = unit;
+  far.mean = Eigen::Vector3d(10.0, 0.0, 0.0);
+  const GaussianIndex index({far, unit, unit}, 0.5);  // ids 1 and 2 coincide
+  const std::vector<Eigen::Vector3d> points = {Eigen::Vector3d(3.0, 0.0, 0.0), Eigen::Vector3d(0.0, -3.0, 0.0),
+                                               Eigen::Vector3d(0.0, 0.0, 3.0000001),
+                                               Eigen::Vector3d(1.0, 2.0, 2.0)};
+  const std::vector<int> expected = {1, 1, -1, 1};  // |p|^2 = 9, 9, > 9, 9
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    double d2 = -1.0;
+    EXPECT_EQ(index.Associate(points[k], 9.0, &d2), expected[k]) << k;
+    if (expected[k] >= 0) {
+      EXPECT_EQ(d2, 9.0) << k;
+    }
+  }
+  std::vector<int> batched(points.size(), -2);
+  index.AssociateAll(points.data(), points.size(), 9.0, batched.data());
+  EXPECT_EQ(batched, expected);
+  // A gate below the distance leaves every point unassociated.
+  index.AssociateAll(points.data(), points.size(), 8.99, batched.data());
+  EXPECT_EQ(batched, std::vector<int>(points.size(), -1));
+}
+
 TEST(GaussianIndexTest, EmptyIndexAssociatesNothing) {
   const Eigen::Vector3d p(0.1, -0.2, 0.3);
   std::size_t count = 1;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
@@ -136,18 +137,20 @@ const std::uint32_t* GaussianIndex::Candidates(const Eigen::Vector3d& point, std
 
 int GaussianIndex::Nearest(const Eigen::Vector3d& point, const std::uint32_t* candidates, std::size_t count,
                            double gate_sq, double* mahalanobis_sq) const {
+  // A candidate wins when strictly closer than the best so far, so ties go to
+  // the smallest id (candidates come sorted by id); the bound starts one ulp
+  // above the gate, so that a candidate on the gate itself is taken. Without
+  // a branch (the winner is unpredictable): the select compiles to moves.
   int best = -1;
-  double best_d2 = gate_sq;
+  double best_d2 = std::nextafter(gate_sq, std::numeric_limits<double>::infinity());
   for (std::size_t k = 0; k < count; ++k) {
     const std::uint32_t i = candidates[k];
     const IndexedGaussian& entry = gaussians_[i];
     const Eigen::Vector3d e = point - entry.mean;
     const double d2 = e.dot(entry.information * e);
-    // Candidates come sorted by id, so ties go to the smallest id.
-    if (d2 < best_d2 || (best < 0 && d2 <= gate_sq)) {
-      best_d2 = d2;
-      best = static_cast<int>(i);
-    }
+    const bool closer = d2 < best_d2;
+    best_d2 = closer ? d2 : best_d2;
+    best = closer ? static_cast<int>(i) : best;
   }
   if (mahalanobis_sq && best >= 0) *mahalanobis_sq = best_d2;
   return best;
