@@ -86,63 +86,51 @@ T EvaluateSh(const CoefficientT* coefficients, const Eigen::Matrix<T, 3, 1>& d) 
   return value;
 }
 
-// Gradient of each basis function with respect to the direction components:
-// gradient[3 * i + k] = dY_i / dd_k, for the polynomial forms above (d is not
-// renormalised). The analytic twin of the Jet derivatives of EvaluateShBasis.
+// c . Y(d) and its gradient c . dY/dd (polynomial forms, d not renormalised)
+// in one pass: the inner loop of the analytic RCS residual. The gradient is
+// summed band by band from the coefficients scaled by their constants, so
+// that no product with a zero entry of dY/dd is formed. Writes the basis
+// Y(d) to `basis_out` when given.
 template <int Degree>
-void EvaluateShBasisGradient(const Eigen::Vector3d& d, double* gradient) {
+double EvaluateShWithGradient(const double* c, const Eigen::Vector3d& d, Eigen::Vector3d& gradient,
+                              double* basis_out = nullptr) {
   static_assert(Degree >= 0 && Degree <= kMaxShDegree, "SH degree must be 0..3");
   using namespace sh_constants;
-  const auto set = [gradient](int i, double gx, double gy, double gz) {
-    gradient[3 * i] = gx;
-    gradient[3 * i + 1] = gy;
-    gradient[3 * i + 2] = gz;
-  };
-  set(0, 0.0, 0.0, 0.0);
+  if (basis_out != nullptr) EvaluateShBasis<Degree>(d, basis_out);
+  double value = kC0 * c[0];
+  double gx = 0.0, gy = 0.0, gz = 0.0;
   if constexpr (Degree >= 1) {
     const double x = d.x(), y = d.y(), z = d.z();
-    set(1, 0.0, -kC1, 0.0);
-    set(2, 0.0, 0.0, kC1);
-    set(3, -kC1, 0.0, 0.0);
+    const double a1 = -kC1 * c[1], a2 = kC1 * c[2], a3 = -kC1 * c[3];  // Y_1..3 = -C1 y, C1 z, -C1 x
+    value += a1 * y + a2 * z + a3 * x;
+    gx += a3;
+    gy += a1;
+    gz += a2;
     if constexpr (Degree >= 2) {
-      set(4, kC2[0] * y, kC2[0] * x, 0.0);
-      set(5, 0.0, kC2[1] * z, kC2[1] * y);
-      set(6, -2.0 * kC2[2] * x, -2.0 * kC2[2] * y, 4.0 * kC2[2] * z);
-      set(7, kC2[3] * z, 0.0, kC2[3] * x);
-      set(8, 2.0 * kC2[4] * x, -2.0 * kC2[4] * y, 0.0);
+      const double xx = x * x, yy = y * y, zz = z * z;
+      const double xy = x * y, yz = y * z, xz = x * z;
+      const double b4 = kC2[0] * c[4], b5 = kC2[1] * c[5], b6 = kC2[2] * c[6], b7 = kC2[3] * c[7],
+                   b8 = kC2[4] * c[8];
+      value += b4 * xy + b5 * yz + b6 * (2.0 * zz - xx - yy) + b7 * xz + b8 * (xx - yy);
+      gx += b4 * y + b7 * z + 2.0 * (b8 - b6) * x;
+      gy += b4 * x + b5 * z - 2.0 * (b6 + b8) * y;
+      gz += b5 * y + b7 * x + 4.0 * b6 * z;
       if constexpr (Degree >= 3) {
-        const double xx = x * x, yy = y * y, zz = z * z;
-        set(9, 6.0 * kC3[0] * x * y, 3.0 * kC3[0] * (xx - yy), 0.0);
-        set(10, kC3[1] * y * z, kC3[1] * x * z, kC3[1] * x * y);
-        set(11, -2.0 * kC3[2] * x * y, kC3[2] * (4.0 * zz - xx - 3.0 * yy), 8.0 * kC3[2] * y * z);
-        set(12, -6.0 * kC3[3] * x * z, -6.0 * kC3[3] * y * z, kC3[3] * (6.0 * zz - 3.0 * xx - 3.0 * yy));
-        set(13, kC3[4] * (4.0 * zz - 3.0 * xx - yy), -2.0 * kC3[4] * x * y, 8.0 * kC3[4] * x * z);
-        set(14, 2.0 * kC3[5] * x * z, -2.0 * kC3[5] * y * z, kC3[5] * (xx - yy));
-        set(15, 3.0 * kC3[6] * (xx - yy), -6.0 * kC3[6] * x * y, 0.0);
+        const double e9 = kC3[0] * c[9], e10 = kC3[1] * c[10], e11 = kC3[2] * c[11], e12 = kC3[3] * c[12],
+                     e13 = kC3[4] * c[13], e14 = kC3[5] * c[14], e15 = kC3[6] * c[15];
+        const double xx_yy = xx - yy, four_zz = 4.0 * zz;
+        value += e9 * y * (3.0 * xx - yy) + e10 * xy * z + e11 * y * (four_zz - xx - yy) +
+                 e12 * z * (2.0 * zz - 3.0 * (xx + yy)) + e13 * x * (four_zz - xx - yy) + e14 * z * xx_yy +
+                 e15 * x * (xx - 3.0 * yy);
+        gx += (6.0 * e9 - 2.0 * e11) * xy + e10 * yz + (2.0 * e14 - 6.0 * e12) * xz +
+              e13 * (four_zz - 3.0 * xx - yy) + 3.0 * e15 * xx_yy;
+        gy += 3.0 * e9 * xx_yy + e10 * xz + e11 * (four_zz - xx - 3.0 * yy) - 2.0 * (3.0 * e12 + e14) * yz -
+              2.0 * (e13 + 3.0 * e15) * xy;
+        gz += e10 * xy + 8.0 * (e11 * yz + e13 * xz) + e12 * (6.0 * zz - 3.0 * (xx + yy)) + e14 * xx_yy;
       }
     }
   }
-}
-
-// c . Y(d) and its gradient c . dY/dd (polynomial forms, d not renormalised)
-// in one pass: the inner loop of the analytic RCS residual. With the degree
-// fixed, the basis and its gradient stay in registers. Writes the basis
-// Y(d) to `basis_out` when given.
-template <int Degree>
-double EvaluateShWithGradient(const double* coefficients, const Eigen::Vector3d& d, Eigen::Vector3d& gradient,
-                              double* basis_out = nullptr) {
-  constexpr int kCount = ShCoefficientCount(Degree);
-  double basis[kCount];
-  double basis_gradient[3 * kCount];
-  EvaluateShBasis<Degree>(d, basis);
-  EvaluateShBasisGradient<Degree>(d, basis_gradient);
-  double value = 0.0;
-  gradient.setZero();
-  for (int i = 0; i < kCount; ++i) {
-    value += coefficients[i] * basis[i];
-    gradient += coefficients[i] * Eigen::Map<const Eigen::Vector3d>(basis_gradient + 3 * i);
-  }
-  if (basis_out != nullptr) std::copy(basis, basis + kCount, basis_out);
+  gradient = Eigen::Vector3d(gx, gy, gz);
   return value;
 }
 
