@@ -160,27 +160,30 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
   const Eigen::Matrix<double, 4, 3> P = QuaternionTangent(pose.rotation());
   for (const RcsTerm& term : c.rcs) {
     Eigen::Matrix<double, 1, 1> r;
-    Eigen::Matrix<double, 1, 6> J;
+    Eigen::Matrix<double, 1, 3> J_rotation, J_translation;
     if (options.jacobians == JacobianMode::kAnalytic) {
-      // du/ddt = R^T, du/ddphi = -[mu_r]x (conventions.hpp: right perturbation).
+      // du/ddt = R^T, du/ddphi = -[mu_r]x (conventions.hpp: right perturbation),
+      // so dr/ddphi = -dr/du [mu_r]x = (mu_r x dr/du^T)^T.
       const Eigen::Vector3d mean_radar = Rt * (term.mean - translation);
       const RcsLinearisation lin = LineariseRcs(term, mean_radar);
       r[0] = lin.residual;
-      J.block<1, 3>(0, kRotationOffset) = -lin.dr_du * SO3d::Hat(mean_radar);
-      if (!rotation_only) J.block<1, 3>(0, kTranslationOffset) = lin.dr_du * Rt;
+      J_rotation = mean_radar.cross(lin.dr_du.transpose()).transpose();
+      if (!rotation_only) J_translation = lin.dr_du * Rt;
     } else {
       Jet7 rotation[4], t[3], residual[1];
       SeedJets(pose, translation, rotation, t);
       const RcsResidual functor(term);
       functor(rotation, t, residual);
       r[0] = residual[0].a;
-      J.block<1, 3>(0, kTranslationOffset) = residual[0].v.tail<3>().transpose();
-      J.block<1, 3>(0, kRotationOffset) = residual[0].v.head<4>().transpose() * P;
+      J_rotation = residual[0].v.head<4>().transpose() * P;
+      J_translation = residual[0].v.tail<3>().transpose();
     }
     if (rotation_only) {
-      Accumulate(system, kRotationOffset, Eigen::Matrix<double, 1, 3>(J.block<1, 3>(0, kRotationOffset)), r, loss,
-                 options.loss_curvature);
+      Accumulate(system, kRotationOffset, J_rotation, r, loss, options.loss_curvature);
     } else {
+      Eigen::Matrix<double, 1, 6> J;
+      J.block<1, 3>(0, kTranslationOffset) = J_translation;
+      J.block<1, 3>(0, kRotationOffset) = J_rotation;
       Accumulate(system, 0, J, r, loss, options.loss_curvature);
     }
   }
