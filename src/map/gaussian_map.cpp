@@ -64,13 +64,13 @@ VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel) {
 std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
   // A non-finite point has no voxel: the empty key finds an empty slot (no candidates).
   if (!p.allFinite()) return kEmptyCell;
-  const VoxelKey v = VoxelOf(p, cell_size_);
-  return PackKey(v.x, v.y, v.z);
+  return PackKey(FloorToInt(p.x() * inverse_cell_), FloorToInt(p.y() * inverse_cell_),
+                 FloorToInt(p.z() * inverse_cell_));
 }
 
 GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size,
                              double extent_sigmas)
-    : cell_size_(cell_size) {
+    : inverse_cell_(1.0 / cell_size) {
   if (!(cell_size > 0.0)) throw std::invalid_argument("index cell size must be > 0");
   const std::size_t n = gaussians.size();
   gaussians_.resize(n);
@@ -82,8 +82,10 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
     entry.information = g.covariance.inverse();
     entry.sqrt_information_t = Eigen::LLT<Eigen::Matrix3d>(entry.information).matrixL().transpose();
     const Eigen::Vector3d half = extent_sigmas * g.covariance.diagonal().cwiseSqrt();
-    const Eigen::Vector3d lo = ((g.mean - half) / cell_size).array().floor();
-    const Eigen::Vector3d hi = ((g.mean + half) / cell_size).array().floor();
+    // The cells as Key finds them (the same product: monotone, so a point
+    // in the box is in one of its cells).
+    const Eigen::Vector3d lo = ((g.mean - half) * inverse_cell_).array().floor();
+    const Eigen::Vector3d hi = ((g.mean + half) * inverse_cell_).array().floor();
     for (auto x = std::int64_t(lo.x()); x <= std::int64_t(hi.x()); ++x) {
       for (auto y = std::int64_t(lo.y()); y <= std::int64_t(hi.y()); ++y) {
         for (auto z = std::int64_t(lo.z()); z <= std::int64_t(hi.z()); ++z) {
@@ -135,14 +137,19 @@ const std::uint32_t* GaussianIndex::Candidates(const Eigen::Vector3d& point, std
   return cell_entries_.data() + cell.begin;
 }
 
+double GaussianIndex::GateBound(double gate_sq) {
+  return std::nextafter(gate_sq, std::numeric_limits<double>::infinity());
+}
+
 int GaussianIndex::Nearest(const Eigen::Vector3d& point, const std::uint32_t* candidates, std::size_t count,
-                           double gate_sq, double* mahalanobis_sq) const {
+                           double bound, double* mahalanobis_sq) const {
   // A candidate wins when strictly closer than the best so far, so ties go to
   // the smallest id (candidates come sorted by id); the bound starts one ulp
-  // above the gate, so that a candidate on the gate itself is taken. Without
-  // a branch (the winner is unpredictable): the select compiles to moves.
+  // above the gate (GateBound), so that a candidate on the gate itself is
+  // taken. Without a branch (the winner is unpredictable): the select
+  // compiles to moves.
   int best = -1;
-  double best_d2 = std::nextafter(gate_sq, std::numeric_limits<double>::infinity());
+  double best_d2 = bound;
   for (std::size_t k = 0; k < count; ++k) {
     const std::uint32_t i = candidates[k];
     const IndexedGaussian& entry = gaussians_[i];
@@ -160,7 +167,7 @@ int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
                              double* mahalanobis_sq) const {
   std::size_t count = 0;
   const std::uint32_t* candidates = Candidates(point, count);
-  return Nearest(point, candidates, count, gate_sq, mahalanobis_sq);
+  return Nearest(point, candidates, count, GateBound(gate_sq), mahalanobis_sq);
 }
 
 void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t count, double gate_sq,
@@ -172,6 +179,7 @@ void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t coun
   // Four stages kAhead points apart: fetch the cell's home slot; find the
   // cell and fetch its list of candidates; fetch the candidates' entries; score.
   constexpr std::size_t kAhead = 8;
+  const double bound = GateBound(gate_sq);
   std::vector<std::int64_t> keys(count);
   std::vector<const Cell*> cells(count);
   const auto fetch_cell = [&](std::size_t k) {
@@ -197,7 +205,7 @@ void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t coun
     if (k + 2 * kAhead < count) fetch_list(k + 2 * kAhead);
     if (k + kAhead < count) fetch_candidates(k + kAhead);
     const Cell& cell = *cells[k];
-    associations[k] = Nearest(points[k], cell_entries_.data() + cell.begin, cell.end - cell.begin, gate_sq,
+    associations[k] = Nearest(points[k], cell_entries_.data() + cell.begin, cell.end - cell.begin, bound,
                               mahalanobis_sq ? mahalanobis_sq + k : nullptr);
   }
 }

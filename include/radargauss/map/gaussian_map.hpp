@@ -104,7 +104,7 @@ class GaussianIndex {
  private:
   std::int64_t Key(const Eigen::Vector3d& p) const;
 
-  double cell_size_ = 1.0;
+  double inverse_cell_ = 1.0;  // 1 / cell size: cells are floor(p * inverse_cell_)
   // What a query reads per candidate, side by side in one entry; aligned so
   // that the mean and information a query scores fill two cache lines.
   struct alignas(64) IndexedGaussian {
@@ -128,8 +128,11 @@ class GaussianIndex {
   std::size_t HomeSlot(std::int64_t key) const;
   // The slot holding `key`, or the empty slot where it would go.
   std::size_t Slot(std::int64_t key) const;
-  // The best candidate of `point` among `count` (-1 if none within the gate).
-  int Nearest(const Eigen::Vector3d& point, const std::uint32_t* candidates, std::size_t count, double gate_sq,
+  // The smallest Mahalanobis^2 a candidate must beat: one ulp above gate_sq.
+  static double GateBound(double gate_sq);
+  // The best candidate of `point` among `count` (-1 if none within the gate
+  // GateBound made `bound` from).
+  int Nearest(const Eigen::Vector3d& point, const std::uint32_t* candidates, std::size_t count, double bound,
               double* mahalanobis_sq) const;
 };
 
