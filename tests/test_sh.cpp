@@ -188,7 +188,12 @@ TEST(SphericalHarmonics, ValueWithGradientMatchesDotProductAndNumeric) {
       const Eigen::Vector3d d = RandomUnitVector(rng);
       Eigen::Vector3d gradient;
       const double value = EvaluateShWithGradient(degree, c.data(), d, gradient);
-      EXPECT_NEAR(value, EvaluateSh(degree, c.data(), d), 1e-13) << degree;
+      double basis_values[kCount];
+      EvaluateShBasis(degree, d, basis_values);
+      double dot = 0.0;
+      for (int i = 0; i < ShCoefficientCount(degree); ++i) dot += c[i] * basis_values[i];
+      EXPECT_NEAR(value, dot, 1e-13) << degree;
+      EXPECT_NEAR(EvaluateSh(degree, c.data(), d), dot, 1e-13) << degree;
       const Eigen::MatrixXd numeric = NumericJacobian(
           [&](const Eigen::VectorXd& x) {
             return Eigen::VectorXd::Constant(1, EvaluateSh(degree, c.data(), Eigen::Vector3d(x)));

@@ -76,13 +76,33 @@ Eigen::Matrix<T, ShCoefficientCount(Degree), 1> ShBasis(const Eigen::Matrix<T, 3
   return basis;
 }
 
-// c . Y(d) with (Degree+1)^2 coefficients: the model's value in direction d.
+// c . Y(d) with (Degree+1)^2 coefficients: the model's value in direction d,
+// summed band by band from the coefficients scaled by their constants (the
+// products of EvaluateShBasis, without the basis itself).
 template <int Degree, typename T, typename CoefficientT>
-T EvaluateSh(const CoefficientT* coefficients, const Eigen::Matrix<T, 3, 1>& d) {
-  T basis[ShCoefficientCount(Degree)];
-  EvaluateShBasis<Degree>(d, basis);
-  T value = T(0.0);
-  for (int i = 0; i < ShCoefficientCount(Degree); ++i) value += T(coefficients[i]) * basis[i];
+T EvaluateSh(const CoefficientT* c, const Eigen::Matrix<T, 3, 1>& d) {
+  static_assert(Degree >= 0 && Degree <= kMaxShDegree, "SH degree must be 0..3");
+  using namespace sh_constants;
+  T value = T(kC0) * T(c[0]);
+  if constexpr (Degree >= 1) {
+    const T& x = d.x();
+    const T& y = d.y();
+    const T& z = d.z();
+    value += T(kC1) * (T(c[2]) * z - T(c[1]) * y - T(c[3]) * x);  // Y_1..3 = -C1 y, C1 z, -C1 x
+    if constexpr (Degree >= 2) {
+      const T xx = x * x, yy = y * y, zz = z * z;
+      value += T(kC2[0] * c[4]) * (x * y) + T(kC2[1] * c[5]) * (y * z) +
+               T(kC2[2] * c[6]) * (T(2.0) * zz - xx - yy) + T(kC2[3] * c[7]) * (x * z) +
+               T(kC2[4] * c[8]) * (xx - yy);
+      if constexpr (Degree >= 3) {
+        value += T(kC3[0] * c[9]) * y * (T(3.0) * xx - yy) + T(kC3[1] * c[10]) * (x * y) * z +
+                 T(kC3[2] * c[11]) * y * (T(4.0) * zz - xx - yy) +
+                 T(kC3[3] * c[12]) * z * (T(2.0) * zz - T(3.0) * (xx + yy)) +
+                 T(kC3[4] * c[13]) * x * (T(4.0) * zz - xx - yy) + T(kC3[5] * c[14]) * z * (xx - yy) +
+                 T(kC3[6] * c[15]) * x * (xx - T(3.0) * yy);
+      }
+    }
+  }
   return value;
 }
 
@@ -97,41 +117,31 @@ double EvaluateShWithGradient(const double* c, const Eigen::Vector3d& d, Eigen::
   static_assert(Degree >= 0 && Degree <= kMaxShDegree, "SH degree must be 0..3");
   using namespace sh_constants;
   if (basis_out != nullptr) EvaluateShBasis<Degree>(d, basis_out);
-  double value = kC0 * c[0];
-  double gx = 0.0, gy = 0.0, gz = 0.0;
+  gradient.setZero();
   if constexpr (Degree >= 1) {
     const double x = d.x(), y = d.y(), z = d.z();
-    const double a1 = -kC1 * c[1], a2 = kC1 * c[2], a3 = -kC1 * c[3];  // Y_1..3 = -C1 y, C1 z, -C1 x
-    value += a1 * y + a2 * z + a3 * x;
-    gx += a3;
-    gy += a1;
-    gz += a2;
+    gradient += kC1 * Eigen::Vector3d(-c[3], -c[1], c[2]);  // Y_1..3 = -C1 y, C1 z, -C1 x
     if constexpr (Degree >= 2) {
-      const double xx = x * x, yy = y * y, zz = z * z;
-      const double xy = x * y, yz = y * z, xz = x * z;
       const double b4 = kC2[0] * c[4], b5 = kC2[1] * c[5], b6 = kC2[2] * c[6], b7 = kC2[3] * c[7],
                    b8 = kC2[4] * c[8];
-      value += b4 * xy + b5 * yz + b6 * (2.0 * zz - xx - yy) + b7 * xz + b8 * (xx - yy);
-      gx += b4 * y + b7 * z + 2.0 * (b8 - b6) * x;
-      gy += b4 * x + b5 * z - 2.0 * (b6 + b8) * y;
-      gz += b5 * y + b7 * x + 4.0 * b6 * z;
+      gradient += Eigen::Vector3d(b4 * y + b7 * z + 2.0 * (b8 - b6) * x, b4 * x + b5 * z - 2.0 * (b6 + b8) * y,
+                                  b5 * y + b7 * x + 4.0 * b6 * z);
       if constexpr (Degree >= 3) {
+        const double xx = x * x, yy = y * y, zz = z * z;
+        const double xy = x * y, yz = y * z, xz = x * z;
         const double e9 = kC3[0] * c[9], e10 = kC3[1] * c[10], e11 = kC3[2] * c[11], e12 = kC3[3] * c[12],
                      e13 = kC3[4] * c[13], e14 = kC3[5] * c[14], e15 = kC3[6] * c[15];
         const double xx_yy = xx - yy, four_zz = 4.0 * zz;
-        value += e9 * y * (3.0 * xx - yy) + e10 * xy * z + e11 * y * (four_zz - xx - yy) +
-                 e12 * z * (2.0 * zz - 3.0 * (xx + yy)) + e13 * x * (four_zz - xx - yy) + e14 * z * xx_yy +
-                 e15 * x * (xx - 3.0 * yy);
-        gx += (6.0 * e9 - 2.0 * e11) * xy + e10 * yz + (2.0 * e14 - 6.0 * e12) * xz +
-              e13 * (four_zz - 3.0 * xx - yy) + 3.0 * e15 * xx_yy;
-        gy += 3.0 * e9 * xx_yy + e10 * xz + e11 * (four_zz - xx - 3.0 * yy) - 2.0 * (3.0 * e12 + e14) * yz -
-              2.0 * (e13 + 3.0 * e15) * xy;
-        gz += e10 * xy + 8.0 * (e11 * yz + e13 * xz) + e12 * (6.0 * zz - 3.0 * (xx + yy)) + e14 * xx_yy;
+        gradient += Eigen::Vector3d(
+            (6.0 * e9 - 2.0 * e11) * xy + e10 * yz + (2.0 * e14 - 6.0 * e12) * xz + e13 * (four_zz - 3.0 * xx - yy) +
+                3.0 * e15 * xx_yy,
+            3.0 * e9 * xx_yy + e10 * xz + e11 * (four_zz - xx - 3.0 * yy) - 2.0 * (3.0 * e12 + e14) * yz -
+                2.0 * (e13 + 3.0 * e15) * xy,
+            e10 * xy + 8.0 * (e11 * yz + e13 * xz) + e12 * (6.0 * zz - 3.0 * (xx + yy)) + e14 * xx_yy);
       }
     }
   }
-  gradient = Eigen::Vector3d(gx, gy, gz);
-  return value;
+  return EvaluateSh<Degree, double>(c, d);
 }
 
 // Calls f(std::integral_constant<int, degree>{}) for a degree read from data;
