@@ -174,7 +174,7 @@ class RcsCostFunction final : public ceres::SizedCostFunction<1, 4, 3> {
     residuals[0] = lin.residual;
     if (jacobians[0] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
-      J = -lin.dr_du * InverseRotatePointJacobian(parameters[0], term_.mean - t);
+      J = InverseRotatePointJacobianLeft(-lin.dr_du, parameters[0], term_.mean - t);
     }
     if (jacobians[1] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 1, 3>> J(jacobians[1]);
@@ -205,7 +205,7 @@ class RcsRotationCostFunction final : public ceres::SizedCostFunction<1, 4> {
     residuals[0] = lin.residual;
     if (jacobians[0] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
-      J = -lin.dr_du * InverseRotatePointJacobian(parameters[0], term_.mean - translation_);
+      J = InverseRotatePointJacobianLeft(-lin.dr_du, parameters[0], term_.mean - translation_);
     }
     return true;
   }
@@ -277,7 +277,7 @@ class RcsCoefficientCostFunction final : public ceres::CostFunction {
     residuals[0] = lin.residual;
     if (jacobians[0] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
-      J = -lin.dr_du * InverseRotatePointJacobian(parameters[0], term_.mean - t);
+      J = InverseRotatePointJacobianLeft(-lin.dr_du, parameters[0], term_.mean - t);
     }
     if (jacobians[1] != nullptr) {
       for (int i = 0; i < ShCoefficientCount(term_.degree); ++i) jacobians[1][i] = -jacobians[1][i];
