@@ -77,7 +77,8 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     // H_tt = sum w Sigma^-1, H_tr = (sum -w Sigma^-1 [q]x) R,
     // H_rr = R^T (sum w [q]x^T Sigma^-1 [q]x) R, g_t = sum w Sigma^-1 e,
     // g_r = R^T (sum w [q]x Sigma^-1 e).
-    double tt[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}, rr[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    // The symmetric A_tt and A_rr by their upper triangles (00 01 02 11 12 22).
+    double A_tt_upper[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}, A_rr_upper[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     Eigen::Matrix3d A_tr = Eigen::Matrix3d::Zero();
     Eigen::Vector3d b_t = Eigen::Vector3d::Zero(), b_r = Eigen::Vector3d::Zero();
     // Loss curvature (options.loss_curvature), with J^T r = [I_e; R^T (q x I_e)]
@@ -101,34 +102,33 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
       // the upper triangle of [q]x (Sigma^-1 [q]x) as components of cross
       // products: the zeros of [q]x never enter a product.
       const Eigen::Vector3d w_q = weight * q;
-      Eigen::Matrix3d w_information_q_hat;
-      w_information_q_hat.col(0) = w_q.z() * information.col(1) - w_q.y() * information.col(2);
-      w_information_q_hat.col(1) = w_q.x() * information.col(2) - w_q.z() * information.col(0);
-      w_information_q_hat.col(2) = w_q.y() * information.col(0) - w_q.x() * information.col(1);
-      const auto& B = w_information_q_hat;
-      tt[0] += weight * information(0, 0);
-      tt[1] += weight * information(0, 1);
-      tt[2] += weight * information(0, 2);
-      tt[3] += weight * information(1, 1);
-      tt[4] += weight * information(1, 2);
-      tt[5] += weight * information(2, 2);
+      Eigen::Matrix3d B;  // w Sigma^-1 [q]x
+      B.col(0) = w_q.z() * information.col(1) - w_q.y() * information.col(2);
+      B.col(1) = w_q.x() * information.col(2) - w_q.z() * information.col(0);
+      B.col(2) = w_q.y() * information.col(0) - w_q.x() * information.col(1);
+      A_tt_upper[0] += weight * information(0, 0);
+      A_tt_upper[1] += weight * information(0, 1);
+      A_tt_upper[2] += weight * information(0, 2);
+      A_tt_upper[3] += weight * information(1, 1);
+      A_tt_upper[4] += weight * information(1, 2);
+      A_tt_upper[5] += weight * information(2, 2);
       A_tr.noalias() -= B;
       // (q x B_k)_i for the upper triangle i <= k; A_rr -= it ([q]x^T = -[q]x).
-      rr[0] -= q.y() * B(2, 0) - q.z() * B(1, 0);
-      rr[1] -= q.y() * B(2, 1) - q.z() * B(1, 1);
-      rr[2] -= q.y() * B(2, 2) - q.z() * B(1, 2);
-      rr[3] -= q.z() * B(0, 1) - q.x() * B(2, 1);
-      rr[4] -= q.z() * B(0, 2) - q.x() * B(2, 2);
-      rr[5] -= q.x() * B(1, 2) - q.y() * B(0, 2);
+      A_rr_upper[0] -= q.y() * B(2, 0) - q.z() * B(1, 0);
+      A_rr_upper[1] -= q.y() * B(2, 1) - q.z() * B(1, 1);
+      A_rr_upper[2] -= q.y() * B(2, 2) - q.z() * B(1, 2);
+      A_rr_upper[3] -= q.z() * B(0, 1) - q.x() * B(2, 1);
+      A_rr_upper[4] -= q.z() * B(0, 2) - q.x() * B(2, 2);
+      A_rr_upper[5] -= q.x() * B(1, 2) - q.y() * B(0, 2);
       b_t.noalias() += weight * information_e;
       b_r.noalias() += w_q.cross(information_e);
     }
-    const auto symmetric = [](const double* u) {
+    const auto from_upper = [](const double* u) {
       Eigen::Matrix3d m;
       m << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
       return m;
     };
-    const Eigen::Matrix3d A_tt = symmetric(tt), A_rr = symmetric(rr);
+    const Eigen::Matrix3d A_tt = from_upper(A_tt_upper), A_rr = from_upper(A_rr_upper);
     system.H.block<3, 3>(kTranslationOffset, kTranslationOffset) = A_tt;
     system.H.block<3, 3>(kTranslationOffset, kRotationOffset) = A_tr * R;
     system.H.block<3, 3>(kRotationOffset, kTranslationOffset) = (A_tr * R).transpose();

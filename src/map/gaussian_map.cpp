@@ -70,8 +70,9 @@ std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
 
 GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size,
                              double extent_sigmas)
-    : inverse_cell_(1.0 / cell_size) {
+{
   if (!(cell_size > 0.0)) throw std::invalid_argument("index cell size must be > 0");
+  inverse_cell_ = 1.0 / cell_size;
   const std::size_t n = gaussians.size();
   gaussians_.resize(n);
   std::vector<std::pair<std::int64_t, std::uint32_t>> entries;
