@@ -48,17 +48,30 @@ struct RcsTerm {
   std::uint32_t gaussian = 0;   // index in the map (for joint refinement)
 };
 
-// y - c . Y(d) for a rotation quaternion, a translation and coefficients c
-// (the term's own, or a parameter block in joint refinement).
+// d = s u / |u| for the Gaussian centre mu_r in the radar frame; writes |u|.
+template <typename T>
+Eigen::Matrix<T, 3, 1> RcsDirection(const RcsTerm& term, const Eigen::Matrix<T, 3, 1>& mean_radar, T& norm) {
+  const Eigen::Matrix<T, 3, 1> u = IncidenceVector<T>(term.incidence, term.point_radar.cast<T>(), mean_radar);
+  using std::sqrt;
+  norm = sqrt(u.squaredNorm());
+  return T(term.facing) * u / norm;
+}
+
+// y - c . Y(d) for the Gaussian centre mu_r in the radar frame and
+// coefficients c (the term's own, or a parameter block in joint refinement).
+template <typename T, typename CoefficientT>
+T RcsResidualAt(const RcsTerm& term, const Eigen::Matrix<T, 3, 1>& mean_radar, const CoefficientT* coefficients) {
+  T norm = T(0.0);
+  return T(term.measurement) - EvaluateSh<T>(term.degree, coefficients, RcsDirection<T>(term, mean_radar, norm));
+}
+
+// The same for a rotation quaternion and a translation: mu_r = R^T (mu - t).
 template <typename T, typename CoefficientT>
 T RcsResidualValue(const RcsTerm& term, const T* rotation, const Eigen::Matrix<T, 3, 1>& translation,
                    const CoefficientT* coefficients) {
   const Eigen::Map<const Eigen::Quaternion<T>> q(rotation);
-  const Eigen::Matrix<T, 3, 1> mean_radar = q.conjugate() * (term.mean.cast<T>() - translation);
-  const Eigen::Matrix<T, 3, 1> u = IncidenceVector<T>(term.incidence, term.point_radar.cast<T>(), mean_radar);
-  using std::sqrt;
-  const Eigen::Matrix<T, 3, 1> d = u * (T(term.facing) / sqrt(u.squaredNorm()));
-  return T(term.measurement) - EvaluateSh<T>(term.degree, coefficients, d);
+  return RcsResidualAt<T>(term, Eigen::Matrix<T, 3, 1>(q.conjugate() * (term.mean.cast<T>() - translation)),
+                          coefficients);
 }
 
 template <typename T>
@@ -124,29 +137,13 @@ struct RcsLinearisation {
   Eigen::RowVector3d dr_du = Eigen::RowVector3d::Zero();
 };
 
-// d = s u / |u| for the Gaussian centre mu_r in the radar frame; writes |u|.
-inline Eigen::Vector3d RcsDirection(const RcsTerm& term, const Eigen::Vector3d& mean_radar, double& norm) {
-  const Eigen::Vector3d u = IncidenceVector(term.incidence, term.point_radar, mean_radar);
-  norm = u.norm();
-  return term.facing * u / norm;
-}
-
-// y - c . Y(d) (the term's coefficients) for the Gaussian centre mu_r in the
-// radar frame: RcsResidualValue with the rotation already applied, for
-// passes that rotate every term by one matrix.
-inline double RcsResidualAt(const RcsTerm& term, const Eigen::Vector3d& mean_radar) {
-  double norm = 0.0;
-  return term.measurement -
-         EvaluateSh<double>(term.degree, term.coefficients.data(), RcsDirection(term, mean_radar, norm));
-}
-
 // With coefficients c from a parameter block (joint refinement), else the
 // term's; writes Y(d) = -dr/dc to `basis_out` when given.
 inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d& mean_radar,
                                      const double* coefficients, double* basis_out = nullptr) {
   double norm = 0.0;
   RcsLinearisation out;
-  const Eigen::Vector3d d = RcsDirection(term, mean_radar, norm);
+  const Eigen::Vector3d d = RcsDirection<double>(term, mean_radar, norm);
   Eigen::Vector3d c_dY;
   const double prediction = EvaluateShWithGradient(term.degree, coefficients, d, c_dY, basis_out);
   out.residual = term.measurement - prediction;

@@ -154,7 +154,7 @@ double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchi
   const Eigen::Vector3d rcs_translation =
       options.rcs_translation == RcsTranslation::kRotationOnly ? c.pose.translation() : pose.translation();
   for (const RcsTerm& term : c.rcs) {
-    const double r = RcsResidualAt(term, Rt * (term.mean - rcs_translation));
+    const double r = RcsResidualAt<double>(term, Rt * (term.mean - rcs_translation), term.coefficients.data());
     rcs_loss.Evaluate(r * r, rho, weight);
     rcs += rho;
   }

@@ -173,7 +173,7 @@ TEST_P(JacobianTest, RcsCoefficientBlocksAnalyticAutodiffNumeric) {
       EXPECT_NEAR(ra[0], rd[0], 1e-12);
       // The coefficients of the block, not the term's, predict the RCS.
       double d_norm = 0.0;
-      const Eigen::Vector3d d = RcsDirection(term, mean_radar, d_norm);
+      const Eigen::Vector3d d = RcsDirection<double>(term, mean_radar, d_norm);
       EXPECT_NEAR(ra[0], term.measurement - EvaluateSh(term.degree, c.data(), d), 1e-12);
       double cost_only = 0.0;
       ASSERT_TRUE(analytic.Evaluate(blocks.data(), &cost_only, nullptr));

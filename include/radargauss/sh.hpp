@@ -106,9 +106,9 @@ T EvaluateSh(const CoefficientT* c, const Eigen::Matrix<T, 3, 1>& d) {
   return value;
 }
 
-// c . Y(d) and its gradient c . dY/dd (polynomial forms, d not renormalised)
-// in one pass: the inner loop of the analytic RCS residual. The gradient is
-// summed band by band from the coefficients scaled by their constants, so
+// c . Y(d) (EvaluateSh) and its gradient c . dY/dd (polynomial forms, d not
+// renormalised): the inner loop of the analytic RCS residual. The gradient
+// is summed band by band from the coefficients scaled by their constants, so
 // that no product with a zero entry of dY/dd is formed. Writes the basis
 // Y(d) to `basis_out` when given.
 template <int Degree>

@@ -58,21 +58,23 @@ std::int64_t FloorToInt(double x) {
 }  // namespace
 
 VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel) {
-  return {FloorToInt(p.x() / voxel), FloorToInt(p.y() / voxel), FloorToInt(p.z() / voxel)};
+  // One division, then products: monotone in p, so a point inside a box is
+  // in one of the voxels of the box's corners.
+  const double inverse = 1.0 / voxel;
+  return {FloorToInt(p.x() * inverse), FloorToInt(p.y() * inverse), FloorToInt(p.z() * inverse)};
 }
 
 std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
   // A non-finite point has no voxel: the empty key finds an empty slot (no candidates).
   if (!p.allFinite()) return kEmptyCell;
-  return PackKey(FloorToInt(p.x() * inverse_cell_), FloorToInt(p.y() * inverse_cell_),
-                 FloorToInt(p.z() * inverse_cell_));
+  const VoxelKey v = VoxelOf(p, cell_size_);
+  return PackKey(v.x, v.y, v.z);
 }
 
 GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size,
                              double extent_sigmas)
-{
+    : cell_size_(cell_size) {
   if (!(cell_size > 0.0)) throw std::invalid_argument("index cell size must be > 0");
-  inverse_cell_ = 1.0 / cell_size;
   const std::size_t n = gaussians.size();
   gaussians_.resize(n);
   std::vector<std::pair<std::int64_t, std::uint32_t>> entries;
@@ -83,13 +85,12 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
     entry.information = g.covariance.inverse();
     entry.sqrt_information_t = Eigen::LLT<Eigen::Matrix3d>(entry.information).matrixL().transpose();
     const Eigen::Vector3d half = extent_sigmas * g.covariance.diagonal().cwiseSqrt();
-    // The cells as Key finds them (the same product: monotone, so a point
-    // in the box is in one of its cells).
-    const Eigen::Vector3d lo = ((g.mean - half) * inverse_cell_).array().floor();
-    const Eigen::Vector3d hi = ((g.mean + half) * inverse_cell_).array().floor();
-    for (auto x = std::int64_t(lo.x()); x <= std::int64_t(hi.x()); ++x) {
-      for (auto y = std::int64_t(lo.y()); y <= std::int64_t(hi.y()); ++y) {
-        for (auto z = std::int64_t(lo.z()); z <= std::int64_t(hi.z()); ++z) {
+    // The cells as Key finds them (VoxelOf of the box's corners).
+    const VoxelKey lo = VoxelOf(g.mean - half, cell_size);
+    const VoxelKey hi = VoxelOf(g.mean + half, cell_size);
+    for (auto x = lo.x; x <= hi.x; ++x) {
+      for (auto y = lo.y; y <= hi.y; ++y) {
+        for (auto z = lo.z; z <= hi.z; ++z) {
           entries.emplace_back(PackKey(x, y, z), static_cast<std::uint32_t>(i));
         }
       }

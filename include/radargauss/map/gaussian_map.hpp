@@ -104,7 +104,7 @@ class GaussianIndex {
  private:
   std::int64_t Key(const Eigen::Vector3d& p) const;
 
-  double inverse_cell_ = 1.0;  // 1 / cell size: cells are floor(p * inverse_cell_)
+  double cell_size_ = 1.0;
   // What a query reads per candidate, side by side in one entry; aligned so
   // that the mean and information a query scores fill two cache lines.
   struct alignas(64) IndexedGaussian {
