@@ -37,4 +37,26 @@ ceres::LossFunction* MakeLoss(const LossConfig& config) {
   return nullptr;
 }
 
+LossSum::LossSum(const LossConfig& config) {
+  if (config.type == LossType::kCauchy) {
+    if (!(config.scale > 0.0)) throw std::invalid_argument("loss scale must be > 0");
+    cauchy_ = true;
+    a2_ = config.scale * config.scale;
+    inverse_a2_ = 1.0 / a2_;
+  } else {
+    loss_.reset(MakeLoss(config));
+  }
+}
+
+void LossSum::Renormalise() {
+  int exponent = 0;
+  product_ = std::frexp(product_, &exponent);
+  exponent_ += exponent;
+}
+
+double LossSum::Sum() const {
+  if (!cauchy_) return sum_;
+  return a2_ * (std::log(product_) + exponent_ * std::log(2.0) + logs_);
+}
+
 }  // namespace radargauss

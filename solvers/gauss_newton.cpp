@@ -41,10 +41,10 @@ double CurvatureAlongResidual(double s, double weight, double second) {
 // rotation's three).
 template <int Rows, int Cols>
 void Accumulate(LinearSystem& system, int offset, const Eigen::Matrix<double, Rows, Cols>& J,
-                const Eigen::Matrix<double, Rows, 1>& r, const RobustLoss& loss, bool loss_curvature) {
-  double rho = 0.0, weight = 0.0, second = 0.0;
+                const Eigen::Matrix<double, Rows, 1>& r, LossSum& loss, bool loss_curvature) {
+  double second = 0.0;
   const double s = r.squaredNorm();
-  loss.Evaluate(s, rho, weight, &second);
+  const double weight = loss.Add(s, &second);
   const Eigen::Matrix<double, Rows, Cols> weighted_J = weight * J;
   system.H.block<Cols, Cols>(offset, offset).noalias() += weighted_J.transpose() * J;
   system.g.segment<Cols>(offset).noalias() += weighted_J.transpose() * r;
@@ -53,7 +53,6 @@ void Accumulate(LinearSystem& system, int offset, const Eigen::Matrix<double, Ro
     system.loss_curvature.block<Cols, Cols>(offset, offset).noalias() +=
         CurvatureAlongResidual(s, weight, second) * Jt_r * Jt_r.transpose();
   }
-  system.rho_sum += rho;
   ++system.residuals;
 }
 
@@ -68,7 +67,7 @@ SE3d Step(const SE3d& pose, const Eigen::Matrix<double, 6, 1>& dx) {
 LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
                                   const ScanMatchingOptions& options) {
   LinearSystem system;
-  const RobustLoss loss(options.geometric_loss);
+  LossSum loss(options.geometric_loss);
   const Eigen::Matrix3d R = pose.rotation().Matrix();
   if (options.jacobians == JacobianMode::kAnalytic) {
     // r = L^T e, e = q + t - mu with q = R p; dr/ddt = L^T and
@@ -84,15 +83,14 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     // Loss curvature (options.loss_curvature), with J^T r = [I_e; R^T (q x I_e)]
     // (I_e = Sigma^-1 e): summed without R as well.
     Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
-    double rho = 0.0, weight = 0.0, second = 0.0;
+    double second = 0.0;
     for (const GeometricTerm& term : c.geometric) {
       const Eigen::Matrix3d& information = c.index->Information(term.gaussian);
       const Eigen::Vector3d q = R * term.point_radar;
       const Eigen::Vector3d e = q + pose.translation() - c.index->Mean(term.gaussian);
       const Eigen::Vector3d information_e = information * e;
       const double s = e.dot(information_e);
-      loss.Evaluate(s, rho, weight, &second);
-      system.rho_sum += rho;
+      const double weight = loss.Add(s, &second);
       if (options.loss_curvature && second != 0.0) {
         Eigen::Matrix<double, 6, 1> Jt_r;
         Jt_r << information_e, q.cross(information_e);
@@ -141,6 +139,7 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
       system.loss_curvature = rotate.transpose() * C * rotate;
     }
     system.residuals = c.geometric.size();
+    system.rho_sum = loss.Sum();
     return system;
   }
   // Autodiff: the Ceres functor evaluated with Jets, per term.
@@ -163,13 +162,14 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     J.block<3, 3>(0, kRotationOffset) = ambient.leftCols<4>() * P;
     Accumulate(system, 0, J, r, loss, options.loss_curvature);
   }
+  system.rho_sum = loss.Sum();
   return system;
 }
 
 LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
                             const ScanMatchingOptions& options) {
   LinearSystem system;
-  const RobustLoss loss(options.rcs_loss);
+  LossSum loss(options.rcs_loss);
   // Rotation-only: the translation is the association's constant.
   const bool rotation_only = options.rcs_translation == RcsTranslation::kRotationOnly;
   const Eigen::Vector3d translation = rotation_only ? c.pose.translation() : pose.translation();
@@ -209,6 +209,7 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
     // translation gradient -> zero (only the rotation block was accumulated).
     system.H.block<3, 3>(kTranslationOffset, kTranslationOffset).setIdentity();
   }
+  system.rho_sum = loss.Sum();
   return system;
 }
 

@@ -138,29 +138,23 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
 }
 
 double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchingOptions& options) {
-  const RobustLoss geometric_loss(options.geometric_loss);
-  const RobustLoss rcs_loss(options.rcs_loss);
-  double rho = 0.0, weight = 0.0;
+  LossSum geometric(options.geometric_loss), rcs(options.rcs_loss);
   // One rotation matrix for all terms (the functors rotate by the quaternion per term).
   const Eigen::Matrix3d R = pose.rotation().Matrix();
   const Eigen::Matrix3d Rt = R.transpose();
-  double geometric = 0.0;
   for (const GeometricTerm& term : c.geometric) {
     const Eigen::Vector3d e = R * term.point_radar + pose.translation() - c.index->Mean(term.gaussian);
-    geometric_loss.Evaluate(e.dot(c.index->Information(term.gaussian) * e), rho, weight);  // ||L^T e||^2
-    geometric += rho;
+    geometric.Add(e.dot(c.index->Information(term.gaussian) * e));  // ||L^T e||^2
   }
-  double rcs = 0.0;
   const Eigen::Vector3d rcs_translation =
       options.rcs_translation == RcsTranslation::kRotationOnly ? c.pose.translation() : pose.translation();
   for (const RcsTerm& term : c.rcs) {
     const double r = RcsResidualAt<double>(term, Rt * (term.mean - rcs_translation), term.coefficients.data());
-    rcs_loss.Evaluate(r * r, rho, weight);
-    rcs += rho;
+    rcs.Add(r * r);
   }
   double f = 0.0;
-  if (options.w_rcs < 1.0 && !c.geometric.empty()) f += (1.0 - options.w_rcs) / c.geometric.size() * geometric;
-  if (options.w_rcs > 0.0 && !c.rcs.empty()) f += options.w_rcs / c.rcs.size() * rcs;
+  if (options.w_rcs < 1.0 && !c.geometric.empty()) f += (1.0 - options.w_rcs) / c.geometric.size() * geometric.Sum();
+  if (options.w_rcs > 0.0 && !c.rcs.empty()) f += options.w_rcs / c.rcs.size() * rcs.Sum();
   return f;
 }
 
