@@ -543,7 +543,7 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
     options.translation_tolerance = 1e-9;
     options.rotation_tolerance = 1e-10;
     CeresSolverOptions ceres_options;
-    ceres_options.max_inner_iterations = 200;
+    ceres_options.max_exact_inner_iterations = 200;
     ceres_options.function_tolerance = 1e-12;
     ceres_options.gradient_tolerance = 1e-12;
     ceres_options.parameter_tolerance = 1e-10;
@@ -600,12 +600,12 @@ TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
     ceres_options.parameter_tolerance = 1e-12;
     const SE3d initial = Perturbed(truth, 0.1, 0.5, 6);
     const RadarScan& scan = world.simulated.scans[kTestScan];
-    ceres_options.max_inner_iterations = 100;
+    ceres_options.max_exact_inner_iterations = 100;
     const ScanMatchingResult reference = CeresSolver(options, ceres_options).Match(scan, single, initial);
     ASSERT_TRUE(reference.converged) << reference.reason;
     EXPECT_EQ(reference.iterations, 1) << "w " << w;  // one solve on the one association
     for (const int limit : {1, 3}) {
-      ceres_options.max_inner_iterations = limit;
+      ceres_options.max_exact_inner_iterations = limit;
       const ScanMatchingResult chunked = CeresSolver(options, ceres_options).Match(scan, single, initial);
       ASSERT_TRUE(chunked.converged) << chunked.reason;
       double dt = 0.0, dr = 0.0;
@@ -616,6 +616,35 @@ TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
         EXPECT_GT(chunked.iterations, 1) << "w " << w;  // the limit did cut the solve
       }
     }
+  }
+}
+
+// On the exact map a solve ends once the pose leaves the association's
+// re-association thresholds: with thresholds of zero (re-associate after every
+// step) a cap of 50 iterations per solve does what a cap of one does.
+TEST(CeresSolver, ExactMapSolveEndsWhenThePoseLeavesTheAssociation) {
+  const World& world = SimulatedWorld();
+  const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
+  const MatchingMap single(world.map, ExactMapOnly());
+  for (const double w : {0.0, 0.25}) {
+    ScanMatchingOptions options;
+    options.w_rcs = w;
+    options.reassociation_translation = 0.0;
+    options.reassociation_rotation = 0.0;
+    const SE3d initial = Perturbed(truth, 0.1, 0.5, 7);
+    const RadarScan& scan = world.simulated.scans[kTestScan];
+    CeresSolverOptions one, fifty;
+    one.max_exact_inner_iterations = 1;
+    fifty.max_exact_inner_iterations = 50;
+    const ScanMatchingResult a = CeresSolver(options, one).Match(scan, single, initial);
+    const ScanMatchingResult b = CeresSolver(options, fifty).Match(scan, single, initial);
+    ASSERT_TRUE(a.converged) << a.reason;
+    ASSERT_GT(a.iterations, 2) << "w " << w;  // several associations
+    EXPECT_EQ(a.iterations, b.iterations) << "w " << w;
+    double dt = 0.0, dr = 0.0;
+    PoseErrors(a.pose, b.pose, dt, dr);
+    EXPECT_LT(dt, 1e-12) << "w " << w;
+    EXPECT_LT(dr, 1e-10) << "w " << w;
   }
 }
 
