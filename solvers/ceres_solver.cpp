@@ -203,26 +203,27 @@ class TermBlocks {
   std::vector<ceres::ResidualBlockId> shared_ids_;
 };
 
-// Ends a solve on the exact map once the pose has left the association's
-// re-association thresholds (CeresSolverOptions::max_exact_inner_iterations).
+// Ends a solve on the exact map once the pose has left the re-association
+// thresholds of the association made at `associated_at`
+// (CeresSolverOptions::max_exact_inner_iterations).
 class LeaveAssociation final : public ceres::IterationCallback {
  public:
-  LeaveAssociation(const ScanMatchingOptions& options, const double* rotation, const double* translation,
-                   const Correspondences*& held)
-      : options_(options), rotation_(rotation), translation_(translation), held_(held) {}
+  LeaveAssociation(const ScanMatchingOptions& options, const double* rotation, const double* translation)
+      : options_(options), rotation_(rotation), translation_(translation) {}
+
+  SE3d associated_at;
 
   ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
     const SE3d pose(SO3d(Eigen::Quaterniond(rotation_[3], rotation_[0], rotation_[1], rotation_[2])),
                     Eigen::Vector3d(translation_[0], translation_[1], translation_[2]));
-    return KeepsAssociation(true, held_->pose, pose, options_) ? ceres::SOLVER_CONTINUE
-                                                               : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    return KeepsAssociation(true, associated_at, pose, options_) ? ceres::SOLVER_CONTINUE
+                                                                 : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
   }
 
  private:
   const ScanMatchingOptions& options_;
   const double* rotation_;  // x y z w, as Ceres updates it
   const double* translation_;
-  const Correspondences*& held_;
 };
 
 }  // namespace
@@ -298,6 +299,9 @@ ceres::Problem& CeresScanProblem::problem() { return impl_->problem_; }
 CeresSolver::CeresSolver(const ScanMatchingOptions& options, const CeresSolverOptions& ceres_options)
     : options_(options), ceres_options_(ceres_options) {
   ValidateOptions(options_);
+  if (ceres_options_.max_inner_iterations < 1 || ceres_options_.max_exact_inner_iterations < 1) {
+    throw std::invalid_argument("Ceres iterations per solve must be >= 1");
+  }
 }
 
 std::string CeresSolver::Name() const {
@@ -324,15 +328,14 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
   ceres::Solver::Options exact_options = solver_options;
   exact_options.max_num_iterations = ceres_options_.max_exact_inner_iterations;
   exact_options.update_state_every_iteration = true;  // the callback reads the pose
-  const Correspondences* held = nullptr;               // the association being solved
-  LeaveAssociation leave(options_, rotation.data(), translation.data(), held);
+  LeaveAssociation leave(options_, rotation.data(), translation.data());
   exact_options.callbacks.push_back(&leave);
   return RunCoarseToFine(scan, map, initial, options_, [&](const LevelStep& level, ScanMatchingResult& result) {
     const Correspondences& c = level.correspondences;
     problem.Update(c, level.options.w_rcs);
     ceres::Solver::Summary summary;
     const SE3d before = result.pose;
-    held = &c;
+    leave.associated_at = c.pose;
     ceres::Solve(level.finest ? exact_options : solver_options, &problem.problem(), &summary);
     if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
       result.reason = "Ceres: " + summary.message;

@@ -646,6 +646,9 @@ TEST(CeresSolver, ExactMapSolveEndsWhenThePoseLeavesTheAssociation) {
     EXPECT_LT(dt, 1e-12) << "w " << w;
     EXPECT_LT(dr, 1e-10) << "w " << w;
   }
+  CeresSolverOptions none;
+  none.max_exact_inner_iterations = 0;
+  EXPECT_THROW(CeresSolver(ScanMatchingOptions(), none), std::invalid_argument);
 }
 
 // The Ceres problem kept across associations holds exactly the latest
