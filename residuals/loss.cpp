@@ -25,8 +25,16 @@ std::string ToString(LossType type) {
   return "unknown";
 }
 
-ceres::LossFunction* MakeLoss(const LossConfig& config) {
+namespace {
+
+void ValidateScale(const LossConfig& config) {
   if (!(config.scale > 0.0)) throw std::invalid_argument("loss scale must be > 0");
+}
+
+}  // namespace
+
+ceres::LossFunction* MakeLoss(const LossConfig& config) {
+  ValidateScale(config);
   switch (config.type) {
     case LossType::kTrivial: return nullptr;
     case LossType::kHuber: return new ceres::HuberLoss(config.scale);
@@ -39,7 +47,7 @@ ceres::LossFunction* MakeLoss(const LossConfig& config) {
 
 LossSum::LossSum(const LossConfig& config) {
   if (config.type == LossType::kCauchy) {
-    if (!(config.scale > 0.0)) throw std::invalid_argument("loss scale must be > 0");
+    ValidateScale(config);
     cauchy_ = true;
     a2_ = config.scale * config.scale;
     inverse_a2_ = 1.0 / a2_;

@@ -203,6 +203,12 @@ class TermBlocks {
   std::vector<ceres::ResidualBlockId> shared_ids_;
 };
 
+// The pose held by the rotation (x y z w) and translation blocks.
+SE3d PoseOfBlocks(const double* rotation, const double* translation) {
+  return SE3d(SO3d(Eigen::Quaterniond(rotation[3], rotation[0], rotation[1], rotation[2])),
+              Eigen::Vector3d(translation[0], translation[1], translation[2]));
+}
+
 // Ends a solve on the exact map once the pose has left the re-association
 // thresholds of the association made at `associated_at`
 // (CeresSolverOptions::max_exact_inner_iterations).
@@ -214,10 +220,9 @@ class LeaveAssociation final : public ceres::IterationCallback {
   SE3d associated_at;
 
   ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
-    const SE3d pose(SO3d(Eigen::Quaterniond(rotation_[3], rotation_[0], rotation_[1], rotation_[2])),
-                    Eigen::Vector3d(translation_[0], translation_[1], translation_[2]));
-    return KeepsAssociation(true, associated_at, pose, options_) ? ceres::SOLVER_CONTINUE
-                                                                 : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    return KeepsAssociation(true, associated_at, PoseOfBlocks(rotation_, translation_), options_)
+               ? ceres::SOLVER_CONTINUE
+               : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
   }
 
  private:
@@ -343,7 +348,7 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
       translation = before.translation();
       return StepOutcome::kFailed;
     }
-    result.pose = SE3d(SO3d(Eigen::Quaterniond(rotation[3], rotation[0], rotation[1], rotation[2])), translation);
+    result.pose = PoseOfBlocks(rotation.data(), translation.data());
     const SE3d step = before.Inverse() * result.pose;
     const bool small = level.SmallStep(step.translation().norm(), step.rotation().Log().norm());
     // Converged when the pose settled, or when Ceres converged on an

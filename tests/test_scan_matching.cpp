@@ -245,6 +245,9 @@ TEST(Losses, LossSumMatchesTheLossClasses) {
   not_a_number.Add(std::numeric_limits<double>::quiet_NaN());
   not_a_number.Add(1.0);
   EXPECT_TRUE(std::isnan(not_a_number.Sum()));
+  for (const LossType type : {LossType::kCauchy, LossType::kHuber}) {
+    EXPECT_THROW(LossSum({type, 0.0}), std::invalid_argument) << ToString(type);
+  }
 }
 
 // ---------------------------------------------------------------------------
