@@ -228,6 +228,22 @@ void BM_MatchScanMerged(benchmark::State& state) {
 }
 BENCHMARK(BM_MatchScanMerged)->ArgsProduct({{0, 2}, {0, 25}, {0, 400}})->Unit(benchmark::kMillisecond);
 
+// How much of BM_MatchScanMerged the coarse levels take: the same matches
+// (own GN), stopped after the exact map's first iteration. Args: w_rcs x 100
+// (the coarse levels are geometric only; w enters that one iteration),
+// coarse_points.
+void BM_MatchScanMergedCoarseLevels(benchmark::State& state) {
+  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const MatchingWorld& world = World();
+  const SimulatedSequence& scans = world.scans.at(800);
+  ScanMatchingOptions options;
+  options.w_rcs = double(state.range(0)) / 100.0;
+  options.coarse_points = std::size_t(state.range(1));
+  options.max_iterations = 1;
+  MatchScans(state, *Solver(0, options), *world.merged_matching, scans, InitialPoses(scans), options.w_rcs);
+}
+BENCHMARK(BM_MatchScanMergedCoarseLevels)->ArgsProduct({{0, 25}, {0, 400}})->Unit(benchmark::kMillisecond);
+
 // Tracking's initial poses: 5 cm and 0.2 deg (yaw) off the truth, as a
 // motion model would give them.
 std::vector<SE3d> TrackingPoses(const SimulatedSequence& sequence) {
