@@ -214,17 +214,21 @@ BENCHMARK(BM_MatchScan)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MatchScan)->Args({800, 3, 0})->Args({800, 3, 25})->Unit(benchmark::kMillisecond);
 
-// Merged coarse levels (CoarseLevels::kMerged), 800 points, from the paper's
-// errors. Args: solver (0 gn, 2 ceres), w_rcs x 100, coarse_points.
-void BM_MatchScanMerged(benchmark::State& state) {
+// Matches the 800-point scans on the map with merged coarse levels
+// (CoarseLevels::kMerged) from the paper's errors, one thread.
+void MatchScansMerged(benchmark::State& state, int solver, const ScanMatchingOptions& options) {
   const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const MatchingWorld& world = World();
   const SimulatedSequence& scans = world.scans.at(800);
+  MatchScans(state, *Solver(solver, options), *world.merged_matching, scans, InitialPoses(scans), options.w_rcs);
+}
+
+// Args: solver (0 gn, 2 ceres), w_rcs x 100, coarse_points.
+void BM_MatchScanMerged(benchmark::State& state) {
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(1)) / 100.0;
   options.coarse_points = std::size_t(state.range(2));
-  MatchScans(state, *Solver(int(state.range(0)), options), *world.merged_matching, scans, InitialPoses(scans),
-             options.w_rcs);
+  MatchScansMerged(state, int(state.range(0)), options);
 }
 BENCHMARK(BM_MatchScanMerged)->ArgsProduct({{0, 2}, {0, 25}, {0, 400}})->Unit(benchmark::kMillisecond);
 
@@ -233,14 +237,11 @@ BENCHMARK(BM_MatchScanMerged)->ArgsProduct({{0, 2}, {0, 25}, {0, 400}})->Unit(be
 // (the coarse levels are geometric only; w enters that one iteration),
 // coarse_points.
 void BM_MatchScanMergedCoarseLevels(benchmark::State& state) {
-  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
-  const MatchingWorld& world = World();
-  const SimulatedSequence& scans = world.scans.at(800);
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(0)) / 100.0;
   options.coarse_points = std::size_t(state.range(1));
   options.max_iterations = 1;
-  MatchScans(state, *Solver(0, options), *world.merged_matching, scans, InitialPoses(scans), options.w_rcs);
+  MatchScansMerged(state, 0, options);
 }
 BENCHMARK(BM_MatchScanMergedCoarseLevels)->ArgsProduct({{0, 25}, {0, 400}})->Unit(benchmark::kMillisecond);
 
