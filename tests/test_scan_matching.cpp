@@ -258,6 +258,7 @@ struct World {
   GaussianMap map;       // RCS models with the paper's offset incidence
   GaussianMap view_map;  // the same Gaussians, RCS models with view incidence
   std::unique_ptr<MatchingMap> matching;
+  std::unique_ptr<MatchingMap> exact;  // the map alone (ExactMapOnly): one association at a time
 };
 
 const World& SimulatedWorld() {
@@ -277,6 +278,7 @@ const World& SimulatedWorld() {
     view.incidence = IncidenceModel::kView;
     FitRcsModels(w->view_map, cloud, association, view);
     w->matching = std::make_unique<MatchingMap>(w->map);
+    w->exact = std::make_unique<MatchingMap>(w->map, ExactMapOnly());
     return w;
   }();
   return *world;
@@ -343,7 +345,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(GaussNewton, FinalCostIsEq2AtTheFinalPose) {
   const World& world = SimulatedWorld();
   const RadarScan& scan = world.simulated.scans[kTestScan];
-  const MatchingMap exact(world.map, ExactMapOnly());
+  const MatchingMap& exact = *world.exact;
   const SE3d initial = Perturbed(world.simulated.ground_truth[kTestScan].pose, 0.1, 0.5, 4);
   for (const double w : {0.0, 0.25}) {
     ScanMatchingOptions options;
@@ -590,7 +592,6 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
 TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
   const World& world = SimulatedWorld();
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
-  const MatchingMap single(world.map, ExactMapOnly());
   for (const double w : {0.0, 0.25}) {
     ScanMatchingOptions options;
     options.w_rcs = w;
@@ -604,12 +605,12 @@ TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
     const SE3d initial = Perturbed(truth, 0.1, 0.5, 6);
     const RadarScan& scan = world.simulated.scans[kTestScan];
     ceres_options.max_exact_inner_iterations = 100;
-    const ScanMatchingResult reference = CeresSolver(options, ceres_options).Match(scan, single, initial);
+    const ScanMatchingResult reference = CeresSolver(options, ceres_options).Match(scan, *world.exact, initial);
     ASSERT_TRUE(reference.converged) << reference.reason;
     EXPECT_EQ(reference.iterations, 1) << "w " << w;  // one solve on the one association
     for (const int limit : {1, 3}) {
       ceres_options.max_exact_inner_iterations = limit;
-      const ScanMatchingResult chunked = CeresSolver(options, ceres_options).Match(scan, single, initial);
+      const ScanMatchingResult chunked = CeresSolver(options, ceres_options).Match(scan, *world.exact, initial);
       ASSERT_TRUE(chunked.converged) << chunked.reason;
       double dt = 0.0, dr = 0.0;
       PoseErrors(chunked.pose, reference.pose, dt, dr);
@@ -628,7 +629,6 @@ TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
 TEST(CeresSolver, ExactMapSolveEndsWhenThePoseLeavesTheAssociation) {
   const World& world = SimulatedWorld();
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
-  const MatchingMap single(world.map, ExactMapOnly());
   for (const double w : {0.0, 0.25}) {
     ScanMatchingOptions options;
     options.w_rcs = w;
@@ -639,8 +639,8 @@ TEST(CeresSolver, ExactMapSolveEndsWhenThePoseLeavesTheAssociation) {
     CeresSolverOptions one, fifty;
     one.max_exact_inner_iterations = 1;
     fifty.max_exact_inner_iterations = 50;
-    const ScanMatchingResult a = CeresSolver(options, one).Match(scan, single, initial);
-    const ScanMatchingResult b = CeresSolver(options, fifty).Match(scan, single, initial);
+    const ScanMatchingResult a = CeresSolver(options, one).Match(scan, *world.exact, initial);
+    const ScanMatchingResult b = CeresSolver(options, fifty).Match(scan, *world.exact, initial);
     ASSERT_TRUE(a.converged) << a.reason;
     ASSERT_GT(a.iterations, 2) << "w " << w;  // several associations
     EXPECT_EQ(a.iterations, b.iterations) << "w " << w;
@@ -939,7 +939,7 @@ TEST(ScanMatchingOptionsTest, Validation) {
 // as small steps no longer make points swap Gaussians back and forth).
 TEST(LazyReassociation, SameOptimumFewerIterations) {
   const World& world = SimulatedWorld();
-  const MatchingMap exact(world.map, ExactMapOnly());
+  const MatchingMap& exact = *world.exact;
   double eager_iterations = 0.0, lazy_iterations = 0.0;
   for (const int scan : {20, 40, 60}) {
     const SE3d truth = world.simulated.ground_truth[scan].pose;
