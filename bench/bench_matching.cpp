@@ -115,7 +115,7 @@ BENCHMARK_TEMPLATE(BM_RcsResidualWithCoefficients, AutoDiff);
 struct MatchingWorld {
   GaussianMap map;
   std::unique_ptr<MatchingMap> matching;         // inflated coarse levels (the default)
-  std::unique_ptr<MatchingMap> merged_matching;  // merged coarse levels
+  std::map<int, std::unique_ptr<MatchingMap>> merged_matching;  // merged coarse levels, by coarse gate x 10
   std::map<int, SimulatedSequence> scans;  // by detections per scan
   SimulatedSequence drive;                 // the 1000-scan drive of the map
 };
@@ -132,9 +132,12 @@ const MatchingWorld& World() {
     w->map.gaussians = BuildGaussians(cloud.points, options, {}, &association);
     FitRcsModels(w->map, cloud, association);
     w->matching = std::make_unique<MatchingMap>(w->map);
-    MatchingMapOptions merged;
-    merged.coarse = CoarseLevels::kMerged;
-    w->merged_matching = std::make_unique<MatchingMap>(w->map, merged);
+    for (const int gate_x10 : {30, 20}) {
+      MatchingMapOptions merged;
+      merged.coarse = CoarseLevels::kMerged;
+      merged.coarse_gate = gate_x10 / 10.0;
+      w->merged_matching[gate_x10] = std::make_unique<MatchingMap>(w->map, merged);
+    }
     for (const int n : {150, 800, 4000}) {
       SimulationConfig scan_config;  // same seed: the same world and drive
       scan_config.scans = 20;
@@ -215,35 +218,40 @@ BENCHMARK(BM_MatchScan)
 BENCHMARK(BM_MatchScan)->Args({800, 3, 0})->Args({800, 3, 25})->Unit(benchmark::kMillisecond);
 
 // Matches the 800-point scans on the map with merged coarse levels
-// (CoarseLevels::kMerged) from the paper's errors, one thread.
-void MatchScansMerged(benchmark::State& state, int solver, const ScanMatchingOptions& options) {
+// (CoarseLevels::kMerged) and the coarse gate `coarse_gate_x10` / 10 from the
+// paper's errors, one thread.
+void MatchScansMerged(benchmark::State& state, int solver, const ScanMatchingOptions& options,
+                      int coarse_gate_x10) {
   const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const MatchingWorld& world = World();
   const SimulatedSequence& scans = world.scans.at(800);
-  MatchScans(state, *Solver(solver, options), *world.merged_matching, scans, InitialPoses(scans), options.w_rcs);
+  MatchScans(state, *Solver(solver, options), *world.merged_matching.at(coarse_gate_x10), scans,
+             InitialPoses(scans), options.w_rcs);
 }
 
-// Args: solver (0 gn, 2 ceres), w_rcs x 100, coarse_points.
+// Args: solver (0 gn, 2 ceres), w_rcs x 100, coarse_points, coarse gate x 10.
 void BM_MatchScanMerged(benchmark::State& state) {
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(1)) / 100.0;
   options.coarse_points = std::size_t(state.range(2));
-  MatchScansMerged(state, int(state.range(0)), options);
+  MatchScansMerged(state, int(state.range(0)), options, int(state.range(3)));
 }
-BENCHMARK(BM_MatchScanMerged)->ArgsProduct({{0, 2}, {0, 25}, {0, 400}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MatchScanMerged)->ArgsProduct({{0, 2}, {0, 25}, {0, 400}, {30, 20}})->Unit(benchmark::kMillisecond);
 
 // How much of BM_MatchScanMerged the coarse levels take: the same matches
 // (own GN), stopped after the exact map's first iteration. Args: w_rcs x 100
 // (the coarse levels are geometric only; w enters that one iteration),
-// coarse_points.
+// coarse_points, coarse gate x 10.
 void BM_MatchScanMergedCoarseLevels(benchmark::State& state) {
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(0)) / 100.0;
   options.coarse_points = std::size_t(state.range(1));
   options.max_iterations = 1;
-  MatchScansMerged(state, 0, options);
+  MatchScansMerged(state, 0, options, int(state.range(2)));
 }
-BENCHMARK(BM_MatchScanMergedCoarseLevels)->ArgsProduct({{0, 25}, {0, 400}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MatchScanMergedCoarseLevels)
+    ->ArgsProduct({{0, 25}, {0, 400}, {30, 20}})
+    ->Unit(benchmark::kMillisecond);
 
 // Tracking's initial poses: 5 cm and 0.2 deg (yaw) off the truth, as a
 // motion model would give them.

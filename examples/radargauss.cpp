@@ -266,6 +266,7 @@ struct LocalizeSettings {
   int stride = 1;
   std::string coarse_levels = "inflated";
   std::size_t coarse_points = 0;
+  double coarse_gate = 3.0;
   bool loss_curvature = false;
 };
 
@@ -330,6 +331,10 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--coarse-points", s.coarse_points, "Points used on the coarse levels (0: all)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app->add_option("--coarse-gate", s.coarse_gate,
+                  "Association gate on the coarse levels (Mahalanobis; smaller: faster, less reach)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app->add_flag("--loss-curvature", s.loss_curvature,
                 "Own GN: the robust losses' curvature in the Hessian instead of IRLS weights alone");
 }
@@ -378,6 +383,7 @@ int RunLocalize(LocalizeSettings s) {
   for (std::size_t m = 0; m < maps.size(); ++m) {
     MatchingMapOptions matching_options;
     matching_options.coarse = CoarseLevelsFromString(s.coarse_levels);
+    matching_options.coarse_gate = s.coarse_gate;
     const MatchingMap matching(maps[m], matching_options);
     const int degree = s.map_path.empty() ? s.degrees[m % s.degrees.size()] : s.degrees[0];
     for (const std::string& solver : s.solvers) {

@@ -68,15 +68,17 @@ CoarseLevels CoarseLevelsFromString(const std::string& name) {
   throw std::invalid_argument("unknown coarse levels '" + name + "' (inflated, merged)");
 }
 
-MatchingMap::MatchingMap(const GaussianMap& map, const MatchingMapOptions& options) : map_(map) {
+MatchingMap::MatchingMap(const GaussianMap& map, const MatchingMapOptions& options)
+    : map_(map), coarse_gate_(options.coarse_gate) {
   if (!(options.index_cell > 0.0)) throw std::invalid_argument("index cell must be > 0");
+  if (!(options.coarse_gate > 0.0)) throw std::invalid_argument("coarse gate must be > 0");
   for (const double sigma : options.inflation) {
     if (!(sigma > 0.0)) throw std::invalid_argument("coarse-to-fine inflation must be > 0");
     std::vector<Gaussian> level = options.coarse == CoarseLevels::kMerged
                                       ? MergedGaussians(map.gaussians, kMergeCellPerSigma * sigma)
                                       : map.gaussians;
     for (Gaussian& g : level) g.covariance += sigma * sigma * Eigen::Matrix3d::Identity();
-    levels_.emplace_back(level, std::max(options.index_cell, sigma));
+    levels_.emplace_back(level, std::max(options.index_cell, sigma), options.coarse_gate);
   }
   levels_.emplace_back(map.gaussians, options.index_cell);
 }
@@ -228,11 +230,12 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     const bool with_rcs = level_options.w_rcs > 0.0;
     result.converged = false;
     const RadarScan& level_scan = finest ? scan : coarse_scan;
-    c = FindCorrespondences(level_scan, map, level, result.pose, options.gate, with_rcs);
+    const double gate = finest ? options.gate : map.coarse_gate();
+    c = FindCorrespondences(level_scan, map, level, result.pose, gate, with_rcs);
     evaluated.known = false;
     for (int iteration = 1; iteration <= max_iterations; ++iteration) {
       if (iteration > 1 && !KeepsAssociation(finest, c.pose, result.pose, options)) {
-        c = FindCorrespondences(level_scan, map, level, result.pose, options.gate, with_rcs);
+        c = FindCorrespondences(level_scan, map, level, result.pose, gate, with_rcs);
         evaluated.known = false;
       }
       if (!CheckCorrespondences(level_scan, c, level_options, result.reason)) {

@@ -96,6 +96,12 @@ struct MatchingMapOptions {
   std::vector<double> inflation = {1.0, 0.5, 0.25};  // sigma_k of the coarse levels (m), coarse first
   double index_cell = 0.5;  // m: cell of the exact level's index (coarse: max(cell, sigma_k))
   CoarseLevels coarse = CoarseLevels::kInflated;
+  // tau on the coarse levels (Mahalanobis distance to the blurred Gaussians;
+  // the exact map uses ScanMatchingOptions::gate). Their indexes cover
+  // +/- coarse_gate std, so a smaller gate means fewer candidates per query:
+  // faster coarse levels, less reach for large initial errors (measured
+  // trade-off in the README).
+  double coarse_gate = 3.0;
 };
 // The exact map alone: one level, no coarse-to-fine.
 inline MatchingMapOptions ExactMapOnly() {
@@ -111,10 +117,12 @@ class MatchingMap {
   std::size_t levels() const { return levels_.size(); }
   const GaussianIndex& level(std::size_t k) const { return levels_[k]; }
   const GaussianIndex& index() const { return levels_.back(); }  // the exact map
+  double coarse_gate() const { return coarse_gate_; }
 
  private:
   const GaussianMap& map_;
   std::vector<GaussianIndex> levels_;
+  double coarse_gate_ = 3.0;
 };
 
 struct GeometricTerm {
@@ -175,8 +183,9 @@ struct EvaluatedCost {
 };
 
 // The outer loop every single-scan solver shares (kiss-icp style): map level
-// by map level, coarse to fine (coarse levels with the geometric term only
-// and at most coarse_points points, w = 1 without them), associate (again
+// by map level, coarse to fine (coarse levels with the geometric term only,
+// at most coarse_points points and the map's coarse gate; w = 1 without
+// them), associate (again
 // each iteration on coarse levels; on the exact map once the pose has moved
 // past the re-association thresholds), check the correspondences, and let
 // `step` update result.pose. At the end: the final association (the last

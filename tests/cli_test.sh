@@ -65,13 +65,16 @@ for f in per_scan.csv summary.json table.md reference.tum trajectories/gn-w0-tri
 done
 expect_ok "localize with merged coarse levels" "configurations" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
-  --w-rcs 0 --coarse-levels merged --coarse-points 100 --out "$work/results_merged"
+  --w-rcs 0 --coarse-levels merged --coarse-points 100 --coarse-gate 2 --out "$work/results_merged"
 expect_ok "localize with the losses' curvature" "configurations" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --w-rcs 0.25 --solver gn --loss-curvature --out "$work/results_curvature"
 expect_fail "localize with unknown coarse levels" "coarse-levels" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --coarse-levels blurred --out "$work/r5"
+expect_fail "localize with a zero coarse gate" "coarse-gate" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --coarse-gate 0 --out "$work/r6"
 expect_fail "localize with a bad weight" "w-rcs" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --w-rcs 1.5 --out "$work/r2"
 expect_fail "localize with a map of another version" "map version" -- \

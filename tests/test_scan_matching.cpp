@@ -1044,34 +1044,89 @@ TEST(MergedCoarseLevels, MomentMatchedMixturePerVoxel) {
 }
 
 // With merged coarse levels (and with the coarse levels subsampled to 400
-// points) the solvers still reach 5 cm / 0.2 deg on the test scan from
-// 2 m / 5 deg.
+// points, and with a coarse gate of 2) the solvers still reach 5 cm / 0.2 deg
+// on the test scan from 2 m / 5 deg.
 TEST(MergedCoarseLevels, ConvergesFromTwoMetresFiveDegrees) {
   const World& world = SimulatedWorld();
   const RadarScan& scan = world.simulated.scans[kTestScan];
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
-  MatchingMapOptions merged_options;
-  merged_options.coarse = CoarseLevels::kMerged;
-  const MatchingMap merged(world.map, merged_options);
-  ASSERT_LT(merged.level(0).size(), world.matching->level(0).size() / 4);
-  for (const std::string name : {"gn", "ceres"}) {
-    for (const double w : {0.0, 0.25}) {
-      for (const std::size_t coarse_points : {std::size_t(0), std::size_t(400)}) {
-        ScanMatchingOptions options;
-        options.w_rcs = w;
-        options.coarse_points = coarse_points;
-        const auto solver = MakeSolver(name, options);
-        for (const std::uint32_t seed : {1u, 2u, 3u}) {
-          const ScanMatchingResult result = solver->Match(scan, merged, Perturbed(truth, 2.0, 5.0, seed));
-          double dt = 0.0, dr = 0.0;
-          PoseErrors(result.pose, truth, dt, dr);
-          EXPECT_TRUE(result.converged) << result.reason;
-          EXPECT_LT(dt, 0.05) << name << " w " << w << " coarse points " << coarse_points << " seed " << seed;
-          EXPECT_LT(dr, 0.2) << name << " w " << w << " coarse points " << coarse_points << " seed " << seed;
+  for (const double coarse_gate : {3.0, 2.0}) {
+    MatchingMapOptions merged_options;
+    merged_options.coarse = CoarseLevels::kMerged;
+    merged_options.coarse_gate = coarse_gate;
+    const MatchingMap merged(world.map, merged_options);
+    ASSERT_LT(merged.level(0).size(), world.matching->level(0).size() / 4);
+    for (const std::string name : {"gn", "ceres"}) {
+      for (const double w : {0.0, 0.25}) {
+        for (const std::size_t coarse_points : {std::size_t(0), std::size_t(400)}) {
+          ScanMatchingOptions options;
+          options.w_rcs = w;
+          options.coarse_points = coarse_points;
+          const auto solver = MakeSolver(name, options);
+          for (const std::uint32_t seed : {1u, 2u, 3u}) {
+            const ScanMatchingResult result = solver->Match(scan, merged, Perturbed(truth, 2.0, 5.0, seed));
+            double dt = 0.0, dr = 0.0;
+            PoseErrors(result.pose, truth, dt, dr);
+            const std::string where = name + " w " + std::to_string(w) + " coarse points " +
+                                      std::to_string(coarse_points) + " coarse gate " +
+                                      std::to_string(coarse_gate) + " seed " + std::to_string(seed);
+            EXPECT_TRUE(result.converged) << result.reason << " " << where;
+            EXPECT_LT(dt, 0.05) << where;
+            EXPECT_LT(dr, 0.2) << where;
+          }
         }
       }
     }
   }
+}
+
+// The coarse gate: on a coarse level a point goes to a blurred Gaussian only
+// within coarse_gate (the exact map keeps ScanMatchingOptions::gate), and the
+// level's index lists a Gaussian only in the cells of its +/- coarse_gate box.
+// One Gaussian at the origin, Sigma = 0.01 I, blurred by sigma = 1 m:
+// Sigma_1 = 1.01 I, so a point at radius r is r / 1.005 blurred std away.
+TEST(CoarseGate, CoarseLevelsAssociateWithinIt) {
+  GaussianMap map;
+  Gaussian g;
+  g.covariance = 0.01 * Eigen::Matrix3d::Identity();
+  g.point_count = 10;
+  map.gaussians = {g};
+  RadarScan scan;
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(1.5, 0, 0), Eigen::Vector3d(0, 1.5, 0),
+                                   Eigen::Vector3d(0, 0, -1.5), Eigen::Vector3d(2.6, 0, 0),
+                                   Eigen::Vector3d(0, -2.6, 0), Eigen::Vector3d(0, 0, 2.6)}) {
+    RadarPoint point;
+    point.position = p;
+    scan.points.push_back(point);
+  }
+  ScanMatchingOptions options;  // gate 3 on the exact map
+  for (const double coarse_gate : {3.0, 2.0}) {
+    MatchingMapOptions map_options;
+    map_options.inflation = {1.0};
+    map_options.coarse_gate = coarse_gate;
+    const MatchingMap matching(map, map_options);
+    EXPECT_EQ(matching.coarse_gate(), coarse_gate);
+    std::vector<std::size_t> associated;  // per level visited
+    const auto record = [&](const LevelStep& step, ScanMatchingResult&) {
+      associated.push_back(step.correspondences.geometric.size());
+      return StepOutcome::kConverged;
+    };
+    const ScanMatchingResult result = RunCoarseToFine(scan, matching, SE3d(), options, record);
+    // The coarse level: the 1.5 m points (1.49 std) always, the 2.6 m ones
+    // (2.59 std) only within a gate of 3. The exact map (0.1 m std): none.
+    ASSERT_EQ(associated.size(), 1u);
+    EXPECT_EQ(associated[0], coarse_gate > 2.59 ? 6u : 3u);
+    EXPECT_FALSE(result.converged);
+    EXPECT_EQ(result.reason, "no point associated to the map");
+    // Cells of side 1 m: x = 3.2 m lies in the box of +/- 3 std (3.015 m), not
+    // in that of +/- 2 std (2.01 m).
+    std::size_t count = 0;
+    matching.level(0).Candidates(Eigen::Vector3d(3.2, 0.0, 0.0), count);
+    EXPECT_EQ(count, coarse_gate == 3.0 ? 1u : 0u);
+  }
+  MatchingMapOptions bad;
+  bad.coarse_gate = 0.0;
+  EXPECT_THROW(MatchingMap(map, bad), std::invalid_argument);
 }
 
 }  // namespace
