@@ -185,13 +185,12 @@ struct EvaluatedCost {
 // The outer loop every single-scan solver shares (kiss-icp style): map level
 // by map level, coarse to fine (coarse levels with the geometric term only,
 // at most coarse_points points and the map's coarse gate; w = 1 without
-// them), associate (again
-// each iteration on coarse levels; on the exact map once the pose has moved
-// past the re-association thresholds), check the correspondences, and let
-// `step` update result.pose. At the end: the final association (the last
-// one when it is within the thresholds of the final pose), N_geo, N_rcs,
-// the cost of eq. 2 (the one a step recorded at the final pose on that
-// association, if any; EvaluatedCost) and the time.
+// them), associate (again each iteration on coarse levels; on the exact map
+// once the pose has moved past the re-association thresholds), check the
+// correspondences, and let `step` update result.pose. At the end: the final
+// association (the last one when it is within the thresholds of the final
+// pose), N_geo, N_rcs, the cost of eq. 2 (the one a step recorded at the
+// final pose on that association, if any; EvaluatedCost) and the time.
 struct LevelStep {
   const Correspondences& correspondences;
   const ScanMatchingOptions& options;  // with this level's w_rcs
