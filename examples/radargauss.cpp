@@ -265,6 +265,7 @@ struct LocalizeSettings {
   std::uint32_t seed = 42;
   int stride = 1;
   std::string coarse_levels = "inflated";
+  double coarse_voxel = ScanMatchingOptions().coarse_voxel_per_sigma;
   std::size_t coarse_points = 0;
   double coarse_gate = 3.0;
   bool loss_curvature = false;
@@ -327,6 +328,11 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--coarse-levels", s.coarse_levels,
                   "Coarse-to-fine levels: inflated (every Gaussian blurred) or merged (voxel merges, faster)")
       ->check(CLI::IsMember({"inflated", "merged"}))
+      ->capture_default_str();
+  app->add_option("--coarse-voxel", s.coarse_voxel,
+                  "Coarse levels match the scan's voxel centroids, voxel side this times the level's blur "
+                  "(0: the points)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app->add_option("--coarse-points", s.coarse_points, "Points used on the coarse levels (0: all)")
       ->check(CLI::NonNegativeNumber)
@@ -405,6 +411,7 @@ int RunLocalize(LocalizeSettings s) {
           options.w_rcs = w;
           options.geometric_loss = {LossTypeFromString(loss), s.loss_scale};
           options.rcs_loss = {LossTypeFromString(s.rcs_loss), s.rcs_loss_scale};
+          options.coarse_voxel_per_sigma = s.coarse_voxel;
           options.coarse_points = s.coarse_points;
           options.loss_curvature = s.loss_curvature;
           const auto matcher = MakeScanMatcher(solver, options);

@@ -6,6 +6,8 @@
 #include <map>
 #include <stdexcept>
 
+#include "radargauss/map/builder.hpp"
+
 namespace radargauss {
 
 void ValidateOptions(const ScanMatchingOptions& o) {
@@ -16,6 +18,8 @@ void ValidateOptions(const ScanMatchingOptions& o) {
   require(o.geometric_loss.scale > 0.0 && o.rcs_loss.scale > 0.0, "loss scales must be > 0");
   require(o.gate > 0.0, "association gate must be > 0");
   require(o.max_iterations >= 1 && o.coarse_iterations >= 1, "iteration limits must be >= 1");
+  require(o.coarse_voxel_per_sigma >= 0.0 && std::isfinite(o.coarse_voxel_per_sigma),
+          "coarse voxel per sigma must be >= 0 and finite");
   require(o.max_step_halvings >= 0, "max step halvings must be >= 0");
   require(o.translation_tolerance > 0.0 && o.rotation_tolerance > 0.0 && o.coarse_translation_tolerance > 0.0 &&
               o.coarse_rotation_tolerance > 0.0,
@@ -79,6 +83,7 @@ MatchingMap::MatchingMap(const GaussianMap& map, const MatchingMapOptions& optio
                                       : map.gaussians;
     for (Gaussian& g : level) g.covariance += sigma * sigma * Eigen::Matrix3d::Identity();
     levels_.emplace_back(level, std::max(options.index_cell, sigma), options.coarse_gate);
+    sigmas_.push_back(sigma);
   }
   levels_.emplace_back(map.gaussians, options.index_cell);
 }
@@ -196,15 +201,22 @@ bool KeepsAssociation(bool exact_level, const SE3d& associated_at, const SE3d& p
 
 namespace {
 
-// `count` points of `scan`, evenly strided (count < scan size).
-RadarScan Subsample(const RadarScan& scan, std::size_t count) {
-  RadarScan subsampled;
-  subsampled.timestamp = scan.timestamp;
-  subsampled.has_doppler = scan.has_doppler;
-  subsampled.has_rcs = scan.has_rcs;
-  subsampled.points.reserve(count);
-  for (std::size_t k = 0; k < count; ++k) subsampled.points.push_back(scan.points[k * scan.points.size() / count]);
-  return subsampled;
+// The points of `scan` a coarse level blurred by `sigma` matches
+// (ScanMatchingOptions::coarse_voxel_per_sigma and coarse_points); only
+// their positions.
+RadarScan CoarseScan(const RadarScan& scan, double sigma, const ScanMatchingOptions& options) {
+  std::vector<Eigen::Vector3d> positions(scan.points.size());
+  for (std::size_t k = 0; k < positions.size(); ++k) positions[k] = scan.points[k].position;
+  if (options.coarse_voxel_per_sigma > 0.0) {
+    positions = VoxelDownsample(positions, options.coarse_voxel_per_sigma * sigma, VoxelOrder::kFirstPoint);
+  }
+  const std::size_t n = positions.size();
+  const std::size_t count = options.coarse_points > 0 ? std::min(options.coarse_points, n) : n;
+  RadarScan coarse;
+  coarse.timestamp = scan.timestamp;
+  coarse.points.resize(count);
+  for (std::size_t k = 0; k < count; ++k) coarse.points[k].position = positions[k * n / count];
+  return coarse;
 }
 
 }  // namespace
@@ -218,10 +230,11 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
   Correspondences c;
   EvaluatedCost evaluated;  // on c
   bool failed = false;
-  const bool subsample = w < 1.0 && map.levels() > 1 && options.coarse_points > 0 &&
-                         scan.points.size() > options.coarse_points;
-  const RadarScan subsampled = subsample ? Subsample(scan, options.coarse_points) : RadarScan();
-  const RadarScan& coarse_scan = subsample ? subsampled : scan;
+  // The coarse levels' points: the scan's own (all, or evenly strided), the
+  // same on every level; or its voxel centroids, made per level.
+  const bool voxels = options.coarse_voxel_per_sigma > 0.0;
+  const bool subsample = !voxels && options.coarse_points > 0 && scan.points.size() > options.coarse_points;
+  RadarScan coarse_scan = subsample && w < 1.0 ? CoarseScan(scan, 0.0, options) : RadarScan();
   for (std::size_t level = w < 1.0 ? 0 : map.levels() - 1; level < map.levels() && !failed; ++level) {
     const bool finest = level + 1 == map.levels();
     ScanMatchingOptions level_options = options;
@@ -229,7 +242,8 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     const int max_iterations = finest ? options.max_iterations : options.coarse_iterations;
     const bool with_rcs = level_options.w_rcs > 0.0;
     result.converged = false;
-    const RadarScan& level_scan = finest ? scan : coarse_scan;
+    if (!finest && voxels) coarse_scan = CoarseScan(scan, map.sigma(level), options);
+    const RadarScan& level_scan = finest || !(voxels || subsample) ? scan : coarse_scan;
     const double gate = finest ? options.gate : map.coarse_gate();
     c = FindCorrespondences(level_scan, map, level, result.pose, gate, with_rcs);
     evaluated.known = false;

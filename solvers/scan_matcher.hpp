@@ -35,7 +35,12 @@ struct ScanMatchingOptions {
   double gate = 3.0;          // tau: association gate (Mahalanobis distance)
   int max_iterations = 30;    // outer iterations (association + update) on the exact map
   int coarse_iterations = 15; // outer iterations on each coarse level of the MatchingMap
-  std::size_t coarse_points = 0;  // points (evenly strided) used on coarse levels; 0: all
+  // Coarse levels: the scan reduced to the centroids of its voxels of side
+  // coarse_voxel_per_sigma * sigma_k (the level's blur), so that a level
+  // scores each patch of the scan once, weighted like every other; 0: the
+  // points themselves. Then at most coarse_points of them (evenly strided); 0: all.
+  double coarse_voxel_per_sigma = 0.0;
+  std::size_t coarse_points = 0;
   int max_step_halvings = 8;  // own GN: backtracking halvings of a step that raises the cost
   bool reassociate = true;    // false: associate once at the initial pose
   // Lazy re-association on the exact map: associate again only once the pose
@@ -117,11 +122,13 @@ class MatchingMap {
   std::size_t levels() const { return levels_.size(); }
   const GaussianIndex& level(std::size_t k) const { return levels_[k]; }
   const GaussianIndex& index() const { return levels_.back(); }  // the exact map
+  double sigma(std::size_t k) const { return k < sigmas_.size() ? sigmas_[k] : 0.0; }  // level k's blur (m)
   double coarse_gate() const { return coarse_gate_; }
 
  private:
   const GaussianMap& map_;
   std::vector<GaussianIndex> levels_;
+  std::vector<double> sigmas_;  // of the coarse levels
   double coarse_gate_ = 3.0;
 };
 
@@ -184,7 +191,8 @@ struct EvaluatedCost {
 
 // The outer loop every single-scan solver shares (kiss-icp style): map level
 // by map level, coarse to fine (coarse levels with the geometric term only,
-// at most coarse_points points and the map's coarse gate; w = 1 without
+// the scan's voxel centroids and at most coarse_points points
+// (ScanMatchingOptions) and the map's coarse gate; w = 1 without
 // them), associate (again each iteration on coarse levels; on the exact map
 // once the pose has moved past the re-association thresholds), check the
 // correspondences, and let `step` update result.pose. At the end: the final

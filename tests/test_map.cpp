@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -51,6 +52,45 @@ Planted PlantGaussians(int per, std::uint32_t seed) {
     }
   }
   return planted;
+}
+
+// Voxel downsampling: the centroid of each occupied voxel (by hand), in key
+// order or in the order of each voxel's first point, non-finite points
+// skipped; many random clouds give the same centroids in both orders.
+TEST(VoxelDownsample, CentroidsPerVoxelInEitherOrder) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<Eigen::Vector3d> points = {
+      {1.2, 0.1, 0.1}, {-0.5, 0.5, 0.5}, {1.6, 0.3, 0.9}, {nan, 0.0, 0.0}, {-0.7, 0.1, 0.3}, {0.5, 0.5, 0.5}};
+  // Voxels of 1 m: (1,0,0) first, then (-1,0,0), then (0,0,0).
+  const std::vector<Eigen::Vector3d> by_first = {
+      {1.4, 0.2, 0.5}, {-0.6, 0.3, 0.4}, {0.5, 0.5, 0.5}};
+  const std::vector<Eigen::Vector3d> first = VoxelDownsample(points, 1.0, VoxelOrder::kFirstPoint);
+  const std::vector<Eigen::Vector3d> keyed = VoxelDownsample(points, 1.0);
+  ASSERT_EQ(first.size(), 3u);
+  ASSERT_EQ(keyed.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_LT((first[k] - by_first[k]).norm(), 1e-12) << k;
+  EXPECT_LT((keyed[0] - by_first[1]).norm(), 1e-12);  // x = -1, 0, 1
+  EXPECT_LT((keyed[1] - by_first[2]).norm(), 1e-12);
+  EXPECT_LT((keyed[2] - by_first[0]).norm(), 1e-12);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal(0.0, 5.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<Eigen::Vector3d> cloud(1 + rng() % 3000);
+    for (Eigen::Vector3d& p : cloud) p = {normal(rng), normal(rng), 0.2 * normal(rng)};
+    const double voxel = 0.1 + 0.2 * trial;
+    const auto less = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+      return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+    };
+    std::vector<Eigen::Vector3d> a = VoxelDownsample(cloud, voxel, VoxelOrder::kFirstPoint);
+    std::vector<Eigen::Vector3d> b = VoxelDownsample(cloud, voxel);
+    for (std::size_t k = 1; k < b.size(); ++k) {
+      EXPECT_TRUE(VoxelOf(b[k - 1], voxel) < VoxelOf(b[k], voxel)) << "trial " << trial;
+    }
+    std::sort(a.begin(), a.end(), less);
+    std::sort(b.begin(), b.end(), less);
+    EXPECT_EQ(a, b) << "trial " << trial;
+  }
+  EXPECT_TRUE(VoxelDownsample({}, 1.0).empty());
 }
 
 TEST(GaussianBuilder, RecoversPlantedGaussians) {

@@ -1129,6 +1129,69 @@ TEST(CoarseGate, CoarseLevelsAssociateWithinIt) {
   EXPECT_THROW(MatchingMap(map, bad), std::invalid_argument);
 }
 
+// Coarse voxels: each coarse level matches the centroids of the scan's voxels
+// of side coarse_voxel_per_sigma * sigma_k (then at most coarse_points of
+// them, evenly strided). One Gaussian at the origin, levels blurred by 1 and
+// 0.5 m, voxels of 2 and 1 m; the centroids by hand.
+TEST(CoarseVoxels, CoarseLevelsMatchTheScansVoxelCentroids) {
+  GaussianMap map;
+  Gaussian g;
+  g.covariance = 0.01 * Eigen::Matrix3d::Identity();
+  g.point_count = 10;
+  map.gaussians = {g};
+  const Eigen::Vector3d a(0.2, 0.2, 0.2), b(0.6, 0.4, 0.2), c(1.4, 0.2, 0.2), d(-0.5, 0.3, 0.2);
+  RadarScan scan;
+  for (const Eigen::Vector3d& p : {a, b, c, d}) {
+    RadarPoint point;
+    point.position = p;
+    scan.points.push_back(point);
+  }
+  MatchingMapOptions map_options;
+  map_options.inflation = {1.0, 0.5};
+  const MatchingMap matching(map, map_options);
+  EXPECT_EQ(matching.sigma(0), 1.0);
+  EXPECT_EQ(matching.sigma(1), 0.5);
+  EXPECT_EQ(matching.sigma(2), 0.0);  // the exact map
+  const auto coarse_points = [&](const ScanMatchingOptions& options) {
+    std::vector<std::vector<Eigen::Vector3d>> levels;  // the associated points, per coarse level
+    const auto record = [&](const LevelStep& step, ScanMatchingResult&) {
+      if (!step.finest) {
+        levels.emplace_back();
+        for (const GeometricTerm& term : step.correspondences.geometric) levels.back().push_back(term.point_radar);
+      }
+      return StepOutcome::kConverged;
+    };
+    RunCoarseToFine(scan, matching, SE3d(), options, record);
+    return levels;
+  };
+  const auto expect_points = [](const std::vector<Eigen::Vector3d>& got, const std::vector<Eigen::Vector3d>& want,
+                                const std::string& where) {
+    ASSERT_EQ(got.size(), want.size()) << where;
+    for (std::size_t k = 0; k < want.size(); ++k) EXPECT_LT((got[k] - want[k]).norm(), 1e-12) << where << " " << k;
+  };
+  ScanMatchingOptions options;
+  options.coarse_voxel_per_sigma = 2.0;
+  auto levels = coarse_points(options);
+  ASSERT_EQ(levels.size(), 2u);
+  expect_points(levels[0], {(a + b + c) / 3.0, d}, "2 m voxels");  // in the order of their first points
+  expect_points(levels[1], {(a + b) / 2.0, c, d}, "1 m voxels");
+  options.coarse_points = 2;  // of the centroids, evenly strided
+  levels = coarse_points(options);
+  ASSERT_EQ(levels.size(), 2u);
+  expect_points(levels[0], {(a + b + c) / 3.0, d}, "2 m voxels, 2 points");
+  expect_points(levels[1], {(a + b) / 2.0, c}, "1 m voxels, 2 points");
+  ScanMatchingOptions points;
+  points.coarse_voxel_per_sigma = 0.0;  // without voxels: the points themselves
+  levels = coarse_points(points);
+  ASSERT_EQ(levels.size(), 2u);
+  expect_points(levels[0], {a, b, c, d}, "points");
+  ScanMatchingOptions bad;
+  bad.coarse_voxel_per_sigma = -1.0;
+  EXPECT_THROW(GaussNewtonSolver{bad}, std::invalid_argument);
+  bad.coarse_voxel_per_sigma = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(CeresSolver{bad}, std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace radargauss
 

@@ -236,20 +236,45 @@ void ValidateOptions(const GaussianMapOptions& o) {
 
 }  // namespace
 
-std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points,
-                                             double voxel) {
-  const auto keyed = SortedByVoxel(points, voxel);
-  std::vector<Eigen::Vector3d> centroids;
-  for (std::size_t begin = 0; begin < keyed.size();) {
-    std::size_t end = begin;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    while (end < keyed.size() && keyed[end].first == keyed[begin].first) {
-      sum += points[keyed[end].second];
-      ++end;
+std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points, double voxel,
+                                             VoxelOrder order) {
+  // Sums per occupied voxel in an open-addressing table (linear probing, at
+  // most half full), in the order of their first points: a scan's coarse
+  // levels downsample it on every match, so this sorts neither the points
+  // nor, unless asked, the voxels.
+  struct Voxel {
+    VoxelKey key;
+    Eigen::Vector3d sum;
+    std::uint32_t count;
+  };
+  std::vector<Voxel> voxels;
+  voxels.reserve(points.size());
+  std::size_t slots = 16;
+  while (slots < 2 * points.size()) slots *= 2;
+  std::vector<std::int32_t> table(slots, -1);  // index into voxels
+  for (const Eigen::Vector3d& p : points) {
+    if (!p.allFinite()) continue;
+    const VoxelKey key = VoxelOf(p, voxel);
+    const std::uint64_t mixed =
+        (std::uint64_t(key.x) * 0x9E3779B97F4A7C15ull) ^ (std::uint64_t(key.y) * 0xC2B2AE3D27D4EB4Full) ^
+        (std::uint64_t(key.z) * 0x165667B19E3779F9ull);
+    std::size_t slot = (mixed ^ (mixed >> 29)) & (slots - 1);
+    while (table[slot] >= 0 && !(voxels[table[slot]].key == key)) slot = (slot + 1) & (slots - 1);
+    if (table[slot] < 0) {
+      table[slot] = std::int32_t(voxels.size());
+      voxels.push_back({key, p, 1});
+    } else {
+      Voxel& v = voxels[table[slot]];
+      v.sum += p;
+      ++v.count;
     }
-    centroids.push_back(sum / double(end - begin));
-    begin = end;
   }
+  if (order == VoxelOrder::kByKey) {
+    std::sort(voxels.begin(), voxels.end(), [](const Voxel& a, const Voxel& b) { return a.key < b.key; });
+  }
+  std::vector<Eigen::Vector3d> centroids;
+  centroids.reserve(voxels.size());
+  for (const Voxel& v : voxels) centroids.push_back(v.sum / double(v.count));
   return centroids;
 }
 

@@ -50,9 +50,11 @@ std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
                                      const ProgressCallback& progress = {},
                                      std::vector<int>* association = nullptr);
 
-// Centroids of the occupied voxels of edge `voxel`, ordered by voxel key.
-std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points,
-                                             double voxel);
+// Centroids of the occupied voxels of edge `voxel` (non-finite points
+// skipped), ordered by voxel key or, cheaper, by each voxel's first point.
+enum class VoxelOrder { kByKey, kFirstPoint };
+std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points, double voxel,
+                                             VoxelOrder order = VoxelOrder::kByKey);
 
 // For each point, the Gaussian it belongs to (-1: none within the gate).
 std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points,
