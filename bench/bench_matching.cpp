@@ -229,28 +229,33 @@ void MatchScansMerged(benchmark::State& state, int solver, const ScanMatchingOpt
              InitialPoses(scans), options.w_rcs);
 }
 
-// Args: solver (0 gn, 2 ceres), w_rcs x 100, coarse_points, coarse gate x 10.
+// Args: solver (0 gn, 2 ceres), w_rcs x 100, coarse_points, coarse gate x 10,
+// coarse voxel per sigma x 10 (0: the scan's points).
 void BM_MatchScanMerged(benchmark::State& state) {
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(1)) / 100.0;
   options.coarse_points = std::size_t(state.range(2));
+  options.coarse_voxel_per_sigma = double(state.range(4)) / 10.0;
   MatchScansMerged(state, int(state.range(0)), options, int(state.range(3)));
 }
-BENCHMARK(BM_MatchScanMerged)->ArgsProduct({{0, 2}, {0, 25}, {0, 400}, {30, 20}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MatchScanMerged)
+    ->ArgsProduct({{0, 2}, {0, 25}, {0, 400}, {30, 20}, {0, 20}})
+    ->Unit(benchmark::kMillisecond);
 
 // How much of BM_MatchScanMerged the coarse levels take: the same matches
 // (own GN), stopped after the exact map's first iteration. Args: w_rcs x 100
 // (the coarse levels are geometric only; w enters that one iteration),
-// coarse_points, coarse gate x 10.
+// coarse_points, coarse gate x 10, coarse voxel per sigma x 10.
 void BM_MatchScanMergedCoarseLevels(benchmark::State& state) {
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(0)) / 100.0;
   options.coarse_points = std::size_t(state.range(1));
+  options.coarse_voxel_per_sigma = double(state.range(3)) / 10.0;
   options.max_iterations = 1;
   MatchScansMerged(state, 0, options, int(state.range(2)));
 }
 BENCHMARK(BM_MatchScanMergedCoarseLevels)
-    ->ArgsProduct({{0, 25}, {0, 400}, {30, 20}})
+    ->ArgsProduct({{0, 25}, {0, 400}, {30, 20}, {0, 20}})
     ->Unit(benchmark::kMillisecond);
 
 // Tracking's initial poses: 5 cm and 0.2 deg (yaw) off the truth, as a

@@ -36,10 +36,11 @@ struct ScanMatchingOptions {
   int max_iterations = 30;    // outer iterations (association + update) on the exact map
   int coarse_iterations = 15; // outer iterations on each coarse level of the MatchingMap
   // Coarse levels: the scan reduced to the centroids of its voxels of side
-  // coarse_voxel_per_sigma * sigma_k (the level's blur), so that a level
-  // scores each patch of the scan once, weighted like every other; 0: the
-  // points themselves. Then at most coarse_points of them (evenly strided); 0: all.
-  double coarse_voxel_per_sigma = 0.0;
+  // coarse_voxel_per_sigma * sigma_k (the level's blur), so that each patch
+  // of the scene steers once, however densely the radar sampled it (fewer
+  // points, fewer wrong basins: README); 0: the points themselves. Then at
+  // most coarse_points of them (evenly strided); 0: all.
+  double coarse_voxel_per_sigma = 2.0;
   std::size_t coarse_points = 0;
   int max_step_halvings = 8;  // own GN: backtracking halvings of a step that raises the cost
   bool reassociate = true;    // false: associate once at the initial pose

@@ -75,6 +75,12 @@ expect_fail "localize with unknown coarse levels" "coarse-levels" -- \
 expect_fail "localize with a zero coarse gate" "coarse-gate" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --coarse-gate 0 --out "$work/r6"
+expect_ok "localize with the scan's points on the coarse levels" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0 --coarse-voxel 0 --out "$work/results_points"
+expect_fail "localize with a negative coarse voxel" "coarse-voxel" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --coarse-voxel -1 --out "$work/r7"
 expect_fail "localize with a bad weight" "w-rcs" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --w-rcs 1.5 --out "$work/r2"
 expect_fail "localize with a map of another version" "map version" -- \

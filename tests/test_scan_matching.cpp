@@ -1043,9 +1043,9 @@ TEST(MergedCoarseLevels, MomentMatchedMixturePerVoxel) {
   EXPECT_EQ(CoarseLevelsFromString(ToString(CoarseLevels::kMerged)), CoarseLevels::kMerged);
 }
 
-// With merged coarse levels (and with the coarse levels subsampled to 400
-// points, and with a coarse gate of 2) the solvers still reach 5 cm / 0.2 deg
-// on the test scan from 2 m / 5 deg.
+// With merged coarse levels (matching the scan's voxel centroids or 400 of
+// its points there, and with a coarse gate of 2) the solvers still reach
+// 5 cm / 0.2 deg on the test scan from 2 m / 5 deg.
 TEST(MergedCoarseLevels, ConvergesFromTwoMetresFiveDegrees) {
   const World& world = SimulatedWorld();
   const RadarScan& scan = world.simulated.scans[kTestScan];
@@ -1062,6 +1062,7 @@ TEST(MergedCoarseLevels, ConvergesFromTwoMetresFiveDegrees) {
           ScanMatchingOptions options;
           options.w_rcs = w;
           options.coarse_points = coarse_points;
+          options.coarse_voxel_per_sigma = coarse_points > 0 ? 0.0 : 2.0;  // the points, or voxel centroids
           const auto solver = MakeSolver(name, options);
           for (const std::uint32_t seed : {1u, 2u, 3u}) {
             const ScanMatchingResult result = solver->Match(scan, merged, Perturbed(truth, 2.0, 5.0, seed));
@@ -1100,6 +1101,7 @@ TEST(CoarseGate, CoarseLevelsAssociateWithinIt) {
     scan.points.push_back(point);
   }
   ScanMatchingOptions options;  // gate 3 on the exact map
+  options.coarse_voxel_per_sigma = 0.0;  // the points themselves
   for (const double coarse_gate : {3.0, 2.0}) {
     MatchingMapOptions map_options;
     map_options.inflation = {1.0};
