@@ -248,7 +248,6 @@ std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>&
     std::uint32_t count;
   };
   std::vector<Voxel> voxels;
-  voxels.reserve(points.size());
   std::size_t slots = 16;
   while (slots < 2 * points.size()) slots *= 2;
   std::vector<std::int32_t> table(slots, -1);  // index into voxels
