@@ -266,8 +266,8 @@ struct LocalizeSettings {
   int stride = 1;
   std::string coarse_levels = "inflated";
   double coarse_voxel = ScanMatchingOptions().coarse_voxel_per_sigma;
-  std::size_t coarse_points = 0;
-  double coarse_gate = 3.0;
+  std::size_t coarse_points = ScanMatchingOptions().coarse_points;
+  double coarse_gate = MatchingMapOptions().coarse_gate;
   bool loss_curvature = false;
 };
 

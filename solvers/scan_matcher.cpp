@@ -201,21 +201,18 @@ bool KeepsAssociation(bool exact_level, const SE3d& associated_at, const SE3d& p
 
 namespace {
 
-// The points of `scan` a coarse level blurred by `sigma` matches
-// (ScanMatchingOptions::coarse_voxel_per_sigma and coarse_points); only
-// their positions.
-RadarScan CoarseScan(const RadarScan& scan, double sigma, const ScanMatchingOptions& options) {
-  std::vector<Eigen::Vector3d> positions(scan.points.size());
-  for (std::size_t k = 0; k < positions.size(); ++k) positions[k] = scan.points[k].position;
-  if (options.coarse_voxel_per_sigma > 0.0) {
-    positions = VoxelDownsample(positions, options.coarse_voxel_per_sigma * sigma, VoxelOrder::kFirstPoint);
-  }
-  const std::size_t n = positions.size();
-  const std::size_t count = options.coarse_points > 0 ? std::min(options.coarse_points, n) : n;
+// The points a coarse level matches, from the scan's `positions`: the
+// centroids of their voxels of side `voxel` (0: the positions themselves),
+// then at most `max_points` of them, evenly strided (0: all).
+RadarScan CoarseScan(const std::vector<Eigen::Vector3d>& positions, double voxel, std::size_t max_points) {
+  const std::vector<Eigen::Vector3d> centroids =
+      voxel > 0.0 ? VoxelDownsample(positions, voxel, VoxelOrder::kFirstPoint) : std::vector<Eigen::Vector3d>();
+  const std::vector<Eigen::Vector3d>& source = voxel > 0.0 ? centroids : positions;
+  const std::size_t n = source.size();
+  const std::size_t count = max_points > 0 ? std::min(max_points, n) : n;
   RadarScan coarse;
-  coarse.timestamp = scan.timestamp;
   coarse.points.resize(count);
-  for (std::size_t k = 0; k < count; ++k) coarse.points[k].position = positions[k * n / count];
+  for (std::size_t k = 0; k < count; ++k) coarse.points[k].position = source[k * n / count];
   return coarse;
 }
 
@@ -230,11 +227,17 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
   Correspondences c;
   EvaluatedCost evaluated;  // on c
   bool failed = false;
-  // The coarse levels' points: the scan's own (all, or evenly strided), the
-  // same on every level; or its voxel centroids, made per level.
+  // The coarse levels' points (CoarseScan): voxel centroids, made per level
+  // from the scan's positions, or the scan's own points, strided once when
+  // there are more than coarse_points.
   const bool voxels = options.coarse_voxel_per_sigma > 0.0;
-  const bool subsample = !voxels && options.coarse_points > 0 && scan.points.size() > options.coarse_points;
-  RadarScan coarse_scan = subsample && w < 1.0 ? CoarseScan(scan, 0.0, options) : RadarScan();
+  const bool reduce = w < 1.0 && (voxels || (options.coarse_points > 0 && scan.points.size() > options.coarse_points));
+  std::vector<Eigen::Vector3d> positions;
+  if (reduce) {
+    positions.reserve(scan.points.size());
+    for (const RadarPoint& point : scan.points) positions.push_back(point.position);
+  }
+  RadarScan coarse_scan;
   for (std::size_t level = w < 1.0 ? 0 : map.levels() - 1; level < map.levels() && !failed; ++level) {
     const bool finest = level + 1 == map.levels();
     ScanMatchingOptions level_options = options;
@@ -242,8 +245,10 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     const int max_iterations = finest ? options.max_iterations : options.coarse_iterations;
     const bool with_rcs = level_options.w_rcs > 0.0;
     result.converged = false;
-    if (!finest && voxels) coarse_scan = CoarseScan(scan, map.sigma(level), options);
-    const RadarScan& level_scan = finest || !(voxels || subsample) ? scan : coarse_scan;
+    if (!finest && reduce && (voxels || level == 0)) {  // strided points: the same on every level
+      coarse_scan = CoarseScan(positions, options.coarse_voxel_per_sigma * map.sigma(level), options.coarse_points);
+    }
+    const RadarScan& level_scan = finest || !reduce ? scan : coarse_scan;
     const double gate = finest ? options.gate : map.coarse_gate();
     c = FindCorrespondences(level_scan, map, level, result.pose, gate, with_rcs);
     evaluated.known = false;

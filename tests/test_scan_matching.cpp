@@ -1081,25 +1081,37 @@ TEST(MergedCoarseLevels, ConvergesFromTwoMetresFiveDegrees) {
   }
 }
 
+// The hand-built map of the coarse-level tests: one Gaussian at the origin,
+// Sigma = 0.01 I (0.1 m std).
+GaussianMap OneGaussianAtTheOrigin() {
+  GaussianMap map;
+  Gaussian g;
+  g.covariance = 0.01 * Eigen::Matrix3d::Identity();
+  g.point_count = 10;
+  map.gaussians = {g};
+  return map;
+}
+
+// A scan of points at `positions` (no RCS, no Doppler).
+RadarScan ScanOf(const std::vector<Eigen::Vector3d>& positions) {
+  RadarScan scan;
+  for (const Eigen::Vector3d& p : positions) {
+    RadarPoint point;
+    point.position = p;
+    scan.points.push_back(point);
+  }
+  return scan;
+}
+
 // The coarse gate: on a coarse level a point goes to a blurred Gaussian only
 // within coarse_gate (the exact map keeps ScanMatchingOptions::gate), and the
 // level's index lists a Gaussian only in the cells of its +/- coarse_gate box.
 // One Gaussian at the origin, Sigma = 0.01 I, blurred by sigma = 1 m:
 // Sigma_1 = 1.01 I, so a point at radius r is r / 1.005 blurred std away.
 TEST(CoarseGate, CoarseLevelsAssociateWithinIt) {
-  GaussianMap map;
-  Gaussian g;
-  g.covariance = 0.01 * Eigen::Matrix3d::Identity();
-  g.point_count = 10;
-  map.gaussians = {g};
-  RadarScan scan;
-  for (const Eigen::Vector3d& p : {Eigen::Vector3d(1.5, 0, 0), Eigen::Vector3d(0, 1.5, 0),
-                                   Eigen::Vector3d(0, 0, -1.5), Eigen::Vector3d(2.6, 0, 0),
-                                   Eigen::Vector3d(0, -2.6, 0), Eigen::Vector3d(0, 0, 2.6)}) {
-    RadarPoint point;
-    point.position = p;
-    scan.points.push_back(point);
-  }
+  const GaussianMap map = OneGaussianAtTheOrigin();
+  const RadarScan scan = ScanOf({Eigen::Vector3d(1.5, 0, 0), Eigen::Vector3d(0, 1.5, 0), Eigen::Vector3d(0, 0, -1.5),
+                                 Eigen::Vector3d(2.6, 0, 0), Eigen::Vector3d(0, -2.6, 0), Eigen::Vector3d(0, 0, 2.6)});
   ScanMatchingOptions options;  // gate 3 on the exact map
   options.coarse_voxel_per_sigma = 0.0;  // the points themselves
   for (const double coarse_gate : {3.0, 2.0}) {
@@ -1136,18 +1148,9 @@ TEST(CoarseGate, CoarseLevelsAssociateWithinIt) {
 // them, evenly strided). One Gaussian at the origin, levels blurred by 1 and
 // 0.5 m, voxels of 2 and 1 m; the centroids by hand.
 TEST(CoarseVoxels, CoarseLevelsMatchTheScansVoxelCentroids) {
-  GaussianMap map;
-  Gaussian g;
-  g.covariance = 0.01 * Eigen::Matrix3d::Identity();
-  g.point_count = 10;
-  map.gaussians = {g};
+  const GaussianMap map = OneGaussianAtTheOrigin();
   const Eigen::Vector3d a(0.2, 0.2, 0.2), b(0.6, 0.4, 0.2), c(1.4, 0.2, 0.2), d(-0.5, 0.3, 0.2);
-  RadarScan scan;
-  for (const Eigen::Vector3d& p : {a, b, c, d}) {
-    RadarPoint point;
-    point.position = p;
-    scan.points.push_back(point);
-  }
+  const RadarScan scan = ScanOf({a, b, c, d});
   MatchingMapOptions map_options;
   map_options.inflation = {1.0, 0.5};
   const MatchingMap matching(map, map_options);
