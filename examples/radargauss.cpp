@@ -269,6 +269,7 @@ struct LocalizeSettings {
   std::size_t coarse_points = ScanMatchingOptions().coarse_points;
   double coarse_gate = MatchingMapOptions().coarse_gate;
   bool loss_curvature = false;
+  bool geometric_first = ScanMatchingOptions().geometric_first;
 };
 
 // Our solvers, plus the PCL peers when built with RADARGAUSS_WITH_PCL.
@@ -343,6 +344,8 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
       ->capture_default_str();
   app->add_flag("--loss-curvature", s.loss_curvature,
                 "Own GN: the robust losses' curvature in the Hessian instead of IRLS weights alone");
+  app->add_flag("--geometric-first,!--no-geometric-first", s.geometric_first,
+                "With 0 < w < 1: the exact map's geometric term alone first, then eq. 2 (default on)");
 }
 
 std::string FormatWeight(double w) {
@@ -414,6 +417,7 @@ int RunLocalize(LocalizeSettings s) {
           options.coarse_voxel_per_sigma = s.coarse_voxel;
           options.coarse_points = s.coarse_points;
           options.loss_curvature = s.loss_curvature;
+          options.geometric_first = s.geometric_first;
           const auto matcher = MakeScanMatcher(solver, options);
           const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" +
                                    ToString(maps[m].incidence) + "-L" + std::to_string(degree);

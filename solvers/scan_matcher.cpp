@@ -107,27 +107,33 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
   out.index = &map.level(level);
   out.pose = pose;
   out.geometric.reserve(scan.points.size());
-  const bool rcs = with_rcs && scan.has_rcs;
-  if (rcs) out.rcs.reserve(scan.points.size());
-  const Eigen::Matrix3d Rt = pose.rotation().Matrix().transpose();
-  const std::size_t n = scan.points.size();
   const std::vector<int> associations = AssociateScan(scan, *out.index, pose, gate);
+  for (std::size_t k = 0; k < associations.size(); ++k) {
+    if (associations[k] >= 0) {
+      out.geometric.push_back({scan.points[k].position, std::uint32_t(associations[k]), std::uint32_t(k)});
+    }
+  }
+  if (with_rcs) AddRcsTerms(scan, map, out);
+  return out;
+}
+
+void AddRcsTerms(const RadarScan& scan, const MatchingMap& map, Correspondences& c) {
+  c.rcs.clear();
+  if (!scan.has_rcs) return;
+  c.rcs.reserve(c.geometric.size());
+  const Eigen::Matrix3d Rt = c.pose.rotation().Matrix().transpose();
   const std::vector<Gaussian>& gaussians = map.map().gaussians;
+  const std::size_t n = c.geometric.size();
   constexpr std::size_t kAhead = 8;  // RCS terms read the Gaussian's model: fetch it early
   for (std::size_t k = 0; k < n; ++k) {
-    if (rcs && k + kAhead < n && associations[k + kAhead] >= 0) {
-      __builtin_prefetch(&gaussians[associations[k + kAhead]].rcs);
-    }
-    const RadarPoint& point = scan.points[k];
-    const int g = associations[k];
-    if (g < 0) continue;
-    out.geometric.push_back({point.position, std::uint32_t(g)});
-    if (!rcs) continue;
-    const Gaussian& gaussian = gaussians[g];
+    if (k + kAhead < n) __builtin_prefetch(&gaussians[c.geometric[k + kAhead].gaussian].rcs);
+    const GeometricTerm& pair = c.geometric[k];
+    const RadarPoint& point = scan.points[pair.point];
+    const Gaussian& gaussian = gaussians[pair.gaussian];
     if (!gaussian.rcs.valid()) continue;
     const double y = gaussian.rcs.Normalise(point.rcs);
     if (!(std::abs(y) <= 1.0)) continue;  // RCS outlier: no residual (eq. 2)
-    const Eigen::Vector3d mean_radar = Rt * (gaussian.mean - pose.translation());
+    const Eigen::Vector3d mean_radar = Rt * (gaussian.mean - c.pose.translation());
     const Eigen::Vector3d u = IncidenceVector(map.map().incidence, point.position, mean_radar);
     if (u.squaredNorm() < 1e-12) continue;  // no incidence direction
     RcsTerm term;
@@ -138,10 +144,9 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
     term.coefficients = gaussian.rcs.coefficients;
     term.incidence = map.map().incidence;
     term.facing = FacingSign(u);
-    term.gaussian = std::uint32_t(g);
-    out.rcs.push_back(term);
+    term.gaussian = pair.gaussian;
+    c.rcs.push_back(term);
   }
-  return out;
 }
 
 double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchingOptions& options) {
@@ -238,11 +243,18 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     for (const RadarPoint& point : scan.points) positions.push_back(point.position);
   }
   RadarScan coarse_scan;
-  for (std::size_t level = w < 1.0 ? 0 : map.levels() - 1; level < map.levels() && !failed; ++level) {
+  // The stages: the coarse levels, the exact map with the geometric term
+  // alone (geometric_first, when re-associating), the exact map with eq. 2;
+  // with w = 1 the last alone.
+  const bool geometric_first = options.geometric_first && options.reassociate && w > 0.0 && w < 1.0;
+  const std::size_t stages = map.levels() + (geometric_first ? 1 : 0);
+  for (std::size_t stage = w < 1.0 ? 0 : stages - 1; stage < stages && !failed; ++stage) {
+    const std::size_t level = std::min(stage, map.levels() - 1);
     const bool finest = level + 1 == map.levels();
+    const bool full_cost = stage + 1 == stages;  // eq. 2 with the requested w
     ScanMatchingOptions level_options = options;
-    level_options.w_rcs = finest ? w : 0.0;
-    const int max_iterations = finest ? options.max_iterations : options.coarse_iterations;
+    level_options.w_rcs = full_cost ? w : 0.0;
+    const int max_iterations = full_cost ? options.max_iterations : options.coarse_iterations;
     const bool with_rcs = level_options.w_rcs > 0.0;
     result.converged = false;
     if (!finest && reduce && (voxels || level == 0)) {  // strided points: the same on every level
@@ -250,7 +262,12 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     }
     const RadarScan& level_scan = finest || !reduce ? scan : coarse_scan;
     const double gate = finest ? options.gate : map.coarse_gate();
-    c = FindCorrespondences(level_scan, map, level, result.pose, gate, with_rcs);
+    if (full_cost && geometric_first && c.index == &map.level(level) &&
+        KeepsAssociation(true, c.pose, result.pose, options)) {
+      AddRcsTerms(scan, map, c);  // eq. 2 on the geometric stage's last association
+    } else {
+      c = FindCorrespondences(level_scan, map, level, result.pose, gate, with_rcs);
+    }
     evaluated.known = false;
     for (int iteration = 1; iteration <= max_iterations; ++iteration) {
       if (iteration > 1 && !KeepsAssociation(finest, c.pose, result.pose, options)) {
@@ -264,8 +281,8 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
       ++result.iterations;
       const StepOutcome outcome =
           step({c, level_options, finest,
-                finest ? options.translation_tolerance : options.coarse_translation_tolerance,
-                finest ? options.rotation_tolerance : options.coarse_rotation_tolerance,
+                full_cost ? options.translation_tolerance : options.coarse_translation_tolerance,
+                full_cost ? options.rotation_tolerance : options.coarse_rotation_tolerance,
                 iteration == max_iterations, &evaluated},
                result);
       if (outcome == StepOutcome::kFailed) failed = true;

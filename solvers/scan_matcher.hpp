@@ -42,6 +42,14 @@ struct ScanMatchingOptions {
   // most coarse_points of them (evenly strided); 0: all.
   double coarse_voxel_per_sigma = 2.0;
   std::size_t coarse_points = 0;
+  // With 0 < w < 1: on the exact map, match with the geometric term alone
+  // first (to the coarse tolerances, as a last coarse level), then with
+  // eq. 2's RCS term from there. The RCS terms (a third of an association,
+  // two thirds of a system at w = 0.25) then enter the last iterations only,
+  // not the re-associating steps that close the few cm the coarse levels
+  // leave; the optimum is eq. 2's either way. false: eq. 2 throughout (as
+  // without reassociate, where the exact map has one association).
+  bool geometric_first = true;
   int max_step_halvings = 8;  // own GN: backtracking halvings of a step that raises the cost
   bool reassociate = true;    // false: associate once at the initial pose
   // Lazy re-association on the exact map: associate again only once the pose
@@ -136,6 +144,7 @@ class MatchingMap {
 struct GeometricTerm {
   Eigen::Vector3d point_radar;
   std::uint32_t gaussian = 0;
+  std::uint32_t point = 0;  // index in the scan it was associated from
 };
 
 struct Correspondences {
@@ -156,6 +165,12 @@ std::vector<int> AssociateScan(const RadarScan& scan, const GaussianIndex& index
 // (and the scan has RCS).
 Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level,
                                     const SE3d& pose, double gate, bool with_rcs);
+
+// Replaces the RCS terms of `correspondences` (made from `scan`) by those of
+// their geometric pairs, at the pose they were made at: what
+// FindCorrespondences gives with_rcs, without associating again (when the
+// scan has RCS).
+void AddRcsTerms(const RadarScan& scan, const MatchingMap& map, Correspondences& correspondences);
 
 // f of eq. 2 for fixed correspondences at `pose`. RCS residuals take the
 // translation of the correspondences when rotation-only.
@@ -194,7 +209,8 @@ struct EvaluatedCost {
 // by map level, coarse to fine (coarse levels with the geometric term only,
 // the scan's voxel centroids and at most coarse_points points
 // (ScanMatchingOptions) and the map's coarse gate; w = 1 without
-// them), associate (again each iteration on coarse levels; on the exact map
+// them; then the exact map, with the geometric term alone first when
+// geometric_first and 0 < w < 1), associate (again each iteration on coarse levels; on the exact map
 // once the pose has moved past the re-association thresholds), check the
 // correspondences, and let `step` update result.pose. At the end: the final
 // association (the last one when it is within the thresholds of the final
