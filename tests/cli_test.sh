@@ -78,6 +78,12 @@ expect_fail "localize with a zero coarse gate" "coarse-gate" -- \
 expect_ok "localize with the scan's points on the coarse levels" "configurations" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --w-rcs 0 --coarse-voxel 0 --out "$work/results_points"
+expect_ok "localize with eq. 2 throughout on the exact map" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0.25 --no-geometric-first --out "$work/results_throughout"
+expect_fail "localize with a value for the geometric-first flag" "geometric-first" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --no-geometric-first=maybe --out "$work/r8"
 expect_fail "localize with a negative coarse voxel" "coarse-voxel" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --coarse-voxel -1 --out "$work/r7"
