@@ -209,18 +209,33 @@ SE3d PoseOfBlocks(const double* rotation, const double* translation) {
               Eigen::Vector3d(translation[0], translation[1], translation[2]));
 }
 
-// Ends a solve on the exact map once the pose has left the re-association
-// thresholds of the association made at `associated_at`
-// (CeresSolverOptions::max_exact_inner_iterations).
-class LeaveAssociation final : public ceres::IterationCallback {
+// Ends a solve of the match's last stage on the exact map once the pose has
+// left the re-association thresholds of the association made at
+// `associated_at` (CeresSolverOptions::max_exact_inner_iterations), or once
+// an accepted step is below the loop's step tolerances, as the own GN stops
+// (`small_step`: the solve ended so).
+class ExactMapStop final : public ceres::IterationCallback {
  public:
-  LeaveAssociation(const ScanMatchingOptions& options, const double* rotation, const double* translation)
+  ExactMapStop(const ScanMatchingOptions& options, const double* rotation, const double* translation)
       : options_(options), rotation_(rotation), translation_(translation) {}
 
-  SE3d associated_at;
+  // Before each solve: the association's pose.
+  void Start(const SE3d& associated_at) {
+    associated_at_ = associated_at;
+    small_step = false;
+  }
 
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
-    return KeepsAssociation(true, associated_at, PoseOfBlocks(rotation_, translation_), options_)
+  bool small_step = false;
+
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    const SE3d pose = PoseOfBlocks(rotation_, translation_);
+    if (summary.iteration > 0 && summary.step_is_successful) {
+      const SE3d step = previous_.Inverse() * pose;
+      small_step = step.translation().norm() < options_.translation_tolerance &&
+                   step.rotation().Log().norm() < options_.rotation_tolerance;
+    }
+    previous_ = pose;
+    return !small_step && KeepsAssociation(true, associated_at_, pose, options_)
                ? ceres::SOLVER_CONTINUE
                : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
   }
@@ -229,6 +244,7 @@ class LeaveAssociation final : public ceres::IterationCallback {
   const ScanMatchingOptions& options_;
   const double* rotation_;  // x y z w, as Ceres updates it
   const double* translation_;
+  SE3d associated_at_, previous_;
 };
 
 }  // namespace
@@ -333,14 +349,14 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
   ceres::Solver::Options exact_options = solver_options;
   exact_options.max_num_iterations = ceres_options_.max_exact_inner_iterations;
   exact_options.update_state_every_iteration = true;  // the callback reads the pose
-  LeaveAssociation leave(options_, rotation.data(), translation.data());
-  exact_options.callbacks.push_back(&leave);
+  ExactMapStop stop(options_, rotation.data(), translation.data());
+  exact_options.callbacks.push_back(&stop);
   return RunCoarseToFine(scan, map, initial, options_, [&](const LevelStep& level, ScanMatchingResult& result) {
     const Correspondences& c = level.correspondences;
     problem.Update(c, level.options.w_rcs);
     ceres::Solver::Summary summary;
     const SE3d before = result.pose;
-    leave.associated_at = c.pose;
+    stop.Start(c.pose);
     ceres::Solve(level.finest ? exact_options : solver_options, &problem.problem(), &summary);
     if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
       result.reason = "Ceres: " + summary.message;
@@ -351,11 +367,11 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
     result.pose = PoseOfBlocks(rotation.data(), translation.data());
     const SE3d step = before.Inverse() * result.pose;
     const bool small = level.SmallStep(step.translation().norm(), step.rotation().Log().norm());
-    // Converged when the pose settled, or when Ceres converged on an
-    // association the outer loop keeps: the next solve would be the same
-    // problem from its own solution.
-    if (small || (KeepsAssociation(level.finest, c.pose, result.pose, options_) &&
-                  summary.termination_type == ceres::CONVERGENCE)) {
+    // Converged when the pose settled, or when Ceres converged (or took a
+    // step below the tolerances) on an association the outer loop keeps: the
+    // next solve would be the same problem from its own solution.
+    const bool settled = summary.termination_type == ceres::CONVERGENCE || (level.full_cost && stop.small_step);
+    if (small || (KeepsAssociation(level.finest, c.pose, result.pose, options_) && settled)) {
       return StepOutcome::kConverged;
     }
     return StepOutcome::kContinue;

@@ -280,7 +280,7 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
       }
       ++result.iterations;
       const StepOutcome outcome =
-          step({c, level_options, finest,
+          step({c, level_options, finest, full_cost,
                 full_cost ? options.translation_tolerance : options.coarse_translation_tolerance,
                 full_cost ? options.rotation_tolerance : options.coarse_rotation_tolerance,
                 iteration == max_iterations, &evaluated},

@@ -219,7 +219,8 @@ struct EvaluatedCost {
 struct LevelStep {
   const Correspondences& correspondences;
   const ScanMatchingOptions& options;  // with this level's w_rcs
-  bool finest = false;
+  bool finest = false;                 // on the exact map
+  bool full_cost = false;              // eq. 2 with the match's w: its last stage (else one that steers)
   double translation_tolerance = 0.0;  // m: this level's step tolerances
   double rotation_tolerance = 0.0;     // rad
   bool last_iteration = false;         // the level's iteration limit is reached with this step
