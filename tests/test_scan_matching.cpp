@@ -626,6 +626,41 @@ TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
 // On the exact map a solve ends once the pose leaves the association's
 // re-association thresholds: with thresholds of zero (re-associate after every
 // step) a cap of 50 iterations per solve does what a cap of one does.
+// A solve of the last stage also ends once an accepted step is below the
+// step tolerances, as the own GN stops: with tolerances no step reaches,
+// one association (no re-association) ends after one LM step, where
+// max_exact_inner_iterations = 1 takes it too; tight tolerances go on.
+TEST(CeresSolver, ExactMapSolveEndsOnASmallStep) {
+  const World& world = SimulatedWorld();
+  const RadarScan& scan = world.simulated.scans[kTestScan];
+  const SE3d initial = Perturbed(world.simulated.ground_truth[kTestScan].pose, 0.1, 0.5, 8);
+  for (const double w : {0.0, 0.25}) {
+    ScanMatchingOptions loose;
+    loose.w_rcs = w;
+    loose.geometric_loss = {LossType::kCauchy, 1.0};  // not solved in one step
+    loose.reassociate = false;
+    loose.translation_tolerance = 1e3;
+    loose.rotation_tolerance = 1e3;
+    ScanMatchingOptions one_step = loose;
+    one_step.max_iterations = 1;
+    CeresSolverOptions one_iteration;
+    one_iteration.max_exact_inner_iterations = 1;
+    ScanMatchingOptions tight = loose;
+    tight.translation_tolerance = tight.rotation_tolerance = 1e-12;
+    const ScanMatchingResult a = CeresSolver(loose).Match(scan, *world.exact, initial);
+    const ScanMatchingResult b = CeresSolver(one_step, one_iteration).Match(scan, *world.exact, initial);
+    const ScanMatchingResult c = CeresSolver(tight).Match(scan, *world.exact, initial);
+    ASSERT_TRUE(a.converged) << a.reason;
+    EXPECT_EQ(a.iterations, 1);
+    double dt = 0.0, dr = 0.0;
+    PoseErrors(a.pose, b.pose, dt, dr);
+    EXPECT_LT(dt, 1e-12) << "w " << w;
+    EXPECT_LT(dr, 1e-10) << "w " << w;
+    PoseErrors(a.pose, c.pose, dt, dr);
+    EXPECT_GT(dt + dr, 1e-6) << "w " << w;  // the tight solve went on
+  }
+}
+
 TEST(CeresSolver, ExactMapSolveEndsWhenThePoseLeavesTheAssociation) {
   const World& world = SimulatedWorld();
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
