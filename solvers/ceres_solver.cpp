@@ -357,7 +357,7 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
     ceres::Solver::Summary summary;
     const SE3d before = result.pose;
     stop.Start(c.pose);
-    ceres::Solve(level.finest ? exact_options : solver_options, &problem.problem(), &summary);
+    ceres::Solve(level.full_cost ? exact_options : solver_options, &problem.problem(), &summary);
     if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
       result.reason = "Ceres: " + summary.message;
       rotation = before.rotation().quaternion().coeffs();

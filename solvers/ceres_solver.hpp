@@ -16,19 +16,22 @@ namespace radargauss {
 
 struct CeresSolverOptions {
   bool dogleg = false;           // Levenberg-Marquardt (default) or dogleg
-  // Ceres iterations per solve, i.e. per association, on the coarse levels.
-  // Few: the outer loop re-associates after each solve there, and iterating
-  // a fresh association to full convergence pays Jacobian evaluations for
-  // terms about to change. RESULTS.md has 1-5.
+  // Ceres iterations per solve, i.e. per association, in the stages that
+  // steer (the coarse levels and, with geometric_first, the exact map's
+  // geometric stage). Few: the outer loop re-associates after each solve
+  // there, and iterating a fresh association to full convergence pays
+  // Jacobian evaluations for terms about to change. RESULTS.md has 1-5.
   int max_inner_iterations = 2;
-  // On the exact map a solve ends once the pose has moved past the
-  // association's re-association thresholds (the outer loop's lazy rule,
-  // ScanMatchingOptions, checked after each iteration), once Ceres
-  // converges, or after this many iterations: what the loop would do over
-  // several solves on an association it keeps runs in one, without a solve's
-  // set-up and first Jacobian each time. A match ends only once Ceres
-  // converged on an association the loop keeps (more solves on it when this
-  // limit cuts one short).
+  // In the match's last stage (eq. 2 on the exact map) a solve ends once the
+  // pose has moved past the association's re-association thresholds (the
+  // outer loop's lazy rule, ScanMatchingOptions, checked after each
+  // iteration), once an accepted step is below the loop's step tolerances
+  // (as the own GN stops), once Ceres converges, or after this many
+  // iterations: what the loop would do over several solves on an
+  // association it keeps runs in one, without a solve's set-up and first
+  // Jacobian each time. A match ends only once such a solve settled (Ceres
+  // converged or the step was small) on an association the loop keeps (more
+  // solves on it when this limit cuts one short).
   int max_exact_inner_iterations = 8;
   // Analytic terms share residual blocks of CeresScanProblem::kTermsPerBlock
   // terms, each term's robust loss applied in its own residual (the cost and
