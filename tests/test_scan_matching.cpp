@@ -623,9 +623,6 @@ TEST(CeresSolver, InnerIterationLimitKeepsTheOptimum) {
   }
 }
 
-// On the exact map a solve ends once the pose leaves the association's
-// re-association thresholds: with thresholds of zero (re-associate after every
-// step) a cap of 50 iterations per solve does what a cap of one does.
 // A solve of the last stage also ends once an accepted step is below the
 // step tolerances, as the own GN stops: with tolerances no step reaches,
 // one association (no re-association) ends after one LM step, where
@@ -661,6 +658,9 @@ TEST(CeresSolver, ExactMapSolveEndsOnASmallStep) {
   }
 }
 
+// On the exact map a solve ends once the pose leaves the association's
+// re-association thresholds: with thresholds of zero (re-associate after every
+// step) a cap of 50 iterations per solve does what a cap of one does.
 TEST(CeresSolver, ExactMapSolveEndsWhenThePoseLeavesTheAssociation) {
   const World& world = SimulatedWorld();
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
