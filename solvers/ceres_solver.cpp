@@ -370,7 +370,8 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
     // Converged when the pose settled, or when Ceres converged (or took a
     // step below the tolerances) on an association the outer loop keeps: the
     // next solve would be the same problem from its own solution.
-    const bool settled = summary.termination_type == ceres::CONVERGENCE || (level.full_cost && stop.small_step);
+    // (stop.small_step: only the last stage's solves carry the callback)
+    const bool settled = summary.termination_type == ceres::CONVERGENCE || stop.small_step;
     if (small || (KeepsAssociation(level.finest, c.pose, result.pose, options_) && settled)) {
       return StepOutcome::kConverged;
     }

@@ -262,9 +262,8 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     }
     const RadarScan& level_scan = finest || !reduce ? scan : coarse_scan;
     const double gate = finest ? options.gate : map.coarse_gate();
-    if (full_cost && geometric_first && c.index == &map.level(level) &&
-        KeepsAssociation(true, c.pose, result.pose, options)) {
-      AddRcsTerms(scan, map, c);  // eq. 2 on the geometric stage's last association
+    if (full_cost && geometric_first && KeepsAssociation(true, c.pose, result.pose, options)) {
+      AddRcsTerms(scan, map, c);  // eq. 2 on the geometric stage's last association (same level)
     } else {
       c = FindCorrespondences(level_scan, map, level, result.pose, gate, with_rcs);
     }
