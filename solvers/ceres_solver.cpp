@@ -7,6 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -29,35 +33,40 @@ struct SizedDims {
 template <int Residuals, int... BlockSizes>
 SizedDims<Residuals, BlockSizes...> DimsOf(const ceres::SizedCostFunction<Residuals, BlockSizes...>*);
 
-// Terms [begin, end) of one kind (analytic cost functions `Term`) as one
-// shared residual block (CeresScanProblem): term k's residuals and Jacobian
-// rows sit at k times one term's (Ceres's Jacobians are row-major), each with
-// the term's robust loss applied in it (ApplyLoss).
+// Terms of one kind (analytic cost functions `Term`) as one shared residual
+// block (CeresScanProblem), each term with its robust loss applied in its own
+// residual (ApplyLoss). Shared rows: term k's residuals and Jacobian rows sit
+// at k times one term's (Ceres's Jacobians are row-major). Square root: the
+// block's square-root form (EvaluateSquareRoot).
 template <typename Term>
 class TermRangeCost final : public ceres::CostFunction {
   using Dims = decltype(DimsOf(static_cast<const Term*>(nullptr)));
   static constexpr int kRows = Dims::kResiduals;
   static constexpr int kMaxBlockSize = 4;  // the quaternion
-  static constexpr bool BlocksFit() {
-    for (int b = 0; b < Dims::kBlocks; ++b) {
-      if (Dims::kBlockSizes[b] > kMaxBlockSize) return false;
+  static constexpr bool RotationThenTranslations() {
+    if (Dims::kBlockSizes[0] != 4) return false;
+    for (int b = 1; b < Dims::kBlocks; ++b) {
+      if (Dims::kBlockSizes[b] != 3) return false;
     }
     return true;
   }
-  static_assert(BlocksFit(), "parameter blocks of at most four coordinates");
+  static_assert(RotationThenTranslations(), "a rotation block (x y z w), then translation blocks");
+  static constexpr int kAmbient = 4 + 3 * (Dims::kBlocks - 1);
+  static constexpr int kTangent = 3 * Dims::kBlocks;
 
  public:
   // `loss`: each term's robust loss (nullptr: trivial); it must outlive this.
-  explicit TermRangeCost(const ceres::LossFunction* loss) : loss_(loss) {
+  TermRangeCost(const ceres::LossFunction* loss, bool square_root) : loss_(loss), square_root_(square_root) {
     *mutable_parameter_block_sizes() = std::vector<std::int32_t>(Dims::kBlockSizes, Dims::kBlockSizes + Dims::kBlocks);
   }
 
   void Reset(std::vector<const Term*> terms) {
     terms_ = std::move(terms);
-    set_num_residuals(kRows * int(terms_.size()));
+    set_num_residuals(square_root_ ? kTangent + 1 : kRows * int(terms_.size()));
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    if (square_root_) return EvaluateSquareRoot(parameters, residuals, jacobians);
     double* term_jacobians[Dims::kBlocks];
     for (std::size_t k = 0; k < terms_.size(); ++k) {
       double* r = residuals + k * kRows;
@@ -96,28 +105,112 @@ class TermRangeCost final : public ceres::CostFunction {
     for (int i = 0; i < kRows; ++i) r[i] *= f;
   }
 
+  // The terms' square-root form (CeresScanProblem): with r and J the terms'
+  // stacked residuals (loss applied) and Jacobian on the tangent space,
+  // R^T R = J^T J and R^T z = J^T r; residuals [z; sqrt(|r|^2 - |z|^2)] and
+  // Jacobian [R; 0] (with residuals only: [|r|; 0]). J^T J and J^T r are
+  // summed on the ambient coordinates and projected once by the rotation's
+  // Plus Jacobian.
+  bool EvaluateSquareRoot(double const* const* parameters, double* residuals, double** jacobians) const {
+    double ss = 0.0;
+    Eigen::Matrix<double, kAmbient, kAmbient> A = Eigen::Matrix<double, kAmbient, kAmbient>::Zero();
+    Eigen::Matrix<double, kAmbient, 1> b = Eigen::Matrix<double, kAmbient, 1>::Zero();
+    double r[kRows];
+    double storage[kRows * kAmbient];  // the term's Jacobian blocks, each row-major
+    double* term_jacobians[Dims::kBlocks];
+    for (int blk = 0; blk < Dims::kBlocks; ++blk) term_jacobians[blk] = storage + (blk == 0 ? 0 : kRows * (4 + 3 * (blk - 1)));
+    const bool with_jacobians = jacobians != nullptr;
+    for (std::size_t k = 0; k < terms_.size(); ++k) {
+      if (!terms_[k]->Term::Evaluate(parameters, r, with_jacobians ? term_jacobians : nullptr)) return false;
+      if (loss_ != nullptr) ApplyLoss(r, with_jacobians ? term_jacobians : nullptr);
+      for (int i = 0; i < kRows; ++i) ss += r[i] * r[i];
+      if (!with_jacobians) continue;
+      Eigen::Matrix<double, kRows, kAmbient> J;
+      for (int blk = 0, col = 0; blk < Dims::kBlocks; col += Dims::kBlockSizes[blk], ++blk) {
+        const int n = Dims::kBlockSizes[blk];
+        for (int i = 0; i < kRows; ++i)
+          for (int j = 0; j < n; ++j) J(i, col + j) = term_jacobians[blk][i * n + j];
+      }
+      A.noalias() += J.transpose() * J;
+      b.noalias() += J.transpose() * Eigen::Map<const Eigen::Matrix<double, kRows, 1>>(r);
+    }
+    Eigen::Map<Eigen::Matrix<double, kTangent + 1, 1>> out(residuals);
+    if (!with_jacobians) {
+      out.setZero();
+      out[0] = std::sqrt(ss);
+      return true;
+    }
+    // Tangent coordinates: the rotation's Plus Jacobian P (4 x 3), identity for translations.
+    Eigen::Matrix<double, 4, 3, Eigen::RowMajor> P;
+    SO3Manifold().PlusJacobian(parameters[0], P.data());
+    Eigen::Matrix<double, kAmbient, kTangent> T = Eigen::Matrix<double, kAmbient, kTangent>::Zero();
+    T.template topLeftCorner<4, 3>() = P;
+    T.template bottomRightCorner<kAmbient - 4, kTangent - 3>().setIdentity();
+    const Eigen::Matrix<double, kTangent, kTangent> At = T.transpose() * A * T;
+    const Eigen::Matrix<double, kTangent, 1> bt = T.transpose() * b;
+    Eigen::Matrix<double, kTangent, kTangent> R;
+    Eigen::Matrix<double, kTangent, 1> z;
+    // Cholesky unless a pivot is negligible (then rounding would swamp z).
+    const Eigen::LLT<Eigen::Matrix<double, kTangent, kTangent>> llt(At);
+    const double negligible = 1e-12 * std::max(At.diagonal().maxCoeff(), std::numeric_limits<double>::min());
+    if (llt.info() == Eigen::Success && llt.matrixLLT().diagonal().cwiseAbs2().minCoeff() > negligible) {
+      R = llt.matrixU();
+      z = llt.matrixL().solve(bt);
+    } else {  // rank-deficient: R = Lambda^1/2 V^T, z = Lambda^-1/2 V^T b on the range
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kTangent, kTangent>> eigen(At);
+      const double floor = 1e-12 * std::max(1.0, eigen.eigenvalues().cwiseAbs().maxCoeff());
+      for (int i = 0; i < kTangent; ++i) {
+        const double lambda = eigen.eigenvalues()[i];
+        const double root = lambda > floor ? std::sqrt(lambda) : 0.0;
+        R.row(i) = root * eigen.eigenvectors().col(i).transpose();
+        z[i] = root > 0.0 ? eigen.eigenvectors().col(i).dot(bt) / root : 0.0;
+      }
+    }
+    out.template head<kTangent>() = z;
+    out[kTangent] = std::sqrt(std::max(0.0, ss - z.squaredNorm()));
+    // Ambient Jacobians whose product with the Plus Jacobian is R: the
+    // rotation's R_phi P^+ with P^+ = (P^T P)^-1 P^T, so that P^+ P = I.
+    const Eigen::Matrix<double, 3, 4> P_plus = (P.transpose() * P).inverse() * P.transpose();
+    if (jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, kTangent + 1, 4, Eigen::RowMajor>> J0(jacobians[0]);
+      J0.template topRows<kTangent>() = R.template leftCols<3>() * P_plus;
+      J0.template bottomRows<1>().setZero();
+    }
+    for (int blk = 1, col = 3; blk < Dims::kBlocks; col += 3, ++blk) {
+      if (jacobians[blk] == nullptr) continue;
+      Eigen::Map<Eigen::Matrix<double, kTangent + 1, 3, Eigen::RowMajor>> Jb(jacobians[blk]);
+      Jb.template topRows<kTangent>() = R.template middleCols<3>(col);
+      Jb.template bottomRows<1>().setZero();
+    }
+    return true;
+  }
+
   const ceres::LossFunction* loss_;
+  bool square_root_;
   std::vector<const Term*> terms_;
 };
 
 // The residual blocks of one kind of term, kept across associations: cost
 // function k holds term k of the current association. A new association
 // re-targets the cost functions it keeps (Reset on the functor or the
-// analytic twin). Shared (analytic terms, by default): the terms sit in
-// residual blocks of kTermsPerBlock (TermRangeCost), made afresh for each
-// association (a handful per match), with their loss inside and eq. 2's
-// weight as the blocks' ScaledLoss. Otherwise a block per term under the
-// ScaledLoss of its loss (Ceres's own loss handling), added or removed only
-// for the change in count, so that Ceres's per-block set-up is paid about
-// once per match instead of once per association.
+// analytic twin). Shared (analytic terms, kShared or kSquareRoot): the terms
+// sit in residual blocks (TermRangeCost) of kTermsPerBlock terms, or square
+// root, `threads` blocks, made afresh for each association (a handful per
+// match), with their loss inside and eq. 2's weight as the blocks'
+// ScaledLoss. Otherwise a block per term under the ScaledLoss of its loss
+// (Ceres's own loss handling), added or removed only for the change in
+// count, so that Ceres's per-block set-up is paid about once per match
+// instead of once per association.
 template <typename Functor, typename AnalyticCost>
 class TermBlocks {
  public:
-  TermBlocks(ceres::Problem& problem, const LossConfig& loss, bool analytic, bool shared,
+  TermBlocks(ceres::Problem& problem, const LossConfig& loss, bool analytic, CeresBlocks blocks, int threads,
              std::vector<double*> parameters)
       : problem_(problem),
         analytic_(analytic),
-        shared_(analytic && shared),
+        shared_(analytic && blocks != CeresBlocks::kPerTerm),
+        square_root_(analytic && blocks == CeresBlocks::kSquareRoot),
+        threads_(std::max(threads, 1)),
         robust_loss_(MakeLoss(loss)),
         parameters_(std::move(parameters)) {}
 
@@ -172,10 +265,12 @@ class TermBlocks {
   void Share(std::size_t count) {
     for (const ceres::ResidualBlockId id : shared_ids_) problem_.RemoveResidualBlock(id);
     shared_ids_.clear();
-    for (std::size_t begin = 0, r = 0; begin < count; begin += CeresScanProblem::kTermsPerBlock, ++r) {
-      const std::size_t end = std::min(count, begin + CeresScanProblem::kTermsPerBlock);
+    const std::size_t per_block =
+        square_root_ ? std::max<std::size_t>(1, (count + threads_ - 1) / threads_) : CeresScanProblem::kTermsPerBlock;
+    for (std::size_t begin = 0, r = 0; begin < count; begin += per_block, ++r) {
+      const std::size_t end = std::min(count, begin + per_block);
       if (r == shared_costs_.size()) {
-        shared_costs_.push_back(std::make_unique<TermRangeCost<AnalyticCost>>(robust_loss_.get()));
+        shared_costs_.push_back(std::make_unique<TermRangeCost<AnalyticCost>>(robust_loss_.get(), square_root_));
       }
       std::vector<const AnalyticCost*> terms;
       terms.reserve(end - begin);
@@ -195,6 +290,8 @@ class TermBlocks {
   ceres::Problem& problem_;
   bool analytic_;
   bool shared_;
+  bool square_root_;
+  std::size_t threads_;
   std::unique_ptr<ceres::LossFunction> robust_loss_;  // null: trivial
   ceres::LossFunctionWrapper loss_{nullptr, ceres::TAKE_OWNERSHIP};  // the blocks' loss
   std::vector<double*> parameters_;
@@ -250,13 +347,13 @@ class ExactMapStop final : public ceres::IterationCallback {
 }  // namespace
 
 struct CeresScanProblem::Impl {
-  Impl(const ScanMatchingOptions& options, double* rotation, double* translation, bool shared_blocks)
+  Impl(const ScanMatchingOptions& options, double* rotation, double* translation, CeresBlocks blocks, int threads)
       : options_(options),
-        geometric_(problem_, options.geometric_loss, options.jacobians == JacobianMode::kAnalytic, shared_blocks,
+        geometric_(problem_, options.geometric_loss, options.jacobians == JacobianMode::kAnalytic, blocks, threads,
                    {rotation, translation}),
-        rcs_full_(problem_, options.rcs_loss, options.jacobians == JacobianMode::kAnalytic, shared_blocks,
+        rcs_full_(problem_, options.rcs_loss, options.jacobians == JacobianMode::kAnalytic, blocks, threads,
                   {rotation, translation}),
-        rcs_rotation_(problem_, options.rcs_loss, options.jacobians == JacobianMode::kAnalytic, shared_blocks,
+        rcs_rotation_(problem_, options.rcs_loss, options.jacobians == JacobianMode::kAnalytic, blocks, threads,
                       {rotation}),
         problem_(ProblemOptions()) {
     problem_.AddParameterBlock(rotation, 4, &so3_);
@@ -309,8 +406,8 @@ struct CeresScanProblem::Impl {
 };
 
 CeresScanProblem::CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation,
-                                   bool shared_blocks)
-    : impl_(std::make_unique<Impl>(options, rotation, translation, shared_blocks)) {}
+                                   CeresBlocks blocks, int threads)
+    : impl_(std::make_unique<Impl>(options, rotation, translation, blocks, threads)) {}
 CeresScanProblem::~CeresScanProblem() = default;
 void CeresScanProblem::Update(const Correspondences& correspondences, double w_rcs) {
   impl_->Update(correspondences, w_rcs);
@@ -344,7 +441,8 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
   solver_options.function_tolerance = ceres_options_.function_tolerance;
   solver_options.gradient_tolerance = ceres_options_.gradient_tolerance;
   solver_options.parameter_tolerance = ceres_options_.parameter_tolerance;
-  CeresScanProblem problem(options_, rotation.data(), translation.data(), ceres_options_.shared_blocks);
+  CeresScanProblem problem(options_, rotation.data(), translation.data(), ceres_options_.blocks,
+                           ceres_options_.threads);
 
   ceres::Solver::Options exact_options = solver_options;
   exact_options.max_num_iterations = ceres_options_.max_exact_inner_iterations;

@@ -14,6 +14,14 @@
 
 namespace radargauss {
 
+// How analytic terms enter the ceres::Problem (CeresScanProblem); autodiff
+// terms always take a residual block each.
+enum class CeresBlocks {
+  kPerTerm,     // a residual block per term under ScaledLoss(its loss): Ceres's own loss handling
+  kShared,      // blocks of CeresScanProblem::kTermsPerBlock terms, each term's loss in its residual
+  kSquareRoot,  // shared blocks, each handed to Ceres in its square-root form (default)
+};
+
 struct CeresSolverOptions {
   bool dogleg = false;           // Levenberg-Marquardt (default) or dogleg
   // Ceres iterations per solve, i.e. per association, in the stages that
@@ -33,11 +41,11 @@ struct CeresSolverOptions {
   // converged or the step was small) on an association the loop keeps (more
   // solves on it when this limit cuts one short).
   int max_exact_inner_iterations = 8;
-  // Analytic terms share residual blocks of CeresScanProblem::kTermsPerBlock
-  // terms, each term's robust loss applied in its own residual (the cost and
-  // gradient of eq. 2; see CeresScanProblem). False: a residual block per
-  // term under Ceres's own loss handling, as autodiff terms always have.
-  bool shared_blocks = true;
+  // How analytic terms enter the problem (see CeresScanProblem): by default
+  // the terms of a kind share a residual block per thread, handed to Ceres in
+  // its square-root form; kShared and kPerTerm are the plainer layouts, for
+  // comparison (RESULTS.md has all three).
+  CeresBlocks blocks = CeresBlocks::kSquareRoot;
   int threads = 1;
   // Ceres's stopping rules per association (Ceres's defaults; the outer
   // loop's step tolerances decide convergence of the match).
@@ -50,7 +58,7 @@ struct CeresSolverOptions {
 // (rotation with SO3Manifold, translation) and the terms of the current
 // association, with eq. 2's weights as ScaledLoss.
 //
-// Shared blocks (analytic terms, `shared_blocks`): kTermsPerBlock terms of a
+// Shared blocks (analytic terms, CeresBlocks::kShared): kTermsPerBlock terms of a
 // kind per residual block, so that Ceres's per-block work (evaluator loop,
 // manifold product, loss correction, checks, preprocessing) is paid per
 // block of terms. Ceres applies a block's loss to the block's squared norm,
@@ -60,19 +68,36 @@ struct CeresSolverOptions {
 // per term; the Gauss-Newton model is that of the rescaled residual, where
 // Ceres's loss correction would take sqrt(rho') J (IRLS, for every loss here).
 //
-// Otherwise (autodiff terms, or shared_blocks = false) a block per term under
+// Square-root blocks (the default for analytic terms): the terms of a kind
+// share `threads` blocks (so that Ceres can evaluate them in parallel), and
+// each block hands Ceres, instead of its rows r (loss applied as above) and
+// their Jacobian J on the tangent space, the residuals [z; sqrt(|r|^2 -
+// |z|^2)] with the Jacobian [R; 0], where R^T R = J^T J (Cholesky; on a
+// rank-deficient block R = Lambda^1/2 V^T from J^T J's eigenvectors) and
+// R^T z = J^T r. The cost |r|^2, the gradient J^T r and the Gauss-Newton
+// matrix J^T J, all that Levenberg-Marquardt and dogleg use (step, jacobi
+// scaling, model cost change, tolerances), are those of the shared rows, so
+// Ceres takes the same steps; it handles 7 (geometric) or 4 (rotation-only
+// RCS) rows per block instead of 3 per geometric and 1 per RCS term, which
+// saves it its per-row work (Jacobian writing, manifold products, normal
+// equations, scaling). A Jacobian from Problem::Evaluate is then R's, not
+// the terms' (use kShared to read theirs). With residuals only (the cost of
+// a candidate step) a block returns [|r|; 0].
+//
+// Otherwise (autodiff terms, or kPerTerm) a block per term under
 // ScaledLoss(its loss); Update re-targets the blocks it keeps at the new
 // terms and adds or removes blocks only for the change in count, so Ceres's
 // per-block set-up is paid about once per match instead of once per
 // association.
 class CeresScanProblem {
  public:
-  static constexpr std::size_t kTermsPerBlock = 64;
+  static constexpr std::size_t kTermsPerBlock = 64;  // kShared
 
   // `rotation` (quaternion x y z w) and `translation` are the parameter
-  // blocks; they must outlive the problem.
+  // blocks; they must outlive the problem. `threads`: square-root blocks
+  // per kind of term.
   CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation,
-                   bool shared_blocks = true);
+                   CeresBlocks blocks = CeresBlocks::kSquareRoot, int threads = 1);
   ~CeresScanProblem();
   CeresScanProblem(const CeresScanProblem&) = delete;
   CeresScanProblem& operator=(const CeresScanProblem&) = delete;

@@ -1,8 +1,10 @@
 #include <ceres/cost_function.h>
 #include <ceres/crs_matrix.h>
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include <iterator>
 #include <memory>
 #include <cctype>
 #include <cmath>
@@ -533,8 +535,8 @@ TEST(RcsFacing, HeldFromTheAssociationPose) {
 
 // Own GN and Ceres LM reach the same optimum on the same association, for
 // both incidence models (the association holds each RCS term's facing sign,
-// so the cost they minimise is smooth); so do Ceres with shared blocks and
-// with a block per term, and the own GN with the losses' curvature.
+// so the cost they minimise is smooth); so does Ceres with each layout of
+// its blocks, and the own GN with the losses' curvature.
 TEST(SolverAgreement, SameOptimumOnSameAssociation) {
   const World& world = SimulatedWorld();
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
@@ -556,11 +558,15 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
     const ScanMatchingResult gn = GaussNewtonSolver(options).Match(world.simulated.scans[kTestScan], single, initial);
     const ScanMatchingResult lm =
         CeresSolver(options, ceres_options).Match(world.simulated.scans[kTestScan], single, initial);
-    // A residual block per term under Ceres's own loss handling: another path, the same optimum.
+    // A residual block per term under Ceres's own loss handling, and shared
+    // rows without the square-root form: other paths, the same optimum.
     CeresSolverOptions unshared = ceres_options;
-    unshared.shared_blocks = false;
+    unshared.blocks = CeresBlocks::kPerTerm;
     const ScanMatchingResult lm_unshared =
         CeresSolver(options, unshared).Match(world.simulated.scans[kTestScan], single, initial);
+    CeresSolverOptions rows = ceres_options;
+    rows.blocks = CeresBlocks::kShared;
+    const ScanMatchingResult lm_rows = CeresSolver(options, rows).Match(world.simulated.scans[kTestScan], single, initial);
     // The losses' curvature in the own GN's Hessian changes its path, not its optimum.
     ScanMatchingOptions curved = options;
     curved.loss_curvature = true;
@@ -571,6 +577,10 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
     ASSERT_TRUE(lm_unshared.converged) << lm_unshared.reason;
     EXPECT_LT(dt, 1e-4) << "w " << w << ", a block per term";
     EXPECT_LT(dr * M_PI / 180.0, 1e-4) << "w " << w << ", a block per term";
+    PoseErrors(lm_rows.pose, lm.pose, dt, dr);
+    ASSERT_TRUE(lm_rows.converged) << lm_rows.reason;
+    EXPECT_LT(dt, 1e-4) << "w " << w << ", shared rows";
+    EXPECT_LT(dr * M_PI / 180.0, 1e-4) << "w " << w << ", shared rows";
     PoseErrors(gn_curved.pose, lm.pose, dt, dr);
     ASSERT_TRUE(gn_curved.converged) << gn_curved.reason;
     EXPECT_LT(dt, 1e-4) << "w " << w << ", loss curvature";
@@ -692,14 +702,15 @@ TEST(CeresSolver, ExactMapSolveEndsWhenThePoseLeavesTheAssociation) {
 // The Ceres problem kept across associations holds exactly the latest
 // association: after updates that grow and shrink the term counts, change
 // level and weight, its cost (Ceres: 1/2 sum) is eq. 2 as EvaluateCost gives
-// it, and it holds one residual per residual of the latest terms, in one
-// block per term or, shared, in blocks of kTermsPerBlock terms; for both RCS
-// translation modes, robust and trivial losses. Its gradient is the same
-// whether the terms are blocks of their own under Ceres's loss handling
-// (autodiff, and analytic unshared) or share blocks with their loss in the
-// residual (analytic): the shared blocks place each term's rows and apply its
-// loss consistently. The shared blocks' Jacobian is their residuals'
-// derivative (central differences on the manifold).
+// it, in one block per term, shared blocks of kTermsPerBlock terms, or one
+// square-root block per thread; for both RCS translation modes, robust and
+// trivial losses. Its gradient is the same whether the terms are blocks of
+// their own under Ceres's loss handling (autodiff, and analytic per term) or
+// share blocks with their loss in the residual (analytic): the shared blocks
+// place each term's rows and apply its loss consistently. The shared blocks'
+// Jacobian is their residuals' derivative (central differences on the
+// manifold), and the square-root blocks' Jacobian J has the shared rows'
+// Gauss-Newton matrix J^T J.
 TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
   const World& world = SimulatedWorld();
   const MatchingMap& map = *world.matching;
@@ -707,37 +718,54 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
   RadarScan half_scan = full_scan;
   half_scan.points.resize(full_scan.points.size() / 2);
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
-  const auto blocks_of = [](std::size_t terms, bool shared) {
-    return shared ? (terms + CeresScanProblem::kTermsPerBlock - 1) / CeresScanProblem::kTermsPerBlock : terms;
-  };
   struct Layout {
     JacobianMode jacobians;
-    bool shared_blocks;  // asked for; autodiff terms never share
+    CeresBlocks blocks;  // asked for; autodiff terms always take a block each
+    int threads;
     const char* name;
   };
-  const Layout layouts[] = {{JacobianMode::kAutoDiff, true, "autodiff"},
-                            {JacobianMode::kAnalytic, true, "analytic, shared"},
-                            {JacobianMode::kAnalytic, false, "analytic, a block per term"}};
+  const Layout layouts[] = {{JacobianMode::kAutoDiff, CeresBlocks::kSquareRoot, 1, "autodiff"},
+                            {JacobianMode::kAnalytic, CeresBlocks::kShared, 1, "analytic, shared rows"},
+                            {JacobianMode::kAnalytic, CeresBlocks::kPerTerm, 1, "analytic, a block per term"},
+                            {JacobianMode::kAnalytic, CeresBlocks::kSquareRoot, 1, "analytic, square root"},
+                            {JacobianMode::kAnalytic, CeresBlocks::kSquareRoot, 3, "analytic, square root, 3 threads"}};
+  constexpr int kLayouts = int(std::size(layouts));
+  // Per layout: blocks and residuals of n terms with `rows` residuals each on a tangent space of `tangent`.
+  const auto blocks_of = [](const Layout& layout, std::size_t n) -> std::size_t {
+    if (layout.jacobians == JacobianMode::kAutoDiff || layout.blocks == CeresBlocks::kPerTerm) return n;
+    if (layout.blocks == CeresBlocks::kShared) {
+      return (n + CeresScanProblem::kTermsPerBlock - 1) / CeresScanProblem::kTermsPerBlock;
+    }
+    return std::min<std::size_t>(n, std::size_t(layout.threads));
+  };
+  const auto residuals_of = [&](const Layout& layout, std::size_t n, int rows, int tangent) -> std::size_t {
+    const bool square_root = layout.jacobians == JacobianMode::kAnalytic && layout.blocks == CeresBlocks::kSquareRoot;
+    return square_root ? blocks_of(layout, n) * (tangent + 1) : n * rows;
+  };
   for (const bool trivial : {false, true}) {
     for (const RcsTranslation mode : {RcsTranslation::kRotationOnly, RcsTranslation::kFull}) {
-      std::vector<double> gradients[3];  // per layout, all updates in a row
-      for (int l = 0; l < 3; ++l) {
+      std::vector<double> gradients[kLayouts];  // per layout, all updates in a row
+      std::vector<Eigen::Matrix<double, 6, 6>> shared_normal;  // J^T J of the shared rows, per update
+      for (int l = 0; l < kLayouts; ++l) {
         const Layout& layout = layouts[l];
         ScanMatchingOptions options;
         options.jacobians = layout.jacobians;
         options.rcs_translation = mode;
         options.geometric_loss = trivial ? LossConfig{LossType::kTrivial, 1.0} : LossConfig{LossType::kHuber, 0.5};
         if (trivial) options.rcs_loss = {LossType::kTrivial, 1.0};
-        const bool shared = layout.shared_blocks && layout.jacobians == JacobianMode::kAnalytic;
+        const bool analytic = layout.jacobians == JacobianMode::kAnalytic;
+        const bool shared_rows = analytic && layout.blocks == CeresBlocks::kShared;
+        const bool square_root = analytic && layout.blocks == CeresBlocks::kSquareRoot;
         const SE3d pose = Perturbed(truth, 0.1, 0.5, 3);
         Eigen::Vector4d rotation = pose.rotation().quaternion().coeffs();
         Eigen::Vector3d translation = pose.translation();
-        CeresScanProblem problem(options, rotation.data(), translation.data(), layout.shared_blocks);
+        CeresScanProblem problem(options, rotation.data(), translation.data(), layout.blocks, layout.threads);
         struct Update {
           const RadarScan* scan;
           std::size_t level;
           double w;
         };
+        int u = 0;
         for (const Update& update :
              {Update{&full_scan, map.levels() - 1, 0.25}, Update{&half_scan, 0, 0.0},
               Update{&full_scan, map.levels() - 1, 0.0}, Update{&half_scan, map.levels() - 1, 0.5},
@@ -752,18 +780,43 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
           weighted.w_rcs = update.w;
           const std::size_t n_geo = update.w < 1.0 ? c.geometric.size() : 0;
           const std::size_t n_rcs = update.w > 0.0 ? c.rcs.size() : 0;
-          EXPECT_EQ(problem.problem().NumResidualBlocks(), int(blocks_of(n_geo, shared) + blocks_of(n_rcs, shared)))
+          const int rcs_tangent = mode == RcsTranslation::kRotationOnly ? 3 : 6;
+          EXPECT_EQ(problem.problem().NumResidualBlocks(), int(blocks_of(layout, n_geo) + blocks_of(layout, n_rcs)))
               << "w " << update.w << ", " << layout.name;
-          EXPECT_EQ(problem.problem().NumResiduals(), int(3 * n_geo + n_rcs)) << "w " << update.w;
+          EXPECT_EQ(problem.problem().NumResiduals(),
+                    int(residuals_of(layout, n_geo, 3, 6) + residuals_of(layout, n_rcs, 1, rcs_tangent)))
+              << "w " << update.w << ", " << layout.name;
           double cost = 0.0;
           std::vector<double> gradient;
           ceres::CRSMatrix jacobian;
           ASSERT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient,
-                                                 shared ? &jacobian : nullptr));
+                                                 analytic ? &jacobian : nullptr));
           const double f = EvaluateCost(c, pose, weighted);
           EXPECT_NEAR(2.0 * cost, f, 1e-12 * f) << "w " << update.w << " level " << update.level << ", " << layout.name;
+          // With residuals only (a candidate step's cost), the same cost.
+          double cost_only = 0.0;
+          ASSERT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost_only, nullptr, nullptr,
+                                                 nullptr));
+          EXPECT_NEAR(cost_only, cost, 1e-14 * cost) << layout.name;
           gradients[l].insert(gradients[l].end(), gradient.begin(), gradient.end());
-          if (!shared) continue;
+          if (!analytic) continue;
+          ASSERT_EQ(jacobian.num_cols, 6);
+          Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(jacobian.num_rows, 6);
+          for (int row = 0; row < jacobian.num_rows; ++row) {
+            for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
+              dense(row, jacobian.cols[k]) = jacobian.values[k];
+            }
+          }
+          const Eigen::Matrix<double, 6, 6> normal = dense.transpose() * dense;
+          if (shared_rows) shared_normal.push_back(normal);
+          if (square_root) {
+            ASSERT_LT(std::size_t(u), shared_normal.size());
+            const double scale = shared_normal[u].cwiseAbs().maxCoeff();
+            EXPECT_LT((normal - shared_normal[u]).cwiseAbs().maxCoeff(), 1e-10 * scale)
+                << "w " << update.w << ", " << layout.name;
+          }
+          ++u;
+          if (!shared_rows) continue;
           // Central differences of the residuals along the tangent coordinates
           // x = [dphi; dt] (Ceres's Jacobian columns: rotation, then translation).
           const Eigen::Vector4d rotation0 = rotation;
@@ -780,31 +833,71 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
               Eigen::VectorXd::Zero(6));
           rotation = rotation0;
           translation = translation0;
-          ASSERT_EQ(jacobian.num_cols, 6);
           ASSERT_EQ(jacobian.num_rows, numeric.rows());
           double worst = 0.0;  // entry by entry
           for (int row = 0; row < jacobian.num_rows; ++row) {
-            Eigen::Matrix<double, 1, 6> analytic = Eigen::Matrix<double, 1, 6>::Zero();
-            for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
-              analytic[jacobian.cols[k]] = jacobian.values[k];
-            }
-            const Eigen::Matrix<double, 1, 6> difference = analytic - numeric.row(row);
-            const Eigen::Matrix<double, 1, 6> scale = analytic.cwiseAbs() + numeric.row(row).cwiseAbs();
+            const Eigen::Matrix<double, 1, 6> difference = dense.row(row) - numeric.row(row);
+            const Eigen::Matrix<double, 1, 6> scale = dense.row(row).cwiseAbs() + numeric.row(row).cwiseAbs();
             worst = std::max(worst, (difference.cwiseAbs().array() / (1e-6 + scale.array())).maxCoeff());
           }
           EXPECT_LT(worst, 1e-5) << "w " << update.w << (trivial ? ", trivial losses" : ", robust losses");
         }
       }
-      for (int l = 0; l < 2; ++l) {
-        ASSERT_EQ(gradients[l + 1].size(), gradients[0].size());
+      for (int l = 1; l < kLayouts; ++l) {
+        ASSERT_EQ(gradients[l].size(), gradients[0].size());
         for (std::size_t i = 0; i < gradients[0].size(); ++i) {
-          EXPECT_NEAR(gradients[l + 1][i], gradients[0][i], 1e-8 * (1.0 + std::abs(gradients[0][i])))
-              << "gradient entry " << i << ", " << layouts[l + 1].name
+          EXPECT_NEAR(gradients[l][i], gradients[0][i], 1e-8 * (1.0 + std::abs(gradients[0][i])))
+              << "gradient entry " << i << ", " << layouts[l].name
               << (trivial ? ", trivial losses" : ", robust losses");
         }
       }
     }
   }
+}
+
+// A square-root block whose terms do not span the tangent space (one
+// geometric term: rank 3 of 6; two rotation-only RCS terms: rank 2 of 3)
+// takes its square root from J^T J's eigenvectors: cost, gradient and J^T J
+// are still those of the shared rows, and nothing is NaN.
+TEST(CeresScanProblem, SquareRootOfARankDeficientBlock) {
+  const World& world = SimulatedWorld();
+  const SE3d pose = Perturbed(world.simulated.ground_truth[kTestScan].pose, 0.1, 0.5, 3);
+  Correspondences c = FindCorrespondences(world.simulated.scans[kTestScan], *world.exact, 0, pose, 3.0, true);
+  ASSERT_GE(c.rcs.size(), 2u);
+  c.geometric.resize(1);
+  c.rcs.resize(2);
+  struct Evaluation {
+    double cost = 0.0;
+    std::vector<double> gradient;
+    Eigen::Matrix<double, 6, 6> normal;
+  };
+  const auto evaluate = [&](CeresBlocks blocks) {
+    Eigen::Vector4d rotation = pose.rotation().quaternion().coeffs();
+    Eigen::Vector3d translation = pose.translation();
+    CeresScanProblem problem(ScanMatchingOptions(), rotation.data(), translation.data(), blocks);
+    problem.Update(c, 0.5);
+    Evaluation e;
+    ceres::CRSMatrix jacobian;
+    EXPECT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &e.cost, nullptr, &e.gradient,
+                                           &jacobian));
+    Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(jacobian.num_rows, 6);
+    for (int row = 0; row < jacobian.num_rows; ++row) {
+      for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) dense(row, jacobian.cols[k]) = jacobian.values[k];
+    }
+    EXPECT_TRUE(dense.allFinite());
+    e.normal = dense.transpose() * dense;
+    return e;
+  };
+  const Evaluation rows = evaluate(CeresBlocks::kShared);
+  const Evaluation root = evaluate(CeresBlocks::kSquareRoot);
+  EXPECT_NEAR(root.cost, rows.cost, 1e-12 * rows.cost);
+  ASSERT_EQ(root.gradient.size(), rows.gradient.size());
+  for (std::size_t i = 0; i < rows.gradient.size(); ++i) {
+    EXPECT_NEAR(root.gradient[i], rows.gradient[i], 1e-9 * (1.0 + std::abs(rows.gradient[i]))) << "entry " << i;
+  }
+  EXPECT_LT((root.normal - rows.normal).cwiseAbs().maxCoeff(), 1e-10 * rows.normal.cwiseAbs().maxCoeff());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(rows.normal);
+  EXPECT_LT(eigen.eigenvalues()[0], 1e-9 * eigen.eigenvalues()[5]);  // the case this test is for
 }
 
 // w = 1 with rotation-only RCS: the translation does not move. On the
