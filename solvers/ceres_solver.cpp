@@ -51,6 +51,7 @@ class TermRangeCost final : public ceres::CostFunction {
     return true;
   }
   static_assert(RotationThenTranslations(), "a rotation block (x y z w), then translation blocks");
+  static_assert(Dims::kBlocks <= 2, "a rotation and at most one translation block");
   static constexpr int kAmbient = 4 + 3 * (Dims::kBlocks - 1);
   static constexpr int kTangent = 3 * Dims::kBlocks;
 
@@ -116,24 +117,27 @@ class TermRangeCost final : public ceres::CostFunction {
     Eigen::Matrix<double, kAmbient, kAmbient> A = Eigen::Matrix<double, kAmbient, kAmbient>::Zero();
     Eigen::Matrix<double, kAmbient, 1> b = Eigen::Matrix<double, kAmbient, 1>::Zero();
     double r[kRows];
-    double storage[kRows * kAmbient];  // the term's Jacobian blocks, each row-major
-    double* term_jacobians[Dims::kBlocks];
-    for (int blk = 0; blk < Dims::kBlocks; ++blk) term_jacobians[blk] = storage + (blk == 0 ? 0 : kRows * (4 + 3 * (blk - 1)));
+    // The term's Jacobian blocks (row-major): rotation J_q, then translation J_t.
+    Eigen::Matrix<double, kRows, 4, Eigen::RowMajor> J_q;
+    Eigen::Matrix<double, kRows, 3, Eigen::RowMajor> J_t;
+    double* term_jacobians[2] = {J_q.data(), J_t.data()};
     const bool with_jacobians = jacobians != nullptr;
     for (std::size_t k = 0; k < terms_.size(); ++k) {
       if (!terms_[k]->Term::Evaluate(parameters, r, with_jacobians ? term_jacobians : nullptr)) return false;
       if (loss_ != nullptr) ApplyLoss(r, with_jacobians ? term_jacobians : nullptr);
-      for (int i = 0; i < kRows; ++i) ss += r[i] * r[i];
+      const Eigen::Map<const Eigen::Matrix<double, kRows, 1>> residual(r);
+      ss += residual.squaredNorm();
       if (!with_jacobians) continue;
-      Eigen::Matrix<double, kRows, kAmbient> J;
-      for (int blk = 0, col = 0; blk < Dims::kBlocks; col += Dims::kBlockSizes[blk], ++blk) {
-        const int n = Dims::kBlockSizes[blk];
-        for (int i = 0; i < kRows; ++i)
-          for (int j = 0; j < n; ++j) J(i, col + j) = term_jacobians[blk][i * n + j];
+      // The upper triangle of J^T J (mirrored below), and J^T r.
+      A.template topLeftCorner<4, 4>().noalias() += J_q.transpose() * J_q;
+      b.template head<4>().noalias() += J_q.transpose() * residual;
+      if constexpr (kAmbient == 7) {
+        A.template topRightCorner<4, 3>().noalias() += J_q.transpose() * J_t;
+        A.template bottomRightCorner<3, 3>().noalias() += J_t.transpose() * J_t;
+        b.template tail<3>().noalias() += J_t.transpose() * residual;
       }
-      A.noalias() += J.transpose() * J;
-      b.noalias() += J.transpose() * Eigen::Map<const Eigen::Matrix<double, kRows, 1>>(r);
     }
+    A.template triangularView<Eigen::StrictlyLower>() = A.transpose();
     Eigen::Map<Eigen::Matrix<double, kTangent + 1, 1>> out(residuals);
     if (!with_jacobians) {
       out.setZero();
