@@ -20,6 +20,7 @@
 #include "residuals/geometric_residual.hpp"
 #include "residuals/rcs_residual.hpp"
 #include "radargauss/experiment.hpp"
+#include "solvers/ceres_solver.hpp"
 #include "solvers/factory.hpp"
 #include "solvers/gauss_newton.hpp"
 #include "solvers/joint_refinement.hpp"
@@ -397,21 +398,54 @@ PairedRuns MatchPaired(benchmark::State& state, const ScanMatcher& a, const Scan
 
 // Ceres LM against the own GN when tracking, paired (MatchPaired): the
 // medians of their per-scan times and the ratio of the medians (the goal:
-// <= 5x). Arg: w_rcs x 100.
+// <= 5x). Args: w_rcs x 100, Ceres's blocks (0 square root, the default;
+// 1 shared rows; 2 a block per term).
 void BM_RefineScanCeresOverGn(benchmark::State& state) {
   const Tracking tracking;
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(0)) / 100.0;
+  static const CeresBlocks blocks[] = {CeresBlocks::kSquareRoot, CeresBlocks::kShared, CeresBlocks::kPerTerm};
+  static const char* block_names[] = {"square root", "shared rows", "a block per term"};
+  CeresSolverOptions ceres_options;
+  ceres_options.blocks = blocks[state.range(1)];
+  const CeresSolver ceres(options, ceres_options);
   const PairedRuns runs =
-      MatchPaired(state, *Solver(0, options), *Solver(2, options), tracking.exact, tracking.scans, tracking.initial);
+      MatchPaired(state, *Solver(0, options), ceres, tracking.exact, tracking.scans, tracking.initial);
   const double gn_median = MedianMs(runs.times[0]);
   const double ceres_median = MedianMs(runs.times[1]);
-  state.SetLabel("ceres / gn, w=" + std::to_string(options.w_rcs).substr(0, 4));
+  state.SetLabel("ceres (" + std::string(block_names[state.range(1)]) + ") / gn, w=" +
+                 std::to_string(options.w_rcs).substr(0, 4));
   state.counters["gn_median_ms"] = gn_median;
   state.counters["ceres_median_ms"] = ceres_median;
   state.counters["ratio"] = ceres_median / gn_median;
 }
-BENCHMARK(BM_RefineScanCeresOverGn)->Arg(0)->Arg(25)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RefineScanCeresOverGn)->ArgsProduct({{0, 25}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
+
+// Ceres LM (default blocks) against the own GN from the paper's errors
+// (2 m / 5 deg), paired (MatchPaired): medians, their ratio and the mean
+// final errors. Args: w_rcs x 100, levels (1 merged with gate 3, 2 the
+// default inflated).
+void BM_MatchScanCeresOverGn(benchmark::State& state) {
+  const Tracking tracking;
+  const MatchingWorld& world = tracking.world;
+  const bool merged = state.range(1) == 1;
+  const MatchingMap& map = merged ? *world.merged_matching.at(30) : *world.matching;
+  ScanMatchingOptions options;
+  options.w_rcs = double(state.range(0)) / 100.0;
+  const PairedRuns runs = MatchPaired(state, *Solver(0, options), *Solver(2, options), map, tracking.scans,
+                                      InitialPoses(tracking.scans));
+  const double count = double(runs.times[0].size());
+  state.SetLabel(std::string("ceres / gn, ") + (merged ? "merged" : "inflated") +
+                 ", w=" + std::to_string(options.w_rcs).substr(0, 4));
+  state.counters["gn_median_ms"] = MedianMs(runs.times[0]);
+  state.counters["ceres_median_ms"] = MedianMs(runs.times[1]);
+  state.counters["ratio"] = MedianMs(runs.times[1]) / MedianMs(runs.times[0]);
+  state.counters["gn_t_err_m"] = runs.t_err[0] / count;
+  state.counters["gn_r_err_deg"] = runs.r_err[0] / count;
+  state.counters["ceres_t_err_m"] = runs.t_err[1] / count;
+  state.counters["ceres_r_err_deg"] = runs.r_err[1] / count;
+}
+BENCHMARK(BM_MatchScanCeresOverGn)->ArgsProduct({{0, 25}, {1, 2}})->Unit(benchmark::kMillisecond);
 
 // geometric_first against eq. 2 throughout on the exact map, w = 0.25,
 // paired (MatchPaired): the medians of their per-scan times, their ratio and
