@@ -155,8 +155,13 @@ int GaussianIndex::Nearest(const Eigen::Vector3d& point, const std::uint32_t* ca
   for (std::size_t k = 0; k < count; ++k) {
     const std::uint32_t i = candidates[k];
     const IndexedGaussian& entry = gaussians_[i];
+    // Mahalanobis^2 = |L^T e|^2, L^T upper triangular: 9 products (e^T Sigma^-1 e takes 12).
     const Eigen::Vector3d e = point - entry.mean;
-    const double d2 = e.dot(entry.information * e);
+    const Eigen::Matrix3d& U = entry.sqrt_information_t;
+    const double y0 = U(0, 0) * e.x() + U(0, 1) * e.y() + U(0, 2) * e.z();
+    const double y1 = U(1, 1) * e.y() + U(1, 2) * e.z();
+    const double y2 = U(2, 2) * e.z();
+    const double d2 = y0 * y0 + y1 * y1 + y2 * y2;
     const bool closer = d2 < best_d2;
     best_d2 = closer ? d2 : best_d2;
     best = closer ? static_cast<int>(i) : best;
@@ -195,7 +200,7 @@ void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t coun
   const auto fetch_candidates = [&](std::size_t k) {
     for (std::uint32_t e = cells[k]->begin; e < cells[k]->end; ++e) {
       const char* entry = reinterpret_cast<const char*>(&gaussians_[cell_entries_[e]]);
-      __builtin_prefetch(entry);  // mean and information: the entry's first two cache lines
+      __builtin_prefetch(entry);  // mean and L^T: the entry's first two cache lines
       __builtin_prefetch(entry + 64);
     }
   };

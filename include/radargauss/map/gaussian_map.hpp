@@ -106,11 +106,11 @@ class GaussianIndex {
 
   double cell_size_ = 1.0;
   // What a query reads per candidate, side by side in one entry; aligned so
-  // that the mean and information a query scores fill two cache lines.
+  // that the mean and L^T a query scores fill two cache lines.
   struct alignas(64) IndexedGaussian {
     Eigen::Vector3d mean;
-    Eigen::Matrix3d information;
     Eigen::Matrix3d sqrt_information_t;
+    Eigen::Matrix3d information;
   };
   std::vector<IndexedGaussian> gaussians_;
   std::vector<std::uint32_t> cell_entries_;  // Gaussian ids grouped by cell
