@@ -535,8 +535,8 @@ TEST(RcsFacing, HeldFromTheAssociationPose) {
 
 // Own GN and Ceres LM reach the same optimum on the same association, for
 // both incidence models (the association holds each RCS term's facing sign,
-// so the cost they minimise is smooth); so does Ceres with each layout of
-// its blocks, and the own GN with the losses' curvature.
+// so the cost they minimise is smooth); so do Ceres with each layout of its
+// blocks and Ceres's dogleg, and the own GN with the losses' curvature.
 TEST(SolverAgreement, SameOptimumOnSameAssociation) {
   const World& world = SimulatedWorld();
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
@@ -566,7 +566,12 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
         CeresSolver(options, unshared).Match(world.simulated.scans[kTestScan], single, initial);
     CeresSolverOptions rows = ceres_options;
     rows.blocks = CeresBlocks::kShared;
-    const ScanMatchingResult lm_rows = CeresSolver(options, rows).Match(world.simulated.scans[kTestScan], single, initial);
+    const ScanMatchingResult lm_rows =
+        CeresSolver(options, rows).Match(world.simulated.scans[kTestScan], single, initial);
+    // Dogleg on the square-root blocks (its Cauchy point reads the gradient and J^T J as LM does).
+    CeresSolverOptions dogleg = ceres_options;
+    dogleg.dogleg = true;
+    const ScanMatchingResult dl = CeresSolver(options, dogleg).Match(world.simulated.scans[kTestScan], single, initial);
     // The losses' curvature in the own GN's Hessian changes its path, not its optimum.
     ScanMatchingOptions curved = options;
     curved.loss_curvature = true;
@@ -581,6 +586,10 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
     ASSERT_TRUE(lm_rows.converged) << lm_rows.reason;
     EXPECT_LT(dt, 1e-4) << "w " << w << ", shared rows";
     EXPECT_LT(dr * M_PI / 180.0, 1e-4) << "w " << w << ", shared rows";
+    PoseErrors(dl.pose, lm.pose, dt, dr);
+    ASSERT_TRUE(dl.converged) << dl.reason;
+    EXPECT_LT(dt, 1e-4) << "w " << w << ", dogleg";
+    EXPECT_LT(dr * M_PI / 180.0, 1e-4) << "w " << w << ", dogleg";
     PoseErrors(gn_curved.pose, lm.pose, dt, dr);
     ASSERT_TRUE(gn_curved.converged) << gn_curved.reason;
     EXPECT_LT(dt, 1e-4) << "w " << w << ", loss curvature";
@@ -882,7 +891,9 @@ TEST(CeresScanProblem, SquareRootOfARankDeficientBlock) {
                                            &jacobian));
     Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(jacobian.num_rows, 6);
     for (int row = 0; row < jacobian.num_rows; ++row) {
-      for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) dense(row, jacobian.cols[k]) = jacobian.values[k];
+      for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
+        dense(row, jacobian.cols[k]) = jacobian.values[k];
+      }
     }
     EXPECT_TRUE(dense.allFinite());
     e.normal = dense.transpose() * dense;
