@@ -396,6 +396,18 @@ PairedRuns MatchPaired(benchmark::State& state, const ScanMatcher& a, const Scan
   return runs;
 }
 
+// The counters of paired runs: per solver (named `a` and `b`) its median
+// time per scan and its mean final errors.
+void ReportPaired(benchmark::State& state, const PairedRuns& runs, const std::string& a, const std::string& b) {
+  const double count = double(runs.times[0].size());
+  const std::string names[2] = {a, b};
+  for (int s = 0; s < 2; ++s) {
+    state.counters[names[s] + "_median_ms"] = MedianMs(runs.times[s]);
+    state.counters[names[s] + "_t_err_m"] = runs.t_err[s] / count;
+    state.counters[names[s] + "_r_err_deg"] = runs.r_err[s] / count;
+  }
+}
+
 // Ceres LM against the own GN when tracking, paired (MatchPaired): the
 // medians of their per-scan times and the ratio of the medians (the goal:
 // <= 5x). Args: w_rcs x 100, Ceres's blocks (0 square root, the default;
@@ -411,13 +423,10 @@ void BM_RefineScanCeresOverGn(benchmark::State& state) {
   const CeresSolver ceres(options, ceres_options);
   const PairedRuns runs =
       MatchPaired(state, *Solver(0, options), ceres, tracking.exact, tracking.scans, tracking.initial);
-  const double gn_median = MedianMs(runs.times[0]);
-  const double ceres_median = MedianMs(runs.times[1]);
   state.SetLabel("ceres (" + std::string(block_names[state.range(1)]) + ") / gn, w=" +
                  std::to_string(options.w_rcs).substr(0, 4));
-  state.counters["gn_median_ms"] = gn_median;
-  state.counters["ceres_median_ms"] = ceres_median;
-  state.counters["ratio"] = ceres_median / gn_median;
+  ReportPaired(state, runs, "gn", "ceres");
+  state.counters["ratio"] = MedianMs(runs.times[1]) / MedianMs(runs.times[0]);
 }
 BENCHMARK(BM_RefineScanCeresOverGn)->ArgsProduct({{0, 25}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
 
@@ -434,16 +443,10 @@ void BM_MatchScanCeresOverGn(benchmark::State& state) {
   options.w_rcs = double(state.range(0)) / 100.0;
   const PairedRuns runs = MatchPaired(state, *Solver(0, options), *Solver(2, options), map, tracking.scans,
                                       InitialPoses(tracking.scans));
-  const double count = double(runs.times[0].size());
   state.SetLabel(std::string("ceres / gn, ") + (merged ? "merged" : "inflated") +
                  ", w=" + std::to_string(options.w_rcs).substr(0, 4));
-  state.counters["gn_median_ms"] = MedianMs(runs.times[0]);
-  state.counters["ceres_median_ms"] = MedianMs(runs.times[1]);
+  ReportPaired(state, runs, "gn", "ceres");
   state.counters["ratio"] = MedianMs(runs.times[1]) / MedianMs(runs.times[0]);
-  state.counters["gn_t_err_m"] = runs.t_err[0] / count;
-  state.counters["gn_r_err_deg"] = runs.r_err[0] / count;
-  state.counters["ceres_t_err_m"] = runs.t_err[1] / count;
-  state.counters["ceres_r_err_deg"] = runs.r_err[1] / count;
 }
 BENCHMARK(BM_MatchScanCeresOverGn)->ArgsProduct({{0, 25}, {1, 2}})->Unit(benchmark::kMillisecond);
 
@@ -464,15 +467,9 @@ void BM_GeometricFirstOverThroughout(benchmark::State& state) {
   const std::unique_ptr<ScanMatcher> solver = Solver(int(state.range(0)), first);
   const PairedRuns runs =
       MatchPaired(state, *solver, *Solver(int(state.range(0)), throughout), map, tracking.scans, initial);
-  const double count = double(runs.times[0].size());
   state.SetLabel(solver->Name() + (start == 0 ? " tracking" : start == 1 ? " merged" : " inflated"));
-  state.counters["first_median_ms"] = MedianMs(runs.times[0]);
-  state.counters["throughout_median_ms"] = MedianMs(runs.times[1]);
+  ReportPaired(state, runs, "first", "throughout");
   state.counters["ratio"] = MedianMs(runs.times[0]) / MedianMs(runs.times[1]);
-  state.counters["first_t_err_m"] = runs.t_err[0] / count;
-  state.counters["first_r_err_deg"] = runs.r_err[0] / count;
-  state.counters["throughout_t_err_m"] = runs.t_err[1] / count;
-  state.counters["throughout_r_err_deg"] = runs.r_err[1] / count;
 }
 BENCHMARK(BM_GeometricFirstOverThroughout)->ArgsProduct({{0, 2}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
 

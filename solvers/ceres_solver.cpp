@@ -8,12 +8,12 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <memory>
 #include <stdexcept>
 #include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "radargauss/lie/manifold.hpp"
 #include "residuals/geometric_residual.hpp"
@@ -43,17 +43,12 @@ class TermRangeCost final : public ceres::CostFunction {
   using Dims = decltype(DimsOf(static_cast<const Term*>(nullptr)));
   static constexpr int kRows = Dims::kResiduals;
   static constexpr int kMaxBlockSize = 4;  // the quaternion
-  static constexpr bool RotationThenTranslations() {
-    if (Dims::kBlockSizes[0] != 4) return false;
-    for (int b = 1; b < Dims::kBlocks; ++b) {
-      if (Dims::kBlockSizes[b] != 3) return false;
-    }
-    return true;
-  }
-  static_assert(RotationThenTranslations(), "a rotation block (x y z w), then translation blocks");
-  static_assert(Dims::kBlocks <= 2, "a rotation and at most one translation block");
-  static constexpr int kAmbient = 4 + 3 * (Dims::kBlocks - 1);
-  static constexpr int kTangent = 3 * Dims::kBlocks;
+  // The pose blocks a term takes: the rotation (x y z w), then the translation or not.
+  static constexpr bool kWithTranslation = Dims::kBlocks == 2;
+  static_assert(Dims::kBlockSizes[0] == 4 && (Dims::kBlocks == 1 || (kWithTranslation && Dims::kBlockSizes[1] == 3)),
+                "a rotation block (x y z w), then at most a translation block");
+  static constexpr int kAmbient = kWithTranslation ? 7 : 4;
+  static constexpr int kTangent = kWithTranslation ? 6 : 3;
 
  public:
   // `loss`: each term's robust loss (nullptr: trivial); it must outlive this.
@@ -131,7 +126,7 @@ class TermRangeCost final : public ceres::CostFunction {
       // The upper triangle of J^T J (mirrored below), and J^T r.
       A.template topLeftCorner<4, 4>().noalias() += J_q.transpose() * J_q;
       b.template head<4>().noalias() += J_q.transpose() * residual;
-      if constexpr (kAmbient == 7) {
+      if constexpr (kWithTranslation) {
         A.template topRightCorner<4, 3>().noalias() += J_q.transpose() * J_t;
         A.template bottomRightCorner<3, 3>().noalias() += J_t.transpose() * J_t;
         b.template tail<3>().noalias() += J_t.transpose() * residual;
@@ -180,11 +175,12 @@ class TermRangeCost final : public ceres::CostFunction {
       J0.template topRows<kTangent>() = R.template leftCols<3>() * P_plus;
       J0.template bottomRows<1>().setZero();
     }
-    for (int blk = 1, col = 3; blk < Dims::kBlocks; col += 3, ++blk) {
-      if (jacobians[blk] == nullptr) continue;
-      Eigen::Map<Eigen::Matrix<double, kTangent + 1, 3, Eigen::RowMajor>> Jb(jacobians[blk]);
-      Jb.template topRows<kTangent>() = R.template middleCols<3>(col);
-      Jb.template bottomRows<1>().setZero();
+    if constexpr (kWithTranslation) {
+      if (jacobians[1] != nullptr) {
+        Eigen::Map<Eigen::Matrix<double, kTangent + 1, 3, Eigen::RowMajor>> J1(jacobians[1]);
+        J1.template topRows<kTangent>() = R.template rightCols<3>();
+        J1.template bottomRows<1>().setZero();
+      }
     }
     return true;
   }
