@@ -708,6 +708,15 @@ TEST(CeresSolver, ExactMapSolveEndsWhenThePoseLeavesTheAssociation) {
   EXPECT_THROW(CeresSolver(ScanMatchingOptions(), none), std::invalid_argument);
 }
 
+// A Jacobian Ceres returned (compressed rows) as a dense matrix.
+Eigen::MatrixXd Dense(const ceres::CRSMatrix& jacobian) {
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(jacobian.num_rows, jacobian.num_cols);
+  for (int row = 0; row < jacobian.num_rows; ++row) {
+    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) dense(row, jacobian.cols[k]) = jacobian.values[k];
+  }
+  return dense;
+}
+
 // The Ceres problem kept across associations holds exactly the latest
 // association: after updates that grow and shrink the term counts, change
 // level and weight, its cost (Ceres: 1/2 sum) is eq. 2 as EvaluateCost gives
@@ -810,12 +819,7 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
           gradients[l].insert(gradients[l].end(), gradient.begin(), gradient.end());
           if (!analytic) continue;
           ASSERT_EQ(jacobian.num_cols, 6);
-          Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(jacobian.num_rows, 6);
-          for (int row = 0; row < jacobian.num_rows; ++row) {
-            for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
-              dense(row, jacobian.cols[k]) = jacobian.values[k];
-            }
-          }
+          const Eigen::MatrixXd dense = Dense(jacobian);
           const Eigen::Matrix<double, 6, 6> normal = dense.transpose() * dense;
           if (shared_rows) shared_normal.push_back(normal);
           if (square_root) {
@@ -889,12 +893,7 @@ TEST(CeresScanProblem, SquareRootOfARankDeficientBlock) {
     ceres::CRSMatrix jacobian;
     EXPECT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &e.cost, nullptr, &e.gradient,
                                            &jacobian));
-    Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(jacobian.num_rows, 6);
-    for (int row = 0; row < jacobian.num_rows; ++row) {
-      for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
-        dense(row, jacobian.cols[k]) = jacobian.values[k];
-      }
-    }
+    const Eigen::MatrixXd dense = Dense(jacobian);
     EXPECT_TRUE(dense.allFinite());
     e.normal = dense.transpose() * dense;
     return e;
