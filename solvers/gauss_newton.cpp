@@ -85,7 +85,7 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
     double second = 0.0;
     for (const GeometricTerm& term : c.geometric) {
-      const Eigen::Matrix3d& information = c.index->Information(term.gaussian);
+      const Eigen::Matrix3d information = c.index->Information(term.gaussian);
       const Eigen::Vector3d q = R * term.point_radar;
       const Eigen::Vector3d e = q + pose.translation() - c.index->Mean(term.gaussian);
       const Eigen::Vector3d information_e = information * e;

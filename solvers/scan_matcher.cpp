@@ -156,7 +156,7 @@ double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchi
   const Eigen::Matrix3d Rt = R.transpose();
   for (const GeometricTerm& term : c.geometric) {
     const Eigen::Vector3d e = R * term.point_radar + pose.translation() - c.index->Mean(term.gaussian);
-    geometric.Add(e.dot(c.index->Information(term.gaussian) * e));  // ||L^T e||^2
+    geometric.Add(c.index->MahalanobisSq(term.gaussian, e));  // ||L^T e||^2
   }
   const Eigen::Vector3d rcs_translation =
       options.rcs_translation == RcsTranslation::kRotationOnly ? c.pose.translation() : pose.translation();

@@ -190,12 +190,18 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
     if (expected >= 0) {
       EXPECT_NEAR(d2, best, 1e-9);
       ++associated;
-      // ||L^T e||^2 is the Mahalanobis^2 too.
+      // ||L^T e||^2 is the Mahalanobis^2 too, and so is MahalanobisSq.
       EXPECT_NEAR((index.SqrtInformationT(expected) * (p - index.Mean(expected))).squaredNorm(), best,
                   1e-9);
+      EXPECT_NEAR(index.MahalanobisSq(expected, p - index.Mean(expected)), best, 1e-9);
     }
   }
   EXPECT_GT(associated, 50);
+  // The information the index forms from its factor L^T is Sigma^-1.
+  for (std::size_t g = 0; g < planted.gaussians.size(); ++g) {
+    const Eigen::Matrix3d information = planted.gaussians[g].covariance.inverse();
+    EXPECT_LT((index.Information(g) - information).norm(), 1e-10 * information.norm()) << g;
+  }
   std::vector<int> batched(points.size(), -2);
   std::vector<double> batched_d2(points.size(), -1.0);
   index.AssociateAll(points.data(), points.size(), 9.0, batched.data(), batched_d2.data());

@@ -173,7 +173,7 @@ std::vector<Gaussian> HardEm(const std::vector<Eigen::Vector3d>& points,
       for (std::size_t c = 0; c < count; ++c) {
         const std::uint32_t g = candidates[c];
         const Eigen::Vector3d e = points[i] - index.Mean(g);
-        const double cost = 0.5 * e.dot(index.Information(g) * e) + half_log_det[g];
+        const double cost = 0.5 * index.MahalanobisSq(g, e) + half_log_det[g];
         if (cost < best_cost) {
           best_cost = cost;
           best = int(g);

@@ -82,8 +82,7 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
     const Gaussian& g = gaussians[i];
     IndexedGaussian& entry = gaussians_[i];
     entry.mean = g.mean;
-    entry.information = g.covariance.inverse();
-    entry.sqrt_information_t = Eigen::LLT<Eigen::Matrix3d>(entry.information).matrixL().transpose();
+    entry.sqrt_information_t = Eigen::LLT<Eigen::Matrix3d>(g.covariance.inverse()).matrixL().transpose();
     const Eigen::Vector3d half = extent_sigmas * g.covariance.diagonal().cwiseSqrt();
     // The cells as Key finds them (VoxelOf of the box's corners).
     const VoxelKey lo = VoxelOf(g.mean - half, cell_size);
@@ -154,14 +153,7 @@ int GaussianIndex::Nearest(const Eigen::Vector3d& point, const std::uint32_t* ca
   double best_d2 = bound;
   for (std::size_t k = 0; k < count; ++k) {
     const std::uint32_t i = candidates[k];
-    const IndexedGaussian& entry = gaussians_[i];
-    // Mahalanobis^2 = |L^T e|^2, L^T upper triangular: 9 products (e^T Sigma^-1 e takes 12).
-    const Eigen::Vector3d e = point - entry.mean;
-    const Eigen::Matrix3d& U = entry.sqrt_information_t;
-    const double y0 = U(0, 0) * e.x() + U(0, 1) * e.y() + U(0, 2) * e.z();
-    const double y1 = U(1, 1) * e.y() + U(1, 2) * e.z();
-    const double y2 = U(2, 2) * e.z();
-    const double d2 = y0 * y0 + y1 * y1 + y2 * y2;
+    const double d2 = MahalanobisSq(i, point - gaussians_[i].mean);
     const bool closer = d2 < best_d2;
     best_d2 = closer ? d2 : best_d2;
     best = closer ? static_cast<int>(i) : best;

@@ -94,9 +94,26 @@ class GaussianIndex {
   // Gaussians whose box contains the cell of `point`.
   const std::uint32_t* Candidates(const Eigen::Vector3d& point, std::size_t& count) const;
 
-  const Eigen::Matrix3d& Information(std::size_t i) const { return gaussians_[i].information; }
   // L^T with Sigma^-1 = L L^T (Cholesky), so ||L^T (x - mu)||^2 is the Mahalanobis^2.
   const Eigen::Matrix3d& SqrtInformationT(std::size_t i) const { return gaussians_[i].sqrt_information_t; }
+  // Sigma^-1 = L L^T, formed from the upper-triangular L^T (the index keeps
+  // only the factor: a query reads two cache lines per candidate).
+  Eigen::Matrix3d Information(std::size_t i) const {
+    const Eigen::Matrix3d& U = gaussians_[i].sqrt_information_t;
+    const double i00 = U(0, 0) * U(0, 0), i01 = U(0, 0) * U(0, 1), i02 = U(0, 0) * U(0, 2);
+    const double i11 = U(0, 1) * U(0, 1) + U(1, 1) * U(1, 1), i12 = U(0, 1) * U(0, 2) + U(1, 1) * U(1, 2);
+    const double i22 = U(0, 2) * U(0, 2) + U(1, 2) * U(1, 2) + U(2, 2) * U(2, 2);
+    return (Eigen::Matrix3d() << i00, i01, i02, i01, i11, i12, i02, i12, i22).finished();
+  }
+  // The Mahalanobis^2 of x - mu = e, |L^T e|^2: 9 products with the triangle
+  // (e^T Sigma^-1 e takes 12).
+  double MahalanobisSq(std::size_t i, const Eigen::Vector3d& e) const {
+    const Eigen::Matrix3d& U = gaussians_[i].sqrt_information_t;
+    const double y0 = U(0, 0) * e.x() + U(0, 1) * e.y() + U(0, 2) * e.z();
+    const double y1 = U(1, 1) * e.y() + U(1, 2) * e.z();
+    const double y2 = U(2, 2) * e.z();
+    return y0 * y0 + y1 * y1 + y2 * y2;
+  }
   const Eigen::Vector3d& Mean(std::size_t i) const { return gaussians_[i].mean; }
   std::size_t size() const { return gaussians_.size(); }
   std::size_t MemoryBytes() const;
@@ -110,7 +127,6 @@ class GaussianIndex {
   struct alignas(64) IndexedGaussian {
     Eigen::Vector3d mean;
     Eigen::Matrix3d sqrt_information_t;
-    Eigen::Matrix3d information;
   };
   std::vector<IndexedGaussian> gaussians_;
   std::vector<std::uint32_t> cell_entries_;  // Gaussian ids grouped by cell
