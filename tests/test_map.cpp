@@ -159,8 +159,8 @@ TEST(GaussianBuilder, ClampsStdAndVoxelBaseline) {
 }
 
 // The index gives the brute-force answer: every point within tau <= 3 of a
-// Gaussian lies in its 3-sigma box. So does the batched query (AssociateAll),
-// which fetches ahead and must not change an answer.
+// Gaussian lies in a cell its 3-sigma ellipsoid meets. So does the batched
+// query (AssociateAll), which fetches ahead and must not change an answer.
 TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
   const Planted planted = PlantGaussians(10, 3);
   const GaussianIndex index(planted.gaussians, 0.7);
@@ -228,6 +228,95 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
   index.AssociateAll(points.data(), 3, 9.0, batched.data());
   EXPECT_EQ(std::vector<int>(batched.begin(), batched.begin() + 3),
             std::vector<int>(expected_all.begin(), expected_all.begin() + 3));
+}
+
+// The smallest Mahalanobis^2 from `mean` over the box [lo, hi], exactly: the
+// minimum of a convex quadratic over a box is where some coordinates lie on
+// a face and the others minimise it given them; the least of those points
+// that are in the box (27 face choices).
+double SmallestMahalanobisSqOverBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                    const Eigen::Vector3d& mean, const Eigen::Matrix3d& information) {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (int choice = 0; choice < 27; ++choice) {
+    int face[3];  // 0: free, 1: on lo, 2: on hi
+    std::vector<int> free;
+    Eigen::Vector3d x = mean;
+    for (int i = 0, c = choice; i < 3; ++i, c /= 3) {
+      face[i] = c % 3;
+      if (face[i] == 0) free.push_back(i);
+      if (face[i] == 1) x[i] = lo[i];
+      if (face[i] == 2) x[i] = hi[i];
+    }
+    if (!free.empty()) {  // d/dx_f of (x - mu)^T I (x - mu) = 0 for the free coordinates
+      const int n = int(free.size());
+      Eigen::MatrixXd A(n, n);
+      Eigen::VectorXd b(n);
+      for (int r = 0; r < n; ++r) {
+        b[r] = 0.0;
+        for (int i = 0; i < 3; ++i) {
+          if (face[i] != 0) b[r] -= information(free[r], i) * (x[i] - mean[i]);
+        }
+        for (int c = 0; c < n; ++c) A(r, c) = information(free[r], free[c]);
+      }
+      const Eigen::VectorXd offset = A.ldlt().solve(b);
+      bool inside = true;
+      for (int r = 0; r < n; ++r) {
+        x[free[r]] = mean[free[r]] + offset[r];
+        inside = inside && x[free[r]] >= lo[free[r]] && x[free[r]] <= hi[free[r]];
+      }
+      if (!inside) continue;
+    }
+    smallest = std::min(smallest, (x - mean).dot(information * (x - mean)));
+  }
+  return smallest;
+}
+
+// The index lists a Gaussian in exactly the cells its ellipsoid of 3 std
+// meets, not in every cell of the ellipsoid's box: against the exact
+// smallest Mahalanobis distance over each cell of the box, for a flat
+// oblique Gaussian (most of its box is empty) and a round one (the box's
+// corners are).
+TEST(GaussianIndexTest, ListsAGaussianInTheCellsItsEllipsoidMeets) {
+  const double cell = 0.25;
+  Gaussian flat;
+  flat.mean = Eigen::Vector3d(0.31, -0.22, 0.13);
+  const Eigen::Matrix3d axes = SO3d::Exp(Eigen::Vector3d(0.4, 0.7, 0.2)).Matrix();
+  flat.covariance = axes * Eigen::Vector3d(1.0, 0.36, 0.0025).asDiagonal() * axes.transpose();
+  Gaussian round;
+  round.mean = Eigen::Vector3d(-0.07, 0.11, 0.05);
+  round.covariance = 0.09 * Eigen::Matrix3d::Identity();
+  for (const Gaussian& g : {flat, round}) {
+    const GaussianIndex index({g}, cell);
+    const Eigen::Matrix3d information = g.covariance.inverse();
+    const Eigen::Vector3d half = 3.0 * g.covariance.diagonal().cwiseSqrt();
+    const VoxelKey lo = VoxelOf(g.mean - half, cell), hi = VoxelOf(g.mean + half, cell);
+    int box_cells = 0, listed = 0;
+    for (auto x = lo.x; x <= hi.x; ++x) {
+      for (auto y = lo.y; y <= hi.y; ++y) {
+        for (auto z = lo.z; z <= hi.z; ++z) {
+          const Eigen::Vector3d corner = cell * Eigen::Vector3d(double(x), double(y), double(z));
+          const double smallest = SmallestMahalanobisSqOverBox(corner, corner.array() + cell, g.mean, information);
+          std::size_t count = 0;
+          index.Candidates(corner.array() + 0.5 * cell, count);
+          ++box_cells;
+          listed += int(count);
+          // Cells whose distance is within 0.1% of the extent may go either way.
+          if (std::abs(smallest - 9.0) > 0.02) {
+            EXPECT_EQ(count, smallest < 9.0 ? 1u : 0u) << x << " " << y << " " << z << ": " << smallest;
+          }
+        }
+      }
+    }
+    EXPECT_LT(listed, 0.8 * box_cells) << listed << " of " << box_cells;
+    // Points on the ellipsoid (just inside the gate) find the Gaussian in their cell.
+    std::mt19937 rng(7);
+    const Eigen::Matrix3d root = g.covariance.llt().matrixL();
+    for (int k = 0; k < 5000; ++k) {
+      const Eigen::Vector3d p = g.mean + root * (3.0 * (1.0 - 1e-12) * RandomUnitVector(rng));
+      ASSERT_EQ(index.Associate(p, 9.0), 0) << p.transpose();
+    }
+  }
+  EXPECT_THROW(GaussianIndex({flat}, cell, 0.0), std::invalid_argument);
 }
 
 // A point exactly on the gate is associated, one just beyond it is not, and

@@ -1422,8 +1422,8 @@ TEST(CoarseGate, CoarseLevelsAssociateWithinIt) {
     EXPECT_EQ(associated[0], coarse_gate > 2.59 ? 6u : 3u);
     EXPECT_FALSE(result.converged);
     EXPECT_EQ(result.reason, "no point associated to the map");
-    // Cells of side 1 m: x = 3.2 m lies in the box of +/- 3 std (3.015 m), not
-    // in that of +/- 2 std (2.01 m).
+    // Cells of side 1 m: the cell of x = 3.2 m meets the ellipsoid of 3 std
+    // (to 3.015 m), not that of 2 std (2.01 m).
     std::size_t count = 0;
     matching.level(0).Candidates(Eigen::Vector3d(3.2, 0.0, 0.0), count);
     EXPECT_EQ(count, coarse_gate == 3.0 ? 1u : 0u);

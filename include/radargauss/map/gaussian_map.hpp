@@ -68,9 +68,10 @@ struct VoxelKey {
 };
 VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel);
 
-// Spatial index: a voxel hash over each Gaussian's box of +/- `extent_sigmas`
-// standard deviations, so a query point has a few candidates; association is
-// the candidate of smallest Mahalanobis^2, gated by tau^2.
+// Spatial index: a voxel hash listing each Gaussian in the cells its
+// ellipsoid of `extent_sigmas` standard deviations (Mahalanobis distance)
+// meets, so a query point has a few candidates; association is the candidate
+// of smallest Mahalanobis^2, gated by tau^2 (complete for tau <= extent).
 class GaussianIndex {
  public:
   GaussianIndex() = default;
@@ -91,7 +92,7 @@ class GaussianIndex {
   void AssociateAll(const Eigen::Vector3d* points, std::size_t count, double gate_sq, int* associations,
                     double* mahalanobis_sq = nullptr) const;
 
-  // Gaussians whose box contains the cell of `point`.
+  // The Gaussians whose ellipsoid of extent_sigmas meets the cell of `point`.
   const std::uint32_t* Candidates(const Eigen::Vector3d& point, std::size_t& count) const;
 
   // L^T with Sigma^-1 = L L^T (Cholesky), so ||L^T (x - mu)||^2 is the Mahalanobis^2.
