@@ -62,6 +62,114 @@ SE3d Step(const SE3d& pose, const Eigen::Matrix<double, 6, 1>& dx) {
               pose.translation() + dx.segment<3>(kTranslationOffset));
 }
 
+// The sums of BuildGeometricSystem's analytic path, taken without R (see
+// there): with T = double one term at a time, with T = Eigen::Array2d two
+// terms at once, one per SIMD lane (the same arithmetic in half the
+// instructions; this loop was a third of a match's).
+template <typename T>
+struct GeometricSums {
+  T A_tt[6], A_rr[6];  // symmetric: upper triangles (00 01 02 11 12 22)
+  T A_tr[3][3];
+  T b_t[3], b_r[3];
+  explicit GeometricSums(const T& zero) {
+    for (int i = 0; i < 6; ++i) A_tt[i] = A_rr[i] = zero;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) A_tr[i][j] = zero;
+      b_t[i] = b_r[i] = zero;
+    }
+  }
+};
+
+// What a term brings: the upper triangle of L^T (00 01 02 11 12 22), q = R p
+// and e = q + t - mu.
+template <typename T>
+struct GeometricTermInputs {
+  T U[6], q[3], e[3];
+};
+
+// One value per lane: f(0) for a term, f(0) and f(1) for a pair.
+template <typename T>
+struct Lanes;
+template <>
+struct Lanes<double> {
+  template <typename F>
+  static double Of(F&& f) { return f(0); }
+};
+template <>
+struct Lanes<Eigen::Array2d> {
+  template <typename F>
+  static Eigen::Array2d Of(F&& f) { return Eigen::Array2d(f(0), f(1)); }
+};
+
+// The inputs of term k, and of term k + 1 in the second lane of a pair.
+template <typename T>
+GeometricTermInputs<T> Inputs(const Correspondences& c, std::size_t k, const Eigen::Matrix3d& R,
+                              const Eigen::Vector3d& t) {
+  const GeometricTerm* terms = &c.geometric[k];
+  const auto gather = [&](auto&& value) { return Lanes<T>::Of([&](int lane) { return value(terms[lane]); }); };
+  constexpr int kUpper[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+  GeometricTermInputs<T> in;
+  for (int i = 0; i < 6; ++i) {
+    in.U[i] = gather([&](const GeometricTerm& term) {
+      return c.index->SqrtInformationT(term.gaussian)(kUpper[i][0], kUpper[i][1]);
+    });
+  }
+  T p[3], mean[3];
+  for (int i = 0; i < 3; ++i) {
+    p[i] = gather([&](const GeometricTerm& term) { return term.point_radar[i]; });
+    mean[i] = gather([&](const GeometricTerm& term) { return c.index->Mean(term.gaussian)[i]; });
+  }
+  for (int i = 0; i < 3; ++i) {
+    in.q[i] = R(i, 0) * p[0] + R(i, 1) * p[1] + R(i, 2) * p[2];
+    in.e[i] = in.q[i] + t[i] - mean[i];
+  }
+  return in;
+}
+
+// Adds a term (or a pair) to `sums`; weight_of(s, Sigma^-1 e) gives the IRLS
+// weight of s = e^T Sigma^-1 e.
+template <typename T, typename WeightOf>
+void AddGeometricTerm(const GeometricTermInputs<T>& in, GeometricSums<T>& sums, WeightOf&& weight_of) {
+  const T* U = in.U;
+  // Sigma^-1 = L L^T (GaussianIndex::Information).
+  const T i00 = U[0] * U[0], i01 = U[0] * U[1], i02 = U[0] * U[2];
+  const T i11 = U[1] * U[1] + U[3] * U[3], i12 = U[1] * U[2] + U[3] * U[4];
+  const T i22 = U[2] * U[2] + U[4] * U[4] + U[5] * U[5];
+  const T* q = in.q;
+  const T* e = in.e;
+  const T information_e[3] = {i00 * e[0] + i01 * e[1] + i02 * e[2], i01 * e[0] + i11 * e[1] + i12 * e[2],
+                              i02 * e[0] + i12 * e[1] + i22 * e[2]};
+  const T weight = weight_of(e[0] * information_e[0] + e[1] * information_e[1] + e[2] * information_e[2],
+                             information_e);
+  // B = w Sigma^-1 [q]x column by column (column k is Sigma^-1 (e_k x w q)),
+  // then the upper triangle of [q]x B as components of cross products: the
+  // zeros of [q]x never enter a product.
+  const T wq[3] = {weight * q[0], weight * q[1], weight * q[2]};
+  const T B[3][3] = {{wq[2] * i01 - wq[1] * i02, wq[0] * i02 - wq[2] * i00, wq[1] * i00 - wq[0] * i01},
+                     {wq[2] * i11 - wq[1] * i12, wq[0] * i12 - wq[2] * i01, wq[1] * i01 - wq[0] * i11},
+                     {wq[2] * i12 - wq[1] * i22, wq[0] * i22 - wq[2] * i02, wq[1] * i02 - wq[0] * i12}};
+  sums.A_tt[0] += weight * i00;
+  sums.A_tt[1] += weight * i01;
+  sums.A_tt[2] += weight * i02;
+  sums.A_tt[3] += weight * i11;
+  sums.A_tt[4] += weight * i12;
+  sums.A_tt[5] += weight * i22;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) sums.A_tr[i][j] -= B[i][j];
+  }
+  // (q x B_k)_i for i <= k; A_rr -= it ([q]x^T = -[q]x).
+  sums.A_rr[0] -= q[1] * B[2][0] - q[2] * B[1][0];
+  sums.A_rr[1] -= q[1] * B[2][1] - q[2] * B[1][1];
+  sums.A_rr[2] -= q[1] * B[2][2] - q[2] * B[1][2];
+  sums.A_rr[3] -= q[2] * B[0][1] - q[0] * B[2][1];
+  sums.A_rr[4] -= q[2] * B[0][2] - q[0] * B[2][2];
+  sums.A_rr[5] -= q[0] * B[1][2] - q[1] * B[0][2];
+  for (int i = 0; i < 3; ++i) sums.b_t[i] += weight * information_e[i];
+  sums.b_r[0] += wq[1] * information_e[2] - wq[2] * information_e[1];
+  sums.b_r[1] += wq[2] * information_e[0] - wq[0] * information_e[2];
+  sums.b_r[2] += wq[0] * information_e[1] - wq[1] * information_e[0];
+}
+
 }  // namespace
 
 LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
@@ -76,50 +184,49 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     // H_tt = sum w Sigma^-1, H_tr = (sum -w Sigma^-1 [q]x) R,
     // H_rr = R^T (sum w [q]x^T Sigma^-1 [q]x) R, g_t = sum w Sigma^-1 e,
     // g_r = R^T (sum w [q]x Sigma^-1 e).
-    // The symmetric A_tt and A_rr by their upper triangles (00 01 02 11 12 22).
-    double A_tt_upper[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}, A_rr_upper[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-    Eigen::Matrix3d A_tr = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d b_t = Eigen::Vector3d::Zero(), b_r = Eigen::Vector3d::Zero();
+    // Sums of one term at a time, and of pairs of terms in SIMD lanes.
+    GeometricSums<double> single(0.0);
+    GeometricSums<Eigen::Array2d> pairs(Eigen::Array2d::Zero());
     // Loss curvature (options.loss_curvature), with J^T r = [I_e; R^T (q x I_e)]
     // (I_e = Sigma^-1 e): summed without R as well.
     Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
-    double second = 0.0;
-    for (const GeometricTerm& term : c.geometric) {
-      const Eigen::Matrix3d information = c.index->Information(term.gaussian);
-      const Eigen::Vector3d q = R * term.point_radar;
-      const Eigen::Vector3d e = q + pose.translation() - c.index->Mean(term.gaussian);
-      const Eigen::Vector3d information_e = information * e;
-      const double s = e.dot(information_e);
+    const auto weight_of = [&](double s, const Eigen::Vector3d& q, const Eigen::Vector3d& information_e) {
+      double second = 0.0;
       const double weight = loss.Add(s, &second);
       if (options.loss_curvature && second != 0.0) {
         Eigen::Matrix<double, 6, 1> Jt_r;
         Jt_r << information_e, q.cross(information_e);
         C.noalias() += CurvatureAlongResidual(s, weight, second) * Jt_r * Jt_r.transpose();
       }
-      // Sigma^-1 [q]x column by column (column k is Sigma^-1 (e_k x q)), then
-      // the upper triangle of [q]x (Sigma^-1 [q]x) as components of cross
-      // products: the zeros of [q]x never enter a product.
-      const Eigen::Vector3d w_q = weight * q;
-      Eigen::Matrix3d B;  // w Sigma^-1 [q]x
-      B.col(0) = w_q.z() * information.col(1) - w_q.y() * information.col(2);
-      B.col(1) = w_q.x() * information.col(2) - w_q.z() * information.col(0);
-      B.col(2) = w_q.y() * information.col(0) - w_q.x() * information.col(1);
-      A_tt_upper[0] += weight * information(0, 0);
-      A_tt_upper[1] += weight * information(0, 1);
-      A_tt_upper[2] += weight * information(0, 2);
-      A_tt_upper[3] += weight * information(1, 1);
-      A_tt_upper[4] += weight * information(1, 2);
-      A_tt_upper[5] += weight * information(2, 2);
-      A_tr.noalias() -= B;
-      // (q x B_k)_i for the upper triangle i <= k; A_rr -= it ([q]x^T = -[q]x).
-      A_rr_upper[0] -= q.y() * B(2, 0) - q.z() * B(1, 0);
-      A_rr_upper[1] -= q.y() * B(2, 1) - q.z() * B(1, 1);
-      A_rr_upper[2] -= q.y() * B(2, 2) - q.z() * B(1, 2);
-      A_rr_upper[3] -= q.z() * B(0, 1) - q.x() * B(2, 1);
-      A_rr_upper[4] -= q.z() * B(0, 2) - q.x() * B(2, 2);
-      A_rr_upper[5] -= q.x() * B(1, 2) - q.y() * B(0, 2);
-      b_t.noalias() += weight * information_e;
-      b_r.noalias() += w_q.cross(information_e);
+      return weight;
+    };
+    const std::size_t n = c.geometric.size();
+    std::size_t k = 0;
+    for (; k + 1 < n; k += 2) {
+      const GeometricTermInputs<Eigen::Array2d> in = Inputs<Eigen::Array2d>(c, k, R, pose.translation());
+      AddGeometricTerm(in, pairs, [&](const Eigen::Array2d& s, const Eigen::Array2d* information_e) {
+        const auto lane = [&](const Eigen::Array2d* v, int l) { return Eigen::Vector3d(v[0][l], v[1][l], v[2][l]); };
+        const double weight_a = weight_of(s[0], lane(in.q, 0), lane(information_e, 0));  // in term order
+        return Eigen::Array2d(weight_a, weight_of(s[1], lane(in.q, 1), lane(information_e, 1)));
+      });
+    }
+    for (; k < n; ++k) {
+      const GeometricTermInputs<double> in = Inputs<double>(c, k, R, pose.translation());
+      AddGeometricTerm(in, single, [&](double s, const double* information_e) {
+        return weight_of(s, Eigen::Vector3d(in.q), Eigen::Vector3d(information_e));
+      });
+    }
+    double A_tt_upper[6], A_rr_upper[6];
+    Eigen::Matrix3d A_tr;
+    Eigen::Vector3d b_t, b_r;
+    for (int i = 0; i < 6; ++i) {
+      A_tt_upper[i] = single.A_tt[i] + pairs.A_tt[i].sum();
+      A_rr_upper[i] = single.A_rr[i] + pairs.A_rr[i].sum();
+    }
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) A_tr(i, j) = single.A_tr[i][j] + pairs.A_tr[i][j].sum();
+      b_t[i] = single.b_t[i] + pairs.b_t[i].sum();
+      b_r[i] = single.b_r[i] + pairs.b_r[i].sum();
     }
     const auto from_upper = [](const double* u) {
       Eigen::Matrix3d m;
