@@ -71,14 +71,16 @@ bool CellMeetsEllipsoid(Eigen::Vector3d lo, Eigen::Vector3d hi, const Eigen::Vec
   lo.array() -= margin;
   hi.array() += margin;
   extent *= 1.0 + 1e-6;
+  const double extent_sq = extent * extent;
   Eigen::Vector3d x = mean.cwiseMax(lo).cwiseMin(hi);
   for (int sweep = 0; sweep < 6; ++sweep) {
+    if ((x - mean).dot(information * (x - mean)) <= extent_sq) return true;  // x itself is within the extent
     for (int i = 0; i < 3; ++i) {
       x[i] = std::clamp(x[i] - information.row(i).dot(x - mean) / information(i, i), lo[i], hi[i]);
     }
   }
   const Eigen::Vector3d n = information * (x - mean);  // the outward normal of the ellipsoid through x
-  if ((x - mean).dot(n) <= extent * extent) return true;  // x itself is within the extent
+  if ((x - mean).dot(n) <= extent_sq) return true;
   // Along n the ellipsoid reaches n.mu + extent sqrt(n^T Sigma n); the cell starts at its lowest corner.
   double cell_low = 0.0;
   for (int i = 0; i < 3; ++i) cell_low += std::min(n[i] * lo[i], n[i] * hi[i]);
