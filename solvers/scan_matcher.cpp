@@ -82,7 +82,8 @@ MatchingMap::MatchingMap(const GaussianMap& map, const MatchingMapOptions& optio
                                       ? MergedGaussians(map.gaussians, kMergeCellPerSigma * sigma)
                                       : map.gaussians;
     for (Gaussian& g : level) g.covariance += sigma * sigma * Eigen::Matrix3d::Identity();
-    levels_.emplace_back(level, std::max(options.index_cell, sigma), options.coarse_gate);
+    levels_.emplace_back(level, std::max(options.index_cell, CoarseIndexCell(options.coarse, sigma)),
+                         options.coarse_gate);
     sigmas_.push_back(sigma);
   }
   levels_.emplace_back(map.gaussians, options.index_cell);

@@ -95,6 +95,14 @@ enum class CoarseLevels {
               // far fewer candidates per query (faster), measured trade-off in the README
 };
 inline constexpr double kMergeCellPerSigma = 3.0;
+// The index cell of a coarse level before MatchingMapOptions::index_cell's
+// floor: sigma_k for inflated levels (every Gaussian, blurred); half the merge
+// cell for merged ones, whose Gaussians are one per merge cell, so that a
+// query still has few candidates and the index is half the size (faster:
+// RESULTS.md).
+inline double CoarseIndexCell(CoarseLevels coarse, double sigma) {
+  return coarse == CoarseLevels::kMerged ? 0.5 * kMergeCellPerSigma * sigma : sigma;
+}
 std::string ToString(CoarseLevels coarse);
 CoarseLevels CoarseLevelsFromString(const std::string& name);  // throws std::invalid_argument
 
@@ -108,7 +116,7 @@ CoarseLevels CoarseLevelsFromString(const std::string& name);  // throws std::in
 // and with w = 1 the coarse levels are skipped.
 struct MatchingMapOptions {
   std::vector<double> inflation = {1.0, 0.5, 0.25};  // sigma_k of the coarse levels (m), coarse first
-  double index_cell = 0.5;  // m: cell of the exact level's index (coarse: max(cell, sigma_k))
+  double index_cell = 0.5;  // m: cell of the exact level's index (coarse: max(cell, CoarseIndexCell))
   CoarseLevels coarse = CoarseLevels::kInflated;
   // tau on the coarse levels (Mahalanobis distance to the blurred Gaussians;
   // the exact map uses ScanMatchingOptions::gate). Their indexes cover

@@ -1339,6 +1339,15 @@ TEST(MergedCoarseLevels, MomentMatchedMixturePerVoxel) {
   EXPECT_LT((coarse.Information(1 - merged).inverse() - far_covariance).norm(), 1e-9);
   // The exact level is the map itself.
   EXPECT_EQ(matching.index().size(), 3u);
+  // Index cells: half the merge cell on a merged level, sigma on an inflated
+  // one, at least index_cell.
+  EXPECT_EQ(coarse.cell_size(), 1.5);
+  EXPECT_EQ(matching.index().cell_size(), options.index_cell);
+  options.coarse = CoarseLevels::kInflated;
+  options.inflation = {1.0, 0.25};
+  const MatchingMap inflated(map, options);
+  EXPECT_EQ(inflated.level(0).cell_size(), 1.0);
+  EXPECT_EQ(inflated.level(1).cell_size(), options.index_cell);
   EXPECT_THROW(CoarseLevelsFromString("blurred"), std::invalid_argument);
   EXPECT_EQ(CoarseLevelsFromString(ToString(CoarseLevels::kMerged)), CoarseLevels::kMerged);
 }

@@ -117,6 +117,7 @@ class GaussianIndex {
   }
   const Eigen::Vector3d& Mean(std::size_t i) const { return gaussians_[i].mean; }
   std::size_t size() const { return gaussians_.size(); }
+  double cell_size() const { return cell_size_; }
   std::size_t MemoryBytes() const;
 
  private:
