@@ -141,7 +141,7 @@ void AddGeometricTerm(const GeometricTermInputs<T>& in, GeometricSums<T>& sums, 
                               i02 * e[0] + i12 * e[1] + i22 * e[2]};
   const T weight = weight_of(e[0] * information_e[0] + e[1] * information_e[1] + e[2] * information_e[2],
                              information_e);
-  // B = w Sigma^-1 [q]x column by column (column k is Sigma^-1 (e_k x w q)),
+  // B = w Sigma^-1 [q]x column by column (column k is Sigma^-1 (w q x e_k)),
   // then the upper triangle of [q]x B as components of cross products: the
   // zeros of [q]x never enter a product.
   const T wq[3] = {weight * q[0], weight * q[1], weight * q[2]};
