@@ -130,11 +130,10 @@ GeometricTermInputs<T> Inputs(const Correspondences& c, std::size_t k, const Eig
 // weight of s = e^T Sigma^-1 e.
 template <typename T, typename WeightOf>
 void AddGeometricTerm(const GeometricTermInputs<T>& in, GeometricSums<T>& sums, WeightOf&& weight_of) {
-  const T* U = in.U;
-  // Sigma^-1 = L L^T (GaussianIndex::Information).
-  const T i00 = U[0] * U[0], i01 = U[0] * U[1], i02 = U[0] * U[2];
-  const T i11 = U[1] * U[1] + U[3] * U[3], i12 = U[1] * U[2] + U[3] * U[4];
-  const T i22 = U[2] * U[2] + U[4] * U[4] + U[5] * U[5];
+  T information[6];
+  InformationFromSqrtInformationT(in.U, information);
+  const T &i00 = information[0], &i01 = information[1], &i02 = information[2];
+  const T &i11 = information[3], &i12 = information[4], &i22 = information[5];
   const T* q = in.q;
   const T* e = in.e;
   const T information_e[3] = {i00 * e[0] + i01 * e[1] + i02 * e[2], i01 * e[0] + i11 * e[1] + i12 * e[2],

@@ -115,7 +115,8 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
     const Gaussian& g = gaussians[i];
     IndexedGaussian& entry = gaussians_[i];
     entry.mean = g.mean;
-    entry.sqrt_information_t = Eigen::LLT<Eigen::Matrix3d>(g.covariance.inverse()).matrixL().transpose();
+    const Eigen::Matrix3d information = g.covariance.inverse();
+    entry.sqrt_information_t = Eigen::LLT<Eigen::Matrix3d>(information).matrixL().transpose();
     const Eigen::Vector3d half = extent_sigmas * g.covariance.diagonal().cwiseSqrt();
     // The cells as Key finds them (VoxelOf of the box's corners).
     const VoxelKey lo = VoxelOf(g.mean - half, cell_size);
@@ -123,7 +124,6 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
     // Of the box's cells, those the ellipsoid itself meets: an oblique or
     // round Gaussian leaves many of its box's cells empty (fewer candidates
     // per query, the same answers).
-    const Eigen::Matrix3d information = g.covariance.inverse();
     for (auto x = lo.x; x <= hi.x; ++x) {
       for (auto y = lo.y; y <= hi.y; ++y) {
         for (auto z = lo.z; z <= hi.z; ++z) {

@@ -68,6 +68,19 @@ struct VoxelKey {
 };
 VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel);
 
+// The upper triangle (00 01 02 11 12 22) of Sigma^-1 = L L^T from that of the
+// upper-triangular L^T, for one Gaussian (T = double) or one per SIMD lane
+// (T = Eigen::Array2d): 10 products over the symmetric triangle.
+template <typename T>
+void InformationFromSqrtInformationT(const T u[6], T information[6]) {
+  information[0] = u[0] * u[0];
+  information[1] = u[0] * u[1];
+  information[2] = u[0] * u[2];
+  information[3] = u[1] * u[1] + u[3] * u[3];
+  information[4] = u[1] * u[2] + u[3] * u[4];
+  information[5] = u[2] * u[2] + u[4] * u[4] + u[5] * u[5];
+}
+
 // Spatial index: a voxel hash listing each Gaussian in the cells its
 // ellipsoid of `extent_sigmas` standard deviations (Mahalanobis distance)
 // meets, so a query point has a few candidates; association is the candidate
@@ -101,10 +114,10 @@ class GaussianIndex {
   // only the factor: a query reads two cache lines per candidate).
   Eigen::Matrix3d Information(std::size_t i) const {
     const Eigen::Matrix3d& U = gaussians_[i].sqrt_information_t;
-    const double i00 = U(0, 0) * U(0, 0), i01 = U(0, 0) * U(0, 1), i02 = U(0, 0) * U(0, 2);
-    const double i11 = U(0, 1) * U(0, 1) + U(1, 1) * U(1, 1), i12 = U(0, 1) * U(0, 2) + U(1, 1) * U(1, 2);
-    const double i22 = U(0, 2) * U(0, 2) + U(1, 2) * U(1, 2) + U(2, 2) * U(2, 2);
-    return (Eigen::Matrix3d() << i00, i01, i02, i01, i11, i12, i02, i12, i22).finished();
+    const double u[6] = {U(0, 0), U(0, 1), U(0, 2), U(1, 1), U(1, 2), U(2, 2)};
+    double m[6];
+    InformationFromSqrtInformationT(u, m);
+    return (Eigen::Matrix3d() << m[0], m[1], m[2], m[1], m[3], m[4], m[2], m[4], m[5]).finished();
   }
   // The Mahalanobis^2 of x - mu = e, |L^T e|^2: 9 products with the triangle
   // (e^T Sigma^-1 e takes 12).
