@@ -17,13 +17,13 @@
 #include "radargauss/map/map_cloud.hpp"
 #include "radargauss/map/rcs_model.hpp"
 #include "radargauss/simulator.hpp"
-#include "residuals/geometric_residual.hpp"
-#include "residuals/rcs_residual.hpp"
+#include "radargauss/residuals/geometric_residual.hpp"
+#include "radargauss/residuals/rcs_residual.hpp"
 #include "radargauss/experiment.hpp"
-#include "solvers/ceres_solver.hpp"
-#include "solvers/factory.hpp"
-#include "solvers/gauss_newton.hpp"
-#include "solvers/joint_refinement.hpp"
+#include "radargauss/solvers/ceres_solver.hpp"
+#include "radargauss/solvers/factory.hpp"
+#include "radargauss/solvers/gauss_newton.hpp"
+#include "radargauss/solvers/joint_refinement.hpp"
 
 namespace radargauss {
 namespace {

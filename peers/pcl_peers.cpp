@@ -1,6 +1,6 @@
 // Kept in its own small translation unit: NDT and GICP instantiations are
 // heavy to compile (DESIGN.md section 9).
-#include "peers/pcl_peers.hpp"
+#include "radargauss/peers/pcl_peers.hpp"
 
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>

@@ -11,7 +11,7 @@
 
 #include <Eigen/Core>
 
-#include "solvers/scan_matcher.hpp"
+#include "radargauss/solvers/scan_matcher.hpp"
 
 namespace radargauss {
 

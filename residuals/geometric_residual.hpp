@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "residuals/quaternion_jacobians.hpp"
+#include "radargauss/residuals/quaternion_jacobians.hpp"
 
 namespace radargauss {
 

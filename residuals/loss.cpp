@@ -1,26 +1,46 @@
-#include "residuals/loss.hpp"
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/residuals/loss.hpp"
 
 #include <stdexcept>
+#include <utility>
 
 namespace radargauss {
 
+namespace {
+
+// Every loss's name, in enum order: the one table the parsers and lists use.
+const std::pair<LossType, const char*> kLossNames[] = {
+    {LossType::kTrivial, "trivial"},
+    {LossType::kHuber, "huber"},
+    {LossType::kCauchy, "cauchy"},
+    {LossType::kGemanMcClure, "geman-mcclure"},
+    {LossType::kTukey, "tukey"},
+};
+
+}  // namespace
+
+const std::vector<std::string>& LossNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> all;
+    for (const auto& entry : kLossNames) all.push_back(entry.second);
+    return all;
+  }();
+  return names;
+}
+
 LossType LossTypeFromString(const std::string& name) {
-  if (name == "trivial" || name == "none") return LossType::kTrivial;
-  if (name == "huber") return LossType::kHuber;
-  if (name == "cauchy") return LossType::kCauchy;
-  if (name == "geman-mcclure") return LossType::kGemanMcClure;
-  if (name == "tukey") return LossType::kTukey;
-  throw std::invalid_argument("unknown loss '" + name +
-                              "' (trivial, huber, cauchy, geman-mcclure, tukey)");
+  if (name == "none") return LossType::kTrivial;
+  for (const auto& [type, n] : kLossNames) {
+    if (name == n) return type;
+  }
+  std::string known;
+  for (const std::string& n : LossNames()) known += (known.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("unknown loss '" + name + "' (" + known + ")");
 }
 
 std::string ToString(LossType type) {
-  switch (type) {
-    case LossType::kTrivial: return "trivial";
-    case LossType::kHuber: return "huber";
-    case LossType::kCauchy: return "cauchy";
-    case LossType::kGemanMcClure: return "geman-mcclure";
-    case LossType::kTukey: return "tukey";
+  for (const auto& [t, name] : kLossNames) {
+    if (t == type) return name;
   }
   return "unknown";
 }

@@ -13,6 +13,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <ceres/loss_function.h>
 
@@ -25,8 +26,9 @@ struct LossConfig {
   double scale = 1.0;  // a
 };
 
-LossType LossTypeFromString(const std::string& name);  // throws std::invalid_argument
+LossType LossTypeFromString(const std::string& name);  // throws std::invalid_argument ("none": trivial)
 std::string ToString(LossType type);
+const std::vector<std::string>& LossNames();  // every loss's name, in enum order
 
 class GemanMcClureLoss final : public ceres::LossFunction {
  public:

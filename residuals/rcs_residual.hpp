@@ -32,7 +32,7 @@
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/map/rcs_model.hpp"
 #include "radargauss/sh.hpp"
-#include "residuals/quaternion_jacobians.hpp"
+#include "radargauss/residuals/quaternion_jacobians.hpp"
 
 namespace radargauss {
 

@@ -9,7 +9,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 RADARGAUSS_DEPS_EXTRA="python3-matplotlib ${RADARGAUSS_DEPS_EXTRA:-}" "$root/scripts/deps.sh"
 cmake -S "$root" -B "$root/build/release" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$root/build/release" -j "$(nproc)" --target radargauss_cli
-tool="$root/build/release/examples/radargauss"
+tool="$root/build/release/bin/radargauss"
 demo="$root/build/demo"
 mkdir -p "$demo"
 

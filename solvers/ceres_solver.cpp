@@ -1,4 +1,4 @@
-#include "solvers/ceres_solver.hpp"
+#include "radargauss/solvers/ceres_solver.hpp"
 
 #include <ceres/loss_function.h>
 #include <ceres/problem.h>
@@ -16,8 +16,8 @@
 #include <Eigen/Eigenvalues>
 
 #include "radargauss/lie/manifold.hpp"
-#include "residuals/geometric_residual.hpp"
-#include "residuals/rcs_residual.hpp"
+#include "radargauss/residuals/geometric_residual.hpp"
+#include "radargauss/residuals/rcs_residual.hpp"
 
 namespace radargauss {
 

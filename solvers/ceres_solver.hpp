@@ -10,7 +10,7 @@
 
 #include <memory>
 
-#include "solvers/scan_matcher.hpp"
+#include "radargauss/solvers/scan_matcher.hpp"
 
 namespace radargauss {
 

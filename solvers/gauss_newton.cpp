@@ -1,323 +1,128 @@
-#include "solvers/gauss_newton.hpp"
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/solvers/gauss_newton.hpp"
 
-#include <ceres/jet.h>
-
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <string>
 
 #include <Eigen/Cholesky>
 
 #include "radargauss/conventions.hpp"
-#include "radargauss/lie/manifold.hpp"
-#include "residuals/geometric_residual.hpp"
+#include "radargauss/solvers/normal_equations.hpp"
 
 namespace radargauss {
 
 namespace {
 
-using Matrix3x6 = Eigen::Matrix<double, 3, 6>;
-using Jet7 = ceres::Jet<double, 7>;
-
-// d q / d dphi at q (right perturbation): the SO3Manifold PlusJacobian.
-Eigen::Matrix<double, 4, 3> QuaternionTangent(const SO3d& rotation) {
-  Eigen::Matrix<double, 4, 3, Eigen::RowMajor> P;
-  SO3Manifold().PlusJacobian(rotation.data(), P.data());
-  return P;
-}
-
-// Jets seeded for the rotation (derivatives 0..3) and translation (4..6) blocks.
-void SeedJets(const SE3d& pose, const Eigen::Vector3d& translation, Jet7 rotation[4], Jet7 t[3]) {
-  for (int i = 0; i < 4; ++i) rotation[i] = Jet7(pose.rotation().data()[i], i);
-  for (int i = 0; i < 3; ++i) t[i] = Jet7(translation[i], 4 + i);
-}
-
-// The loss's curvature along r (ScanMatchingOptions::loss_curvature): the
-// coefficient c of (J^T r)(J^T r)^T, 2 rho'' clamped so that rho' + c s >= 0.
-double CurvatureAlongResidual(double s, double weight, double second) {
-  return s > 0.0 ? std::max(2.0 * second, -weight / s) : 0.0;
-}
-
-// Fixed sizes throughout: this is the inner loop of every iteration. J holds
-// the columns of the tangent block starting at `offset` (all six, or the
-// rotation's three).
-template <int Rows, int Cols>
-void Accumulate(LinearSystem& system, int offset, const Eigen::Matrix<double, Rows, Cols>& J,
-                const Eigen::Matrix<double, Rows, 1>& r, LossSum& loss, bool loss_curvature) {
-  double second = 0.0;
-  const double s = r.squaredNorm();
-  const double weight = loss.Add(s, &second);
-  const Eigen::Matrix<double, Rows, Cols> weighted_J = weight * J;
-  system.H.block<Cols, Cols>(offset, offset).noalias() += weighted_J.transpose() * J;
-  system.g.segment<Cols>(offset).noalias() += weighted_J.transpose() * r;
-  if (loss_curvature && second != 0.0) {
-    const Eigen::Matrix<double, Cols, 1> Jt_r = J.transpose() * r;
-    system.loss_curvature.block<Cols, Cols>(offset, offset).noalias() +=
-        CurvatureAlongResidual(s, weight, second) * Jt_r * Jt_r.transpose();
-  }
-  ++system.residuals;
-}
+using Vector6 = Eigen::Matrix<double, 6, 1>;
 
 // The update of conventions.hpp: t += dt (world), R = R Exp(dphi) (radar frame).
-SE3d Step(const SE3d& pose, const Eigen::Matrix<double, 6, 1>& dx) {
+SE3d Step(const SE3d& pose, const Vector6& dx) {
   return SE3d(pose.rotation() * SO3d::Exp(dx.segment<3>(kRotationOffset)),
               pose.translation() + dx.segment<3>(kTranslationOffset));
 }
 
-// The sums of BuildGeometricSystem's analytic path, taken without R (see
-// there): with T = double one term at a time, with T = Eigen::Array2d two
-// terms at once, one per SIMD lane (the same arithmetic in half the
-// instructions; this loop was a third of a match's).
-template <typename T>
-struct GeometricSums {
-  T A_tt[6], A_rr[6];  // symmetric: upper triangles (00 01 02 11 12 22)
-  T A_tr[3][3];
-  T b_t[3], b_r[3];
-  explicit GeometricSums(const T& zero) {
-    for (int i = 0; i < 6; ++i) A_tt[i] = A_rr[i] = zero;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) A_tr[i][j] = zero;
-      b_t[i] = b_r[i] = zero;
+bool PositiveDefinite(const Eigen::LDLT<Eigen::Matrix<double, 6, 6>>& ldlt) {
+  const Vector6 pivots = ldlt.vectorD();
+  return ldlt.info() == Eigen::Success && pivots.minCoeff() > 1e-10 * std::max(1e-300, pivots.maxCoeff());
+}
+
+// H dx = -g by LDLT, with the losses' curvature in H when asked and positive
+// definite, else IRLS; false with a reason when degenerate.
+bool SolveStep(const CombinedSystem& system, bool loss_curvature, Vector6& dx, std::string& reason) {
+  Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt;
+  if (!loss_curvature || !PositiveDefinite(ldlt.compute(system.H + system.loss_curvature))) {
+    if (!PositiveDefinite(ldlt.compute(system.H))) {
+      reason = "degenerate normal equations (too few or ill-placed residuals)";
+      return false;
     }
   }
-};
-
-// What a term brings: the upper triangle of L^T (00 01 02 11 12 22), q = R p
-// and e = q + t - mu.
-template <typename T>
-struct GeometricTermInputs {
-  T U[6], q[3], e[3];
-};
-
-// One value per lane: f(0) for a term, f(0) and f(1) for a pair.
-template <typename T>
-struct Lanes;
-template <>
-struct Lanes<double> {
-  template <typename F>
-  static double Of(F&& f) { return f(0); }
-};
-template <>
-struct Lanes<Eigen::Array2d> {
-  template <typename F>
-  static Eigen::Array2d Of(F&& f) { return Eigen::Array2d(f(0), f(1)); }
-};
-
-// The inputs of term k, and of term k + 1 in the second lane of a pair.
-template <typename T>
-GeometricTermInputs<T> Inputs(const Correspondences& c, std::size_t k, const Eigen::Matrix3d& R,
-                              const Eigen::Vector3d& t) {
-  const GeometricTerm* terms = &c.geometric[k];
-  const auto gather = [&](auto&& value) { return Lanes<T>::Of([&](int lane) { return value(terms[lane]); }); };
-  constexpr int kUpper[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
-  GeometricTermInputs<T> in;
-  for (int i = 0; i < 6; ++i) {
-    in.U[i] = gather([&](const GeometricTerm& term) {
-      return c.index->SqrtInformationT(term.gaussian)(kUpper[i][0], kUpper[i][1]);
-    });
+  dx = ldlt.solve(-system.g);
+  if (!dx.allFinite()) {
+    reason = "non-finite update";
+    return false;
   }
-  T p[3], mean[3];
-  for (int i = 0; i < 3; ++i) {
-    p[i] = gather([&](const GeometricTerm& term) { return term.point_radar[i]; });
-    mean[i] = gather([&](const GeometricTerm& term) { return c.index->Mean(term.gaussian)[i]; });
-  }
-  for (int i = 0; i < 3; ++i) {
-    in.q[i] = R(i, 0) * p[0] + R(i, 1) * p[1] + R(i, 2) * p[2];
-    in.e[i] = in.q[i] + t[i] - mean[i];
-  }
-  return in;
+  return true;
 }
 
-// Adds a term (or a pair) to `sums`; weight_of(s, Sigma^-1 e) gives the IRLS
-// weight of s = e^T Sigma^-1 e.
-template <typename T, typename WeightOf>
-void AddGeometricTerm(const GeometricTermInputs<T>& in, GeometricSums<T>& sums, WeightOf&& weight_of) {
-  T information[6];
-  InformationFromSqrtInformationT(in.U, information);
-  const T &i00 = information[0], &i01 = information[1], &i02 = information[2];
-  const T &i11 = information[3], &i12 = information[4], &i22 = information[5];
-  const T* q = in.q;
-  const T* e = in.e;
-  const T information_e[3] = {i00 * e[0] + i01 * e[1] + i02 * e[2], i01 * e[0] + i11 * e[1] + i12 * e[2],
-                              i02 * e[0] + i12 * e[1] + i22 * e[2]};
-  const T weight = weight_of(e[0] * information_e[0] + e[1] * information_e[1] + e[2] * information_e[2],
-                             information_e);
-  // B = w Sigma^-1 [q]x column by column (column k is Sigma^-1 (w q x e_k)),
-  // then the upper triangle of [q]x B as components of cross products: the
-  // zeros of [q]x never enter a product.
-  const T wq[3] = {weight * q[0], weight * q[1], weight * q[2]};
-  const T B[3][3] = {{wq[2] * i01 - wq[1] * i02, wq[0] * i02 - wq[2] * i00, wq[1] * i00 - wq[0] * i01},
-                     {wq[2] * i11 - wq[1] * i12, wq[0] * i12 - wq[2] * i01, wq[1] * i01 - wq[0] * i11},
-                     {wq[2] * i12 - wq[1] * i22, wq[0] * i22 - wq[2] * i02, wq[1] * i02 - wq[0] * i12}};
-  sums.A_tt[0] += weight * i00;
-  sums.A_tt[1] += weight * i01;
-  sums.A_tt[2] += weight * i02;
-  sums.A_tt[3] += weight * i11;
-  sums.A_tt[4] += weight * i12;
-  sums.A_tt[5] += weight * i22;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) sums.A_tr[i][j] -= B[i][j];
+// The step check on the exact map: a step must not raise eq. 2 for its
+// association; one that does is halved (at most max_halvings times). When
+// the next iteration keeps the association, its system carries the cost at
+// the new pose, so the check waits for it (no extra pass over the
+// residuals); otherwise eq. 2 is evaluated at once.
+class StepCheck {
+ public:
+  explicit StepCheck(int max_halvings) : max_halvings_(max_halvings) {}
+
+  // First in every iteration, with eq. 2 at the current pose: a waiting step
+  // on this association that raised it is taken back and halved; returns
+  // the step taken instead then.
+  std::optional<Vector6> TakeBackRaisingStep(const LevelStep& level, double cost, SE3d& pose) {
+    const Correspondences& c = level.correspondences;
+    same_association_ = c.index == index_ && SamePose(c.pose, associated_at_);
+    if (!pending_) return std::nullopt;
+    pending_ = false;
+    if (!same_association_ || !(cost > cost_)) return std::nullopt;
+    taken_back_ = true;
+    return Backtrack(level, from_, dx_, cost_, 0.5, 1, pose);
   }
-  // (q x B_k)_i for i <= k; A_rr -= it ([q]x^T = -[q]x).
-  sums.A_rr[0] -= q[1] * B[2][0] - q[2] * B[1][0];
-  sums.A_rr[1] -= q[1] * B[2][1] - q[2] * B[1][1];
-  sums.A_rr[2] -= q[1] * B[2][2] - q[2] * B[1][2];
-  sums.A_rr[3] -= q[2] * B[0][1] - q[0] * B[2][1];
-  sums.A_rr[4] -= q[2] * B[0][2] - q[0] * B[2][2];
-  sums.A_rr[5] -= q[0] * B[1][2] - q[1] * B[0][2];
-  for (int i = 0; i < 3; ++i) sums.b_t[i] += weight * information_e[i];
-  sums.b_r[0] += wq[1] * information_e[2] - wq[2] * information_e[1];
-  sums.b_r[1] += wq[2] * information_e[0] - wq[0] * information_e[2];
-  sums.b_r[2] += wq[0] * information_e[1] - wq[1] * information_e[0];
-}
+
+  // Takes dx from `pose` (eq. 2 there: cost). Checked now when it converges,
+  // is the level's last, follows a taken-back step on this association, or
+  // leaves the association; otherwise it waits. Returns the step taken.
+  Vector6 Take(const LevelStep& level, const Vector6& dx, double cost, const ScanMatchingOptions& options,
+               SE3d& pose) {
+    const Correspondences& c = level.correspondences;
+    const bool small = level.SmallStep(dx.segment<3>(kTranslationOffset).norm(), dx.segment<3>(kRotationOffset).norm());
+    const SE3d next = Step(pose, dx);
+    if (small || level.last_iteration || (same_association_ && taken_back_) ||
+        !KeepsAssociation(true, c.pose, next, options)) {
+      return Backtrack(level, pose, dx, cost, 1.0, 0, pose);
+    }
+    pending_ = true;
+    from_ = pose;
+    dx_ = dx;
+    cost_ = cost;
+    index_ = c.index;
+    associated_at_ = c.pose;
+    taken_back_ = false;
+    pose = next;
+    return dx;
+  }
+
+ private:
+  // Halves dx from `from` (first by `scale`) while eq. 2 exceeds `cost`; sets
+  // `pose`, records eq. 2 there when it evaluated it, returns the step taken.
+  Vector6 Backtrack(const LevelStep& level, SE3d from, const Vector6& dx, double cost, double scale, int halvings,
+                    SE3d& pose) const {
+    SE3d next = Step(from, scale * dx);
+    level.evaluated->known = false;
+    for (; halvings < max_halvings_; ++halvings) {
+      const double next_cost = EvaluateCost(level.correspondences, next, level.options);
+      if (next_cost <= cost) {
+        *level.evaluated = {true, next, next_cost};
+        break;
+      }
+      scale *= 0.5;
+      next = Step(from, scale * dx);
+    }
+    pose = next;
+    return scale * dx;
+  }
+
+  int max_halvings_;
+  bool pending_ = false;                // a step waits for its check
+  SE3d from_;                           // the pose it was taken from
+  Vector6 dx_ = Vector6::Zero();        // the full step
+  double cost_ = 0.0;                   // eq. 2 at from_
+  const GaussianIndex* index_ = nullptr;  // the association it was taken on
+  SE3d associated_at_;
+  bool taken_back_ = false;             // a step on that association was taken back
+  bool same_association_ = false;       // this iteration's association is that one
+};
 
 }  // namespace
-
-LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
-                                  const ScanMatchingOptions& options) {
-  LinearSystem system;
-  LossSum loss(options.geometric_loss);
-  const Eigen::Matrix3d R = pose.rotation().Matrix();
-  if (options.jacobians == JacobianMode::kAnalytic) {
-    // r = L^T e, e = q + t - mu with q = R p; dr/ddt = L^T and
-    // dr/ddphi = -L^T R [p]x = -L^T [q]x R. R is common to all terms, so the
-    // sums are taken without it and applied once: with Sigma^-1 = L L^T,
-    // H_tt = sum w Sigma^-1, H_tr = (sum -w Sigma^-1 [q]x) R,
-    // H_rr = R^T (sum w [q]x^T Sigma^-1 [q]x) R, g_t = sum w Sigma^-1 e,
-    // g_r = R^T (sum w [q]x Sigma^-1 e).
-    // Sums of one term at a time, and of pairs of terms in SIMD lanes.
-    GeometricSums<double> single(0.0);
-    GeometricSums<Eigen::Array2d> pairs(Eigen::Array2d::Zero());
-    // Loss curvature (options.loss_curvature), with J^T r = [I_e; R^T (q x I_e)]
-    // (I_e = Sigma^-1 e): summed without R as well.
-    Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
-    const auto weight_of = [&](double s, const Eigen::Vector3d& q, const Eigen::Vector3d& information_e) {
-      double second = 0.0;
-      const double weight = loss.Add(s, &second);
-      if (options.loss_curvature && second != 0.0) {
-        Eigen::Matrix<double, 6, 1> Jt_r;
-        Jt_r << information_e, q.cross(information_e);
-        C.noalias() += CurvatureAlongResidual(s, weight, second) * Jt_r * Jt_r.transpose();
-      }
-      return weight;
-    };
-    const std::size_t n = c.geometric.size();
-    std::size_t k = 0;
-    for (; k + 1 < n; k += 2) {
-      const GeometricTermInputs<Eigen::Array2d> in = Inputs<Eigen::Array2d>(c, k, R, pose.translation());
-      AddGeometricTerm(in, pairs, [&](const Eigen::Array2d& s, const Eigen::Array2d* information_e) {
-        const auto lane = [&](const Eigen::Array2d* v, int l) { return Eigen::Vector3d(v[0][l], v[1][l], v[2][l]); };
-        const double weight_a = weight_of(s[0], lane(in.q, 0), lane(information_e, 0));  // in term order
-        return Eigen::Array2d(weight_a, weight_of(s[1], lane(in.q, 1), lane(information_e, 1)));
-      });
-    }
-    for (; k < n; ++k) {
-      const GeometricTermInputs<double> in = Inputs<double>(c, k, R, pose.translation());
-      AddGeometricTerm(in, single, [&](double s, const double* information_e) {
-        return weight_of(s, Eigen::Vector3d(in.q), Eigen::Vector3d(information_e));
-      });
-    }
-    double A_tt_upper[6], A_rr_upper[6];
-    Eigen::Matrix3d A_tr;
-    Eigen::Vector3d b_t, b_r;
-    for (int i = 0; i < 6; ++i) {
-      A_tt_upper[i] = single.A_tt[i] + pairs.A_tt[i].sum();
-      A_rr_upper[i] = single.A_rr[i] + pairs.A_rr[i].sum();
-    }
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) A_tr(i, j) = single.A_tr[i][j] + pairs.A_tr[i][j].sum();
-      b_t[i] = single.b_t[i] + pairs.b_t[i].sum();
-      b_r[i] = single.b_r[i] + pairs.b_r[i].sum();
-    }
-    const auto from_upper = [](const double* u) {
-      Eigen::Matrix3d m;
-      m << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
-      return m;
-    };
-    const Eigen::Matrix3d A_tt = from_upper(A_tt_upper), A_rr = from_upper(A_rr_upper);
-    system.H.block<3, 3>(kTranslationOffset, kTranslationOffset) = A_tt;
-    system.H.block<3, 3>(kTranslationOffset, kRotationOffset) = A_tr * R;
-    system.H.block<3, 3>(kRotationOffset, kTranslationOffset) = (A_tr * R).transpose();
-    system.H.block<3, 3>(kRotationOffset, kRotationOffset) = R.transpose() * A_rr * R;
-    system.g.segment<3>(kTranslationOffset) = b_t;
-    system.g.segment<3>(kRotationOffset) = R.transpose() * b_r;
-    if (options.loss_curvature) {
-      Eigen::Matrix<double, 6, 6> rotate = Eigen::Matrix<double, 6, 6>::Identity();
-      rotate.block<3, 3>(kRotationOffset, kRotationOffset) = R;
-      system.loss_curvature = rotate.transpose() * C * rotate;
-    }
-    system.residuals = c.geometric.size();
-    system.rho_sum = loss.Sum();
-    return system;
-  }
-  // Autodiff: the Ceres functor evaluated with Jets, per term.
-  const Eigen::Matrix<double, 4, 3> P = QuaternionTangent(pose.rotation());
-  for (const GeometricTerm& term : c.geometric) {
-    const Eigen::Matrix3d& LT = c.index->SqrtInformationT(term.gaussian);
-    const Eigen::Vector3d& mean = c.index->Mean(term.gaussian);
-    Jet7 rotation[4], t[3], residual[3];
-    SeedJets(pose, pose.translation(), rotation, t);
-    const GeometricResidual functor(term.point_radar, mean, LT);
-    functor(rotation, t, residual);
-    Eigen::Vector3d r;
-    Eigen::Matrix<double, 3, 7> ambient;
-    for (int i = 0; i < 3; ++i) {
-      r[i] = residual[i].a;
-      ambient.row(i) = residual[i].v.transpose();
-    }
-    Matrix3x6 J;
-    J.block<3, 3>(0, kTranslationOffset) = ambient.rightCols<3>();
-    J.block<3, 3>(0, kRotationOffset) = ambient.leftCols<4>() * P;
-    Accumulate(system, 0, J, r, loss, options.loss_curvature);
-  }
-  system.rho_sum = loss.Sum();
-  return system;
-}
-
-LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
-                            const ScanMatchingOptions& options) {
-  LinearSystem system;
-  LossSum loss(options.rcs_loss);
-  // Rotation-only: the translation is the association's constant.
-  const bool rotation_only = options.rcs_translation == RcsTranslation::kRotationOnly;
-  const Eigen::Vector3d translation = rotation_only ? c.pose.translation() : pose.translation();
-  const Eigen::Matrix3d Rt = pose.rotation().Matrix().transpose();
-  const Eigen::Matrix<double, 4, 3> P = QuaternionTangent(pose.rotation());
-  for (const RcsTerm& term : c.rcs) {
-    Eigen::Matrix<double, 1, 1> r;
-    Eigen::Matrix<double, 1, 3> J_rotation, J_translation;
-    if (options.jacobians == JacobianMode::kAnalytic) {
-      // du/ddt = R^T, du/ddphi = -[mu_r]x (conventions.hpp: right perturbation),
-      // so dr/ddphi = -dr/du [mu_r]x = (mu_r x dr/du^T)^T.
-      const Eigen::Vector3d mean_radar = Rt * (term.mean - translation);
-      const RcsLinearisation lin = LineariseRcs(term, mean_radar);
-      r[0] = lin.residual;
-      J_rotation = mean_radar.cross(lin.dr_du.transpose()).transpose();
-      if (!rotation_only) J_translation = lin.dr_du * Rt;
-    } else {
-      Jet7 rotation[4], t[3], residual[1];
-      SeedJets(pose, translation, rotation, t);
-      const RcsResidual functor(term);
-      functor(rotation, t, residual);
-      r[0] = residual[0].a;
-      J_rotation = residual[0].v.head<4>().transpose() * P;
-      J_translation = residual[0].v.tail<3>().transpose();
-    }
-    if (rotation_only) {
-      Accumulate(system, kRotationOffset, J_rotation, r, loss, options.loss_curvature);
-    } else {
-      Eigen::Matrix<double, 1, 6> J;
-      J.block<1, 3>(0, kTranslationOffset) = J_translation;
-      J.block<1, 3>(0, kRotationOffset) = J_rotation;
-      Accumulate(system, 0, J, r, loss, options.loss_curvature);
-    }
-  }
-  if (rotation_only) {
-    // The paper: translation rows/columns of the RCS Hessian -> identity,
-    // translation gradient -> zero (only the rotation block was accumulated).
-    system.H.block<3, 3>(kTranslationOffset, kTranslationOffset).setIdentity();
-  }
-  system.rho_sum = loss.Sum();
-  return system;
-}
 
 GaussNewtonSolver::GaussNewtonSolver(const ScanMatchingOptions& options) : options_(options) {
   ValidateOptions(options_);
@@ -327,120 +132,29 @@ std::string GaussNewtonSolver::Name() const {
   return options_.jacobians == JacobianMode::kAnalytic ? "gn" : "gn-autodiff";
 }
 
-namespace {
-
-// Whether two correspondences are the same association (made at the same
-// pose on the same level).
-bool SameAssociation(const Correspondences& c, const GaussianIndex* index, const SE3d& pose) {
-  return c.index == index && SamePose(c.pose, pose);
-}
-
-}  // namespace
-
+// The paper's loop, per iteration of RunCoarseToFine (which associates):
+// linearise eq. 2, solve the 6x6 system, step (checked on the exact map).
 ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const MatchingMap& map,
                                             const SE3d& initial) const {
-  // The step check on the exact map: a step must not raise eq. 2 for its
-  // association. When the next iteration keeps that association, its system
-  // carries the cost at the new pose, so the check waits for it (no extra
-  // pass over the residuals); otherwise the cost is evaluated at once.
-  struct Unchecked {
-    bool pending = false;
-    SE3d from;                               // the pose the step was taken from
-    Eigen::Matrix<double, 6, 1> dx;          // the full step
-    double cost = 0.0;                       // eq. 2 at `from`
-    const GaussianIndex* index = nullptr;    // the association it was taken on
-    SE3d associated_at;
-    bool taken_back = false;                 // a step on that association was taken back
-  } unchecked;
+  StepCheck check(options_.max_step_halvings);
   return RunCoarseToFine(scan, map, initial, options_, [&, this](const LevelStep& level, ScanMatchingResult& result) {
-    const Correspondences& c = level.correspondences;
-    const double w = level.options.w_rcs;
-    const auto small = [&](const Eigen::Matrix<double, 6, 1>& step) {
-      return level.SmallStep(step.segment<3>(kTranslationOffset).norm(), step.segment<3>(kRotationOffset).norm());
+    const auto outcome = [&](const Vector6& step) {
+      return level.SmallStep(step.segment<3>(kTranslationOffset).norm(), step.segment<3>(kRotationOffset).norm())
+                 ? StepOutcome::kConverged
+                 : StepOutcome::kContinue;
     };
-    // Halves dx from `from` (first by `scale`) while eq. 2 exceeds `cost`;
-    // sets result.pose, records eq. 2 there when it evaluated it, and
-    // returns the step taken.
-    const auto backtrack = [&](const SE3d& from, const Eigen::Matrix<double, 6, 1>& dx, double cost, double scale,
-                               int halvings) {
-      SE3d next = Step(from, scale * dx);
-      level.evaluated->known = false;
-      for (; halvings < options_.max_step_halvings; ++halvings) {
-        const double next_cost = EvaluateCost(c, next, level.options);
-        if (next_cost <= cost) {
-          *level.evaluated = {true, next, next_cost};
-          break;
-        }
-        scale *= 0.5;
-        next = Step(from, scale * dx);
-      }
-      result.pose = next;
-      return Eigen::Matrix<double, 6, 1>(scale * dx);
-    };
-    // Eq. 2: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs (likewise g).
-    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 6> loss_curvature = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    double cost = 0.0;  // eq. 2 at the current pose, as EvaluateCost
-    if (w < 1.0) {
-      const LinearSystem geometric = BuildGeometricSystem(c, result.pose, level.options);
-      const double weight = (1.0 - w) / double(geometric.residuals);
-      H += weight * geometric.H;
-      loss_curvature += weight * geometric.loss_curvature;
-      g += weight * geometric.g;
-      cost += weight * geometric.rho_sum;
+    // Eq. 2: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs, likewise g.
+    const CombinedSystem system = BuildCombinedSystem(level.correspondences, result.pose, level.options);
+    if (const std::optional<Vector6> step = check.TakeBackRaisingStep(level, system.cost, result.pose)) {
+      return outcome(*step);
     }
-    if (w > 0.0) {
-      const LinearSystem rcs = BuildRcsSystem(c, result.pose, level.options);
-      const double weight = w / double(rcs.residuals);
-      H += weight * rcs.H;
-      loss_curvature += weight * rcs.loss_curvature;
-      g += weight * rcs.g;
-      cost += weight * rcs.rho_sum;
-    }
-    const bool same_association = SameAssociation(c, unchecked.index, unchecked.associated_at);
-    // An association that had a step taken back has its further steps checked at once.
-    const bool check_at_once = same_association && unchecked.taken_back;
-    if (unchecked.pending) {
-      unchecked.pending = false;
-      if (same_association && cost > unchecked.cost) {
-        // The last step raised eq. 2: take it back and halve it.
-        unchecked.taken_back = true;
-        const Eigen::Matrix<double, 6, 1> step = backtrack(unchecked.from, unchecked.dx, unchecked.cost, 0.5, 1);
-        return small(step) ? StepOutcome::kConverged : StepOutcome::kContinue;
-      }
-    }
-    const auto positive_definite = [](const Eigen::LDLT<Eigen::Matrix<double, 6, 6>>& ldlt) {
-      const Eigen::Matrix<double, 6, 1> pivots = ldlt.vectorD();
-      return ldlt.info() == Eigen::Success && pivots.minCoeff() > 1e-10 * std::max(1e-300, pivots.maxCoeff());
-    };
-    Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt;
-    // With the losses' curvature when asked and positive definite, else IRLS.
-    if (!options_.loss_curvature || !positive_definite(ldlt.compute(H + loss_curvature))) {
-      if (!positive_definite(ldlt.compute(H))) {
-        result.reason = "degenerate normal equations (too few or ill-placed residuals)";
-        return StepOutcome::kFailed;
-      }
-    }
-    const Eigen::Matrix<double, 6, 1> dx = ldlt.solve(-g);
-    if (!dx.allFinite()) {
-      result.reason = "non-finite update";
-      return StepOutcome::kFailed;
-    }
-    if (!level.finest || options_.max_step_halvings == 0) {  // plain steps (coarse levels only steer into the basin)
+    Vector6 dx;
+    if (!SolveStep(system, options_.loss_curvature, dx, result.reason)) return StepOutcome::kFailed;
+    if (!level.finest || options_.max_step_halvings == 0) {  // plain steps: coarse levels only steer
       result.pose = Step(result.pose, dx);
-      return small(dx) ? StepOutcome::kConverged : StepOutcome::kContinue;
+      return outcome(dx);
     }
-    const SE3d next = Step(result.pose, dx);
-    if (small(dx) || level.last_iteration || check_at_once || !KeepsAssociation(true, c.pose, next, options_)) {
-      // Checked now: a converging step, the last one allowed, one on an
-      // association that had a step taken back, or one after which the loop
-      // re-associates.
-      return small(backtrack(result.pose, dx, cost, 1.0, 0)) ? StepOutcome::kConverged : StepOutcome::kContinue;
-    }
-    unchecked = {true, result.pose, dx, cost, c.index, c.pose, check_at_once};
-    result.pose = next;
-    return StepOutcome::kContinue;
+    return outcome(check.Take(level, dx, system.cost, options_, result.pose));
   });
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The own Gauss-Newton scan matcher (DESIGN.md section 5): per outer
 // iteration, re-associate (lazily on the exact map: RunCoarseToFine),
 // accumulate H and g per residual with IRLS weights
@@ -16,30 +17,10 @@
 // gradient zero, before the weighted sum. With kFull they are kept.
 #pragma once
 
-#include <Eigen/Core>
-
-#include "solvers/scan_matcher.hpp"
+#include "radargauss/solvers/normal_equations.hpp"
+#include "radargauss/solvers/scan_matcher.hpp"
 
 namespace radargauss {
-
-// One linearisation: H = sum w J^T J, g = sum w J^T r over the tangent
-// [dt; dphi], and the number of residuals.
-struct LinearSystem {
-  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-  std::size_t residuals = 0;
-  double rho_sum = 0.0;  // sum of rho(s) over the residuals: the term's cost before eq. 2's weight
-  // With ScanMatchingOptions::loss_curvature: what the losses' curvature adds
-  // to H (sum of c (J^T r)(J^T r)^T, c = max(2 rho'', -rho'/s)); else zero.
-  Eigen::Matrix<double, 6, 6> loss_curvature = Eigen::Matrix<double, 6, 6>::Zero();
-};
-
-// The geometric and RCS systems at `pose` for fixed correspondences (public
-// so that tests and benchmarks can compare the analytic and autodiff paths).
-LinearSystem BuildGeometricSystem(const Correspondences& correspondences, const SE3d& pose,
-                                  const ScanMatchingOptions& options);
-LinearSystem BuildRcsSystem(const Correspondences& correspondences, const SE3d& pose,
-                            const ScanMatchingOptions& options);
 
 class GaussNewtonSolver final : public ScanMatcher {
  public:

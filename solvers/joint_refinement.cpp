@@ -1,4 +1,4 @@
-#include "solvers/joint_refinement.hpp"
+#include "radargauss/solvers/joint_refinement.hpp"
 
 #include <ceres/normal_prior.h>
 #include <ceres/problem.h>
@@ -9,8 +9,8 @@
 #include <stdexcept>
 
 #include "radargauss/lie/manifold.hpp"
-#include "residuals/geometric_residual.hpp"
-#include "residuals/rcs_residual.hpp"
+#include "radargauss/residuals/geometric_residual.hpp"
+#include "radargauss/residuals/rcs_residual.hpp"
 
 namespace radargauss {
 

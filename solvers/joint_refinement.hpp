@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "solvers/scan_matcher.hpp"
+#include "radargauss/solvers/scan_matcher.hpp"
 
 namespace radargauss {
 

@@ -1,4 +1,4 @@
-#include "solvers/multi_hypothesis.hpp"
+#include "radargauss/solvers/multi_hypothesis.hpp"
 
 #include <chrono>
 #include <stdexcept>

@@ -9,7 +9,7 @@
 #include <memory>
 #include <vector>
 
-#include "solvers/scan_matcher.hpp"
+#include "radargauss/solvers/scan_matcher.hpp"
 
 namespace radargauss {
 

@@ -1,4 +1,5 @@
-#include "solvers/scan_matcher.hpp"
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/solvers/scan_matcher.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -7,6 +8,7 @@
 #include <stdexcept>
 
 #include "radargauss/map/builder.hpp"
+#include "radargauss/solvers/normal_equations.hpp"
 
 namespace radargauss {
 
@@ -72,8 +74,13 @@ CoarseLevels CoarseLevelsFromString(const std::string& name) {
   throw std::invalid_argument("unknown coarse levels '" + name + "' (inflated, merged)");
 }
 
-MatchingMap::MatchingMap(const GaussianMap& map, const MatchingMapOptions& options)
-    : map_(map), coarse_gate_(options.coarse_gate) {
+MatchingMap::MatchingMap(GaussianMap map, const MatchingMapOptions& options)
+    : MatchingMap(std::make_shared<const GaussianMap>(std::move(map)), options) {}
+
+MatchingMap::MatchingMap(std::shared_ptr<const GaussianMap> shared, const MatchingMapOptions& options)
+    : map_(std::move(shared)), coarse_gate_(options.coarse_gate) {
+  if (!map_) throw std::invalid_argument("MatchingMap needs a map");
+  const GaussianMap& map = *map_;
   if (!(options.index_cell > 0.0)) throw std::invalid_argument("index cell must be > 0");
   if (!(options.coarse_gate > 0.0)) throw std::invalid_argument("coarse gate must be > 0");
   for (const double sigma : options.inflation) {
@@ -307,6 +314,7 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
     const bool known = last_is_final && c.index == &map.index() && evaluated.known &&
                        SamePose(evaluated.pose, result.pose);
     result.final_cost = known ? evaluated.cost : EvaluateCost(final_c, result.pose, options);
+    result.information = InformationMatrix(final_c, result.pose, options);
   } else {
     result.pose = initial;
   }

@@ -10,14 +10,15 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/types.hpp"
-#include "residuals/loss.hpp"
-#include "residuals/rcs_residual.hpp"
+#include "radargauss/residuals/loss.hpp"
+#include "radargauss/residuals/rcs_residual.hpp"
 
 namespace radargauss {
 
@@ -77,7 +78,7 @@ struct ScanMatchingOptions {
 void ValidateOptions(const ScanMatchingOptions& options);
 
 struct ScanMatchingResult {
-  SE3d pose;
+  SE3d pose;                // T_world_radar at the end
   int iterations = 0;
   double final_cost = 0.0;  // f of eq. 2 at the final pose and association
   std::size_t n_geo = 0;
@@ -85,6 +86,13 @@ struct ScanMatchingResult {
   bool converged = false;
   std::string reason;       // why it did not converge; empty when it did
   double time_ms = 0.0;
+  // The Gauss-Newton matrix of eq. 2's f at the final pose and association,
+  // over the solvers' tangent [dt (world); dphi (radar)] (conventions.hpp):
+  // (1-w)/N_geo H_geo + w/N_rcs H_rcs with the losses' IRLS weights, the RCS
+  // part on the rotation block only when rotation-only. Zero when no match
+  // was made. Multiply by N_geo (w = 0) for the information of the pose in
+  // the Gaussians' units; docs/design.md, "The information matrix".
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
 // How the coarse levels of a MatchingMap are made from the map's Gaussians.
@@ -132,10 +140,13 @@ inline MatchingMapOptions ExactMapOnly() {
   return options;
 }
 
+// A MatchingMap shares its GaussianMap: it takes one by value (move it in;
+// a temporary such as ReadMap(path) is kept alive) or a shared pointer.
 class MatchingMap {
  public:
-  explicit MatchingMap(const GaussianMap& map, const MatchingMapOptions& options = {});
-  const GaussianMap& map() const { return map_; }
+  explicit MatchingMap(GaussianMap map, const MatchingMapOptions& options = {});
+  explicit MatchingMap(std::shared_ptr<const GaussianMap> map, const MatchingMapOptions& options = {});
+  const GaussianMap& map() const { return *map_; }
   std::size_t levels() const { return levels_.size(); }
   const GaussianIndex& level(std::size_t k) const { return levels_[k]; }
   const GaussianIndex& index() const { return levels_.back(); }  // the exact map
@@ -143,7 +154,7 @@ class MatchingMap {
   double coarse_gate() const { return coarse_gate_; }
 
  private:
-  const GaussianMap& map_;
+  std::shared_ptr<const GaussianMap> map_;
   std::vector<GaussianIndex> levels_;
   std::vector<double> sigmas_;  // of the coarse levels
   double coarse_gate_ = 3.0;

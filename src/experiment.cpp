@@ -11,6 +11,7 @@
 
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/stats.hpp"
 #include "radargauss/trajectory.hpp"
 
 namespace radargauss {
@@ -50,7 +51,7 @@ ErrorStatistics Statistics(std::vector<double> values) {
     sum_sq += v * v;
   }
   s.mean = sum / double(n);
-  s.median = n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+  s.median = MedianOfSorted(values);
   s.rmse = std::sqrt(sum_sq / double(n));
   s.max = values.back();
   return s;

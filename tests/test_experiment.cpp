@@ -12,7 +12,7 @@
 #include "radargauss/map/rcs_model.hpp"
 #include "radargauss/simulator.hpp"
 #include "radargauss/trajectory.hpp"
-#include "solvers/gauss_newton.hpp"
+#include "radargauss/solvers/gauss_newton.hpp"
 #include "temp_dir.hpp"
 
 namespace radargauss {

@@ -1,4 +1,4 @@
-#include "peers/pcl_peers.hpp"
+#include "radargauss/peers/pcl_peers.hpp"
 
 #include <gtest/gtest.h>
 

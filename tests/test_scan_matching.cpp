@@ -18,13 +18,13 @@
 #include "radargauss/map/rcs_model.hpp"
 #include "radargauss/sh.hpp"
 #include "radargauss/simulator.hpp"
-#include "residuals/geometric_residual.hpp"
-#include "residuals/loss.hpp"
-#include "residuals/rcs_residual.hpp"
-#include "solvers/ceres_solver.hpp"
-#include "solvers/factory.hpp"
-#include "solvers/gauss_newton.hpp"
-#include "solvers/multi_hypothesis.hpp"
+#include "radargauss/residuals/geometric_residual.hpp"
+#include "radargauss/residuals/loss.hpp"
+#include "radargauss/residuals/rcs_residual.hpp"
+#include "radargauss/solvers/ceres_solver.hpp"
+#include "radargauss/solvers/factory.hpp"
+#include "radargauss/solvers/gauss_newton.hpp"
+#include "radargauss/solvers/multi_hypothesis.hpp"
 #include "test_util.hpp"
 
 namespace radargauss {
@@ -1509,7 +1509,7 @@ TEST(CoarseVoxels, CoarseLevelsMatchTheScansVoxelCentroids) {
 }  // namespace
 }  // namespace radargauss
 
-#include "solvers/joint_refinement.hpp"
+#include "radargauss/solvers/joint_refinement.hpp"
 
 namespace radargauss {
 namespace {

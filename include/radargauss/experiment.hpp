@@ -10,7 +10,7 @@
 
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/types.hpp"
-#include "solvers/scan_matcher.hpp"
+#include "radargauss/solvers/scan_matcher.hpp"
 
 namespace radargauss {
 

@@ -6,17 +6,17 @@
 
 namespace radargauss {
 
-MapCloud BuildMapCloud(const Sequence& sequence, const MapCloudOptions& options,
-                       MapCloudStats* stats) {
-  if (sequence.poses.size() != sequence.scans.size()) {
+MapCloud BuildMapCloud(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
+                       const MapCloudOptions& options, MapCloudStats* stats) {
+  if (poses.size() != scans.size()) {
     throw DataError("building a map needs a ground truth (--gt) for every scan");
   }
-  const std::size_t n = sequence.scans.size();
+  const std::size_t n = scans.size();
   // Ego velocity per scan in parallel; results are per scan, so the merge
   // below is the same for any thread count.
   std::vector<std::vector<bool>> keep(n);
   tbb::parallel_for(std::size_t(0), n, [&](std::size_t k) {
-    const RadarScan& scan = sequence.scans[k];
+    const RadarScan& scan = scans[k];
     if (options.doppler_filter && scan.has_doppler) {
       keep[k] = EstimateEgoVelocity(scan, options.ego_velocity).inlier;
     } else {
@@ -24,17 +24,17 @@ MapCloud BuildMapCloud(const Sequence& sequence, const MapCloudOptions& options,
     }
   });
   MapCloud cloud;
-  cloud.poses = sequence.poses;
+  cloud.poses = poses;
   cloud.has_rcs = n > 0;
   MapCloudStats local;
   for (std::size_t k = 0; k < n; ++k) {
-    const RadarScan& scan = sequence.scans[k];
+    const RadarScan& scan = scans[k];
     cloud.has_rcs = cloud.has_rcs && scan.has_rcs;
     local.points_in += scan.points.size();
     std::size_t kept = 0;
     for (std::size_t i = 0; i < scan.points.size(); ++i) {
       if (!keep[k][i]) continue;
-      cloud.points.push_back(sequence.poses[k] * scan.points[i].position);
+      cloud.points.push_back(poses[k] * scan.points[i].position);
       cloud.rcs.push_back(scan.points[i].rcs);
       cloud.scan.push_back(static_cast<std::uint32_t>(k));
       ++kept;

@@ -7,14 +7,15 @@
 
 #include <Eigen/QR>
 
+#include "radargauss/stats.hpp"
+
 namespace radargauss {
 
 RcsNormalisation NormaliseRcs(std::vector<double> rcs) {
   RcsNormalisation result;
   if (rcs.size() < 2) return result;
-  const std::size_t n = rcs.size();
   std::sort(rcs.begin(), rcs.end());
-  result.median = n % 2 ? rcs[n / 2] : 0.5 * (rcs[n / 2 - 1] + rcs[n / 2]);
+  result.median = MedianOfSorted(rcs);
   result.scale = std::min(result.median - rcs.front(), rcs.back() - result.median);
   result.valid = result.scale > 0.0;
   return result;

@@ -35,10 +35,14 @@ struct MapCloudStats {
   std::size_t points_static = 0;
 };
 
-// Requires sequence.poses (a ground truth). Scans whose ego velocity fails
-// contribute no points and are counted. Without Doppler in the sequence the
-// filter is skipped (every point kept).
-MapCloud BuildMapCloud(const Sequence& sequence, const MapCloudOptions& options = {},
-                       MapCloudStats* stats = nullptr);
+// Needs a pose T_world_radar per scan (a ground truth). Scans whose ego
+// velocity fails contribute no points and are counted. Without Doppler in
+// the scans the filter is skipped (every point kept).
+MapCloud BuildMapCloud(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
+                       const MapCloudOptions& options = {}, MapCloudStats* stats = nullptr);
+inline MapCloud BuildMapCloud(const Sequence& sequence, const MapCloudOptions& options = {},
+                              MapCloudStats* stats = nullptr) {
+  return BuildMapCloud(sequence.scans, sequence.poses, options, stats);
+}
 
 }  // namespace radargauss

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // YAML configuration files for the radargauss command-line tool, through
 // CLI11's config interface: every flag of a subcommand can be set in a YAML
 // map (keys are the long flag names without "--"), and flags given on the

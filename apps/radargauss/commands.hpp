@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The subcommands of the radargauss tool, one file each. A subcommand adds
+// its flags to the parser and returns what runs it once parsing succeeded.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+#include "radargauss/io/sequence.hpp"
+#include "radargauss/map/pipeline.hpp"
+
+namespace radargauss::cli {
+
+struct Subcommand {
+  CLI::App* app = nullptr;
+  std::function<int()> run;  // the exit status
+};
+
+Subcommand AddInfo(CLI::App& parent);
+Subcommand AddSimulate(CLI::App& parent);
+Subcommand AddBuildMap(CLI::App& parent);
+Subcommand AddMapInfo(CLI::App& parent);
+Subcommand AddLocalize(CLI::App& parent);
+
+// The flags every subcommand that reads a sequence shares.
+void AddSequenceOptions(CLI::App* app, SequenceOptions& options);
+
+// The map-building flags of build-map and localize.
+struct MapBuildSettings {
+  MapOptions map;
+  std::string builder = "kmeans";
+  std::string incidence = "offset";
+  bool no_adaptive = false;
+  bool no_doppler_filter = false;
+  // The options the flags describe (builder, incidence, filter, adaptivity).
+  MapOptions Resolved() const;
+};
+void AddMapBuildOptions(CLI::App* app, MapBuildSettings& settings);
+
+// The geometry of the map of `sequence`, with a progress bar; prints the
+// cloud and Gaussian counts when `verbose`.
+MapGeometry BuildGeometry(const Sequence& sequence, const MapBuildSettings& settings, bool verbose);
+// Its RCS models for one incidence model and degree; prints the fit's
+// summary when `verbose`.
+GaussianMap FitRcsModelsOf(const MapGeometry& geometry, const MapBuildSettings& settings,
+                           IncidenceModel incidence, int degree, bool verbose);
+
+}  // namespace radargauss::cli

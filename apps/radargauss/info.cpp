@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// radargauss info: summarise a sequence, or list a bag's topics.
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+#include <memory>
+
+#include "commands.hpp"
+#include "radargauss/io/rosbag.hpp"
+#include "radargauss/stats.hpp"
+
+namespace radargauss::cli {
+
+namespace {
+
+struct Range {
+  double min = std::numeric_limits<double>::infinity();
+  double max = -std::numeric_limits<double>::infinity();
+  void Add(double v) {
+    min = std::min(min, v);
+    max = std::max(max, v);
+  }
+};
+
+int ListTopics(const std::string& bag) {
+  std::printf("bag: %s\n", bag.c_str());
+  for (const BagTopic& topic : ListBagTopics(bag)) {
+    std::printf("  %-40s %-28s %zu messages\n", topic.name.c_str(), topic.type.c_str(), topic.messages);
+  }
+  return 0;
+}
+
+int RunInfo(const SequenceOptions& options) {
+  if (!options.bag.empty() && options.topic.empty()) return ListTopics(options.bag);
+  const Sequence sequence = LoadSequence(options);
+  std::vector<double> counts;
+  Range doppler, rcs;
+  bool has_doppler = true, has_rcs = true, has_std = true;
+  for (const RadarScan& scan : sequence.scans) {
+    counts.push_back(double(scan.points.size()));
+    has_doppler = has_doppler && scan.has_doppler;
+    has_rcs = has_rcs && scan.has_rcs;
+    for (const RadarPoint& p : scan.points) {
+      doppler.Add(p.doppler);
+      rcs.Add(p.rcs);
+      has_std = has_std && p.std_dev.has_value();
+    }
+  }
+  const auto [fewest, most] = std::minmax_element(counts.begin(), counts.end());
+  std::printf("layout: %s\n", sequence.layout.c_str());
+  std::printf("scans: %zu read", sequence.total_scans);
+  if (!options.ground_truth.empty()) {
+    std::printf(", %zu matched to poses, %zu outside the trajectory's time span", sequence.scans.size(),
+                sequence.skipped_scans);
+  }
+  std::printf("\npoints per scan: min %zu, median %.1f, max %zu\n", std::size_t(*fewest), Median(counts),
+              std::size_t(*most));
+  std::printf("fields: xyz%s%s%s\n", has_doppler ? " doppler" : "", has_rcs ? " rcs" : "", has_std ? " stds" : "");
+  std::printf("time span: %.9f .. %.9f (%.3f s)\n", sequence.scans.front().timestamp,
+              sequence.scans.back().timestamp, sequence.scans.back().timestamp - sequence.scans.front().timestamp);
+  if (has_doppler) std::printf("doppler: %.3f .. %.3f m/s\n", doppler.min, doppler.max);
+  if (has_rcs) std::printf("rcs: %.3f .. %.3f dBsm\n", rcs.min, rcs.max);
+  if (!sequence.poses.empty()) {
+    double length = 0.0;
+    for (std::size_t i = 1; i < sequence.poses.size(); ++i) {
+      length += (sequence.poses[i].translation() - sequence.poses[i - 1].translation()).norm();
+    }
+    std::printf("trajectory: %zu poses, %.1f m driven over the matched scans\n", sequence.trajectory.size(),
+                length);
+  }
+  return 0;
+}
+
+}  // namespace
+
+Subcommand AddInfo(CLI::App& parent) {
+  auto options = std::make_shared<SequenceOptions>();
+  CLI::App* app = parent.add_subcommand("info", "Summarise a sequence (or list a bag's topics)");
+  AddSequenceOptions(app, *options);
+  return {app, [options] { return RunInfo(*options); }};
+}
+
+}  // namespace radargauss::cli

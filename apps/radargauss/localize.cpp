@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// radargauss localize: the paper's localisation experiment (docs/design.md,
+// "The localisation experiment"): every scan matched from its reference
+// pose plus a seeded error, for every combination of the swept settings.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "commands.hpp"
+#include "localize_settings.hpp"
+#include "radargauss/atomic_file.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/experiment.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/progress.hpp"
+#include "radargauss/solvers/factory.hpp"
+#ifdef RADARGAUSS_HAVE_PCL
+#include "radargauss/peers/pcl_peers.hpp"
+#endif
+
+namespace radargauss::cli {
+
+namespace {
+
+std::string FormatWeight(double w) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", w);
+  return text;
+}
+
+// The maps to match against: the map file, or one per (incidence, degree)
+// built here; `degrees` receives each map's degree.
+std::vector<GaussianMap> MapsToMatch(const Sequence& sequence, LocalizeSettings& s, std::vector<int>& degrees) {
+  std::vector<GaussianMap> maps;
+  if (!s.map_path.empty()) {
+    if (!s.incidences.empty() || !s.degrees.empty()) {
+      throw DataError("--incidences/--degrees need the map built here (drop --map)");
+    }
+    maps.push_back(ReadMap(s.map_path));
+    degrees = {s.build.map.rcs.max_degree};
+    return maps;
+  }
+  if (s.incidences.empty()) s.incidences = {s.build.incidence};
+  if (s.degrees.empty()) s.degrees = {s.build.map.rcs.max_degree};
+  const MapGeometry geometry = BuildGeometry(sequence, s.build, false);
+  std::printf("map: %zu Gaussians from %zu static points\n", geometry.map.gaussians.size(),
+              geometry.cloud.points.size());
+  for (const std::string& incidence : s.incidences) {
+    for (const int degree : s.degrees) {
+      maps.push_back(FitRcsModelsOf(geometry, s.build, IncidenceModelFromString(incidence), degree, true));
+      degrees.push_back(degree);
+    }
+  }
+  return maps;
+}
+
+// The matched scans (every stride-th), their references and initial errors.
+struct Experiment {
+  std::vector<RadarScan> scans;
+  std::vector<SE3d> references;
+  std::vector<SE3d> errors;
+};
+
+Experiment MakeExperiment(const Sequence& sequence, const LocalizeSettings& s) {
+  Experiment e;
+  for (std::size_t k = 0; k < sequence.scans.size(); k += std::size_t(s.stride)) {
+    e.scans.push_back(sequence.scans[k]);
+    e.references.push_back(sequence.poses[k]);
+  }
+  e.errors = InitialErrors(e.scans.size(), s.max_translation, s.max_rotation, s.seed);
+  return e;
+}
+
+// The PCL peers' row: the merged map cloud as the target (no w_rcs, no loss).
+ConfigurationRun RunPeer(const std::string& solver, const Sequence& sequence, const MatchingMap& matching,
+                         const Experiment& e, std::vector<Eigen::Vector3d>& map_cloud) {
+#ifdef RADARGAUSS_HAVE_PCL
+  if (map_cloud.empty()) map_cloud = BuildMapCloud(sequence).points;
+  const PclPeerMatcher peer(solver == "pcl-ndt" ? PclMethod::kNdt : PclMethod::kGicp, map_cloud);
+  return RunConfiguration(solver, 0.0, peer, matching, e.scans, e.references, e.errors);
+#else
+  (void)sequence, (void)matching, (void)e, (void)map_cloud;
+  throw DataError("solver '" + solver + "' needs radargauss built with RADARGAUSS_WITH_PCL");
+#endif
+}
+
+std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const LocalizeSettings& s,
+                                                const std::vector<GaussianMap>& maps, const std::vector<int>& degrees,
+                                                const Experiment& e) {
+  std::vector<ConfigurationRun> runs;
+  std::vector<Eigen::Vector3d> map_cloud;  // the PCL peers' target
+  ProgressBar bar;
+  const std::size_t total = maps.size() * s.solvers.size() * s.losses.size() * s.w_rcs.size();
+  std::size_t done = 0;
+  for (std::size_t m = 0; m < maps.size(); ++m) {
+    const MatchingMap matching(maps[m], s.MatchingOptions());
+    for (const std::string& solver : s.solvers) {
+      if (solver.rfind("pcl-", 0) == 0) {
+        if (m > 0) continue;  // the peers do not use the RCS models: once
+        bar.Update("localize", done, total);
+        runs.push_back(RunPeer(solver, sequence, matching, e, map_cloud));
+        ++done;
+        continue;
+      }
+      for (const std::string& loss : s.losses) {
+        for (const double w : s.w_rcs) {
+          const auto matcher = MakeScanMatcher(solver, s.MatchOptions(w, loss));
+          const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" +
+                                   ToString(maps[m].incidence) + "-L" + std::to_string(degrees[m]);
+          bar.Update("localize", done, total);
+          runs.push_back(RunConfiguration(name, w, *matcher, matching, e.scans, e.references, e.errors));
+          ++done;
+        }
+      }
+    }
+  }
+  bar.Update("localize", done, total);
+  bar.Finish();
+  return runs;
+}
+
+// The outputs beside the experiment's: the reference trajectory and the
+// map's Gaussian means, for the plots.
+void WritePlotInputs(const std::string& out, const Experiment& e, const GaussianMap& map) {
+  Trajectory reference;
+  for (std::size_t k = 0; k < e.scans.size(); ++k) {
+    if (reference.empty() || e.scans[k].timestamp > reference.EndTime()) {
+      reference.Append(e.scans[k].timestamp, e.references[k]);
+    }
+  }
+  namespace fs = std::filesystem;
+  WriteTum((fs::path(out) / "reference.tum").string(), reference);
+  WriteFileAtomically((fs::path(out) / "map_means.csv").string(), [&](std::ostream& stream) {
+    stream << "x,y,z\n";
+    for (const Gaussian& g : map.gaussians) {
+      stream << g.mean.x() << ',' << g.mean.y() << ',' << g.mean.z() << '\n';
+    }
+  });
+}
+
+int RunLocalize(LocalizeSettings s) {
+  const Sequence sequence = LoadSequence(s.CheckedSequenceOptions());
+  std::vector<int> degrees;
+  const std::vector<GaussianMap> maps = MapsToMatch(sequence, s, degrees);
+  const Experiment e = MakeExperiment(sequence, s);
+  const std::vector<ConfigurationRun> runs = RunConfigurations(sequence, s, maps, degrees, e);
+  const std::string table = WriteExperimentResults(s.out, runs);
+  WritePlotInputs(s.out, e, maps.front());
+  double initial_t = 0.0;
+  for (const ScanOutcome& o : runs.front().outcomes) initial_t += o.initial_translation_error;
+  std::printf("%zu scans, %zu configurations; initial errors: mean %.3f m (uniform in [0, %g] m, [0, %g] deg)\n\n%s\n",
+              e.scans.size(), runs.size(), initial_t / std::max<std::size_t>(1, e.scans.size()), s.max_translation,
+              s.max_rotation, table.c_str());
+  std::printf("results: %s (per_scan.csv, summary.json, table.md, trajectories/); plots: "
+              "scripts/plot_results.py %s --reference %s/reference.tum\n",
+              s.out.c_str(), s.out.c_str(), s.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Subcommand AddLocalize(CLI::App& parent) {
+  auto s = std::make_shared<LocalizeSettings>();
+  CLI::App* app = parent.add_subcommand("localize", "The paper's localisation experiment (w_rcs sweep)");
+  AddLocalizeOptions(app, *s);
+  return {app, [s] { return RunLocalize(*s); }};
+}
+
+}  // namespace radargauss::cli

@@ -1,0 +1,132 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "localize_settings.hpp"
+
+#include "radargauss/error.hpp"
+#include "radargauss/residuals/loss.hpp"
+#include "radargauss/solvers/factory.hpp"
+
+namespace radargauss::cli {
+
+namespace {
+
+// Our solvers, plus the PCL peers when built with RADARGAUSS_WITH_PCL.
+std::vector<std::string> SolverNames() {
+  std::vector<std::string> names = ScanMatcherNames();
+#ifdef RADARGAUSS_HAVE_PCL
+  names.push_back("pcl-ndt");
+  names.push_back("pcl-gicp");
+#endif
+  return names;
+}
+
+std::string Joined(const std::vector<std::string>& names, const char* separator = ", ") {
+  std::string joined;
+  for (const std::string& name : names) joined += (joined.empty() ? "" : separator) + name;
+  return joined;
+}
+
+void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
+  app->add_option("--w-rcs", s.w_rcs, "Weights w_rcs of eq. 2 to sweep (0..1)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app->add_option("--solver", s.solvers,
+                  "Solvers: " + Joined(ScanMatcherNames()) + " (and pcl-ndt, pcl-gicp when built "
+                  "with RADARGAUSS_WITH_PCL)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(SolverNames()))
+      ->capture_default_str();
+  app->add_option("--loss", s.losses, "Geometric losses: " + Joined(LossNames()))
+      ->delimiter(',')
+      ->check(CLI::IsMember(LossNames()))
+      ->capture_default_str();
+  app->add_option("--loss-scale", s.loss_scale, "Scale of the geometric loss")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--rcs-loss", s.rcs_loss, "RCS loss (the paper: cauchy)")
+      ->check(CLI::IsMember(LossNames()))
+      ->capture_default_str();
+  app->add_option("--rcs-loss-scale", s.rcs_loss_scale, "Scale of the RCS loss")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--incidences", s.incidences, "Incidence models to sweep (map built here)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"offset", "view"}));
+  app->add_option("--degrees", s.degrees, "SH degrees to sweep (map built here)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, kMaxShDegree));
+}
+
+void AddInitialErrorOptions(CLI::App* app, LocalizeSettings& s) {
+  app->add_option("--max-translation", s.max_translation, "Initial translation error bound (m)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app->add_option("--max-rotation", s.max_rotation, "Initial rotation error bound (deg)")
+      ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
+  app->add_option("--seed", s.seed, "Seed of the initial errors")->capture_default_str();
+  app->add_option("--stride", s.stride, "Match every n-th scan (the map uses all)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
+void AddCoarseOptions(CLI::App* app, LocalizeSettings& s) {
+  app->add_option("--coarse-levels", s.coarse_levels,
+                  "Coarse-to-fine levels: inflated (every Gaussian blurred) or merged (voxel merges, faster)")
+      ->check(CLI::IsMember({"inflated", "merged"}))
+      ->capture_default_str();
+  app->add_option("--coarse-voxel", s.coarse_voxel,
+                  "Coarse levels match the scan's voxel centroids, voxel side this times the level's blur "
+                  "(0: the points)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app->add_option("--coarse-points", s.coarse_points, "Points used on the coarse levels (0: all)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app->add_option("--coarse-gate", s.coarse_gate,
+                  "Association gate on the coarse levels (Mahalanobis; smaller: faster, less reach)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_flag("--loss-curvature", s.loss_curvature,
+                "Own GN: the robust losses' curvature in the Hessian instead of IRLS weights alone");
+  app->add_flag("--geometric-first,!--no-geometric-first", s.geometric_first,
+                "With 0 < w < 1: the exact map's geometric term alone first, then eq. 2 (default on)");
+}
+
+}  // namespace
+
+const SequenceOptions& LocalizeSettings::CheckedSequenceOptions() const {
+  if (sequence.ground_truth.empty()) throw DataError("localize needs --gt");
+  return sequence;
+}
+
+MatchingMapOptions LocalizeSettings::MatchingOptions() const {
+  MatchingMapOptions options;
+  options.coarse = CoarseLevelsFromString(coarse_levels);
+  options.coarse_gate = coarse_gate;
+  return options;
+}
+
+ScanMatchingOptions LocalizeSettings::MatchOptions(double w, const std::string& loss) const {
+  ScanMatchingOptions options;
+  options.w_rcs = w;
+  options.geometric_loss = {LossTypeFromString(loss), loss_scale};
+  options.rcs_loss = {LossTypeFromString(rcs_loss), rcs_loss_scale};
+  options.coarse_voxel_per_sigma = coarse_voxel;
+  options.coarse_points = coarse_points;
+  options.loss_curvature = loss_curvature;
+  options.geometric_first = geometric_first;
+  return options;
+}
+
+void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
+  AddSequenceOptions(app, s.sequence);
+  AddMapBuildOptions(app, s.build);
+  app->add_option("--map", s.map_path, "Map file (.rgm); without it the map is built from the sequence");
+  app->add_option("--out", s.out, "Results folder")->required();
+  AddSweepOptions(app, s);
+  AddInitialErrorOptions(app, s);
+  AddCoarseOptions(app, s);
+}
+
+}  // namespace radargauss::cli

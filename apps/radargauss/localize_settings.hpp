@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The flags of radargauss localize and the options they make.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "radargauss/solvers/scan_matcher.hpp"
+
+namespace radargauss::cli {
+
+struct LocalizeSettings {
+  SequenceOptions sequence;
+  MapBuildSettings build;
+  std::string map_path;
+  std::string out;
+  std::vector<double> w_rcs = {0.0, 0.25, 1.0};
+  std::vector<std::string> solvers = {"gn"};
+  std::vector<std::string> losses = {"trivial"};
+  std::vector<std::string> incidences;
+  std::vector<int> degrees;
+  std::string rcs_loss = "cauchy";
+  double loss_scale = 1.0;
+  double rcs_loss_scale = 1.0;
+  double max_translation = 2.0;
+  double max_rotation = 5.0;
+  std::uint32_t seed = 42;
+  int stride = 1;
+  std::string coarse_levels = ToString(MatchingMapOptions().coarse);
+  double coarse_voxel = ScanMatchingOptions().coarse_voxel_per_sigma;
+  std::size_t coarse_points = ScanMatchingOptions().coarse_points;
+  double coarse_gate = MatchingMapOptions().coarse_gate;
+  bool loss_curvature = false;
+  bool geometric_first = ScanMatchingOptions().geometric_first;
+
+  // The sequence options, once the flags that a run needs are checked.
+  const SequenceOptions& CheckedSequenceOptions() const;
+  MatchingMapOptions MatchingOptions() const;
+  // The matching options of one configuration: weight w and geometric loss.
+  ScanMatchingOptions MatchOptions(double w, const std::string& loss) const;
+};
+
+void AddLocalizeOptions(CLI::App* app, LocalizeSettings& settings);
+
+}  // namespace radargauss::cli

@@ -1,0 +1,109 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The flags shared by several subcommands: the sequence, the map pipeline.
+#include <cstdio>
+
+#include "commands.hpp"
+#include "radargauss/progress.hpp"
+
+namespace radargauss::cli {
+
+void AddSequenceOptions(CLI::App* app, SequenceOptions& options) {
+  app->add_option("--sequence", options.sequence_dir,
+                  "Sequence folder: Snail-Radar layout (ars548/points/*.pcd), *.pcd or *.bin");
+  app->add_option("--gt", options.ground_truth, "Ground-truth trajectory (TUM)");
+  app->add_option("--extrinsic", options.extrinsic,
+                  "T_gt_radar: auto, identity, snail-20231213, or a file 'x y z qx qy qz qw'")
+      ->capture_default_str();
+  app->add_option("--bag", options.bag, "ROS1 bag with sensor_msgs/PointCloud2 scans");
+  app->add_option("--topic", options.topic, "Topic of the scans in --bag");
+  app->add_option("--bin-layout", options.bin_layout,
+                  "Field order of .bin records (vod = 'x y z rcs v_r v_r_comp time')")
+      ->capture_default_str();
+  app->add_option("--rcs-field", options.fields.rcs_field,
+                  "Field holding RCS (default: first of rcs RCS intensity power; 'none')");
+  app->add_option("--doppler-field", options.fields.doppler_field,
+                  "Field holding Doppler (default: first of doppler velocity v_r "
+                  "radial_velocity vel; 'none')");
+  app->add_option("--doppler-sign", options.fields.doppler_sign,
+                  "Multiplies the file's Doppler to get 'positive receding' (+1 or -1)")
+      ->check(CLI::IsMember({1.0, -1.0}))
+      ->capture_default_str();
+}
+
+MapOptions MapBuildSettings::Resolved() const {
+  MapOptions options = map;
+  options.gaussians.builder = MapBuilderFromString(builder);
+  options.cloud.doppler_filter = !no_doppler_filter;
+  options.rcs.incidence = IncidenceModelFromString(incidence);
+  options.rcs.adaptive = !no_adaptive;
+  return options;
+}
+
+void AddMapBuildOptions(CLI::App* app, MapBuildSettings& s) {
+  GaussianMapOptions& gaussians = s.map.gaussians;
+  app->add_option("--builder", s.builder, "kmeans (RA-L default) or voxel (NDT-style baseline)")
+      ->check(CLI::IsMember({"kmeans", "voxel"}))
+      ->capture_default_str();
+  app->add_option("--points-per-gaussian", gaussians.points_per_gaussian,
+                  "K = round(N_downsampled / this) (about 4 for ARS548, 16 for Oculii Eagle)")
+      ->check(CLI::Range(1.0, 1e6))
+      ->capture_default_str();
+  app->add_option("--downsample", gaussians.downsample_voxel, "Voxel downsample edge (m)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--em-iterations", gaussians.em_iterations, "Hard-EM rounds")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app->add_option("--min-std", gaussians.min_std, "Minimum principal std of a Gaussian (m)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--ndt-voxel", gaussians.ndt_voxel, "Voxel edge of the voxel builder (m)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--gate", gaussians.association_gate, "Association gate tau (Mahalanobis distance)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--map-seed", gaussians.seed, "Seed of the bisecting k-means")->capture_default_str();
+  app->add_option("--degree", s.map.rcs.max_degree, "SH degree of the RCS models (0..3)")
+      ->check(CLI::Range(0, kMaxShDegree))
+      ->capture_default_str();
+  app->add_option("--incidence", s.incidence, "Incidence vector: offset (paper) or view")
+      ->check(CLI::IsMember({"offset", "view"}))
+      ->capture_default_str();
+  app->add_flag("--no-adaptive", s.no_adaptive,
+                "Give no model instead of lowering the degree when members are too few");
+  app->add_flag("--no-doppler-filter", s.no_doppler_filter, "Keep dynamic points too");
+}
+
+MapGeometry BuildGeometry(const Sequence& sequence, const MapBuildSettings& settings, bool verbose) {
+  ProgressBar bar;
+  const MapGeometry geometry = BuildMapGeometry(
+      sequence.scans, sequence.poses, settings.Resolved(),
+      [&](const char* step, std::size_t done, std::size_t total) { bar.Update(step, done, total); });
+  bar.Finish();
+  if (verbose) {
+    const MapCloudStats& stats = geometry.cloud_stats;
+    std::printf("map cloud: %zu scans (%zu without ego velocity), %zu of %zu points static\n", stats.scans,
+                stats.scans_without_ego_velocity, stats.points_static, stats.points_in);
+    std::printf("gaussians: %zu (%s builder)\n", geometry.map.gaussians.size(), settings.builder.c_str());
+  }
+  return geometry;
+}
+
+GaussianMap FitRcsModelsOf(const MapGeometry& geometry, const MapBuildSettings& settings,
+                           IncidenceModel incidence, int degree, bool verbose) {
+  RcsFitOptions rcs = settings.Resolved().rcs;
+  rcs.incidence = incidence;
+  rcs.max_degree = degree;
+  RcsFitStats stats;
+  GaussianMap map = FitRcs(geometry, rcs, &stats);
+  if (verbose) {
+    std::printf("rcs models (%s incidence, degree <= %d, %s): %zu with a model (%zu at a lowered "
+                "degree), %zu without; mean fit RMSE %.4f\n",
+                ToString(incidence).c_str(), degree, rcs.adaptive ? "adaptive" : "fixed", stats.with_model,
+                stats.lowered_degree, stats.no_model, stats.mean_fit_rmse);
+  }
+  return map;
+}
+
+}  // namespace radargauss::cli

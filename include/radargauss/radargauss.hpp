@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The front door: the main jobs in a few calls. Build a Gaussian-RCS map
+// from scans and reference poses, match a scan against it, read and write
+// the files in between. docs/design.md explains each step.
+//
+//   const Sequence sequence = LoadSequence(sequence_options);
+//   const MatchingMap map(BuildMap(sequence));
+//   const ScanMatchingResult match = Match(scan, map, initial_guess);
+#pragma once
+
+#include <vector>
+
+#include "radargauss/error.hpp"
+#include "radargauss/io/sequence.hpp"
+#include "radargauss/lie/se3.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/map/pipeline.hpp"
+#include "radargauss/solvers/factory.hpp"
+#include "radargauss/solvers/scan_matcher.hpp"
+#include "radargauss/trajectory.hpp"
+#include "radargauss/types.hpp"
+
+namespace radargauss {
+
+// The pipeline of `radargauss build-map`: Doppler filter, merged static
+// cloud, Gaussians, RCS models. Needs sequence.poses. Throws DataError.
+GaussianMap BuildMap(const Sequence& sequence, const MapOptions& options = {});
+// The same from scans and their poses T_world_radar (one per scan).
+GaussianMap BuildMap(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
+                     const MapOptions& options = {});
+
+// Matches `scan` against `map` from `initial` (T_world_radar) with the solver
+// of options.solver: minimises eq. 2 coarse to fine. Throws
+// std::invalid_argument for bad options; a match that fails says why in
+// result.reason.
+ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                         const MatchOptions& options = {});
+
+}  // namespace radargauss

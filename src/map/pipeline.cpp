@@ -1,0 +1,25 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/map/pipeline.hpp"
+
+#include "radargauss/error.hpp"
+
+namespace radargauss {
+
+MapGeometry BuildMapGeometry(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
+                             const MapOptions& options, const ProgressCallback& progress) {
+  MapGeometry geometry;
+  geometry.cloud = BuildMapCloud(scans, poses, options.cloud, &geometry.cloud_stats);
+  if (geometry.cloud.points.empty()) throw DataError("no static points to build a map from");
+  geometry.map.gaussians = BuildGaussians(geometry.cloud.points, options.gaussians, progress,
+                                          &geometry.association);
+  return geometry;
+}
+
+GaussianMap FitRcs(const MapGeometry& geometry, const RcsFitOptions& options, RcsFitStats* stats) {
+  GaussianMap map = geometry.map;
+  const RcsFitStats fitted = FitRcsModels(map, geometry.cloud, geometry.association, options);
+  if (stats) *stats = fitted;
+  return map;
+}
+
+}  // namespace radargauss
