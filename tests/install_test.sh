@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs radargauss into a temporary prefix, builds examples/ against it
+# as another project would (find_package, nothing but the prefix), and runs
+# build_map and match_scan on a simulated sequence: the match must end
+# within 5 cm and 0.2 deg of the reference.
+#   install_test.sh <build dir> <source dir>
+set -euo pipefail
+build=$1
+source=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+prefix="$work/prefix"
+
+cmake --install "$build" --prefix "$prefix" >"$work/install.log"
+# The installed target's include path is the prefix's include/ alone.
+targets=$(find "$prefix" -name radargaussTargets.cmake)
+includes=$(grep -o 'INTERFACE_INCLUDE_DIRECTORIES "[^"]*"' "$targets")
+if [ "$includes" != 'INTERFACE_INCLUDE_DIRECTORIES "${_IMPORT_PREFIX}/include"' ]; then
+  echo "FAIL: installed include path is $includes"; exit 1
+fi
+cmake -S "$source/examples" -B "$work/examples" -DCMAKE_PREFIX_PATH="$prefix" \
+  -DCMAKE_BUILD_TYPE=Release >"$work/configure.log"
+cmake --build "$work/examples" -j 2 >"$work/build.log" || { cat "$work/build.log"; exit 1; }
+
+"$prefix/bin/radargauss" simulate --out "$work/sequence" --scans 120 >/dev/null
+"$work/examples/build_map" "$work/sequence" "$work/sequence/gt_radar_tum.txt" "$work/map.rgm"
+output=$("$work/examples/match_scan" "$work/sequence" "$work/sequence/gt_radar_tum.txt" "$work/map.rgm" 100)
+echo "$output"
+echo "$output" | awk '/^error:/ { found = 1; ok = ($3 <= 0.05 && $6 <= 0.2) }
+                      END { if (!found || !ok) { print "FAIL: match outside 5 cm / 0.2 deg"; exit 1 } }'
+echo "1 passed, 0 failed"

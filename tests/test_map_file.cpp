@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Map files: bit-exact round trips, corrupt files, the 3DGS-layout PLY.
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <random>
+
+#include "radargauss/error.hpp"
+#include "radargauss/map/builder.hpp"
+#include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/map/map_cloud.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/map/rcs_model.hpp"
+#include "radargauss/simulator.hpp"
+#include "temp_dir.hpp"
+#include "map_fixtures.hpp"
+
+namespace radargauss {
+namespace {
+
+using testing::RandomUnitVector;
+using MapFiles = testing::TempDirTest;
+
+// ---------------------------------------------------------------------------
+// Map files.
+
+GaussianMap ExampleMap() {
+  const Planted planted = PlantGaussians(1, 5);
+  GaussianMap map;
+  map.incidence = IncidenceModel::kView;
+  map.gaussians = planted.gaussians;
+  std::mt19937 rng(6);
+  std::normal_distribution<double> normal;
+  for (std::size_t i = 0; i < map.gaussians.size(); ++i) {
+    Gaussian& g = map.gaussians[i];
+    g.point_count = std::uint32_t(10 + i);
+    if (i % 3 == 0) continue;  // no model
+    g.rcs.degree = int(i % 4);
+    g.rcs.median = normal(rng);
+    g.rcs.scale = 1.0 + std::abs(normal(rng));
+    g.rcs.fit_rmse = 0.1;
+    g.rcs.inliers = 9;
+    for (int j = 0; j < ShCoefficientCount(g.rcs.degree); ++j) g.rcs.coefficients[j] = normal(rng);
+  }
+  return map;
+}
+
+std::string ReadBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+TEST_F(MapFiles, RoundTripIsBitExact) {
+  const GaussianMap map = ExampleMap();
+  WriteMap(Path("a.rgm"), map);
+  const GaussianMap read = ReadMap(Path("a.rgm"));
+  EXPECT_EQ(read.incidence, map.incidence);
+  ASSERT_EQ(read.gaussians.size(), map.gaussians.size());
+  for (std::size_t i = 0; i < map.gaussians.size(); ++i) {
+    EXPECT_EQ(read.gaussians[i].mean, map.gaussians[i].mean);
+    EXPECT_EQ(read.gaussians[i].covariance, map.gaussians[i].covariance);
+    EXPECT_EQ(read.gaussians[i].rcs.coefficients, map.gaussians[i].rcs.coefficients);
+    EXPECT_EQ(read.gaussians[i].rcs.degree, map.gaussians[i].rcs.degree);
+  }
+  WriteMap(Path("b.rgm"), read);
+  EXPECT_EQ(ReadBytes(Path("a.rgm")), ReadBytes(Path("b.rgm")));
+}
+
+TEST_F(MapFiles, CorruptFilesGiveClearErrors) {
+  WriteMap(Path("good.rgm"), ExampleMap());
+  const std::string good = ReadBytes(Path("good.rgm"));
+  const auto expect_error = [&](const std::string& bytes, const std::string& fault) {
+    const std::string path = WriteFile("bad.rgm", bytes);
+    try {
+      ReadMap(path);
+      ADD_FAILURE() << "accepted a map with " << fault;
+    } catch (const DataError& e) {
+      EXPECT_NE(std::string(e.what()).find(fault), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind(path, 0), 0u) << e.what();
+    }
+  };
+  std::string flipped = good;
+  flipped[good.size() / 2] ^= 0x10;
+  expect_error(flipped, "CRC32 mismatch");
+  expect_error(good.substr(0, good.size() - 100), "truncated");
+  expect_error(good.substr(0, 10), "too short");
+  std::string version = good;
+  version[8] = 7;
+  expect_error(version, "map version 7, this build reads version 1");
+  expect_error("PLY?" + good, "bad magic");
+  EXPECT_THROW(ReadMap(Path("absent.rgm")), DataError);
+}
+
+TEST_F(MapFiles, PlyHasThe3dgsLayout) {
+  const GaussianMap map = ExampleMap();
+  ExportPly(Path("map.ply"), map);
+  const std::string bytes = ReadBytes(Path("map.ply"));
+  const std::size_t end = bytes.find("end_header\n");
+  ASSERT_NE(end, std::string::npos);
+  const std::string header = bytes.substr(0, end);
+  std::size_t properties = 0;
+  for (std::size_t at = header.find("property float"); at != std::string::npos;
+       at = header.find("property float", at + 1)) {
+    ++properties;
+  }
+  EXPECT_EQ(properties, 62u);
+  for (const char* name : {"f_dc_0", "f_rest_44", "opacity", "scale_2", "rot_3", "nz"}) {
+    EXPECT_NE(header.find(std::string("property float ") + name + "\n"), std::string::npos) << name;
+  }
+  const std::size_t data = end + std::string("end_header\n").size();
+  ASSERT_EQ(bytes.size() - data, map.gaussians.size() * 62 * sizeof(float));
+  // Vertex 1: position, grey level 0.5 c_0, scales = log principal stds, and
+  // rotation * diag(exp(2 scale)) * rotation^T = covariance.
+  float v[62];
+  std::memcpy(v, bytes.data() + data + 62 * sizeof(float), sizeof(v));
+  const Gaussian& g = map.gaussians[1];
+  EXPECT_NEAR(v[0], g.mean.x(), 1e-5);
+  EXPECT_NEAR(v[6], 0.5 * g.rcs.coefficients[0], 1e-6);
+  EXPECT_EQ(v[6], v[8]);
+  const Eigen::Quaterniond q(v[58], v[59], v[60], v[61]);
+  const Eigen::Vector3d variances(std::exp(2 * v[55]), std::exp(2 * v[56]), std::exp(2 * v[57]));
+  const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
+  EXPECT_LT((R * variances.asDiagonal() * R.transpose() - g.covariance).norm(), 1e-5);
+}
+
+}  // namespace
+}  // namespace radargauss
