@@ -1,0 +1,193 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The simulator's configuration file and outputs.
+#include "radargauss/simulator.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <sstream>
+#include <variant>
+
+#include "radargauss/atomic_file.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/io/pcd.hpp"
+
+namespace radargauss {
+
+
+// ---------------------------------------------------------------------------
+// Configuration file.
+
+namespace {
+
+using ConfigValue = std::variant<double*, int*, std::uint32_t*>;
+
+std::vector<std::pair<std::string, ConfigValue>> ConfigFields(SimulationConfig& c) {
+  return {{"seed", &c.seed},
+          {"scans", &c.scans},
+          {"rate_hz", &c.rate_hz},
+          {"start_time", &c.start_time},
+          {"speed", &c.speed},
+          {"loop_length", &c.loop_length},
+          {"loop_width", &c.loop_width},
+          {"corner_radius", &c.corner_radius},
+          {"sensor_height", &c.sensor_height},
+          {"attitude_wobble_deg", &c.attitude_wobble_deg},
+          {"azimuth_fov_deg", &c.azimuth_fov_deg},
+          {"elevation_fov_deg", &c.elevation_fov_deg},
+          {"min_range", &c.min_range},
+          {"max_range", &c.max_range},
+          {"min_detections", &c.min_detections},
+          {"max_detections", &c.max_detections},
+          {"max_rays", &c.max_rays},
+          {"detection_threshold_db", &c.detection_threshold_db},
+          {"range_noise", &c.range_noise},
+          {"azimuth_noise_deg", &c.azimuth_noise_deg},
+          {"elevation_noise_deg", &c.elevation_noise_deg},
+          {"doppler_noise", &c.doppler_noise},
+          {"rcs_noise_db", &c.rcs_noise_db},
+          {"clutter_fraction", &c.clutter_fraction},
+          {"rcs_outlier_fraction", &c.rcs_outlier_fraction},
+          {"poles", &c.poles},
+          {"parked_cars", &c.parked_cars},
+          {"moving_cars", &c.moving_cars},
+          {"moving_car_speed", &c.moving_car_speed},
+          {"object_rcs_spread_db", &c.object_rcs_spread_db}};
+}
+
+}  // namespace
+
+void ValidateSimulationConfig(const SimulationConfig& c, const std::string& source) {
+  const auto require = [&](bool ok, const std::string& what) {
+    if (!ok) throw FileError(source, what);
+  };
+  require(c.scans >= 1, "scans must be >= 1");
+  require(c.rate_hz > 0.0, "rate_hz must be > 0");
+  require(std::isfinite(c.start_time) && c.start_time >= 0.0, "start_time must be >= 0");
+  require(c.speed >= 0.0, "speed must be >= 0");
+  require(c.corner_radius > 0.0 && c.loop_length > 2.0 * c.corner_radius &&
+              c.loop_width > 2.0 * c.corner_radius,
+          "loop_length and loop_width must exceed 2 x corner_radius > 0");
+  require(c.sensor_height > 0.0, "sensor_height must be > 0");
+  require(c.azimuth_fov_deg > 0.0 && c.azimuth_fov_deg <= 90.0, "azimuth_fov_deg must be in (0, 90]");
+  require(c.elevation_fov_deg > 0.0 && c.elevation_fov_deg < 90.0,
+          "elevation_fov_deg must be in (0, 90)");
+  require(c.min_range >= 0.0 && c.max_range > c.min_range, "need 0 <= min_range < max_range");
+  require(c.min_detections >= 1 && c.max_detections >= c.min_detections,
+          "need 1 <= min_detections <= max_detections");
+  require(c.max_rays >= 1, "max_rays must be >= 1");
+  for (const double noise : {c.range_noise, c.azimuth_noise_deg, c.elevation_noise_deg,
+                             c.doppler_noise, c.rcs_noise_db, c.object_rcs_spread_db}) {
+    require(noise >= 0.0 && std::isfinite(noise), "noise levels must be finite and >= 0");
+  }
+  require(c.clutter_fraction >= 0.0 && c.clutter_fraction < 1.0, "clutter_fraction must be in [0, 1)");
+  require(c.rcs_outlier_fraction >= 0.0 && c.rcs_outlier_fraction <= 1.0,
+          "rcs_outlier_fraction must be in [0, 1]");
+  require(c.poles >= 0 && c.parked_cars >= 0 && c.moving_cars >= 0, "object counts must be >= 0");
+  for (const char* name : {"ground", "wall", "pole", "car"}) {
+    const auto it = c.materials.find(name);
+    require(it != c.materials.end(), std::string("material '") + name + "' missing");
+    require(it->second.diffuse >= 0.0 && it->second.specular >= 0.0 &&
+                it->second.lobe_width_deg > 0.0 &&
+                it->second.diffuse + it->second.specular > 0.0,
+            std::string("material '") + name + "' needs diffuse, specular >= 0 (not both 0) and lobe_width_deg > 0");
+  }
+}
+
+SimulationConfig LoadSimulationConfig(const std::string& path) {
+  SimulationConfig config;
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw FileError(path, "cannot open simulation config");
+  } catch (const YAML::Exception& e) {
+    throw FileError(path, std::string("YAML: ") + e.what());
+  }
+  if (root.IsNull()) return config;
+  if (!root.IsMap()) throw FileError(path, "expected a map of parameters");
+  auto fields = ConfigFields(config);
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    try {
+      if (key == "materials") {
+        if (!entry.second.IsMap()) throw FileError(path, "materials must be a map");
+        for (const auto& material : entry.second) {
+          const std::string name = material.first.as<std::string>();
+          if (!config.materials.count(name)) {
+            throw FileError(path, "unknown material '" + name + "' (ground, wall, pole, car)");
+          }
+          Material& m = config.materials[name];
+          for (const auto& property : material.second) {
+            const std::string property_name = property.first.as<std::string>();
+            if (property_name == "diffuse") m.diffuse = property.second.as<double>();
+            else if (property_name == "specular") m.specular = property.second.as<double>();
+            else if (property_name == "lobe_width_deg") m.lobe_width_deg = property.second.as<double>();
+            else throw FileError(path, "unknown material property '" + property_name + "'");
+          }
+        }
+        continue;
+      }
+      const auto it = std::find_if(fields.begin(), fields.end(),
+                                   [&](const auto& field) { return field.first == key; });
+      if (it == fields.end()) throw FileError(path, "unknown parameter '" + key + "'");
+      std::visit([&](auto* target) { *target = entry.second.as<std::remove_pointer_t<decltype(target)>>(); },
+                 it->second);
+    } catch (const YAML::Exception&) {
+      throw FileError(path, "parameter '" + key + "' has the wrong type");
+    }
+  }
+  ValidateSimulationConfig(config, path);
+  return config;
+}
+
+std::string SimulationConfigToYaml(const SimulationConfig& config) {
+  SimulationConfig copy = config;
+  std::ostringstream out;
+  out.precision(17);
+  for (const auto& [key, value] : ConfigFields(copy)) {
+    out << key << ": ";
+    std::visit([&](auto* target) { out << *target; }, value);
+    out << "\n";
+  }
+  out << "materials:\n";
+  for (const auto& [name, m] : config.materials) {
+    out << "  " << name << ": {diffuse: " << m.diffuse << ", specular: " << m.specular
+        << ", lobe_width_deg: " << m.lobe_width_deg << "}\n";
+  }
+  return out.str();
+}
+
+Sequence AsSequence(const SimulatedSequence& simulated) {
+  Sequence sequence;
+  sequence.layout = "simulated";
+  sequence.scans = simulated.scans;
+  sequence.total_scans = simulated.scans.size();
+  sequence.trajectory = simulated.ground_truth;
+  for (const StampedPose& sample : simulated.ground_truth) sequence.poses.push_back(sample.pose);
+  return sequence;
+}
+
+void WriteSimulatedSequence(const std::string& dir, const SimulatedSequence& sequence) {
+  namespace fs = std::filesystem;
+  const fs::path points = fs::path(dir) / "ars548" / "points";
+  std::error_code error;
+  fs::create_directories(points, error);
+  if (error) throw FileError(points.string(), "cannot create directory: " + error.message());
+  std::string times;
+  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
+    const std::string& stem = sequence.file_stems[k];
+    WritePcdScan((points / (stem + ".pcd")).string(), sequence.scans[k], PcdFormat::kBinary);
+    times += stem + "\n";
+  }
+  WriteFileAtomically((points / "times.txt").string(), [&](std::ostream& out) { out << times; });
+  WriteTum((fs::path(dir) / "gt_radar_tum.txt").string(), sequence.ground_truth);
+  WriteFileAtomically((fs::path(dir) / "simulation.yaml").string(), [&](std::ostream& out) {
+    out << "# radargauss simulate: the configuration that produced this sequence\n"
+        << SimulationConfigToYaml(sequence.config);
+  });
+}
+
+}  // namespace radargauss

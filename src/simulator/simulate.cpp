@@ -1,0 +1,189 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The simulated drive: per scan, the sensor's state, rays cast through the
+// scene until the scan's detection count is reached, then clutter.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "radargauss/simulator.hpp"
+#include "scene.hpp"
+
+namespace radargauss {
+
+using simulation::kDeg;
+
+double MaterialRcs(const Material& material, double incidence_angle) {
+  const double lobe = material.lobe_width_deg * kDeg;
+  const double sigma = material.diffuse * std::max(0.0, std::cos(incidence_angle)) +
+                       material.specular * std::exp(-std::pow(incidence_angle / lobe, 2));
+  return 10.0 * std::log10(std::max(sigma, 1e-6));
+}
+
+std::string TimestampStem(double time) {
+  long long seconds = static_cast<long long>(std::floor(time));
+  long long nanoseconds = std::llround((time - static_cast<double>(seconds)) * 1e9);
+  if (nanoseconds >= 1000000000LL) {
+    seconds += 1;
+    nanoseconds -= 1000000000LL;
+  }
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%lld.%09lld", seconds, nanoseconds);
+  return buffer;
+}
+
+namespace {
+
+using simulation::Box;
+using simulation::Hit;
+using simulation::Scene;
+
+// The run's random draws, in one order for a seed (every draw goes through here).
+struct Draws {
+  explicit Draws(std::uint32_t seed) : rng(seed) {}
+  double Unit() { return unit(rng); }
+  double Normal() { return normal(rng); }
+  double Uniform(double lo, double hi) { return lo + (hi - lo) * unit(rng); }
+  std::mt19937 rng;
+  std::uniform_real_distribution<double> unit{0.0, 1.0};
+  std::normal_distribution<double> normal{0.0, 1.0};
+};
+
+// What one scan sees: the sensor's pose and velocity, the moving boxes.
+struct ScanState {
+  SE3d pose;
+  Eigen::Matrix3d R;
+  Eigen::Vector3d velocity_radar;
+  std::vector<Box> moving;
+  MeasurementStd stds;
+};
+
+// A detection where the ray at (azimuth, elevation) hits a surface, with the
+// detection probability of its RCS and range; false when it is not detected.
+bool Detect(const SimulationConfig& config, const Scene& scene, const ScanState& state, Draws& draws,
+            RadarPoint& point, DetectionTruth& detection) {
+  const double azimuth = draws.Uniform(-config.azimuth_fov_deg, config.azimuth_fov_deg) * kDeg;
+  const double elevation = draws.Uniform(-config.elevation_fov_deg, config.elevation_fov_deg) * kDeg;
+  const Eigen::Vector3d direction_radar(std::cos(elevation) * std::cos(azimuth),
+                                        std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+  const Eigen::Vector3d direction = state.R * direction_radar;
+  const Eigen::Vector3d& origin = state.pose.translation();
+  const Hit hit = CastRay(scene, state.moving, origin, direction, config.max_range);
+  if (hit.material == nullptr || hit.distance < config.min_range) return false;
+
+  const double incidence = std::acos(std::min(1.0, std::abs(direction.dot(hit.normal))));
+  const double rcs_true = MaterialRcs(config.materials.at(*hit.material), incidence) + hit.rcs_offset;
+  const double margin = rcs_true - 20.0 * std::log10(hit.distance / 10.0) - config.detection_threshold_db;
+  if (draws.Unit() > 1.0 / (1.0 + std::exp(-margin / 2.0))) return false;
+
+  const double range = hit.distance + config.range_noise * draws.Normal();
+  const double az = azimuth + config.azimuth_noise_deg * kDeg * draws.Normal();
+  const double el = elevation + config.elevation_noise_deg * kDeg * draws.Normal();
+  point.position = range * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+  // v_d = u . (v_target - v_sensor), conventions.hpp.
+  point.doppler = direction_radar.dot(state.R.transpose() * hit.velocity - state.velocity_radar) +
+                  config.doppler_noise * draws.Normal();
+  detection.kind = hit.dynamic ? DetectionKind::kDynamic : DetectionKind::kStatic;
+  detection.material = *hit.material;
+  detection.incidence_angle = incidence;
+  detection.rcs_noise_free = rcs_true;
+  detection.position_world = origin + hit.distance * direction;
+  point.rcs = rcs_true + config.rcs_noise_db * draws.Normal();
+  if (draws.Unit() < config.rcs_outlier_fraction) {
+    point.rcs += draws.Uniform(-25.0, 25.0);
+    detection.rcs_outlier = true;
+  }
+  point.std_dev = state.stds;
+  return true;
+}
+
+// Clutter: uniform directions, ranges, Doppler and RCS.
+void AddClutter(const SimulationConfig& config, const ScanState& state, int count, Draws& draws, RadarScan& scan,
+                std::vector<DetectionTruth>& truth) {
+  for (int c = 0; c < count; ++c) {
+    const double azimuth = draws.Uniform(-config.azimuth_fov_deg, config.azimuth_fov_deg) * kDeg;
+    const double elevation = draws.Uniform(-config.elevation_fov_deg, config.elevation_fov_deg) * kDeg;
+    const double range = draws.Uniform(std::max(1.0, config.min_range), 0.6 * config.max_range);
+    RadarPoint point;
+    point.position = range * Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                                             std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+    point.doppler = draws.Uniform(-15.0, 15.0);
+    point.rcs = draws.Uniform(-20.0, 15.0);
+    point.std_dev = state.stds;
+    DetectionTruth detection;
+    detection.kind = DetectionKind::kClutter;
+    detection.position_world = state.pose * point.position;
+    detection.rcs_noise_free = point.rcs;
+    scan.points.push_back(point);
+    truth.push_back(detection);
+  }
+}
+
+// Scan k's time in integer nanoseconds from the start, so file names are exact.
+struct ScanTime {
+  std::string stem;
+  double timestamp = 0.0;
+  double since_start = 0.0;
+};
+
+ScanTime TimeOfScan(const SimulationConfig& config, int k) {
+  const long long start_seconds = static_cast<long long>(std::floor(config.start_time));
+  const long long start_nanoseconds = std::llround((config.start_time - static_cast<double>(start_seconds)) * 1e9);
+  const long long offset_nanoseconds = std::llround(k * 1e9 / config.rate_hz);
+  const long long total = start_nanoseconds + offset_nanoseconds;
+  const long long seconds = start_seconds + total / 1000000000LL;
+  const long long nanoseconds = total % 1000000000LL;
+  char stem[64];
+  std::snprintf(stem, sizeof(stem), "%lld.%09lld", seconds, nanoseconds);
+  return {stem, static_cast<double>(seconds) + static_cast<double>(nanoseconds) * 1e-9, offset_nanoseconds * 1e-9};
+}
+
+}  // namespace
+
+SimulatedSequence Simulate(const SimulationConfig& config) {
+  ValidateSimulationConfig(config, "simulation config");
+  SimulatedSequence sequence;
+  sequence.config = config;
+  const simulation::LoopPath path{config.loop_length, config.loop_width, config.corner_radius};
+  Draws draws(config.seed);
+  const Scene scene = BuildScene(config, path, draws.rng);
+  ScanState state;
+  state.stds = {float(config.range_noise), float(config.azimuth_noise_deg * kDeg),
+                float(config.elevation_noise_deg * kDeg), float(config.doppler_noise)};
+  for (int k = 0; k < config.scans; ++k) {
+    const ScanTime time = TimeOfScan(config, k);
+    sequence.file_stems.push_back(time.stem);
+    Eigen::Vector3d velocity_world;
+    SensorState(config, path, time.since_start, state.pose, velocity_world);
+    state.R = state.pose.rotation().Matrix();
+    state.velocity_radar = state.R.transpose() * velocity_world;
+    state.moving.clear();
+    for (const simulation::MovingCar& car : scene.moving_cars) {
+      state.moving.push_back(MovingCarBox(car, config, path, time.since_start));
+    }
+    RadarScan scan;
+    scan.timestamp = time.timestamp;
+    scan.has_doppler = true;
+    scan.has_rcs = true;
+    std::vector<DetectionTruth> truth;
+    const int target = config.min_detections +
+                       static_cast<int>(draws.Unit() * (config.max_detections - config.min_detections + 1));
+    const int clutter = static_cast<int>(std::lround(target * config.clutter_fraction));
+    const int surface = std::min(target, config.max_detections) - clutter;
+    for (int ray = 0; ray < config.max_rays && static_cast<int>(scan.points.size()) < surface; ++ray) {
+      RadarPoint point;
+      DetectionTruth detection;
+      if (!Detect(config, scene, state, draws, point, detection)) continue;
+      scan.points.push_back(point);
+      truth.push_back(detection);
+    }
+    AddClutter(config, state, clutter, draws, scan, truth);
+    sequence.ground_truth.Append(scan.timestamp, state.pose);
+    sequence.sensor_velocity.push_back(state.velocity_radar);
+    sequence.scans.push_back(std::move(scan));
+    sequence.truth.push_back(std::move(truth));
+  }
+  return sequence;
+}
+
+}  // namespace radargauss
