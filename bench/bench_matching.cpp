@@ -160,7 +160,7 @@ std::vector<SE3d> InitialPoses(const SimulatedSequence& sequence) {
   return initial;
 }
 
-// The median of the per-scan times the solvers report (the goal is a median).
+// The median of the per-scan times the solvers report.
 double MedianMs(std::vector<double> times) {
   if (times.empty()) return 0.0;
   std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
@@ -309,8 +309,7 @@ BENCHMARK(BM_RefineScanLossCurvature)->Arg(0)->Arg(25)->Unit(benchmark::kMillise
 // defaults' answer. Counters t_dev_m / r_dev_deg: mean distance of each
 // scan's result from the default settings' result on the same scan.
 // Args: w_rcs x 100, setting (0 defaults; 1 eager re-association, after
-// every step; 2 steps to 0.1 mm / 1e-5 rad, the defaults before the eighth
-// session; 3 re-association after 2 cm instead of 1 cm; 4 small_gicp's step
+// every step; 2 steps to 0.1 mm / 1e-5 rad; 3 re-association after 2 cm instead of 1 cm; 4 small_gicp's step
 // tolerances, 1 mm / 0.1 deg; 5 re-association after 3 cm / 0.006 rad,
 // beyond this benchmark's initial error: one association per match).
 void BM_RefineScanSettings(benchmark::State& state) {
@@ -409,8 +408,7 @@ void ReportPaired(benchmark::State& state, const PairedRuns& runs, const std::st
 }
 
 // Ceres LM against the own GN when tracking, paired (MatchPaired): the
-// medians of their per-scan times and the ratio of the medians (the goal:
-// <= 5x). Args: w_rcs x 100, Ceres's blocks (0 square root, the default;
+// medians of their per-scan times and the ratio of the medians. Args: w_rcs x 100, Ceres's blocks (0 square root, the default;
 // 1 shared rows; 2 a block per term).
 void BM_RefineScanCeresOverGn(benchmark::State& state) {
   const Tracking tracking;

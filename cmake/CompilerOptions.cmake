@@ -3,7 +3,7 @@
 # every target of the project.
 #
 # No -march=native: Debian's Ceres and PCL are built for generic x86-64 and
-# mixing Eigen alignment assumptions with them crashes (DESIGN.md section 9).
+# mixing Eigen alignment assumptions with them crashes (docs/design.md, "Dependencies and pitfalls").
 function(radargauss_configure_target target)
   target_compile_features(${target} PUBLIC cxx_std_17)
   set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF)

@@ -1,5 +1,5 @@
 // Kept in its own small translation unit: NDT and GICP instantiations are
-// heavy to compile (DESIGN.md section 9).
+// heavy to compile (docs/design.md, "Dependencies and pitfalls").
 #include "radargauss/peers/pcl_peers.hpp"
 
 #include <pcl/point_cloud.h>

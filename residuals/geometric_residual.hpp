@@ -1,5 +1,5 @@
-// The geometric residual of scan matching (paper section III-B, DESIGN.md
-// section 5), for a radar point p associated to the Gaussian (mu, Sigma):
+// The geometric residual of scan matching (paper section III-B, docs/design.md,
+// "Residuals"), for a radar point p associated to the Gaussian (mu, Sigma):
 //
 //   r_geo = L^T (R p + t - mu),   Sigma^-1 = L L^T,
 //

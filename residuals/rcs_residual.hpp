@@ -1,5 +1,5 @@
-// The RCS residual of scan matching (paper section III-B, DESIGN.md section
-// 5), for a radar point p_r whose normalised RCS y (with the associated
+// The RCS residual of scan matching (paper section III-B, docs/design.md,
+// "Residuals"), for a radar point p_r whose normalised RCS y (with the associated
 // Gaussian's median and scale) lies in [-1, 1]:
 //
 //   r_rcs = y - c . Y(d),   d = s u / |u|,   u = IncidenceVector(model, p_r, mu_r),
@@ -217,7 +217,7 @@ class RcsRotationCostFunction final : public ceres::SizedCostFunction<1, 4> {
   Eigen::Vector3d translation_;
 };
 
-// Joint refinement (DESIGN.md section 5): the same residual with the
+// Joint refinement (docs/design.md, "Joint refinement"): the same residual with the
 // Gaussian's coefficients c as a parameter block, so that scans tie their
 // poses to the map. Blocks: rotation (4), coefficients ((degree + 1)^2) and,
 // with `full`, translation (3); rotation-only takes the translation as a

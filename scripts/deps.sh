@@ -8,7 +8,7 @@ set -euo pipefail
 packages=(
   # toolchain
   g++ make cmake pkg-config
-  # core (DESIGN.md section 9)
+  # core (docs/design.md, "Dependencies and pitfalls")
   libceres-dev libeigen3-dev libsuitesparse-dev libmetis-dev
   libyaml-cpp-dev liblzf-dev libcli11-dev nlohmann-json3-dev libtbb-dev zlib1g-dev
   # tests and benchmarks

@@ -1,5 +1,5 @@
-// Scan matching against a Gaussian-RCS map (paper section III-B, DESIGN.md
-// section 5): the options, the result and the interface every solver
+// Scan matching against a Gaussian-RCS map (paper section III-B, docs/design.md,
+// "Scan matching"): the options, the result and the interface every solver
 // implements, and the pieces they share (association, the cost of eq. 2).
 //
 // The cost (eq. 2):

@@ -43,7 +43,7 @@ using testing::RandomUnitVector;
 // thresholds at 0 it re-associates after every step (the textbook loop);
 // both end at the same optimum to well within the association's own
 // resolution, the lazy one with fewer associations (fewer iterations here,
-// as small steps no longer make points swap Gaussians back and forth).
+// as small steps do not make points swap Gaussians back and forth).
 TEST(LazyReassociation, SameOptimumFewerIterations) {
   const World& world = SimulatedWorld();
   const MatchingMap& exact = *world.exact;

@@ -134,9 +134,8 @@ TEST(EgoVelocity, SimulatedScansWithFortyPercentOutliers) {
       << good << " of " << sequence.scans.size();
 }
 
-// NTU Eagle: speed from Doppler against speed from the reference poses. The
-// data README reports 0.041 m/s median with its own RANSAC; the closing note
-// of issue 3 reports ours.
+// NTU Eagle: speed from Doppler against speed from the reference poses (the
+// data README reports 0.041 m/s median with its own RANSAC).
 TEST(EgoVelocityRealData, NtuEagleSpeedAgreesWithGroundTruth) {
   const std::string dir = testing::SharedData("ntu4dradlm_loop1_eagle");
   if (dir.empty()) GTEST_SKIP() << "shared data not found";

@@ -61,7 +61,7 @@ TEST(SE3Manifold, InvariantsHold) {
   }
 }
 
-// The issue asks for central differences as well as Ceres's Ridders check.
+// Central differences as well as Ceres's Ridders check.
 TEST(Manifolds, PlusJacobiansMatchCentralDifferences) {
   const SO3Manifold so3;
   const SE3Manifold se3;

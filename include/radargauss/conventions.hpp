@@ -1,5 +1,5 @@
 // radargauss conventions: the single place where each one is stated
-// (DESIGN.md section 2). Every other file refers here instead of restating.
+// (docs/design.md, "Conventions"). Every other file refers here instead of restating.
 #pragma once
 
 namespace radargauss {

@@ -1,4 +1,4 @@
-// The paper's localisation experiment (section IV, DESIGN.md section 6): for
+// The paper's localisation experiment (section IV, docs/design.md, "The localisation experiment"): for
 // every scan, start from the reference pose composed with a seeded random
 // error (translation magnitude uniform in [0, max] m, rotation angle uniform in
 // [0, max] deg, random directions; the same errors for every configuration),

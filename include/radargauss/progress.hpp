@@ -1,5 +1,5 @@
 // A one-line progress bar on stderr, drawn only when stderr is a terminal
-// (no Debian package offers one; DESIGN.md section 9).
+// (no Debian package offers one; docs/design.md, "Dependencies and pitfalls").
 #pragma once
 
 #include <unistd.h>

@@ -1,4 +1,4 @@
-// Synthetic 4D radar world (DESIGN.md section 7): a town block of ground,
+// Synthetic 4D radar world (docs/design.md, "The synthetic world"): a town block of ground,
 // building walls, poles, parked and moving cars, seen by an ARS548-like radar
 // driving a loop with turns. Deterministic for a seed.
 //

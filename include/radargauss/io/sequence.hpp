@@ -47,7 +47,7 @@ struct Sequence {
 // Throws DataError (one line naming the file and fault) on any bad input.
 Sequence LoadSequence(const SequenceOptions& options);
 
-// T_xt32_ars548 of the Snail-Radar 2023-12-13 sequences (DESIGN.md section 3).
+// T_xt32_ars548 of the Snail-Radar 2023-12-13 sequences (docs/design.md, "Data in and out").
 SE3d SnailRadar20231213Extrinsic();
 
 // Resolves SequenceOptions::extrinsic; throws DataError for an unknown preset

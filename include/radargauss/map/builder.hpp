@@ -1,4 +1,4 @@
-// Gaussian map builders (DESIGN.md section 4).
+// Gaussian map builders (docs/design.md, "Gaussians").
 //   kKMeans (default, the RA-L work done natively): voxel-downsample the
 //     cloud (0.25 m), K = round(N_downsampled / points_per_gaussian),
 //     bisecting k-means initialisation with a fixed seed, then hard EM: every

@@ -1,4 +1,4 @@
-// The Gaussian-RCS map (paper section III-A, DESIGN.md section 4): 3D
+// The Gaussian-RCS map (paper section III-A, docs/design.md, "Building the map"): 3D
 // Gaussians in the world frame, each with an optional RCS model, and the
 // spatial index used to associate points with them.
 #pragma once
@@ -14,8 +14,8 @@
 
 namespace radargauss {
 
-// How the incidence vector d of a member point is formed (DESIGN.md section
-// 4), in the radar frame of the point's scan, mu_r = R^T (mu - t):
+// How the incidence vector d of a member point is formed (docs/design.md,
+// "RCS models"), in the radar frame of the point's scan, mu_r = R^T (mu - t):
 //   kOffset (the paper's): d = normalize(p_r - mu_r)
 //   kView (radar-to-centre ray): d = normalize(-mu_r)
 // In both, d is flipped when d.x > 0 so that it faces the radar.
@@ -56,7 +56,7 @@ struct GaussianMap {
 void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs,
                    Eigen::Matrix3d& axes);
 
-// Clamps every principal std to at least `min_std` (DESIGN.md section 4).
+// Clamps every principal std to at least `min_std` (docs/design.md, "Building the map").
 Eigen::Matrix3d ClampCovariance(const Eigen::Matrix3d& covariance, double min_std);
 
 // The integer voxel of a point in a grid of side `voxel` (floor(p / voxel)),

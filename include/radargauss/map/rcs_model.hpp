@@ -1,4 +1,4 @@
-// Per-Gaussian RCS models (paper section III-A, DESIGN.md section 4).
+// Per-Gaussian RCS models (paper section III-A, docs/design.md, "RCS models").
 //
 // Normalisation: m = median of the members' RCS (mean of the two middle
 // values for an even count), s = min(m - min, max - m); members with
@@ -42,7 +42,7 @@ Eigen::Matrix<T, 3, 1> IncidenceVector(IncidenceModel model, const Eigen::Matrix
 }
 
 // The sign s that makes s u face the radar ((s u).x <= 0): the incidence
-// direction is d = s u / |u| (DESIGN.md section 4, item 3).
+// direction is d = s u / |u| (docs/design.md, "RCS models").
 inline double FacingSign(const Eigen::Vector3d& u) { return u.x() > 0.0 ? -1.0 : 1.0; }
 
 struct RcsFitOptions {

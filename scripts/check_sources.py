@@ -1,0 +1,118 @@
+#!/usr/bin/env python3
+"""Checks the product's files against the project's rules: source files of at
+most 400 lines and functions of at most 80, README.md of at most 200 lines and
+bench/RESULTS.md of at most 400, no narrative of how the project was made, and
+every docs/design.md section that a file cites present there.
+  scripts/check_sources.py [ROOT]"""
+import pathlib
+import re
+import sys
+
+ROOT = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else pathlib.Path(__file__).parent.parent)
+SOURCE_DIRS = ["include", "src", "residuals", "solvers", "apps", "peers", "examples", "tests", "bench"]
+PRODUCT_DIRS = SOURCE_DIRS + ["docs", "configs", "scripts", "cmake", ".ci"]
+MAX_FILE, MAX_FUNCTION, MAX_README, MAX_RESULTS = 400, 80, 200, 400
+# Words that narrate the making of the project instead of describing it.
+PROCESS_WORDS = re.compile(
+    r"\b(sessions?|sprints?|milestones?|the goal|the issue|issue ?#?\d+|task ?#?\d+|tickets?|"
+    r"(first|second|third|fourth|fifth|sixth|seventh|eighth|ninth|tenth|eleventh|twelfth|\w+teenth|twentieth) "
+    r"(session|round|pass of the work)|previously measured|used to be|no longer|was before)\b",
+    re.IGNORECASE)
+COMMIT_HASH = re.compile(r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}\b")
+DESIGN_CITATION = re.compile(r'docs/design\.md,?\s*(?:section\s*)?"([^"]+)"')
+CONTROL = re.compile(r"^\s*(if|for|while|switch|catch|do|else|try)\b|\]\s*\(|=\s*\[|return \[")
+
+
+def product_files():
+    files = [ROOT / "README.md", ROOT / "CMakeLists.txt", ROOT / "bench" / "RESULTS.md"]
+    for folder in PRODUCT_DIRS:
+        files += [p for p in (ROOT / folder).rglob("*") if p.is_file()]
+    return [p for p in files if p.exists() and p.name != "check_sources.py"]
+
+
+def strip_code(line):
+    line = re.sub(r'"(\\.|[^"\\])*"', '""', line)
+    line = re.sub(r"'(\\.|[^'\\])'", "''", line)
+    return line.split("//")[0]
+
+
+def long_functions(path, lines):
+    """Blocks opened by a function signature (not control flow, not a lambda)
+    longer than MAX_FUNCTION lines."""
+    found, stack, signature, parens = [], [], "", 0
+    for number, raw in enumerate(lines, 1):
+        code = strip_code(raw)
+        if re.match(r"^\s*(namespace\b|extern \"C\")", raw) or re.match(r"^\s*}\s*//\s*namespace", raw):
+            signature = ""
+            continue
+        for char in code:
+            if char == "{" and parens > 0:  # a braced initialiser inside a signature or a for
+                stack.append((number, False, ""))
+                signature += char
+            elif char == "}" and parens > 0:
+                if stack:
+                    stack.pop()
+                signature += char
+            elif char == "{":
+                is_function = ")" in signature and not CONTROL.search(signature) and \
+                    not re.search(r"\b(struct|class|enum|union)\b", signature)
+                stack.append((number, is_function, signature.strip()))
+                signature, parens = "", 0
+            elif char == "}":
+                if stack:
+                    start, is_function, name = stack.pop()
+                    if is_function and number - start + 1 > MAX_FUNCTION:
+                        found.append(f"{path}:{start}: function of {number - start + 1} lines: {name[:70]}")
+                signature = ""
+            elif char == ";" and parens == 0:
+                signature = ""
+            else:
+                parens += (char == "(") - (char == ")")
+                signature += char
+        signature += " "
+    return found
+
+
+def main():
+    problems = []
+    design = ROOT / "docs" / "design.md"
+    headings = set()
+    if design.exists():
+        headings = {h.strip() for h in re.findall(r"^#+\s*(?:\d+(?:\.\d+)*\.?\s*)?(.+)$", design.read_text(), re.M)}
+    for path in product_files():
+        relative = path.relative_to(ROOT)
+        try:
+            text = path.read_text()
+        except UnicodeDecodeError:
+            continue
+        lines = text.split("\n")
+        # Citations may wrap over comment lines.
+        joined = re.sub(r"\n\s*(//|#)\s*", " ", text)
+        for section in DESIGN_CITATION.findall(joined):
+            if section not in headings:
+                problems.append(f"{relative}: docs/design.md has no section \"{section}\"")
+        is_source = path.suffix in {".cpp", ".hpp", ".h", ".cc"}
+        if is_source and len(lines) - 1 > MAX_FILE:
+            problems.append(f"{relative}: {len(lines) - 1} lines (at most {MAX_FILE})")
+        if is_source:
+            problems += long_functions(relative, lines)
+        for number, line in enumerate(lines, 1):
+            match = PROCESS_WORDS.search(line)
+            if match:
+                problems.append(f"{relative}:{number}: narrates the work ('{match.group(0)}')")
+            if path.suffix == ".md" and COMMIT_HASH.search(line):
+                problems.append(f"{relative}:{number}: commit hash '{COMMIT_HASH.search(line).group(0)}'")
+            if re.search(r"(?<!docs/)\bDESIGN\.md", line):
+                problems.append(f"{relative}:{number}: cites DESIGN.md, which is not in the repository")
+    for name, limit in (("README.md", MAX_README), ("bench/RESULTS.md", MAX_RESULTS)):
+        count = len((ROOT / name).read_text().split("\n")) - 1
+        if count > limit:
+            problems.append(f"{name}: {count} lines (at most {limit})")
+    for problem in problems:
+        print(problem)
+    print(f"check_sources: {len(problems)} problems")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
