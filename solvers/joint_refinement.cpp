@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/solvers/joint_refinement.hpp"
 
 #include <ceres/normal_prior.h>
@@ -6,6 +7,7 @@
 
 #include <chrono>
 #include <map>
+#include <memory>
 #include <stdexcept>
 
 #include "radargauss/lie/manifold.hpp"
@@ -53,9 +55,10 @@ double RcsResidualRms(const std::vector<RadarScan>& scans, const std::vector<SE3
   return n ? std::sqrt(sum / double(n)) : 0.0;
 }
 
-JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
-                                    const std::vector<SE3d>& initial_poses, const GaussianMap& map,
-                                    const JointRefinementOptions& options) {
+namespace {
+
+void CheckOptions(const std::vector<RadarScan>& scans, const std::vector<SE3d>& initial_poses,
+                  const JointRefinementOptions& options) {
   ValidateOptions(options.matching);
   if (scans.size() != initial_poses.size() || scans.empty()) {
     throw std::invalid_argument("joint refinement needs one initial pose per scan (and a scan)");
@@ -64,103 +67,155 @@ JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
       options.coefficient_prior < 0.0) {
     throw std::invalid_argument("joint refinement: rounds and iterations must be >= 1, priors >= 0");
   }
+}
+
+// The parameter blocks of the joint problem: a rotation and a translation per
+// scan, the SH coefficients of every Gaussian with a model.
+struct JointBlocks {
+  JointBlocks(const std::vector<SE3d>& poses, const GaussianMap& map) : rotations(poses.size()), translations(poses.size()) {
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      rotations[k] = poses[k].rotation().quaternion().coeffs();
+      translations[k] = poses[k].translation();
+    }
+    coefficients.resize(map.gaussians.size());
+    for (std::size_t g = 0; g < map.gaussians.size(); ++g) {
+      const RcsModel& model = map.gaussians[g].rcs;
+      if (model.valid()) {
+        coefficients[g].assign(model.coefficients.begin(), model.coefficients.begin() + ShCoefficientCount(model.degree));
+      }
+    }
+  }
+  SE3d Pose(std::size_t k) const { return SE3d(SO3d::FromXyzw(rotations[k].data()), translations[k]); }
+
+  std::vector<Eigen::Vector4d> rotations;
+  std::vector<Eigen::Vector3d> translations;
+  std::vector<std::vector<double>> coefficients;
+};
+
+// One association round's problem: eq. 2's terms of every scan at its
+// current pose, the priors, the first pose fixed.
+class JointProblem {
+ public:
+  JointProblem(JointBlocks& blocks, const JointRefinementOptions& options)
+      : blocks_(blocks), options_(options), problem_(ProblemOptions()),
+        ordering_(std::make_shared<ceres::ParameterBlockOrdering>()) {
+    for (std::size_t k = 0; k < blocks_.rotations.size(); ++k) {
+      problem_.AddParameterBlock(blocks_.rotations[k].data(), 4, &so3_);
+      problem_.AddParameterBlock(blocks_.translations[k].data(), 3);
+      ordering_->AddElementToGroup(blocks_.rotations[k].data(), 1);
+      ordering_->AddElementToGroup(blocks_.translations[k].data(), 1);
+    }
+  }
+
+  // Scan k's geometric and RCS terms for its correspondences c.
+  void AddScan(std::size_t k, const Correspondences& c) {
+    const double w = options_.matching.w_rcs;
+    double* rotation = blocks_.rotations[k].data();
+    double* translation = blocks_.translations[k].data();
+    if (w < 1.0 && !c.geometric.empty()) {
+      const double weight = (1.0 - w) / double(c.geometric.size());
+      for (const GeometricTerm& term : c.geometric) {
+        problem_.AddResidualBlock(
+            new GeometricCostFunction(term.point_radar, c.index->Mean(term.gaussian),
+                                      c.index->SqrtInformationT(term.gaussian)),
+            new ceres::ScaledLoss(MakeLoss(options_.matching.geometric_loss), weight, ceres::TAKE_OWNERSHIP),
+            rotation, translation);
+      }
+    }
+    if (w > 0.0 && !c.rcs.empty()) {
+      const double weight = w / double(c.rcs.size());
+      const bool full = options_.matching.rcs_translation == RcsTranslation::kFull;
+      for (const RcsTerm& term : c.rcs) {
+        const std::uint32_t g = term.gaussian;
+        ceres::CostFunction* cost =
+            options_.matching.jacobians == JacobianMode::kAnalytic
+                ? static_cast<ceres::CostFunction*>(new RcsCoefficientCostFunction(term, c.pose.translation(), full))
+                : RcsCoefficientResidual::Create(term, c.pose.translation(), full);
+        std::vector<double*> parameters = {rotation, blocks_.coefficients[g].data()};
+        if (full) parameters.push_back(translation);
+        problem_.AddResidualBlock(
+            cost, new ceres::ScaledLoss(MakeLoss(options_.matching.rcs_loss), weight, ceres::TAKE_OWNERSHIP),
+            parameters);
+        if (!used_coefficients_[g]) {
+          used_coefficients_[g] = true;
+          ordering_->AddElementToGroup(blocks_.coefficients[g].data(), 0);  // eliminated first
+        }
+      }
+    }
+  }
+
+  // The optional priors: consecutive relative poses, coefficients near the map's.
+  void AddPriors(const std::vector<SE3d>& initial_poses, const GaussianMap& map) {
+    if (options_.relative_pose_prior > 0.0) {
+      for (std::size_t k = 0; k + 1 < initial_poses.size(); ++k) {
+        problem_.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 4, 3, 4, 3>(new RelativePoseResidual(
+                initial_poses[k].Inverse() * initial_poses[k + 1], options_.relative_pose_prior)),
+            nullptr, blocks_.rotations[k].data(), blocks_.translations[k].data(), blocks_.rotations[k + 1].data(),
+            blocks_.translations[k + 1].data());
+      }
+    }
+    if (options_.coefficient_prior > 0.0) {
+      for (const auto& [g, used] : used_coefficients_) {
+        const int count = int(blocks_.coefficients[g].size());
+        const Eigen::VectorXd initial = Eigen::Map<const Eigen::VectorXd>(map.gaussians[g].rcs.coefficients.data(), count);
+        problem_.AddResidualBlock(
+            new ceres::NormalPrior(options_.coefficient_prior * Eigen::MatrixXd::Identity(count, count), initial),
+            nullptr, blocks_.coefficients[g].data());
+      }
+    }
+  }
+
+  ceres::Solver::Summary Solve(ceres::Solver::Options solver_options) {
+    // Gauge: the first pose is fixed.
+    problem_.SetParameterBlockConstant(blocks_.rotations[0].data());
+    problem_.SetParameterBlockConstant(blocks_.translations[0].data());
+    if (options_.schur) solver_options.linear_solver_ordering = ordering_;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem_, &summary);
+    return summary;
+  }
+
+ private:
+  static ceres::Problem::Options ProblemOptions() {
+    ceres::Problem::Options options;
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    return options;
+  }
+
+  JointBlocks& blocks_;
+  const JointRefinementOptions& options_;
+  SO3Manifold so3_;
+  ceres::Problem problem_;
+  std::shared_ptr<ceres::ParameterBlockOrdering> ordering_;
+  std::map<std::uint32_t, bool> used_coefficients_;
+};
+
+}  // namespace
+
+JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
+                                    const std::vector<SE3d>& initial_poses, const GaussianMap& map,
+                                    const JointRefinementOptions& options) {
+  CheckOptions(scans, initial_poses, options);
   const auto start = std::chrono::steady_clock::now();
   JointRefinementResult result;
   result.map = map;
-  const double w = options.matching.w_rcs;
-  const bool full = options.matching.rcs_translation == RcsTranslation::kFull;
-  const std::size_t n = scans.size();
-  std::vector<Eigen::Vector4d> rotations(n);
-  std::vector<Eigen::Vector3d> translations(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    rotations[k] = initial_poses[k].rotation().quaternion().coeffs();
-    translations[k] = initial_poses[k].translation();
-  }
-  std::vector<std::vector<double>> coefficients(map.gaussians.size());
-  for (std::size_t g = 0; g < map.gaussians.size(); ++g) {
-    const RcsModel& model = map.gaussians[g].rcs;
-    if (model.valid()) {
-      coefficients[g].assign(model.coefficients.begin(), model.coefficients.begin() + ShCoefficientCount(model.degree));
-    }
-  }
+  JointBlocks blocks(initial_poses, map);
   const MatchingMap matching(result.map, ExactMapOnly());
-  SO3Manifold so3;
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = options.schur ? ceres::SPARSE_SCHUR : ceres::SPARSE_NORMAL_CHOLESKY;
   solver_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   solver_options.max_num_iterations = options.max_iterations_per_round;
   solver_options.num_threads = options.threads;
   solver_options.logging_type = ceres::SILENT;
-
   for (int round = 0; round < options.rounds; ++round) {
-    ceres::Problem::Options problem_options;
-    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    ceres::Problem problem(problem_options);
-    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-    for (std::size_t k = 0; k < n; ++k) {
-      problem.AddParameterBlock(rotations[k].data(), 4, &so3);
-      problem.AddParameterBlock(translations[k].data(), 3);
-      ordering->AddElementToGroup(rotations[k].data(), 1);
-      ordering->AddElementToGroup(translations[k].data(), 1);
+    JointProblem problem(blocks, options);
+    for (std::size_t k = 0; k < scans.size(); ++k) {
+      problem.AddScan(k, FindCorrespondences(scans[k], matching, 0, blocks.Pose(k), options.matching.gate,
+                                             options.matching.w_rcs > 0.0));
     }
-    std::map<std::uint32_t, bool> used_coefficients;
-    for (std::size_t k = 0; k < n; ++k) {
-      const SE3d pose(SO3d::FromXyzw(rotations[k].data()), translations[k]);
-      const Correspondences c = FindCorrespondences(scans[k], matching, 0, pose, options.matching.gate, w > 0.0);
-      if (w < 1.0 && !c.geometric.empty()) {
-        const double weight = (1.0 - w) / double(c.geometric.size());
-        for (const GeometricTerm& term : c.geometric) {
-          problem.AddResidualBlock(
-              new GeometricCostFunction(term.point_radar, c.index->Mean(term.gaussian),
-                                        c.index->SqrtInformationT(term.gaussian)),
-              new ceres::ScaledLoss(MakeLoss(options.matching.geometric_loss), weight, ceres::TAKE_OWNERSHIP),
-              rotations[k].data(), translations[k].data());
-        }
-      }
-      if (w > 0.0 && !c.rcs.empty()) {
-        const double weight = w / double(c.rcs.size());
-        for (const RcsTerm& term : c.rcs) {
-          const std::uint32_t g = term.gaussian;
-          ceres::CostFunction* cost =
-              options.matching.jacobians == JacobianMode::kAnalytic
-                  ? static_cast<ceres::CostFunction*>(new RcsCoefficientCostFunction(term, c.pose.translation(), full))
-                  : RcsCoefficientResidual::Create(term, c.pose.translation(), full);
-          std::vector<double*> blocks = {rotations[k].data(), coefficients[g].data()};
-          if (full) blocks.push_back(translations[k].data());
-          problem.AddResidualBlock(
-              cost, new ceres::ScaledLoss(MakeLoss(options.matching.rcs_loss), weight, ceres::TAKE_OWNERSHIP),
-              blocks);
-          if (!used_coefficients[g]) {
-            used_coefficients[g] = true;
-            ordering->AddElementToGroup(coefficients[g].data(), 0);  // eliminated first
-          }
-        }
-      }
-    }
-    if (options.relative_pose_prior > 0.0) {
-      for (std::size_t k = 0; k + 1 < n; ++k) {
-        problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 4, 3, 4, 3>(new RelativePoseResidual(
-                initial_poses[k].Inverse() * initial_poses[k + 1], options.relative_pose_prior)),
-            nullptr, rotations[k].data(), translations[k].data(), rotations[k + 1].data(),
-            translations[k + 1].data());
-      }
-    }
-    if (options.coefficient_prior > 0.0) {
-      for (const auto& [g, used] : used_coefficients) {
-        const int count = int(coefficients[g].size());
-        const Eigen::VectorXd initial = Eigen::Map<const Eigen::VectorXd>(map.gaussians[g].rcs.coefficients.data(), count);
-        problem.AddResidualBlock(
-            new ceres::NormalPrior(options.coefficient_prior * Eigen::MatrixXd::Identity(count, count), initial),
-            nullptr, coefficients[g].data());
-      }
-    }
-    // Gauge: the first pose is fixed.
-    problem.SetParameterBlockConstant(rotations[0].data());
-    problem.SetParameterBlockConstant(translations[0].data());
-    if (options.schur) solver_options.linear_solver_ordering = ordering;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver_options, &problem, &summary);
+    problem.AddPriors(initial_poses, map);
+    const ceres::Solver::Summary summary = problem.Solve(solver_options);
     if (round == 0) result.initial_cost = summary.initial_cost;
     result.final_cost = summary.final_cost;
     result.iterations += int(summary.iterations.size());
@@ -171,10 +226,11 @@ JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
     result.converged = summary.termination_type == ceres::CONVERGENCE;
     if (!result.converged) result.reason = "Ceres: " + summary.message;
   }
-  result.poses.resize(n);
-  for (std::size_t k = 0; k < n; ++k) result.poses[k] = SE3d(SO3d::FromXyzw(rotations[k].data()), translations[k]);
+  for (std::size_t k = 0; k < scans.size(); ++k) result.poses.push_back(blocks.Pose(k));
   for (std::size_t g = 0; g < map.gaussians.size(); ++g) {
-    for (std::size_t j = 0; j < coefficients[g].size(); ++j) result.map.gaussians[g].rcs.coefficients[j] = coefficients[g][j];
+    for (std::size_t j = 0; j < blocks.coefficients[g].size(); ++j) {
+      result.map.gaussians[g].rcs.coefficients[j] = blocks.coefficients[g][j];
+    }
   }
   result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;

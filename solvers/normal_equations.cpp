@@ -162,86 +162,40 @@ void AddGeometricTerm(const GeometricTermInputs<T>& in, GeometricSums<T>& sums, 
   sums.b_r[2] += wq[0] * information_e[1] - wq[1] * information_e[0];
 }
 
-}  // namespace
+// H and g from the sums taken without R (BuildGeometricSystem): the lanes
+// added up, then H_tr = A_tr R, H_rr = R^T A_rr R, g_r = R^T b_r.
+void AddRotatedSums(const GeometricSums<double>& single, const GeometricSums<Eigen::Array2d>& pairs,
+                    const Eigen::Matrix3d& R, LinearSystem& system) {
+  double A_tt_upper[6], A_rr_upper[6];
+  Eigen::Matrix3d A_tr;
+  Eigen::Vector3d b_t, b_r;
+  for (int i = 0; i < 6; ++i) {
+    A_tt_upper[i] = single.A_tt[i] + pairs.A_tt[i].sum();
+    A_rr_upper[i] = single.A_rr[i] + pairs.A_rr[i].sum();
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) A_tr(i, j) = single.A_tr[i][j] + pairs.A_tr[i][j].sum();
+    b_t[i] = single.b_t[i] + pairs.b_t[i].sum();
+    b_r[i] = single.b_r[i] + pairs.b_r[i].sum();
+  }
+  const auto from_upper = [](const double* u) {
+    Eigen::Matrix3d m;
+    m << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
+    return m;
+  };
+  const Eigen::Matrix3d A_tt = from_upper(A_tt_upper), A_rr = from_upper(A_rr_upper);
+  system.H.block<3, 3>(kTranslationOffset, kTranslationOffset) = A_tt;
+  system.H.block<3, 3>(kTranslationOffset, kRotationOffset) = A_tr * R;
+  system.H.block<3, 3>(kRotationOffset, kTranslationOffset) = (A_tr * R).transpose();
+  system.H.block<3, 3>(kRotationOffset, kRotationOffset) = R.transpose() * A_rr * R;
+  system.g.segment<3>(kTranslationOffset) = b_t;
+  system.g.segment<3>(kRotationOffset) = R.transpose() * b_r;
+}
 
-LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
-                                  const ScanMatchingOptions& options) {
+// Autodiff: the Ceres functor evaluated with Jets, per term.
+LinearSystem AutoDiffGeometricSystem(const Correspondences& c, const SE3d& pose, const ScanMatchingOptions& options) {
   LinearSystem system;
   LossSum loss(options.geometric_loss);
-  const Eigen::Matrix3d R = pose.rotation().Matrix();
-  if (options.jacobians == JacobianMode::kAnalytic) {
-    // r = L^T e, e = q + t - mu with q = R p; dr/ddt = L^T and
-    // dr/ddphi = -L^T R [p]x = -L^T [q]x R. R is common to all terms, so the
-    // sums are taken without it and applied once: with Sigma^-1 = L L^T,
-    // H_tt = sum w Sigma^-1, H_tr = (sum -w Sigma^-1 [q]x) R,
-    // H_rr = R^T (sum w [q]x^T Sigma^-1 [q]x) R, g_t = sum w Sigma^-1 e,
-    // g_r = R^T (sum w [q]x Sigma^-1 e).
-    // Sums of one term at a time, and of pairs of terms in SIMD lanes.
-    GeometricSums<double> single(0.0);
-    GeometricSums<Eigen::Array2d> pairs(Eigen::Array2d::Zero());
-    // Loss curvature (options.loss_curvature), with J^T r = [I_e; R^T (q x I_e)]
-    // (I_e = Sigma^-1 e): summed without R as well.
-    Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
-    const auto weight_of = [&](double s, const Eigen::Vector3d& q, const Eigen::Vector3d& information_e) {
-      double second = 0.0;
-      const double weight = loss.Add(s, &second);
-      if (options.loss_curvature && second != 0.0) {
-        Eigen::Matrix<double, 6, 1> Jt_r;
-        Jt_r << information_e, q.cross(information_e);
-        C.noalias() += CurvatureAlongResidual(s, weight, second) * Jt_r * Jt_r.transpose();
-      }
-      return weight;
-    };
-    const std::size_t n = c.geometric.size();
-    std::size_t k = 0;
-    for (; k + 1 < n; k += 2) {
-      const GeometricTermInputs<Eigen::Array2d> in = Inputs<Eigen::Array2d>(c, k, R, pose.translation());
-      AddGeometricTerm(in, pairs, [&](const Eigen::Array2d& s, const Eigen::Array2d* information_e) {
-        const auto lane = [&](const Eigen::Array2d* v, int l) { return Eigen::Vector3d(v[0][l], v[1][l], v[2][l]); };
-        const double weight_a = weight_of(s[0], lane(in.q, 0), lane(information_e, 0));  // in term order
-        return Eigen::Array2d(weight_a, weight_of(s[1], lane(in.q, 1), lane(information_e, 1)));
-      });
-    }
-    for (; k < n; ++k) {
-      const GeometricTermInputs<double> in = Inputs<double>(c, k, R, pose.translation());
-      AddGeometricTerm(in, single, [&](double s, const double* information_e) {
-        return weight_of(s, Eigen::Vector3d(in.q), Eigen::Vector3d(information_e));
-      });
-    }
-    double A_tt_upper[6], A_rr_upper[6];
-    Eigen::Matrix3d A_tr;
-    Eigen::Vector3d b_t, b_r;
-    for (int i = 0; i < 6; ++i) {
-      A_tt_upper[i] = single.A_tt[i] + pairs.A_tt[i].sum();
-      A_rr_upper[i] = single.A_rr[i] + pairs.A_rr[i].sum();
-    }
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) A_tr(i, j) = single.A_tr[i][j] + pairs.A_tr[i][j].sum();
-      b_t[i] = single.b_t[i] + pairs.b_t[i].sum();
-      b_r[i] = single.b_r[i] + pairs.b_r[i].sum();
-    }
-    const auto from_upper = [](const double* u) {
-      Eigen::Matrix3d m;
-      m << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
-      return m;
-    };
-    const Eigen::Matrix3d A_tt = from_upper(A_tt_upper), A_rr = from_upper(A_rr_upper);
-    system.H.block<3, 3>(kTranslationOffset, kTranslationOffset) = A_tt;
-    system.H.block<3, 3>(kTranslationOffset, kRotationOffset) = A_tr * R;
-    system.H.block<3, 3>(kRotationOffset, kTranslationOffset) = (A_tr * R).transpose();
-    system.H.block<3, 3>(kRotationOffset, kRotationOffset) = R.transpose() * A_rr * R;
-    system.g.segment<3>(kTranslationOffset) = b_t;
-    system.g.segment<3>(kRotationOffset) = R.transpose() * b_r;
-    if (options.loss_curvature) {
-      Eigen::Matrix<double, 6, 6> rotate = Eigen::Matrix<double, 6, 6>::Identity();
-      rotate.block<3, 3>(kRotationOffset, kRotationOffset) = R;
-      system.loss_curvature = rotate.transpose() * C * rotate;
-    }
-    system.residuals = c.geometric.size();
-    system.rho_sum = loss.Sum();
-    return system;
-  }
-  // Autodiff: the Ceres functor evaluated with Jets, per term.
   const Eigen::Matrix<double, 4, 3> P = QuaternionTangent(pose.rotation());
   for (const GeometricTerm& term : c.geometric) {
     const Eigen::Matrix3d& LT = c.index->SqrtInformationT(term.gaussian);
@@ -261,6 +215,63 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     J.block<3, 3>(0, kRotationOffset) = ambient.leftCols<4>() * P;
     Accumulate(system, 0, J, r, loss, options.loss_curvature);
   }
+  system.rho_sum = loss.Sum();
+  return system;
+}
+
+}  // namespace
+
+LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
+                                  const ScanMatchingOptions& options) {
+  if (options.jacobians == JacobianMode::kAutoDiff) return AutoDiffGeometricSystem(c, pose, options);
+  LinearSystem system;
+  LossSum loss(options.geometric_loss);
+  const Eigen::Matrix3d R = pose.rotation().Matrix();
+  // r = L^T e, e = q + t - mu with q = R p; dr/ddt = L^T and
+  // dr/ddphi = -L^T R [p]x = -L^T [q]x R. R is common to all terms, so the
+  // sums are taken without it and applied once: with Sigma^-1 = L L^T,
+  // H_tt = sum w Sigma^-1, H_tr = (sum -w Sigma^-1 [q]x) R,
+  // H_rr = R^T (sum w [q]x^T Sigma^-1 [q]x) R, g_t = sum w Sigma^-1 e,
+  // g_r = R^T (sum w [q]x Sigma^-1 e).
+  // Sums of one term at a time, and of pairs of terms in SIMD lanes.
+  GeometricSums<double> single(0.0);
+  GeometricSums<Eigen::Array2d> pairs(Eigen::Array2d::Zero());
+  // Loss curvature (options.loss_curvature), with J^T r = [I_e; R^T (q x I_e)]
+  // (I_e = Sigma^-1 e): summed without R as well.
+  Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
+  const auto weight_of = [&](double s, const Eigen::Vector3d& q, const Eigen::Vector3d& information_e) {
+    double second = 0.0;
+    const double weight = loss.Add(s, &second);
+    if (options.loss_curvature && second != 0.0) {
+      Eigen::Matrix<double, 6, 1> Jt_r;
+      Jt_r << information_e, q.cross(information_e);
+      C.noalias() += CurvatureAlongResidual(s, weight, second) * Jt_r * Jt_r.transpose();
+    }
+    return weight;
+  };
+  const std::size_t n = c.geometric.size();
+  std::size_t k = 0;
+  for (; k + 1 < n; k += 2) {
+    const GeometricTermInputs<Eigen::Array2d> in = Inputs<Eigen::Array2d>(c, k, R, pose.translation());
+    AddGeometricTerm(in, pairs, [&](const Eigen::Array2d& s, const Eigen::Array2d* information_e) {
+      const auto lane = [&](const Eigen::Array2d* v, int l) { return Eigen::Vector3d(v[0][l], v[1][l], v[2][l]); };
+      const double weight_a = weight_of(s[0], lane(in.q, 0), lane(information_e, 0));  // in term order
+      return Eigen::Array2d(weight_a, weight_of(s[1], lane(in.q, 1), lane(information_e, 1)));
+    });
+  }
+  for (; k < n; ++k) {
+    const GeometricTermInputs<double> in = Inputs<double>(c, k, R, pose.translation());
+    AddGeometricTerm(in, single, [&](double s, const double* information_e) {
+      return weight_of(s, Eigen::Vector3d(in.q), Eigen::Vector3d(information_e));
+    });
+  }
+  AddRotatedSums(single, pairs, R, system);
+  if (options.loss_curvature) {
+    Eigen::Matrix<double, 6, 6> rotate = Eigen::Matrix<double, 6, 6>::Identity();
+    rotate.block<3, 3>(kRotationOffset, kRotationOffset) = R;
+    system.loss_curvature = rotate.transpose() * C * rotate;
+  }
+  system.residuals = c.geometric.size();
   system.rho_sum = loss.Sum();
   return system;
 }

@@ -229,6 +229,31 @@ RadarScan CoarseScan(const std::vector<Eigen::Vector3d>& positions, double voxel
   return coarse;
 }
 
+// The end of a match: the final association (the last one, when it was made
+// on the exact map within the re-association thresholds of the final pose, or
+// when not re-associating; otherwise a new one at the final pose), N_geo,
+// N_rcs, the cost of eq. 2 (the one a step recorded at the final pose on that
+// association, if any) and the information matrix.
+void FinishResult(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                  const ScanMatchingOptions& options, const Correspondences& c, const EvaluatedCost& evaluated,
+                  ScanMatchingResult& result) {
+  if (result.iterations == 0) {
+    result.pose = initial;
+    return;
+  }
+  const bool last_is_final = KeepsAssociation(c.index == &map.index(), c.pose, result.pose, options);
+  const Correspondences final_c = last_is_final ? c
+                                                : FindCorrespondences(scan, map, map.levels() - 1, result.pose,
+                                                                      options.gate, options.w_rcs > 0.0);
+  result.n_geo = final_c.geometric.size();
+  result.n_rcs = final_c.rcs.size();
+  // On the exact map the steps' options are these (w_rcs is the requested w there).
+  const bool known =
+      last_is_final && c.index == &map.index() && evaluated.known && SamePose(evaluated.pose, result.pose);
+  result.final_cost = known ? evaluated.cost : EvaluateCost(final_c, result.pose, options);
+  result.information = InformationMatrix(final_c, result.pose, options);
+}
+
 }  // namespace
 
 ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
@@ -301,23 +326,7 @@ ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map
   }
   if (failed) result.converged = false;
   if (!result.converged && result.reason.empty()) result.reason = "iteration limit reached";
-  if (result.iterations > 0) {
-    // The final association: the last one, when it was made on the exact map
-    // within the re-association thresholds of the final pose (or when not
-    // re-associating); otherwise a new one at the final pose.
-    const bool last_is_final = KeepsAssociation(c.index == &map.index(), c.pose, result.pose, options);
-    const Correspondences final_c =
-        last_is_final ? c : FindCorrespondences(scan, map, map.levels() - 1, result.pose, options.gate, w > 0.0);
-    result.n_geo = final_c.geometric.size();
-    result.n_rcs = final_c.rcs.size();
-    // On the exact map the steps' options are these (w_rcs is the requested w there).
-    const bool known = last_is_final && c.index == &map.index() && evaluated.known &&
-                       SamePose(evaluated.pose, result.pose);
-    result.final_cost = known ? evaluated.cost : EvaluateCost(final_c, result.pose, options);
-    result.information = InformationMatrix(final_c, result.pose, options);
-  } else {
-    result.pose = initial;
-  }
+  FinishResult(scan, map, initial, options, c, evaluated, result);
   result.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;

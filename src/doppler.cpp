@@ -37,6 +37,33 @@ bool SolveLeastSquares(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
   return v.allFinite();
 }
 
+// RANSAC over 3-point draws of the rows of H v = y: the largest consensus
+// set (row indices) over `iterations` draws.
+std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
+                                  const EgoVelocityOptions& options, int iterations) {
+  const int n = static_cast<int>(y.size());
+  std::mt19937 rng(options.seed);
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  std::vector<int> best;
+  std::vector<int> consensus;
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    int a = pick(rng), b = pick(rng), c = pick(rng);
+    while (b == a) b = pick(rng);
+    while (c == a || c == b) c = pick(rng);
+    Eigen::Matrix3d h;
+    h << H.row(a), H.row(b), H.row(c);
+    const Eigen::FullPivLU<Eigen::Matrix3d> lu(h);
+    if (!lu.isInvertible() || std::abs(h.determinant()) < 1e-6) continue;
+    const Eigen::Vector3d v = lu.solve(Eigen::Vector3d(y[a], y[b], y[c]));
+    consensus.clear();
+    for (int k = 0; k < n; ++k) {
+      if (std::abs(y[k] - H.row(k).dot(v)) < options.inlier_threshold) consensus.push_back(k);
+    }
+    if (consensus.size() > best.size()) best.swap(consensus);
+  }
+  return best;
+}
+
 }  // namespace
 
 EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOptions& options) {
@@ -87,25 +114,7 @@ EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOp
   // RANSAC over 3-point draws, keeping the largest consensus set.
   result.ransac_iterations = RansacIterations(options.outlier_probability,
                                               options.success_probability);
-  std::mt19937 rng(options.seed);
-  std::uniform_int_distribution<int> pick(0, n - 1);
-  std::vector<int> best;
-  std::vector<int> consensus;
-  for (int iteration = 0; iteration < result.ransac_iterations; ++iteration) {
-    int a = pick(rng), b = pick(rng), c = pick(rng);
-    while (b == a) b = pick(rng);
-    while (c == a || c == b) c = pick(rng);
-    Eigen::Matrix3d h;
-    h << H.row(a), H.row(b), H.row(c);
-    const Eigen::FullPivLU<Eigen::Matrix3d> lu(h);
-    if (!lu.isInvertible() || std::abs(h.determinant()) < 1e-6) continue;
-    const Eigen::Vector3d v = lu.solve(Eigen::Vector3d(y[a], y[b], y[c]));
-    consensus.clear();
-    for (int k = 0; k < n; ++k) {
-      if (std::abs(y[k] - H.row(k).dot(v)) < options.inlier_threshold) consensus.push_back(k);
-    }
-    if (consensus.size() > best.size()) best.swap(consensus);
-  }
+  const std::vector<int> best = LargestConsensus(H, y, options, result.ransac_iterations);
   if (best.size() < 3) {
     result.reason = "RANSAC found no consensus of 3 or more points";
     return result;

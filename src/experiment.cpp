@@ -95,13 +95,10 @@ ConfigurationRun RunConfiguration(const std::string& name, double w_rcs, const S
   return run;
 }
 
-std::string WriteExperimentResults(const std::string& dir, const std::vector<ConfigurationRun>& runs) {
-  namespace fs = std::filesystem;
-  std::error_code error;
-  fs::create_directories(fs::path(dir) / "trajectories", error);
-  if (error) throw FileError(dir, "cannot create results folder: " + error.message());
+namespace {
 
-  WriteFileAtomically((fs::path(dir) / "per_scan.csv").string(), [&](std::ostream& out) {
+void WritePerScanCsv(const std::string& path, const std::vector<ConfigurationRun>& runs) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
     out << "scan,time,configuration,w_rcs,initial_translation_m,initial_rotation_deg,translation_m,"
            "rotation_deg,iterations,cost,n_geo,n_rcs,converged,time_ms\n";
     out.precision(9);
@@ -115,7 +112,10 @@ std::string WriteExperimentResults(const std::string& dir, const std::vector<Con
       }
     }
   });
+}
 
+// summary.json, and each configuration's estimated trajectory (TUM).
+void WriteSummaryAndTrajectories(const std::filesystem::path& dir, const std::vector<ConfigurationRun>& runs) {
   nlohmann::json summary = nlohmann::json::array();
   for (const ConfigurationRun& run : runs) {
     const auto stats = [](const ErrorStatistics& s) {
@@ -133,12 +133,13 @@ std::string WriteExperimentResults(const std::string& dir, const std::vector<Con
     for (const ScanOutcome& o : run.outcomes) {
       if (trajectory.empty() || o.time > trajectory.EndTime()) trajectory.Append(o.time, o.result.pose);
     }
-    WriteTum((fs::path(dir) / "trajectories" / (run.name + ".tum")).string(), trajectory);
+    WriteTum((dir / "trajectories" / (run.name + ".tum")).string(), trajectory);
   }
-  WriteFileAtomically((fs::path(dir) / "summary.json").string(),
-                      [&](std::ostream& out) { out << summary.dump(2) << "\n"; });
+  WriteFileAtomically((dir / "summary.json").string(), [&](std::ostream& out) { out << summary.dump(2) << "\n"; });
+}
 
-  // The Markdown table, best (lowest) value of each error column in bold.
+// The Markdown table, the best (lowest) value of each error column in bold.
+std::string MarkdownTable(const std::vector<ConfigurationRun>& runs) {
   const auto column = [&](auto get) {
     double best = INFINITY;
     for (const ConfigurationRun& run : runs) best = std::min(best, get(run));
@@ -173,9 +174,20 @@ std::string WriteExperimentResults(const std::string& dir, const std::vector<Con
                   100.0 * run.converged_share);
     table << cell;
   }
-  const std::string markdown = table.str();
-  WriteFileAtomically((fs::path(dir) / "table.md").string(),
-                      [&](std::ostream& out) { out << markdown; });
+  return table.str();
+}
+
+}  // namespace
+
+std::string WriteExperimentResults(const std::string& dir, const std::vector<ConfigurationRun>& runs) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  fs::create_directories(fs::path(dir) / "trajectories", error);
+  if (error) throw FileError(dir, "cannot create results folder: " + error.message());
+  WritePerScanCsv((fs::path(dir) / "per_scan.csv").string(), runs);
+  WriteSummaryAndTrajectories(dir, runs);
+  const std::string markdown = MarkdownTable(runs);
+  WriteFileAtomically((fs::path(dir) / "table.md").string(), [&](std::ostream& out) { out << markdown; });
   return markdown;
 }
 

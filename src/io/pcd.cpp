@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/io/pcd.hpp"
 
 #include <lzf.h>
@@ -14,6 +15,7 @@
 
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
+#include "pcd_header.hpp"
 
 namespace radargauss {
 
@@ -25,112 +27,6 @@ std::string ReadWholeFile(const std::string& path) {
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw FileError(path, "read error");
   return bytes;
-}
-
-std::vector<std::string> SplitWords(const std::string& line) {
-  std::istringstream stream(line);
-  std::vector<std::string> words;
-  std::string word;
-  while (stream >> word) words.push_back(word);
-  return words;
-}
-
-std::size_t ParseCount(const std::string& path, const std::string& key, const std::string& word) {
-  std::size_t value = 0;
-  const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
-  if (error != std::errc() || end != word.data() + word.size()) {
-    throw FileError(path, key + ": not a non-negative integer: '" + word + "'");
-  }
-  return value;
-}
-
-bool ValidTypeSize(char type, int size) {
-  if (type == 'F') return size == 4 || size == 8;
-  if (type == 'I' || type == 'U') return size == 1 || size == 2 || size == 4 || size == 8;
-  return false;
-}
-
-PcdHeader ParseHeader(const std::string& path, const std::string& bytes) {
-  PcdHeader header;
-  std::vector<std::string> sizes;
-  std::vector<std::string> types;
-  std::vector<std::string> counts;
-  bool have_width = false;
-  bool have_height = false;
-  bool have_points = false;
-  std::size_t position = 0;
-  while (header.data.empty()) {
-    const std::size_t newline = bytes.find('\n', position);
-    if (newline == std::string::npos) throw FileError(path, "PCD header has no DATA line");
-    const std::string line = bytes.substr(position, newline - position);
-    position = newline + 1;
-    const std::vector<std::string> words = SplitWords(line);
-    if (words.empty() || words[0][0] == '#') continue;
-    const std::string& key = words[0];
-    const std::vector<std::string> rest(words.begin() + 1, words.end());
-    if (key == "VERSION") {
-      if (rest.size() != 1 || (rest[0] != "0.7" && rest[0] != ".7")) {
-        throw FileError(path, "unsupported PCD VERSION (0.7 only)");
-      }
-    } else if (key == "FIELDS") {
-      for (const std::string& name : rest) header.fields.push_back({name, 'F', 4, 1, 0});
-    } else if (key == "SIZE") {
-      sizes = rest;
-    } else if (key == "TYPE") {
-      types = rest;
-    } else if (key == "COUNT") {
-      counts = rest;
-    } else if (key == "WIDTH" && rest.size() == 1) {
-      header.width = ParseCount(path, key, rest[0]);
-      have_width = true;
-    } else if (key == "HEIGHT" && rest.size() == 1) {
-      header.height = ParseCount(path, key, rest[0]);
-      have_height = true;
-    } else if (key == "POINTS" && rest.size() == 1) {
-      header.points = ParseCount(path, key, rest[0]);
-      have_points = true;
-    } else if (key == "VIEWPOINT") {
-      if (rest.size() != 7) throw FileError(path, "VIEWPOINT needs 7 values");
-    } else if (key == "DATA") {
-      if (rest.size() != 1 ||
-          (rest[0] != "ascii" && rest[0] != "binary" && rest[0] != "binary_compressed")) {
-        throw FileError(path, "unknown DATA format (ascii, binary, binary_compressed)");
-      }
-      header.data = rest[0];
-    } else {
-      throw FileError(path, "unexpected PCD header line: '" + line + "'");
-    }
-  }
-  header.data_offset = position;
-
-  if (header.fields.empty()) throw FileError(path, "PCD header has no FIELDS");
-  const std::size_t n = header.fields.size();
-  if (sizes.size() != n || types.size() != n || (!counts.empty() && counts.size() != n)) {
-    throw FileError(path, "FIELDS, SIZE, TYPE and COUNT differ in length");
-  }
-  if (!have_width || !have_height) throw FileError(path, "PCD header lacks WIDTH or HEIGHT");
-  if (!have_points) header.points = header.width * header.height;
-  if (header.width * header.height != header.points) {
-    throw FileError(path, "WIDTH x HEIGHT (" + std::to_string(header.width * header.height) +
-                              ") differs from POINTS (" + std::to_string(header.points) + ")");
-  }
-  std::size_t offset = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    PcdField& field = header.fields[i];
-    if (types[i].size() != 1) throw FileError(path, "unknown TYPE '" + types[i] + "'");
-    field.type = types[i][0];
-    field.size = static_cast<int>(ParseCount(path, "SIZE", sizes[i]));
-    field.count = counts.empty() ? 1 : static_cast<int>(ParseCount(path, "COUNT", counts[i]));
-    if (!ValidTypeSize(field.type, field.size)) {
-      throw FileError(path, "unknown TYPE/SIZE " + types[i] + "/" + sizes[i] + " of field '" +
-                                field.name + "'");
-    }
-    if (field.count < 1) throw FileError(path, "COUNT of field '" + field.name + "' is 0");
-    field.offset = offset;
-    offset += static_cast<std::size_t>(field.size) * field.count;
-  }
-  header.point_step = offset;
-  return header;
 }
 
 // Rejects POINTS that the file cannot hold before anything is allocated for
@@ -187,7 +83,7 @@ void DecodeAscii(const std::string& path, const std::string& bytes, PcdCloud& cl
   std::string line;
   std::size_t point = 0;
   while (std::getline(stream, line)) {
-    const std::vector<std::string> words = SplitWords(line);
+    const std::vector<std::string> words = internal::SplitWords(line);
     if (words.empty()) continue;
     if (point >= h.points) throw FileError(path, "more data lines than POINTS");
     if (words.size() != tokens_per_point) {
@@ -280,7 +176,7 @@ std::vector<std::string> PcdCloud::FieldNames() const {
 PcdCloud ReadPcdCloud(const std::string& path) {
   const std::string bytes = ReadWholeFile(path);
   PcdCloud cloud;
-  cloud.header = ParseHeader(path, bytes);
+  cloud.header = internal::ParsePcdHeader(path, bytes);
   CheckSizeAgainstFile(path, bytes, cloud.header);
   cloud.values.assign(cloud.header.fields.size(), std::vector<double>(cloud.header.points));
   if (cloud.header.data == "ascii") {
