@@ -6,9 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "radargauss/map/builder.hpp"
-#include "radargauss/map/map_cloud.hpp"
-#include "radargauss/map/rcs_model.hpp"
+#include "radargauss/map/pipeline.hpp"
 
 namespace radargauss {
 namespace {
@@ -45,15 +43,8 @@ MapCloud TownCloud(std::size_t n) {
 // The build-map pipeline after the Doppler filter: Gaussians, members, RCS models.
 void BM_BuildMapAndRcs(benchmark::State& state) {
   const MapCloud cloud = TownCloud(std::size_t(state.range(0)));
-  GaussianMapOptions options;
   std::size_t gaussians = 0;
-  for (auto _ : state) {
-    GaussianMap map;
-    std::vector<int> association;
-    map.gaussians = BuildGaussians(cloud.points, options, {}, &association);
-    FitRcsModels(map, cloud, association);
-    gaussians = map.gaussians.size();
-  }
+  for (auto _ : state) gaussians = FitRcs(BuildMapGeometry(cloud)).gaussians.size();
   state.counters["gaussians"] = double(gaussians);
 }
 BENCHMARK(BM_BuildMapAndRcs)->Arg(100000)->Arg(1000000)->Unit(benchmark::kSecond)->Iterations(1);

@@ -19,9 +19,7 @@
 
 #include "radargauss/experiment.hpp"
 #include "radargauss/lie/manifold.hpp"
-#include "radargauss/map/builder.hpp"
-#include "radargauss/map/map_cloud.hpp"
-#include "radargauss/map/rcs_model.hpp"
+#include "radargauss/map/pipeline.hpp"
 #include "radargauss/sh.hpp"
 #include "radargauss/simulator.hpp"
 #include "radargauss/residuals/geometric_residual.hpp"
@@ -107,15 +105,12 @@ inline const World& SimulatedWorld() {
     config.scans = 80;
     config.seed = 5;
     w->simulated = Simulate(config);
-    const MapCloud cloud = BuildMapCloud(AsSequence(w->simulated));
-    GaussianMapOptions options;
-    std::vector<int> association;
-    w->map.gaussians = BuildGaussians(cloud.points, options, {}, &association);
-    w->view_map = w->map;
-    FitRcsModels(w->map, cloud, association);
+    const Sequence sequence = AsSequence(w->simulated);
+    const MapGeometry geometry = BuildMapGeometry(sequence.scans, sequence.poses);
+    w->map = FitRcs(geometry);
     RcsFitOptions view;
     view.incidence = IncidenceModel::kView;
-    FitRcsModels(w->view_map, cloud, association, view);
+    w->view_map = FitRcs(geometry, view);
     w->matching = std::make_unique<MatchingMap>(w->map);
     w->exact = std::make_unique<MatchingMap>(w->map, ExactMapOnly());
     return w;

@@ -140,6 +140,94 @@ TEST(CeresSolver, ExactMapSolveEndsWhenThePoseLeavesTheAssociation) {
   EXPECT_THROW(CeresSolver(ScanMatchingOptions(), none), std::invalid_argument);
 }
 
+// The ways CeresScanProblem can hold the terms.
+struct Layout {
+  JacobianMode jacobians;
+  CeresBlocks blocks;  // asked for; autodiff terms always take a block each
+  int threads;
+  const char* name;
+};
+const Layout kLayoutList[] = {{JacobianMode::kAutoDiff, CeresBlocks::kSquareRoot, 1, "autodiff"},
+                              {JacobianMode::kAnalytic, CeresBlocks::kShared, 1, "analytic, shared rows"},
+                              {JacobianMode::kAnalytic, CeresBlocks::kPerTerm, 1, "analytic, a block per term"},
+                              {JacobianMode::kAnalytic, CeresBlocks::kSquareRoot, 1, "analytic, square root"},
+                              {JacobianMode::kAnalytic, CeresBlocks::kSquareRoot, 3, "analytic, square root, 3 threads"}};
+
+// The residual blocks of n terms in a layout.
+std::size_t BlocksOf(const Layout& layout, std::size_t n) {
+  if (layout.jacobians == JacobianMode::kAutoDiff || layout.blocks == CeresBlocks::kPerTerm) return n;
+  if (layout.blocks == CeresBlocks::kShared) {
+    return (n + CeresScanProblem::kTermsPerBlock - 1) / CeresScanProblem::kTermsPerBlock;
+  }
+  return std::min<std::size_t>(n, std::size_t(layout.threads));
+}
+
+// The residuals of n terms with `rows` rows each on a tangent space of `tangent`.
+std::size_t ResidualsOf(const Layout& layout, std::size_t n, int rows, int tangent) {
+  const bool square_root = layout.jacobians == JacobianMode::kAnalytic && layout.blocks == CeresBlocks::kSquareRoot;
+  return square_root ? BlocksOf(layout, n) * (tangent + 1) : n * rows;
+}
+
+ScanMatchingOptions LayoutOptions(const Layout& layout, RcsTranslation mode, bool trivial) {
+  ScanMatchingOptions options;
+  options.jacobians = layout.jacobians;
+  options.rcs_translation = mode;
+  options.geometric_loss = trivial ? LossConfig{LossType::kTrivial, 1.0} : LossConfig{LossType::kHuber, 0.5};
+  if (trivial) options.rcs_loss = {LossType::kTrivial, 1.0};
+  return options;
+}
+
+// Two layouts' gradients over the same updates, entry by entry.
+void ExpectSameGradient(const std::vector<double>& gradient, const std::vector<double>& reference,
+                        const std::string& label) {
+  ASSERT_EQ(gradient.size(), reference.size());
+  for (std::size_t i = 0; i < reference.size(); ++i) {
+    EXPECT_NEAR(gradient[i], reference[i], 1e-8 * (1.0 + std::abs(reference[i]))) << "entry " << i << ", " << label;
+  }
+}
+
+// The problem's residual blocks and residuals for correspondences c at weight w.
+void ExpectBlockCounts(CeresScanProblem& problem, const Layout& layout, const Correspondences& c, double w,
+                       RcsTranslation mode) {
+  const std::size_t n_geo = w < 1.0 ? c.geometric.size() : 0;
+  const std::size_t n_rcs = w > 0.0 ? c.rcs.size() : 0;
+  const int rcs_tangent = mode == RcsTranslation::kRotationOnly ? 3 : 6;
+  EXPECT_EQ(problem.problem().NumResidualBlocks(), int(BlocksOf(layout, n_geo) + BlocksOf(layout, n_rcs)))
+      << "w " << w << ", " << layout.name;
+  EXPECT_EQ(problem.problem().NumResiduals(),
+            int(ResidualsOf(layout, n_geo, 3, 6) + ResidualsOf(layout, n_rcs, 1, rcs_tangent)))
+      << "w " << w << ", " << layout.name;
+}
+
+// The problem's Jacobian `dense` (at the blocks' values) against central
+// differences of its residuals along the tangent coordinates x = [dphi; dt]
+// (Ceres's Jacobian columns: rotation, then translation), entry by entry.
+void ExpectCentralDifferenceJacobian(CeresScanProblem& problem, Eigen::Vector4d& rotation,
+                                     Eigen::Vector3d& translation, const Eigen::MatrixXd& dense,
+                                     const std::string& label) {
+  const Eigen::Vector4d rotation0 = rotation;
+  const Eigen::Vector3d translation0 = translation;
+  const Eigen::MatrixXd numeric = NumericJacobian(
+      [&](const Eigen::VectorXd& x) {
+        SO3Manifold().Plus(rotation0.data(), x.data(), rotation.data());
+        translation = translation0 + x.tail<3>();
+        std::vector<double> values;
+        EXPECT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), nullptr, &values, nullptr, nullptr));
+        return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(values.data(), Eigen::Index(values.size())));
+      },
+      Eigen::VectorXd::Zero(6));
+  rotation = rotation0;
+  translation = translation0;
+  ASSERT_EQ(dense.rows(), numeric.rows());
+  double worst = 0.0;
+  for (int row = 0; row < dense.rows(); ++row) {
+    const Eigen::Matrix<double, 1, 6> difference = dense.row(row) - numeric.row(row);
+    const Eigen::Matrix<double, 1, 6> scale = dense.row(row).cwiseAbs() + numeric.row(row).cwiseAbs();
+    worst = std::max(worst, (difference.cwiseAbs().array() / (1e-6 + scale.array())).maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-5) << label;
+}
+
 // The Ceres problem kept across associations holds exactly the latest
 // association: after updates that grow and shrink the term counts, change
 // level and weight, its cost (Ceres: 1/2 sum) is eq. 2 as EvaluateCost gives
@@ -159,41 +247,23 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
   RadarScan half_scan = full_scan;
   half_scan.points.resize(full_scan.points.size() / 2);
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
-  struct Layout {
-    JacobianMode jacobians;
-    CeresBlocks blocks;  // asked for; autodiff terms always take a block each
-    int threads;
-    const char* name;
+  const auto& layouts = kLayoutList;
+  constexpr int kLayouts = int(std::size(kLayoutList));
+  struct Update {
+    const RadarScan* scan;
+    std::size_t level;
+    double w;
   };
-  const Layout layouts[] = {{JacobianMode::kAutoDiff, CeresBlocks::kSquareRoot, 1, "autodiff"},
-                            {JacobianMode::kAnalytic, CeresBlocks::kShared, 1, "analytic, shared rows"},
-                            {JacobianMode::kAnalytic, CeresBlocks::kPerTerm, 1, "analytic, a block per term"},
-                            {JacobianMode::kAnalytic, CeresBlocks::kSquareRoot, 1, "analytic, square root"},
-                            {JacobianMode::kAnalytic, CeresBlocks::kSquareRoot, 3, "analytic, square root, 3 threads"}};
-  constexpr int kLayouts = int(std::size(layouts));
-  // Per layout: blocks and residuals of n terms with `rows` residuals each on a tangent space of `tangent`.
-  const auto blocks_of = [](const Layout& layout, std::size_t n) -> std::size_t {
-    if (layout.jacobians == JacobianMode::kAutoDiff || layout.blocks == CeresBlocks::kPerTerm) return n;
-    if (layout.blocks == CeresBlocks::kShared) {
-      return (n + CeresScanProblem::kTermsPerBlock - 1) / CeresScanProblem::kTermsPerBlock;
-    }
-    return std::min<std::size_t>(n, std::size_t(layout.threads));
-  };
-  const auto residuals_of = [&](const Layout& layout, std::size_t n, int rows, int tangent) -> std::size_t {
-    const bool square_root = layout.jacobians == JacobianMode::kAnalytic && layout.blocks == CeresBlocks::kSquareRoot;
-    return square_root ? blocks_of(layout, n) * (tangent + 1) : n * rows;
-  };
+  const Update updates[] = {{&full_scan, map.levels() - 1, 0.25}, {&half_scan, 0, 0.0},
+                            {&full_scan, map.levels() - 1, 0.0},  {&half_scan, map.levels() - 1, 0.5},
+                            {&full_scan, map.levels() - 1, 1.0},  {&full_scan, map.levels() - 1, 0.25}};
   for (const bool trivial : {false, true}) {
     for (const RcsTranslation mode : {RcsTranslation::kRotationOnly, RcsTranslation::kFull}) {
       std::vector<double> gradients[kLayouts];  // per layout, all updates in a row
       std::vector<Eigen::Matrix<double, 6, 6>> shared_normal;  // J^T J of the shared rows, per update
       for (int l = 0; l < kLayouts; ++l) {
         const Layout& layout = layouts[l];
-        ScanMatchingOptions options;
-        options.jacobians = layout.jacobians;
-        options.rcs_translation = mode;
-        options.geometric_loss = trivial ? LossConfig{LossType::kTrivial, 1.0} : LossConfig{LossType::kHuber, 0.5};
-        if (trivial) options.rcs_loss = {LossType::kTrivial, 1.0};
+        const ScanMatchingOptions options = LayoutOptions(layout, mode, trivial);
         const bool analytic = layout.jacobians == JacobianMode::kAnalytic;
         const bool shared_rows = analytic && layout.blocks == CeresBlocks::kShared;
         const bool square_root = analytic && layout.blocks == CeresBlocks::kSquareRoot;
@@ -201,16 +271,8 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
         Eigen::Vector4d rotation = pose.rotation().quaternion().coeffs();
         Eigen::Vector3d translation = pose.translation();
         CeresScanProblem problem(options, rotation.data(), translation.data(), layout.blocks, layout.threads);
-        struct Update {
-          const RadarScan* scan;
-          std::size_t level;
-          double w;
-        };
         int u = 0;
-        for (const Update& update :
-             {Update{&full_scan, map.levels() - 1, 0.25}, Update{&half_scan, 0, 0.0},
-              Update{&full_scan, map.levels() - 1, 0.0}, Update{&half_scan, map.levels() - 1, 0.5},
-              Update{&full_scan, map.levels() - 1, 1.0}, Update{&full_scan, map.levels() - 1, 0.25}}) {
+        for (const Update& update : updates) {
           const Correspondences c = FindCorrespondences(*update.scan, map, update.level, pose, 3.0, update.w > 0.0);
           ASSERT_GT(c.geometric.size(), 2 * CeresScanProblem::kTermsPerBlock);
           if (update.w > 0.0) {
@@ -219,14 +281,7 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
           problem.Update(c, update.w);
           ScanMatchingOptions weighted = options;
           weighted.w_rcs = update.w;
-          const std::size_t n_geo = update.w < 1.0 ? c.geometric.size() : 0;
-          const std::size_t n_rcs = update.w > 0.0 ? c.rcs.size() : 0;
-          const int rcs_tangent = mode == RcsTranslation::kRotationOnly ? 3 : 6;
-          EXPECT_EQ(problem.problem().NumResidualBlocks(), int(blocks_of(layout, n_geo) + blocks_of(layout, n_rcs)))
-              << "w " << update.w << ", " << layout.name;
-          EXPECT_EQ(problem.problem().NumResiduals(),
-                    int(residuals_of(layout, n_geo, 3, 6) + residuals_of(layout, n_rcs, 1, rcs_tangent)))
-              << "w " << update.w << ", " << layout.name;
+          ExpectBlockCounts(problem, layout, c, update.w, mode);
           double cost = 0.0;
           std::vector<double> gradient;
           ceres::CRSMatrix jacobian;
@@ -252,40 +307,14 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
                 << "w " << update.w << ", " << layout.name;
           }
           ++u;
-          if (!shared_rows) continue;
-          // Central differences of the residuals along the tangent coordinates
-          // x = [dphi; dt] (Ceres's Jacobian columns: rotation, then translation).
-          const Eigen::Vector4d rotation0 = rotation;
-          const Eigen::Vector3d translation0 = translation;
-          const Eigen::MatrixXd numeric = NumericJacobian(
-              [&](const Eigen::VectorXd& x) {
-                SO3Manifold().Plus(rotation0.data(), x.data(), rotation.data());
-                translation = translation0 + x.tail<3>();
-                std::vector<double> values;
-                EXPECT_TRUE(
-                    problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), nullptr, &values, nullptr, nullptr));
-                return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(values.data(), Eigen::Index(values.size())));
-              },
-              Eigen::VectorXd::Zero(6));
-          rotation = rotation0;
-          translation = translation0;
-          ASSERT_EQ(jacobian.num_rows, numeric.rows());
-          double worst = 0.0;  // entry by entry
-          for (int row = 0; row < jacobian.num_rows; ++row) {
-            const Eigen::Matrix<double, 1, 6> difference = dense.row(row) - numeric.row(row);
-            const Eigen::Matrix<double, 1, 6> scale = dense.row(row).cwiseAbs() + numeric.row(row).cwiseAbs();
-            worst = std::max(worst, (difference.cwiseAbs().array() / (1e-6 + scale.array())).maxCoeff());
+          if (shared_rows) {
+            ExpectCentralDifferenceJacobian(problem, rotation, translation, dense,
+                                            "w " + std::to_string(update.w) + (trivial ? ", trivial" : ", robust"));
           }
-          EXPECT_LT(worst, 1e-5) << "w " << update.w << (trivial ? ", trivial losses" : ", robust losses");
         }
       }
       for (int l = 1; l < kLayouts; ++l) {
-        ASSERT_EQ(gradients[l].size(), gradients[0].size());
-        for (std::size_t i = 0; i < gradients[0].size(); ++i) {
-          EXPECT_NEAR(gradients[l][i], gradients[0][i], 1e-8 * (1.0 + std::abs(gradients[0][i])))
-              << "gradient entry " << i << ", " << layouts[l].name
-              << (trivial ? ", trivial losses" : ", robust losses");
-        }
+        ExpectSameGradient(gradients[l], gradients[0], std::string(layouts[l].name) + (trivial ? ", trivial" : ", robust"));
       }
     }
   }

@@ -7,9 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "radargauss/map/builder.hpp"
-#include "radargauss/map/map_cloud.hpp"
-#include "radargauss/map/rcs_model.hpp"
+#include "radargauss/radargauss.hpp"
 #include "radargauss/simulator.hpp"
 #include "radargauss/trajectory.hpp"
 #include "radargauss/solvers/gauss_newton.hpp"
@@ -43,12 +41,7 @@ TEST_F(Experiment, ShortSequenceEndToEnd) {
   config.seed = 9;
   const SimulatedSequence simulated = Simulate(config);
   const Sequence sequence = AsSequence(simulated);
-  const MapCloud cloud = BuildMapCloud(sequence);
-  GaussianMap map;
-  std::vector<int> association;
-  map.gaussians = BuildGaussians(cloud.points, GaussianMapOptions{}, {}, &association);
-  FitRcsModels(map, cloud, association);
-  const MatchingMap matching(map);
+  const MatchingMap matching(BuildMap(sequence));
   const std::vector<SE3d> errors = InitialErrors(sequence.scans.size(), 2.0, 5.0, 42);
   std::vector<ConfigurationRun> runs;
   for (const double w : {0.0, 0.25}) {

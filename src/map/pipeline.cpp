@@ -1,15 +1,24 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/map/pipeline.hpp"
 
+#include <utility>
+
 #include "radargauss/error.hpp"
 
 namespace radargauss {
 
 MapGeometry BuildMapGeometry(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
                              const MapOptions& options, const ProgressCallback& progress) {
+  MapCloudStats stats;
+  MapGeometry geometry = BuildMapGeometry(BuildMapCloud(scans, poses, options.cloud, &stats), options, progress);
+  geometry.cloud_stats = stats;
+  return geometry;
+}
+
+MapGeometry BuildMapGeometry(MapCloud cloud, const MapOptions& options, const ProgressCallback& progress) {
+  if (cloud.points.empty()) throw DataError("no static points to build a map from");
   MapGeometry geometry;
-  geometry.cloud = BuildMapCloud(scans, poses, options.cloud, &geometry.cloud_stats);
-  if (geometry.cloud.points.empty()) throw DataError("no static points to build a map from");
+  geometry.cloud = std::move(cloud);
   geometry.map.gaussians = BuildGaussians(geometry.cloud.points, options.gaussians, progress,
                                           &geometry.association);
   return geometry;

@@ -34,6 +34,8 @@ struct MapGeometry {
 // when the counts differ or no point is static.
 MapGeometry BuildMapGeometry(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
                              const MapOptions& options = {}, const ProgressCallback& progress = {});
+// The same from a static cloud already merged (options.cloud unused).
+MapGeometry BuildMapGeometry(MapCloud cloud, const MapOptions& options = {}, const ProgressCallback& progress = {});
 
 // The geometry's map with the RCS model of every Gaussian fitted.
 GaussianMap FitRcs(const MapGeometry& geometry, const RcsFitOptions& options = {},
