@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Core building blocks: SH basis evaluation per degree (double and Jet, as in
 // the autodiff RCS residual) and SE3 Exp / Log / point action.
 #include <benchmark/benchmark.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Data in: load throughput (points/s) per format, and Doppler ego velocity
 // per 800-point scan.
 #include <benchmark/benchmark.h>

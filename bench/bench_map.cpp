@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Map building: the whole map + RCS fit for 100k and 1M map points, the
 // association of one point, the RCS fit of one Gaussian, and the memory of
 // a Gaussian (map entry + spatial index).

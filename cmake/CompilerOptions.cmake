@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # radargauss_configure_target(<target>): the one place that sets the language
 # standard, the warnings and (with RADARGAUSS_SANITIZE) the sanitizers for
 # every target of the project.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A short tour of the core API: poses, spherical harmonics, trajectories.
 #include <cstdio>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Kept in its own small translation unit: NDT and GICP instantiations are
 // heavy to compile (docs/design.md, "Dependencies and pitfalls").
 #include "radargauss/peers/pcl_peers.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // PCL peers on the experiment's protocol (optional, RADARGAUSS_WITH_PCL):
 // NDT and GICP match each scan against the merged map cloud (the static
 // points the Gaussian map was built from), from the same initial poses, and

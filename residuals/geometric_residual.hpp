@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The geometric residual of scan matching (paper section III-B, docs/design.md,
 // "Residuals"), for a radar point p associated to the Gaussian (mu, Sigma):
 //

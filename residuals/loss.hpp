@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Robust losses for scan matching, from Ceres's loss classes (plus
 // Geman-McClure, which Ceres 2.1 lacks), with a scale a, in Ceres's
 // convention rho(s) of the squared residual s:

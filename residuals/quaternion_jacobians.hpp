@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Analytic derivatives of quaternion rotations with respect to the four
 // ambient coordinates x y z w (conventions.hpp), for the polynomial forms
 // that Eigen evaluates (so they equal the Jet derivatives exactly):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The RCS residual of scan matching (paper section III-B, docs/design.md,
 // "Residuals"), for a radar point p_r whose normalised RCS y (with the associated
 // Gaussian's median and scale) lies in [-1, 1]:

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Checks the product's files against the project's rules: source files of at
 most 400 lines and functions of at most 80, README.md of at most 200 lines and
 bench/RESULTS.md of at most 400, no narrative of how the project was made, and
@@ -89,6 +90,7 @@ def main():
         # Citations may wrap over comment lines.
         joined = re.sub(r"\n\s*(//|#)\s*", " ", text)
         for section in DESIGN_CITATION.findall(joined):
+            section = " ".join(section.split())
             if section not in headings:
                 problems.append(f"{relative}: docs/design.md has no section \"{section}\"")
         is_source = path.suffix in {".cpp", ".hpp", ".h", ".cc"}
@@ -96,6 +98,9 @@ def main():
             problems.append(f"{relative}: {len(lines) - 1} lines (at most {MAX_FILE})")
         if is_source:
             problems += long_functions(relative, lines)
+        if (is_source or path.suffix in {".sh", ".py", ".cmake"} or path.name == "CMakeLists.txt") and \
+                "SPDX-License-Identifier:" not in "\n".join(lines[:3]):
+            problems.append(f"{relative}: no SPDX-License-Identifier line")
         for number, line in enumerate(lines, 1):
             match = PROCESS_WORDS.search(line)
             if match:

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The main job on the embedded default: installs what is missing, builds,
 # simulates the default synthetic sequence, builds its Gaussian-RCS map, runs
 # the w_rcs sweep {0, 0.1, 0.25, 0.5, 0.75, 1} with the own Gauss-Newton,

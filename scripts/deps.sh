@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs every Debian 12 package radargauss needs that is not installed yet.
 # Works as root or through sudo; installs nothing when all are present.
 #   scripts/deps.sh            core build, tests and benchmarks
@@ -7,7 +8,7 @@ set -euo pipefail
 
 packages=(
   # toolchain
-  g++ make cmake pkg-config
+  g++ make cmake pkg-config python3
   # core (docs/design.md, "Dependencies and pitfalls")
   libceres-dev libeigen3-dev libsuitesparse-dev libmetis-dev
   libyaml-cpp-dev liblzf-dev libcli11-dev nlohmann-json3-dev libtbb-dev zlib1g-dev

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Plots of a `radargauss localize` results folder (matplotlib, Debian's python3).
 
     scripts/plot_results.py RESULTS [--sequence-tum GT.tum] [--map-points POINTS.csv]

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs what is missing, then builds and runs every test twice: in a
 # Release tree and in an AddressSanitizer + UndefinedBehaviorSanitizer tree.
 #   scripts/test.sh            both trees
@@ -14,6 +15,10 @@ trees=${RADARGAUSS_TEST_TREES:-"release sanitize"}
 # built with the sanitizers, so the sanitizer tree leaves the peers out).
 RADARGAUSS_DEPS_EXTRA="librosbag-storage-dev libsensor-msgs-dev libpcl-dev ${RADARGAUSS_DEPS_EXTRA:-}" \
   "$root/scripts/deps.sh"
+
+# The product's own rules: file and function lengths, README and RESULTS
+# lengths, no narrative of the work, design citations that resolve.
+/usr/bin/python3 "$root/scripts/check_sources.py" "$root"
 
 for tree in $trees; do
   build="$root/build/$tree"

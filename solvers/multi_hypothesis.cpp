@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/solvers/multi_hypothesis.hpp"
 
 #include <chrono>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Multi-hypothesis scan matching (the RA-L work): several starts around the
 // initial pose (x/y and yaw perturbations), each refined by an inner solver;
 // the best score wins. Score (lower is better): the mean over all scan points

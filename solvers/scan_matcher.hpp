@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Scan matching against a Gaussian-RCS map (paper section III-B, docs/design.md,
 // "Scan matching"): the options, the result and the interface every solver
 // implements, and the pieces they share (association, the cost of eq. 2).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/atomic_file.hpp"
 
 #include <unistd.h>

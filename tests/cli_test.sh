@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # End-to-end checks of the radargauss command-line tool: good runs work, bad
 # input gives a one-line error on stderr and a non-zero exit.
 #   cli_test.sh <path to radargauss>

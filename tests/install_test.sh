@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs radargauss into a temporary prefix, builds examples/ against it
 # as another project would (find_package, nothing but the prefix), and runs
 # build_map and match_scan on a simulated sequence: the match must end

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/lie/manifold.hpp"
 
 #include <ceres/manifold_test_utils.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/peers/pcl_peers.hpp"
 
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Shared helpers for the tests: central-difference Jacobians (the independent
 // reference for every analytic Jacobian) and the list of hard rotation angles.
 #pragma once

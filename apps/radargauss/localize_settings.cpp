@@ -34,7 +34,7 @@ void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
                   "Solvers: " + Joined(ScanMatcherNames()) + " (and pcl-ndt, pcl-gicp when built "
                   "with RADARGAUSS_WITH_PCL)")
       ->delimiter(',')
-      ->check(CLI::IsMember(SolverNames()))
+      ->check(CLI::IsMember(SolverNames()).description("{" + Joined(ScanMatcherNames(), ",") + "[,pcl-ndt,pcl-gicp]}"))
       ->capture_default_str();
   app->add_option("--loss", s.losses, "Geometric losses: " + Joined(LossNames()))
       ->delimiter(',')

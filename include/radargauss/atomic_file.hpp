@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Writing output files so that a reader never sees a half-written file: the
 // content goes to "<path>.tmp.<pid>" and is renamed over <path> when complete.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // radargauss conventions: the single place where each one is stated
 // (docs/design.md, "Conventions"). Every other file refers here instead of restating.
 #pragma once

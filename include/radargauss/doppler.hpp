@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Radar ego velocity from one scan's Doppler (Doer and Trommer, "An EKF Based
 // Approach to Radar Inertial Odometry", MFI 2020: RANSAC + least squares, as
 // in their radar_ego_velocity_estimator). Static points satisfy

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Errors at the library's edges (files, flags, user data) are exceptions of
 // these types, with a one-line message that names the source and the fault.
 // Programmer errors inside the library are assertions instead.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The paper's localisation experiment (section IV, docs/design.md, "The localisation experiment"): for
 // every scan, start from the reference pose composed with a seeded random
 // error (translation magnitude uniform in [0, max] m, rotation angle uniform in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A one-line progress bar on stderr, drawn only when stderr is a terminal
 // (no Debian package offers one; docs/design.md, "Dependencies and pitfalls").
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Real spherical harmonics up to degree 3, with the constants, ordering and
 // signs of the 3D Gaussian Splatting reference implementation (Kerbl et al.
 // 2023): index l^2 + l + m for m = -l..l, Condon-Shortley phase included

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Synthetic 4D radar world (docs/design.md, "The synthetic world"): a town block of ground,
 // building walls, poles, parked and moving cars, seen by an ARS548-like radar
 // driving a loop with turns. Deterministic for a seed.

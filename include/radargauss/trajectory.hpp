@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Timestamped trajectories of poses T_world_frame, with interpolation and TUM
 // file I/O ("t x y z qx qy qz qw", the format evo reads).
 // Invariant of Trajectory: timestamps strictly increase.

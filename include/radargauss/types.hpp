@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Core data types: a radar detection and a radar scan.
 // Frames, units and the Doppler sign are those of radargauss/conventions.hpp.
 #pragma once

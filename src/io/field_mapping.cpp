@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/io/field_mapping.hpp"
 
 #include <algorithm>

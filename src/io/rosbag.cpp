@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Built only when Debian's ROS1 bag library is found (RADARGAUSS_HAVE_ROSBAG).
 #include "radargauss/io/rosbag.hpp"
 

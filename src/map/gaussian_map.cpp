@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/map/gaussian_map.hpp"
 
 #include <algorithm>

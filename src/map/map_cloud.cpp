@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/map/map_cloud.hpp"
 
 #include <tbb/parallel_for.h>

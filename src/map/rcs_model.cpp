@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/map/rcs_model.hpp"
 
 #include <tbb/parallel_for.h>

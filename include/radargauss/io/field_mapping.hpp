@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Which input field carries RCS and which carries Doppler, and the Doppler
 // sign, shared by every loader (PCD, KITTI-style .bin, ROS1 PointCloud2).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // KITTI-style .bin radar scans: consecutive records of float32 fields in a
 // declared order (View-of-Delft: "x y z rcs v_r v_r_comp time").
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // PCD v0.7 point clouds (ascii, binary, binary_compressed with LZF), read
 // without PCL. Any field set and any PCL numeric type; radar fields are picked
 // by a FieldMapping. Every fault (header, sizes, counts against the file

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // sensor_msgs/PointCloud2 topics of ROS1 bags, read through Debian's ROS1 bag
 // library (rosbag::Bag / rosbag::View: uncompressed, bz2 and lz4 bags). An
 // optional component: without it (RosbagSupported() false) every call throws

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A sequence: ordered radar scans, the reference trajectory of the radar and
 // the extrinsic that relates it to the ground-truth frame. Sources:
 //   (a) the Snail-Radar layout  <dir>/ars548/points/<secs>.<nsecs>.pcd

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Ceres manifolds for SO3 and SE3 with the right perturbation of
 // radargauss/conventions.hpp: Plus(x, d) = x * Exp(d), Minus(y, x) = Log(x^-1 y).
 //

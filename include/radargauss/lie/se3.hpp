@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // SE3<T>: rigid transforms (R, t) acting as q = R p + t, templated on the
 // scalar (double or ceres::Jet).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // SO3<T>: rotations in 3D as unit quaternions, templated on the scalar so
 // that the same code runs on double and on ceres::Jet.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Gaussian map builders (docs/design.md, "Gaussians").
 //   kKMeans (default, the RA-L work done natively): voxel-downsample the
 //     cloud (0.25 m), K = round(N_downsampled / points_per_gaussian),

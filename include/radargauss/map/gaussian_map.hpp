@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The Gaussian-RCS map (paper section III-A, docs/design.md, "Building the map"): 3D
 // Gaussians in the world frame, each with an optional RCS model, and the
 // spatial index used to associate points with them.

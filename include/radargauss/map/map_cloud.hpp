@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The map cloud: the static points of a sequence (Doppler ego-velocity
 // inliers) merged into the world frame with the reference poses. Every point
 // keeps the index of its scan, so its radar pose is known when incidence

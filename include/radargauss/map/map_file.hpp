@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Gaussian-RCS map files.
 //
 // .rgm, version 1, little-endian:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Per-Gaussian RCS models (paper section III-A, docs/design.md, "RCS models").
 //
 // Normalisation: m = median of the members' RCS (mean of the two middle
