@@ -88,6 +88,12 @@ expect_fail "localize with a value for the geometric-first flag" "geometric-firs
 expect_fail "localize with a negative coarse voxel" "coarse-voxel" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --coarse-voxel -1 --out "$work/r7"
+expect_fail "localize with RCS weights on a sequence without RCS" "has no RCS field" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --rcs-field none \
+  --w-rcs 0,0.25 --out "$work/r9"
+mkdir -p "$work/dataset" && cp -r "$work/seq/ars548/points" "$work/dataset/points"
+expect_fail "a data set's root as the sequence" "did you mean $work/dataset/points" -- \
+  "$tool" info --sequence "$work/dataset"
 expect_fail "localize with a bad weight" "w-rcs" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --w-rcs 1.5 --out "$work/r2"
 expect_fail "localize with a map of another version" "map version" -- \

@@ -23,12 +23,6 @@ namespace radargauss::cli {
 
 namespace {
 
-std::string FormatWeight(double w) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", w);
-  return text;
-}
-
 // The maps to match against: the map file, or one per (incidence, degree)
 // built here; `degrees` receives each map's degree.
 std::vector<GaussianMap> MapsToMatch(const Sequence& sequence, LocalizeSettings& s, std::vector<int>& degrees) {
@@ -141,6 +135,7 @@ void WritePlotInputs(const std::string& out, const Experiment& e, const Gaussian
 
 int RunLocalize(LocalizeSettings s) {
   const Sequence sequence = LoadSequence(s.CheckedSequenceOptions());
+  s.CheckAgainst(sequence);
   std::vector<int> degrees;
   const std::vector<GaussianMap> maps = MapsToMatch(sequence, s, degrees);
   const Experiment e = MakeExperiment(sequence, s);

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "localize_settings.hpp"
 
+#include <algorithm>
+#include <cstdio>
+
 #include "radargauss/error.hpp"
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/solvers/factory.hpp"
@@ -18,6 +21,16 @@ std::vector<std::string> SolverNames() {
 #endif
   return names;
 }
+
+}  // namespace
+
+std::string FormatWeight(double w) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", w);
+  return text;
+}
+
+namespace {
 
 std::string Joined(const std::vector<std::string>& names, const char* separator = ", ") {
   std::string joined;
@@ -98,6 +111,17 @@ void AddCoarseOptions(CLI::App* app, LocalizeSettings& s) {
 const SequenceOptions& LocalizeSettings::CheckedSequenceOptions() const {
   if (sequence.ground_truth.empty()) throw DataError("localize needs --gt");
   return sequence;
+}
+
+void LocalizeSettings::CheckAgainst(const Sequence& sequence) const {
+  const bool any_rcs = std::any_of(sequence.scans.begin(), sequence.scans.end(),
+                                   [](const RadarScan& scan) { return scan.has_rcs; });
+  const auto rcs_weight = std::find_if(w_rcs.begin(), w_rcs.end(), [](double w) { return w > 0.0; });
+  if (!any_rcs && rcs_weight != w_rcs.end()) {
+    throw DataError("--w-rcs " + FormatWeight(*rcs_weight) +
+                    " needs RCS, and the sequence has no RCS field (--rcs-field names it; --w-rcs 0 matches "
+                    "geometry alone)");
+  }
 }
 
 MatchingMapOptions LocalizeSettings::MatchingOptions() const {

@@ -36,11 +36,17 @@ struct LocalizeSettings {
 
   // The sequence options, once the flags that a run needs are checked.
   const SequenceOptions& CheckedSequenceOptions() const;
+  // Throws DataError when the sequence cannot serve the settings (a weight
+  // w > 0 on scans without RCS), before any map is built.
+  void CheckAgainst(const Sequence& sequence) const;
   MatchingMapOptions MatchingOptions() const;
   // The matching options of one configuration: weight w and geometric loss.
   ScanMatchingOptions MatchOptions(double w, const std::string& loss) const;
 };
 
 void AddLocalizeOptions(CLI::App* app, LocalizeSettings& settings);
+
+// A weight as configuration names show it (%g).
+std::string FormatWeight(double w);
 
 }  // namespace radargauss::cli

@@ -97,6 +97,29 @@ bool HasFilesWith(const fs::path& dir, const std::string& extension) {
   return false;
 }
 
+// Where a sequence folder keeps its scans, and in which layout.
+struct ScanFolder {
+  fs::path path;
+  std::string extension;
+  std::string layout;
+};
+
+ScanFolder FindScanFolder(const std::string& sequence_dir) {
+  const fs::path dir(sequence_dir);
+  std::error_code error;
+  if (!fs::is_directory(dir, error)) throw FileError(sequence_dir, "not a directory");
+  if (HasFilesWith(dir / "ars548" / "points", ".pcd")) return {dir / "ars548" / "points", ".pcd", "snail-radar"};
+  if (HasFilesWith(dir, ".pcd")) return {dir, ".pcd", "pcd-folder"};
+  if (HasFilesWith(dir, ".bin")) return {dir, ".bin", "bin-folder"};
+  // A data set's root often holds its scans one folder down.
+  for (const char* sub : {"points", "pcd", "scans", "radar"}) {
+    if (HasFilesWith(dir / sub, ".pcd") || HasFilesWith(dir / sub, ".bin")) {
+      throw FileError(sequence_dir, "no scans found here; did you mean " + (dir / sub).string() + "?");
+    }
+  }
+  throw FileError(sequence_dir, "no scans found (expected ars548/points/*.pcd, *.pcd or *.bin)");
+}
+
 }  // namespace
 
 Sequence LoadSequence(const SequenceOptions& options) {
@@ -112,24 +135,10 @@ Sequence LoadSequence(const SequenceOptions& options) {
     }
   } else {
     if (options.sequence_dir.empty()) throw DataError("no sequence given (--sequence DIR or --bag FILE)");
-    const fs::path dir(options.sequence_dir);
-    std::error_code error;
-    if (!fs::is_directory(dir, error)) throw FileError(options.sequence_dir, "not a directory");
-    fs::path points = dir / "ars548" / "points";
-    std::string extension = ".pcd";
-    if (HasFilesWith(points, ".pcd")) {
-      sequence.layout = "snail-radar";
-    } else if (HasFilesWith(dir, ".pcd")) {
-      sequence.layout = "pcd-folder";
-      points = dir;
-    } else if (HasFilesWith(dir, ".bin")) {
-      sequence.layout = "bin-folder";
-      points = dir;
-      extension = ".bin";
-    } else {
-      throw FileError(options.sequence_dir,
-                      "no scans found (expected ars548/points/*.pcd, *.pcd or *.bin)");
-    }
+    const ScanFolder folder = FindScanFolder(options.sequence_dir);
+    sequence.layout = folder.layout;
+    const fs::path& points = folder.path;
+    const std::string& extension = folder.extension;
     sources = ListScanFiles(points, extension);
     std::vector<std::string> layout;
     if (extension == ".bin") {
