@@ -236,8 +236,8 @@ BENCHMARK(BM_RefineScanCeresOverGn)->ArgsProduct({{0, 25}, {0, 1, 2}})->Unit(ben
 
 // Ceres LM (default blocks) against the own GN from the paper's errors
 // (2 m / 5 deg), paired (MatchPaired): medians, their ratio and the mean
-// final errors. Args: w_rcs x 100, levels (1 merged with gate 3, 2 the
-// default inflated).
+// final errors. Args: w_rcs x 100, levels (1 merged with gate 3, the
+// default; 2 inflated).
 void BM_MatchScanCeresOverGn(benchmark::State& state) {
   const Tracking tracking;
   const MatchingWorld& world = tracking.world;

@@ -24,7 +24,7 @@ namespace radargauss {
 
 struct MatchingWorld {
   GaussianMap map;
-  std::unique_ptr<MatchingMap> matching;         // inflated coarse levels (the default)
+  std::unique_ptr<MatchingMap> matching;         // inflated coarse levels
   std::map<int, std::unique_ptr<MatchingMap>> merged_matching;  // merged coarse levels, by coarse gate x 10
   std::map<int, SimulatedSequence> scans;  // by detections per scan
   SimulatedSequence drive;                 // the 1000-scan drive of the map
@@ -38,7 +38,9 @@ inline const MatchingWorld& World() {
     config.scans = 1000;
     w->drive = Simulate(config);
     w->map = BuildMap(AsSequence(w->drive));
-    w->matching = std::make_unique<MatchingMap>(w->map);
+    MatchingMapOptions inflated;
+    inflated.coarse = CoarseLevels::kInflated;
+    w->matching = std::make_unique<MatchingMap>(w->map, inflated);
     for (const int gate_x10 : {30, 20}) {
       MatchingMapOptions merged;
       merged.coarse = CoarseLevels::kMerged;

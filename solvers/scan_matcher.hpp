@@ -97,11 +97,13 @@ struct ScanMatchingResult {
 };
 
 // How the coarse levels of a MatchingMap are made from the map's Gaussians.
+// kMerged is the default: from the paper's errors it was faster and at least
+// as precise on every data set measured (bench/RESULTS.md, "Coarse levels").
 enum class CoarseLevels {
   kInflated,  // every Gaussian, covariance Sigma + sigma_k^2 I
   kMerged,    // per voxel of side kMergeCellPerSigma * sigma_k, the moment-matched
               // mixture of the Gaussians whose means fall in it, + sigma_k^2 I:
-              // far fewer candidates per query (faster), measured trade-off in the README
+              // far fewer candidates per query
 };
 inline constexpr double kMergeCellPerSigma = 3.0;
 // The index cell of a coarse level before MatchingMapOptions::index_cell's
@@ -126,7 +128,7 @@ CoarseLevels CoarseLevelsFromString(const std::string& name);  // throws std::in
 struct MatchingMapOptions {
   std::vector<double> inflation = {1.0, 0.5, 0.25};  // sigma_k of the coarse levels (m), coarse first
   double index_cell = 0.5;  // m: cell of the exact level's index (coarse: max(cell, CoarseIndexCell))
-  CoarseLevels coarse = CoarseLevels::kInflated;
+  CoarseLevels coarse = CoarseLevels::kMerged;
   // tau on the coarse levels (Mahalanobis distance to the blurred Gaussians;
   // the exact map uses ScanMatchingOptions::gate). Their indexes cover
   // +/- coarse_gate std, so a smaller gate means fewer candidates per query:

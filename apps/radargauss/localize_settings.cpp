@@ -85,7 +85,7 @@ void AddInitialErrorOptions(CLI::App* app, LocalizeSettings& s) {
 
 void AddCoarseOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--coarse-levels", s.coarse_levels,
-                  "Coarse-to-fine levels: inflated (every Gaussian blurred) or merged (voxel merges, faster)")
+                  "Coarse-to-fine levels: merged (voxel merges, the default) or inflated (every Gaussian blurred)")
       ->check(CLI::IsMember({"inflated", "merged"}))
       ->capture_default_str();
   app->add_option("--coarse-voxel", s.coarse_voxel,
