@@ -3,9 +3,12 @@
 // heavy to compile (docs/design.md, "Dependencies and pitfalls").
 #include "radargauss/peers/pcl_peers.hpp"
 
+#include "radargauss/map/builder.hpp"
+
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl/registration/gicp.h>
+#include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/registration/ndt.h>
 #include <tbb/enumerable_thread_specific.h>
 
@@ -20,7 +23,22 @@ struct PclPeerMatcher::Impl {
   PclMethod method;
   PclPeerOptions options;
   Cloud::Ptr target;
+  pcl::KdTreeFLANN<pcl::PointXYZ> target_tree;  // GICP's crops
   mutable tbb::enumerable_thread_specific<std::shared_ptr<Registration>> registrations;
+
+  // The map within `radius` of `origin`, expressed relative to it.
+  Cloud::Ptr LocalTarget(const Eigen::Vector3f& origin, double radius) const {
+    std::vector<int> indices;
+    std::vector<float> squared_distances;
+    target_tree.radiusSearch(pcl::PointXYZ(origin.x(), origin.y(), origin.z()), radius, indices, squared_distances);
+    Cloud::Ptr local(new Cloud);
+    local->reserve(indices.size());
+    for (const int i : indices) {
+      const pcl::PointXYZ& p = (*target)[i];
+      local->push_back(pcl::PointXYZ(p.x - origin.x(), p.y - origin.y(), p.z - origin.z()));
+    }
+    return local;
+  }
 
   std::shared_ptr<Registration> Make() const {
     if (method == PclMethod::kNdt) {
@@ -36,7 +54,7 @@ struct PclPeerMatcher::Impl {
     gicp->setMaxCorrespondenceDistance(options.gicp_max_correspondence);
     gicp->setMaximumIterations(options.max_iterations);
     gicp->setTransformationEpsilon(options.transformation_epsilon);
-    gicp->setInputTarget(target);
+    if (!options.gicp_local_target) gicp->setInputTarget(target);
     return gicp;
   }
 };
@@ -47,8 +65,13 @@ PclPeerMatcher::PclPeerMatcher(PclMethod method, const std::vector<Eigen::Vector
   impl_->method = method;
   impl_->options = options;
   impl_->target = Cloud::Ptr(new Cloud);
-  impl_->target->reserve(map_cloud.size());
-  for (const Eigen::Vector3d& p : map_cloud) impl_->target->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+  const bool reduce = method == PclMethod::kGicp && options.gicp_local_target && options.gicp_target_voxel > 0.0;
+  const std::vector<Eigen::Vector3d> points = reduce ? VoxelDownsample(map_cloud, options.gicp_target_voxel) : map_cloud;
+  impl_->target->reserve(points.size());
+  for (const Eigen::Vector3d& p : points) impl_->target->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+  if (method == PclMethod::kGicp && options.gicp_local_target && !impl_->target->empty()) {
+    impl_->target_tree.setInputCloud(impl_->target);
+  }
 }
 
 PclPeerMatcher::~PclPeerMatcher() = default;
@@ -70,9 +93,23 @@ ScanMatchingResult PclPeerMatcher::Match(const RadarScan& scan, const MatchingMa
     source->push_back(pcl::PointXYZ(float(p.position.x()), float(p.position.y()), float(p.position.z())));
   }
   registration->setInputSource(source);
+  // With a local target the guess and the result are relative to its origin.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  if (impl_->method == PclMethod::kGicp && impl_->options.gicp_local_target) {
+    origin = initial.translation();
+    const Cloud::Ptr local = impl_->LocalTarget(origin.cast<float>(), impl_->options.gicp_crop_radius);
+    if (local->size() < 3) {
+      result.reason = "no map points around the initial pose";
+      return result;
+    }
+    registration->setInputTarget(local);
+  }
+  Eigen::Matrix4d guess = initial.Matrix();
+  guess.topRightCorner<3, 1>() -= origin;
   Cloud aligned;
-  registration->align(aligned, initial.Matrix().cast<float>());
-  const Eigen::Matrix4d T = registration->getFinalTransformation().cast<double>();
+  registration->align(aligned, guess.cast<float>());
+  Eigen::Matrix4d T = registration->getFinalTransformation().cast<double>();
+  T.topRightCorner<3, 1>() += origin;
   if (T.allFinite()) {
     Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
     result.pose = SE3d(SO3d::FromMatrix(R), T.topRightCorner<3, 1>());
