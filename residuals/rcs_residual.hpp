@@ -156,29 +156,43 @@ inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d&
   return LineariseRcs(term, mean_radar, term.coefficients.data());
 }
 
+// The evaluation every analytic RCS twin shares: r at the pose (rotation,
+// t) with coefficients c; with `with_jacobians`, through LineariseRcs, and
+// where asked dr/dq (1x4), dr/dc (1x(degree+1)^2) and dr/dt (1x3).
+inline bool EvaluateRcsTerm(const RcsTerm& term, const double* rotation, const Eigen::Vector3d& t,
+                            const double* coefficients, double* residual, bool with_jacobians,
+                            double* rotation_jacobian, double* coefficient_jacobian, double* translation_jacobian) {
+  if (!with_jacobians) {  // the cost alone (Ceres's step evaluations)
+    residual[0] = RcsResidualValue<double>(term, rotation, t, coefficients);
+    return true;
+  }
+  const Eigen::Map<const Eigen::Quaterniond> q(rotation);
+  // coefficient_jacobian, when asked for, receives Y(d); dr/dc = -Y(d).
+  const RcsLinearisation lin = LineariseRcs(term, q.conjugate() * (term.mean - t), coefficients, coefficient_jacobian);
+  residual[0] = lin.residual;
+  if (rotation_jacobian != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 1, 4>> J(rotation_jacobian);
+    J = InverseRotatePointJacobianLeft(-lin.dr_du, rotation, term.mean - t);
+  }
+  if (coefficient_jacobian != nullptr) {
+    for (int i = 0; i < ShCoefficientCount(term.degree); ++i) coefficient_jacobian[i] = -coefficient_jacobian[i];
+  }
+  if (translation_jacobian != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 1, 3>> J(translation_jacobian);
+    J = (q * lin.dr_du.transpose()).transpose();  // dr/du R^T
+  }
+  return true;
+}
+
 // The analytic twin of RcsResidual ("full": rotation and translation).
 class RcsCostFunction final : public ceres::SizedCostFunction<1, 4, 3> {
  public:
   explicit RcsCostFunction(const RcsTerm& term) : term_(term) {}
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const Eigen::Map<const Eigen::Vector3d> t(parameters[1]);
-    if (jacobians == nullptr) {  // the cost alone (Ceres's step evaluations)
-      residuals[0] = RcsResidualValue<double>(term_, parameters[0], t);
-      return true;
-    }
-    const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
-    const RcsLinearisation lin = LineariseRcs(term_, q.conjugate() * (term_.mean - t));
-    residuals[0] = lin.residual;
-    if (jacobians[0] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
-      J = InverseRotatePointJacobianLeft(-lin.dr_du, parameters[0], term_.mean - t);
-    }
-    if (jacobians[1] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 1, 3>> J(jacobians[1]);
-      J = (q * lin.dr_du.transpose()).transpose();  // dr/du R^T
-    }
-    return true;
+    return EvaluateRcsTerm(term_, parameters[0], Eigen::Map<const Eigen::Vector3d>(parameters[1]),
+                           term_.coefficients.data(), residuals, jacobians != nullptr,
+                           jacobians ? jacobians[0] : nullptr, nullptr, jacobians ? jacobians[1] : nullptr);
   }
 
   void Reset(const RcsTerm& term) { term_ = term; }
@@ -194,18 +208,8 @@ class RcsRotationCostFunction final : public ceres::SizedCostFunction<1, 4> {
       : term_(term), translation_(translation) {}
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    if (jacobians == nullptr) {  // the cost alone (Ceres's step evaluations)
-      residuals[0] = RcsResidualValue<double>(term_, parameters[0], translation_);
-      return true;
-    }
-    const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
-    const RcsLinearisation lin = LineariseRcs(term_, q.conjugate() * (term_.mean - translation_));
-    residuals[0] = lin.residual;
-    if (jacobians[0] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
-      J = InverseRotatePointJacobianLeft(-lin.dr_du, parameters[0], term_.mean - translation_);
-    }
-    return true;
+    return EvaluateRcsTerm(term_, parameters[0], translation_, term_.coefficients.data(), residuals,
+                           jacobians != nullptr, jacobians ? jacobians[0] : nullptr, nullptr, nullptr);
   }
 
   void Reset(const RcsTerm& term, const Eigen::Vector3d& translation) {
@@ -265,26 +269,9 @@ class RcsCoefficientCostFunction final : public ceres::CostFunction {
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const Eigen::Vector3d t = full_ ? Eigen::Vector3d(parameters[2][0], parameters[2][1], parameters[2][2]) : translation_;
-    if (jacobians == nullptr) {  // the cost alone (Ceres's step evaluations)
-      residuals[0] = RcsResidualValue<double>(term_, parameters[0], t, parameters[1]);
-      return true;
-    }
-    const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
-    // jacobians[1], when asked for, receives Y(d); dr/dc = -Y(d).
-    const RcsLinearisation lin = LineariseRcs(term_, q.conjugate() * (term_.mean - t), parameters[1], jacobians[1]);
-    residuals[0] = lin.residual;
-    if (jacobians[0] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 1, 4>> J(jacobians[0]);
-      J = InverseRotatePointJacobianLeft(-lin.dr_du, parameters[0], term_.mean - t);
-    }
-    if (jacobians[1] != nullptr) {
-      for (int i = 0; i < ShCoefficientCount(term_.degree); ++i) jacobians[1][i] = -jacobians[1][i];
-    }
-    if (full_ && jacobians[2] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 1, 3>> J(jacobians[2]);
-      J = (q * lin.dr_du.transpose()).transpose();  // dr/du R^T
-    }
-    return true;
+    return EvaluateRcsTerm(term_, parameters[0], t, parameters[1], residuals, jacobians != nullptr,
+                           jacobians ? jacobians[0] : nullptr, jacobians ? jacobians[1] : nullptr,
+                           full_ && jacobians ? jacobians[2] : nullptr);
   }
 
  private:

@@ -239,32 +239,31 @@ void ValidateOptions(const GaussianMapOptions& o) {
 
 std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points, double voxel,
                                              VoxelOrder order) {
-  // Sums per occupied voxel in an open-addressing table (linear probing, at
-  // most half full), in the order of their first points: a scan's coarse
-  // levels downsample it on every match, so this sorts neither the points
-  // nor, unless asked, the voxels.
+  // Sums per occupied voxel, found through a LinearProbingTable, in the
+  // order of their first points: a scan's coarse levels downsample it on
+  // every match, so this sorts neither the points nor, unless asked, the voxels.
   struct Voxel {
     VoxelKey key;
     Eigen::Vector3d sum;
     std::uint32_t count;
   };
+  struct Slot {
+    VoxelKey key;
+    std::int32_t voxel;  // index into voxels; -1: free
+  };
   std::vector<Voxel> voxels;
-  std::size_t slots = 16;
-  while (slots < 2 * points.size()) slots *= 2;
-  std::vector<std::int32_t> table(slots, -1);  // index into voxels
+  LinearProbingTable<Slot> table;
+  table.Reset(points.size(), Slot{{0, 0, 0}, -1});
   for (const Eigen::Vector3d& p : points) {
     if (!p.allFinite()) continue;
     const VoxelKey key = VoxelOf(p, voxel);
-    const std::uint64_t mixed =
-        (std::uint64_t(key.x) * 0x9E3779B97F4A7C15ull) ^ (std::uint64_t(key.y) * 0xC2B2AE3D27D4EB4Full) ^
-        (std::uint64_t(key.z) * 0x165667B19E3779F9ull);
-    std::size_t slot = (mixed ^ (mixed >> 29)) & (slots - 1);
-    while (table[slot] >= 0 && !(voxels[table[slot]].key == key)) slot = (slot + 1) & (slots - 1);
-    if (table[slot] < 0) {
-      table[slot] = std::int32_t(voxels.size());
+    Slot& slot = table[table.Probe(std::uint64_t(PackVoxelKey(key)),
+                                   [&key](const Slot& s) { return s.voxel < 0 || s.key == key; })];
+    if (slot.voxel < 0) {
+      slot = {key, std::int32_t(voxels.size())};
       voxels.push_back({key, p, 1});
     } else {
-      Voxel& v = voxels[table[slot]];
+      Voxel& v = voxels[slot.voxel];
       v.sum += p;
       ++v.count;
     }

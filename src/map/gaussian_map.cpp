@@ -51,6 +51,12 @@ std::int64_t PackKey(std::int64_t x, std::int64_t y, std::int64_t z) {
          (((z + kKeyOffset) & kKeyMask) << (2 * kKeyBits));
 }
 
+}  // namespace
+
+std::int64_t PackVoxelKey(const VoxelKey& key) { return PackKey(key.x, key.y, key.z); }
+
+namespace {
+
 // floor(x) as an integer, inline (std::floor is a library call without SSE4.1).
 std::int64_t FloorToInt(double x) {
   const auto truncated = static_cast<std::int64_t>(x);
@@ -141,9 +147,7 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
   cell_entries_.resize(entries.size());
   std::size_t cell_count = 0;
   for (std::size_t k = 0; k < entries.size(); ++k) cell_count += k == 0 || entries[k].first != entries[k - 1].first;
-  std::size_t slots = 2;
-  for (slot_shift_ = 63; slots < 2 * cell_count; --slot_shift_) slots *= 2;
-  cells_.assign(slots, Cell());
+  cells_.Reset(cell_count, Cell());
   for (std::size_t begin = 0; begin < entries.size();) {
     std::size_t end = begin;
     while (end < entries.size() && entries[end].first == entries[begin].first) {
@@ -156,18 +160,6 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
     cell.end = std::uint32_t(end);
     begin = end;
   }
-}
-
-std::size_t GaussianIndex::HomeSlot(std::int64_t key) const {
-  // Fibonacci hashing: the product's top bits mix all of the key's bits.
-  return std::size_t((std::uint64_t(key) * 0x9E3779B97F4A7C15ull) >> slot_shift_);
-}
-
-std::size_t GaussianIndex::Slot(std::int64_t key) const {
-  const std::size_t mask = cells_.size() - 1;
-  std::size_t slot = HomeSlot(key);
-  while (cells_[slot].key != key && cells_[slot].key != kEmptyCell) slot = (slot + 1) & mask;
-  return slot;
 }
 
 const std::uint32_t* GaussianIndex::Candidates(const Eigen::Vector3d& point, std::size_t& count) const {
@@ -227,7 +219,7 @@ void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t coun
   const std::unique_ptr<const Cell*[]> cells(new const Cell*[count]);
   const auto fetch_cell = [&](std::size_t k) {
     keys[k] = Key(points[k]);
-    __builtin_prefetch(&cells_[HomeSlot(keys[k])]);
+    __builtin_prefetch(&cells_[cells_.HomeSlot(std::uint64_t(keys[k]))]);
   };
   const auto fetch_list = [&](std::size_t k) {
     cells[k] = &cells_[Slot(keys[k])];

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "radargauss/map/linear_probing_table.hpp"
 #include "radargauss/sh.hpp"
 
 namespace radargauss {
@@ -68,6 +69,9 @@ struct VoxelKey {
   bool operator==(const VoxelKey& o) const { return x == o.x && y == o.y && z == o.z; }
 };
 VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel);
+// The voxel packed into one non-negative integer, 21 bits per axis (wrapping:
+// a hash, and the spatial index's cell key).
+std::int64_t PackVoxelKey(const VoxelKey& key);
 
 // The upper triangle (00 01 02 11 12 22) of Sigma^-1 = L L^T from that of the
 // upper-triangular L^T, for one Gaussian (T = double) or one per SIMD lane
@@ -154,12 +158,11 @@ class GaussianIndex {
     std::uint32_t begin = 0, end = 0;  // [begin, end) in cell_entries_
   };
   static constexpr std::int64_t kEmptyCell = -1;  // packed keys are >= 0
-  std::vector<Cell> cells_;
-  int slot_shift_ = 64;  // 64 - log2(cells_.size())
-  // The slot where the probe for `key` starts.
-  std::size_t HomeSlot(std::int64_t key) const;
+  LinearProbingTable<Cell> cells_;
   // The slot holding `key`, or the empty slot where it would go.
-  std::size_t Slot(std::int64_t key) const;
+  std::size_t Slot(std::int64_t key) const {
+    return cells_.Probe(std::uint64_t(key), [key](const Cell& cell) { return cell.key == key || cell.key == kEmptyCell; });
+  }
   // The smallest Mahalanobis^2 a candidate must beat: one ulp above gate_sq.
   static double GateBound(double gate_sq);
   // The best candidate of `point` among `count` (-1 if none within the gate
