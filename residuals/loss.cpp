@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/residuals/loss.hpp"
 
+#include "radargauss/names.hpp"
+
 #include <stdexcept>
 #include <utility>
 
@@ -8,8 +10,7 @@ namespace radargauss {
 
 namespace {
 
-// Every loss's name, in enum order: the one table the parsers and lists use.
-const std::pair<LossType, const char*> kLossNames[] = {
+const NamedValue<LossType> kLossNames[] = {
     {LossType::kTrivial, "trivial"},
     {LossType::kHuber, "huber"},
     {LossType::kCauchy, "cauchy"},
@@ -20,30 +21,15 @@ const std::pair<LossType, const char*> kLossNames[] = {
 }  // namespace
 
 const std::vector<std::string>& LossNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> all;
-    for (const auto& entry : kLossNames) all.push_back(entry.second);
-    return all;
-  }();
+  static const std::vector<std::string> names = NamesOf(kLossNames);
   return names;
 }
 
 LossType LossTypeFromString(const std::string& name) {
-  if (name == "none") return LossType::kTrivial;
-  for (const auto& [type, n] : kLossNames) {
-    if (name == n) return type;
-  }
-  std::string known;
-  for (const std::string& n : LossNames()) known += (known.empty() ? "" : ", ") + n;
-  throw std::invalid_argument("unknown loss '" + name + "' (" + known + ")");
+  return name == "none" ? LossType::kTrivial : ValueNamed(kLossNames, name, "loss");
 }
 
-std::string ToString(LossType type) {
-  for (const auto& [t, name] : kLossNames) {
-    if (t == type) return name;
-  }
-  return "unknown";
-}
+std::string ToString(LossType type) { return NameOf(kLossNames, type); }
 
 namespace {
 

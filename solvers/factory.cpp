@@ -4,13 +4,14 @@
 #include <stdexcept>
 #include <utility>
 
+#include "radargauss/names.hpp"
 #include "radargauss/solvers/gauss_newton.hpp"
 
 namespace radargauss {
 
 namespace {
 
-const std::pair<SolverKind, const char*> kSolverNames[] = {
+const NamedValue<SolverKind> kSolverNames[] = {
     {SolverKind::kGaussNewton, "gn"},
     {SolverKind::kGaussNewtonAutoDiff, "gn-autodiff"},
     {SolverKind::kCeres, "ceres"},
@@ -18,34 +19,13 @@ const std::pair<SolverKind, const char*> kSolverNames[] = {
     {SolverKind::kMultiHypothesis, "mh-gn"},
 };
 
-std::string JoinedNames() {
-  std::string joined;
-  for (const std::string& name : ScanMatcherNames()) joined += (joined.empty() ? "" : ", ") + name;
-  return joined;
-}
-
 }  // namespace
 
-std::string ToString(SolverKind kind) {
-  for (const auto& [k, name] : kSolverNames) {
-    if (k == kind) return name;
-  }
-  throw std::invalid_argument("unknown solver kind");
-}
-
-SolverKind SolverKindFromString(const std::string& name) {
-  for (const auto& [kind, n] : kSolverNames) {
-    if (name == n) return kind;
-  }
-  throw std::invalid_argument("unknown solver '" + name + "' (" + JoinedNames() + ")");
-}
+std::string ToString(SolverKind kind) { return NameOf(kSolverNames, kind); }
+SolverKind SolverKindFromString(const std::string& name) { return ValueNamed(kSolverNames, name, "solver"); }
 
 const std::vector<std::string>& ScanMatcherNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> all;
-    for (const auto& entry : kSolverNames) all.push_back(entry.second);
-    return all;
-  }();
+  static const std::vector<std::string> names = NamesOf(kSolverNames);
   return names;
 }
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "radargauss/map/builder.hpp"
+#include "radargauss/names.hpp"
 #include "radargauss/solvers/normal_equations.hpp"
 
 namespace radargauss {
@@ -66,13 +67,16 @@ std::vector<Gaussian> MergedGaussians(const std::vector<Gaussian>& gaussians, do
 
 }  // namespace
 
-std::string ToString(CoarseLevels coarse) { return coarse == CoarseLevels::kMerged ? "merged" : "inflated"; }
+namespace {
 
-CoarseLevels CoarseLevelsFromString(const std::string& name) {
-  if (name == "inflated") return CoarseLevels::kInflated;
-  if (name == "merged") return CoarseLevels::kMerged;
-  throw std::invalid_argument("unknown coarse levels '" + name + "' (inflated, merged)");
-}
+const NamedValue<CoarseLevels> kCoarseNames[] = {{CoarseLevels::kMerged, "merged"},
+                                                 {CoarseLevels::kInflated, "inflated"}};
+
+}  // namespace
+
+std::string ToString(CoarseLevels coarse) { return NameOf(kCoarseNames, coarse); }
+CoarseLevels CoarseLevelsFromString(const std::string& name) { return ValueNamed(kCoarseNames, name, "coarse levels"); }
+std::vector<std::string> CoarseLevelsNames() { return NamesOf(kCoarseNames); }
 
 MatchingMap::MatchingMap(GaussianMap map, const MatchingMapOptions& options)
     : MatchingMap(std::make_shared<const GaussianMap>(std::move(map)), options) {}

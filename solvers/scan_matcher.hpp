@@ -116,6 +116,7 @@ inline double CoarseIndexCell(CoarseLevels coarse, double sigma) {
 }
 std::string ToString(CoarseLevels coarse);
 CoarseLevels CoarseLevelsFromString(const std::string& name);  // throws std::invalid_argument
+std::vector<std::string> CoarseLevelsNames();
 
 // The map as the solvers use it: the Gaussians and a coarse-to-fine list of
 // spatial indexes. Level k holds the Gaussians blurred by sigma_k (from

@@ -64,7 +64,7 @@ void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
       ->capture_default_str();
   app->add_option("--incidences", s.incidences, "Incidence models to sweep (map built here)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"offset", "view"}));
+      ->check(CLI::IsMember(IncidenceModelNames()));
   app->add_option("--degrees", s.degrees, "SH degrees to sweep (map built here)")
       ->delimiter(',')
       ->check(CLI::Range(0, kMaxShDegree));
@@ -86,7 +86,7 @@ void AddInitialErrorOptions(CLI::App* app, LocalizeSettings& s) {
 void AddCoarseOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--coarse-levels", s.coarse_levels,
                   "Coarse-to-fine levels: merged (voxel merges, the default) or inflated (every Gaussian blurred)")
-      ->check(CLI::IsMember({"inflated", "merged"}))
+      ->check(CLI::IsMember(CoarseLevelsNames()))
       ->capture_default_str();
   app->add_option("--coarse-voxel", s.coarse_voxel,
                   "Coarse levels match the scan's voxel centroids, voxel side this times the level's blur "

@@ -42,7 +42,7 @@ MapOptions MapBuildSettings::Resolved() const {
 void AddMapBuildOptions(CLI::App* app, MapBuildSettings& s) {
   GaussianMapOptions& gaussians = s.map.gaussians;
   app->add_option("--builder", s.builder, "kmeans (RA-L default) or voxel (NDT-style baseline)")
-      ->check(CLI::IsMember({"kmeans", "voxel"}))
+      ->check(CLI::IsMember(MapBuilderNames()))
       ->capture_default_str();
   app->add_option("--points-per-gaussian", gaussians.points_per_gaussian,
                   "K = round(N_downsampled / this) (about 4 for ARS548, 16 for Oculii Eagle)")
@@ -68,7 +68,7 @@ void AddMapBuildOptions(CLI::App* app, MapBuildSettings& s) {
       ->check(CLI::Range(0, kMaxShDegree))
       ->capture_default_str();
   app->add_option("--incidence", s.incidence, "Incidence vector: offset (paper) or view")
-      ->check(CLI::IsMember({"offset", "view"}))
+      ->check(CLI::IsMember(IncidenceModelNames()))
       ->capture_default_str();
   app->add_flag("--no-adaptive", s.no_adaptive,
                 "Give no model instead of lowering the degree when members are too few");

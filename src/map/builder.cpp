@@ -12,13 +12,18 @@
 
 #include <Eigen/LU>
 
+#include "radargauss/names.hpp"
+
 namespace radargauss {
 
-MapBuilder MapBuilderFromString(const std::string& name) {
-  if (name == "kmeans") return MapBuilder::kKMeans;
-  if (name == "voxel") return MapBuilder::kVoxel;
-  throw std::invalid_argument("unknown map builder '" + name + "' (kmeans, voxel)");
-}
+namespace {
+
+const NamedValue<MapBuilder> kBuilderNames[] = {{MapBuilder::kKMeans, "kmeans"}, {MapBuilder::kVoxel, "voxel"}};
+
+}  // namespace
+
+MapBuilder MapBuilderFromString(const std::string& name) { return ValueNamed(kBuilderNames, name, "map builder"); }
+std::vector<std::string> MapBuilderNames() { return NamesOf(kBuilderNames); }
 
 namespace {
 

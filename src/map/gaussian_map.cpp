@@ -11,17 +11,22 @@
 #include <Eigen/LU>
 #include <Eigen/Eigenvalues>
 
+#include "radargauss/names.hpp"
+
 namespace radargauss {
 
-std::string ToString(IncidenceModel model) {
-  return model == IncidenceModel::kOffset ? "offset" : "view";
-}
+namespace {
 
+const NamedValue<IncidenceModel> kIncidenceNames[] = {{IncidenceModel::kOffset, "offset"},
+                                                      {IncidenceModel::kView, "view"}};
+
+}  // namespace
+
+std::string ToString(IncidenceModel model) { return NameOf(kIncidenceNames, model); }
 IncidenceModel IncidenceModelFromString(const std::string& name) {
-  if (name == "offset") return IncidenceModel::kOffset;
-  if (name == "view") return IncidenceModel::kView;
-  throw std::invalid_argument("unknown incidence model '" + name + "' (offset, view)");
+  return ValueNamed(kIncidenceNames, name, "incidence model");
 }
+std::vector<std::string> IncidenceModelNames() { return NamesOf(kIncidenceNames); }
 
 void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs,
                    Eigen::Matrix3d& axes) {

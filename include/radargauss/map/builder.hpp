@@ -22,7 +22,8 @@
 namespace radargauss {
 
 enum class MapBuilder { kKMeans, kVoxel };
-MapBuilder MapBuilderFromString(const std::string& name);  // "kmeans", "voxel"
+MapBuilder MapBuilderFromString(const std::string& name);  // "kmeans", "voxel"; throws std::invalid_argument
+std::vector<std::string> MapBuilderNames();
 
 struct GaussianMapOptions {
   MapBuilder builder = MapBuilder::kKMeans;

@@ -25,6 +25,7 @@ enum class IncidenceModel : std::uint8_t { kOffset = 0, kView = 1 };
 
 std::string ToString(IncidenceModel model);
 IncidenceModel IncidenceModelFromString(const std::string& name);  // throws std::invalid_argument
+std::vector<std::string> IncidenceModelNames();
 
 // Per-Gaussian RCS model: y = (rcs - median) / scale in [-1, 1] is
 // predicted as c . Y(d) with real SH up to `degree` (sh.hpp).
