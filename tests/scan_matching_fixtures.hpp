@@ -118,6 +118,15 @@ inline const World& SimulatedWorld() {
   return *world;
 }
 
+// Expects `estimate` within `translation` m and `rotation` rad of `reference`.
+inline void ExpectPoseNear(const SE3d& estimate, const SE3d& reference, double translation, double rotation,
+                           const std::string& label) {
+  double dt = 0.0, dr_deg = 0.0;
+  PoseErrors(estimate, reference, dt, dr_deg);
+  EXPECT_LT(dt, translation) << label;
+  EXPECT_LT(dr_deg * M_PI / 180.0, rotation) << label;
+}
+
 constexpr int kTestScan = 40;
 
 inline SE3d Perturbed(const SE3d& pose, double translation, double angle_deg, std::uint32_t seed) {
