@@ -101,12 +101,13 @@ void BM_RefineScan(benchmark::State& state) {
 BENCHMARK(BM_RefineScan)->ArgsProduct({{0, 1, 2}, {0, 25}})->Unit(benchmark::kMillisecond);
 
 // The own GN with the losses' curvature in its Hessian
-// (ScanMatchingOptions::loss_curvature), tracking. Arg: w_rcs x 100.
+// (GaussNewtonOptions::loss_curvature), tracking. Arg: w_rcs x 100.
 void BM_RefineScanLossCurvature(benchmark::State& state) {
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(0)) / 100.0;
-  options.loss_curvature = true;
-  RefineScans(state, 0, options);
+  const Tracking tracking;
+  MatchScans(state, GaussNewtonSolver(options, {8, true}), tracking.exact, tracking.scans, tracking.initial,
+             options.w_rcs);
 }
 BENCHMARK(BM_RefineScanLossCurvature)->Arg(0)->Arg(25)->Unit(benchmark::kMillisecond);
 

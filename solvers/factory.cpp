@@ -34,17 +34,18 @@ std::unique_ptr<ScanMatcher> MakeScanMatcher(const MatchOptions& options) {
   CeresSolverOptions ceres = options.ceres;
   switch (options.solver) {
     case SolverKind::kGaussNewton:
-      return std::make_unique<GaussNewtonSolver>(matching);
+      return std::make_unique<GaussNewtonSolver>(matching, options.gauss_newton);
     case SolverKind::kGaussNewtonAutoDiff:
       matching.jacobians = JacobianMode::kAutoDiff;
-      return std::make_unique<GaussNewtonSolver>(matching);
+      return std::make_unique<GaussNewtonSolver>(matching, options.gauss_newton);
     case SolverKind::kCeres:
       return std::make_unique<CeresSolver>(matching, ceres);
     case SolverKind::kCeresDogleg:
       ceres.dogleg = true;
       return std::make_unique<CeresSolver>(matching, ceres);
     case SolverKind::kMultiHypothesis:
-      return std::make_unique<MultiHypothesisSolver>(std::make_shared<GaussNewtonSolver>(matching), matching,
+      return std::make_unique<MultiHypothesisSolver>(std::make_shared<GaussNewtonSolver>(matching, options.gauss_newton),
+                                                     matching,
                                                      options.hypotheses);
   }
   throw std::invalid_argument("unknown solver kind");

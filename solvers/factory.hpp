@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "radargauss/solvers/ceres_solver.hpp"
+#include "radargauss/solvers/gauss_newton.hpp"
 #include "radargauss/solvers/multi_hypothesis.hpp"
 #include "radargauss/solvers/scan_matcher.hpp"
 
@@ -30,6 +31,7 @@ const std::vector<std::string>& ScanMatcherNames();        // every kind's name,
 struct MatchOptions {
   SolverKind solver = SolverKind::kGaussNewton;
   ScanMatchingOptions matching;         // eq. 2, losses, association, stopping rules
+  GaussNewtonOptions gauss_newton;      // kGaussNewton, kGaussNewtonAutoDiff, kMultiHypothesis
   CeresSolverOptions ceres;             // kCeres (kCeresDogleg sets dogleg)
   MultiHypothesisOptions hypotheses;    // kMultiHypothesis
 };

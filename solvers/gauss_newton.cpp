@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include <Eigen/Cholesky>
@@ -124,8 +125,10 @@ class StepCheck {
 
 }  // namespace
 
-GaussNewtonSolver::GaussNewtonSolver(const ScanMatchingOptions& options) : options_(options) {
+GaussNewtonSolver::GaussNewtonSolver(const ScanMatchingOptions& options, const GaussNewtonOptions& gauss_newton)
+    : options_(options), gauss_newton_(gauss_newton) {
   ValidateOptions(options_);
+  if (gauss_newton_.max_step_halvings < 0) throw std::invalid_argument("max step halvings must be >= 0");
 }
 
 std::string GaussNewtonSolver::Name() const {
@@ -136,7 +139,7 @@ std::string GaussNewtonSolver::Name() const {
 // linearise eq. 2, solve the 6x6 system, step (checked on the exact map).
 ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const MatchingMap& map,
                                             const SE3d& initial) const {
-  StepCheck check(options_.max_step_halvings);
+  StepCheck check(gauss_newton_.max_step_halvings);
   return RunCoarseToFine(scan, map, initial, options_, [&, this](const LevelStep& level, ScanMatchingResult& result) {
     const auto outcome = [&](const Vector6& step) {
       return level.SmallStep(step.segment<3>(kTranslationOffset).norm(), step.segment<3>(kRotationOffset).norm())
@@ -144,13 +147,14 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
                  : StepOutcome::kContinue;
     };
     // Eq. 2: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs, likewise g.
-    const CombinedSystem system = BuildCombinedSystem(level.correspondences, result.pose, level.options);
+    const CombinedSystem system =
+        BuildCombinedSystem(level.correspondences, result.pose, level.options, gauss_newton_.loss_curvature);
     if (const std::optional<Vector6> step = check.TakeBackRaisingStep(level, system.cost, result.pose)) {
       return outcome(*step);
     }
     Vector6 dx;
-    if (!SolveStep(system, options_.loss_curvature, dx, result.reason)) return StepOutcome::kFailed;
-    if (!level.finest || options_.max_step_halvings == 0) {  // plain steps: coarse levels only steer
+    if (!SolveStep(system, gauss_newton_.loss_curvature, dx, result.reason)) return StepOutcome::kFailed;
+    if (!level.finest || gauss_newton_.max_step_halvings == 0) {  // plain steps: coarse levels only steer
       result.pose = Step(result.pose, dx);
       return outcome(dx);
     }

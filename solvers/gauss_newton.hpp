@@ -22,15 +22,29 @@
 
 namespace radargauss {
 
+// What only the own Gauss-Newton has.
+struct GaussNewtonOptions {
+  int max_step_halvings = 8;  // on the exact map, halvings of a step that raises eq. 2; 0: plain steps
+  // The robust losses' curvature in the Hessian: per term J^T (rho' I +
+  // 2 rho'' r r^T) J with the curvature along r clamped at 0, where IRLS
+  // takes J^T rho' J (the same gradient). For concave losses (Cauchy) IRLS
+  // overestimates the curvature and its steps come out short. When the
+  // system is not positive definite the step falls back to IRLS. Off: IRLS,
+  // as the paper and Ceres (whose Corrector ignores rho'' < 0).
+  bool loss_curvature = false;
+};
+
 class GaussNewtonSolver final : public ScanMatcher {
  public:
-  explicit GaussNewtonSolver(const ScanMatchingOptions& options);
+  // Throws std::invalid_argument for bad options.
+  explicit GaussNewtonSolver(const ScanMatchingOptions& options, const GaussNewtonOptions& gauss_newton = {});
   std::string Name() const override;
   ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map,
                            const SE3d& initial) const override;
 
  private:
   ScanMatchingOptions options_;
+  GaussNewtonOptions gauss_newton_;
 };
 
 }  // namespace radargauss

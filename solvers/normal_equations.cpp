@@ -29,7 +29,7 @@ void SeedJets(const SE3d& pose, const Eigen::Vector3d& translation, Jet7 rotatio
   for (int i = 0; i < 3; ++i) t[i] = Jet7(translation[i], 4 + i);
 }
 
-// The loss's curvature along r (ScanMatchingOptions::loss_curvature): the
+// The loss's curvature along r (GaussNewtonOptions::loss_curvature): the
 // coefficient c of (J^T r)(J^T r)^T, 2 rho'' clamped so that rho' + c s >= 0.
 double CurvatureAlongResidual(double s, double weight, double second) {
   return s > 0.0 ? std::max(2.0 * second, -weight / s) : 0.0;
@@ -193,7 +193,8 @@ void AddRotatedSums(const GeometricSums<double>& single, const GeometricSums<Eig
 }
 
 // Autodiff: the Ceres functor evaluated with Jets, per term.
-LinearSystem AutoDiffGeometricSystem(const Correspondences& c, const SE3d& pose, const ScanMatchingOptions& options) {
+LinearSystem AutoDiffGeometricSystem(const Correspondences& c, const SE3d& pose, const ScanMatchingOptions& options,
+                                     bool loss_curvature) {
   LinearSystem system;
   LossSum loss(options.geometric_loss);
   const Eigen::Matrix<double, 4, 3> P = QuaternionTangent(pose.rotation());
@@ -213,7 +214,7 @@ LinearSystem AutoDiffGeometricSystem(const Correspondences& c, const SE3d& pose,
     Matrix3x6 J;
     J.block<3, 3>(0, kTranslationOffset) = ambient.rightCols<3>();
     J.block<3, 3>(0, kRotationOffset) = ambient.leftCols<4>() * P;
-    Accumulate(system, 0, J, r, loss, options.loss_curvature);
+    Accumulate(system, 0, J, r, loss, loss_curvature);
   }
   system.rho_sum = loss.Sum();
   return system;
@@ -222,8 +223,8 @@ LinearSystem AutoDiffGeometricSystem(const Correspondences& c, const SE3d& pose,
 }  // namespace
 
 LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
-                                  const ScanMatchingOptions& options) {
-  if (options.jacobians == JacobianMode::kAutoDiff) return AutoDiffGeometricSystem(c, pose, options);
+                                  const ScanMatchingOptions& options, bool loss_curvature) {
+  if (options.jacobians == JacobianMode::kAutoDiff) return AutoDiffGeometricSystem(c, pose, options, loss_curvature);
   LinearSystem system;
   LossSum loss(options.geometric_loss);
   const Eigen::Matrix3d R = pose.rotation().Matrix();
@@ -236,13 +237,13 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
   // Sums of one term at a time, and of pairs of terms in SIMD lanes.
   GeometricSums<double> single(0.0);
   GeometricSums<Eigen::Array2d> pairs(Eigen::Array2d::Zero());
-  // Loss curvature (options.loss_curvature), with J^T r = [I_e; R^T (q x I_e)]
+  // Loss curvature (loss_curvature), with J^T r = [I_e; R^T (q x I_e)]
   // (I_e = Sigma^-1 e): summed without R as well.
   Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
   const auto weight_of = [&](double s, const Eigen::Vector3d& q, const Eigen::Vector3d& information_e) {
     double second = 0.0;
     const double weight = loss.Add(s, &second);
-    if (options.loss_curvature && second != 0.0) {
+    if (loss_curvature && second != 0.0) {
       Eigen::Matrix<double, 6, 1> Jt_r;
       Jt_r << information_e, q.cross(information_e);
       C.noalias() += CurvatureAlongResidual(s, weight, second) * Jt_r * Jt_r.transpose();
@@ -266,7 +267,7 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
     });
   }
   AddRotatedSums(single, pairs, R, system);
-  if (options.loss_curvature) {
+  if (loss_curvature) {
     Eigen::Matrix<double, 6, 6> rotate = Eigen::Matrix<double, 6, 6>::Identity();
     rotate.block<3, 3>(kRotationOffset, kRotationOffset) = R;
     system.loss_curvature = rotate.transpose() * C * rotate;
@@ -277,7 +278,7 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
 }
 
 LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
-                            const ScanMatchingOptions& options) {
+                            const ScanMatchingOptions& options, bool loss_curvature) {
   LinearSystem system;
   LossSum loss(options.rcs_loss);
   // Rotation-only: the translation is the association's constant.
@@ -306,12 +307,12 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
       J_translation = residual[0].v.tail<3>().transpose();
     }
     if (rotation_only) {
-      Accumulate(system, kRotationOffset, J_rotation, r, loss, options.loss_curvature);
+      Accumulate(system, kRotationOffset, J_rotation, r, loss, loss_curvature);
     } else {
       Eigen::Matrix<double, 1, 6> J;
       J.block<1, 3>(0, kTranslationOffset) = J_translation;
       J.block<1, 3>(0, kRotationOffset) = J_rotation;
-      Accumulate(system, 0, J, r, loss, options.loss_curvature);
+      Accumulate(system, 0, J, r, loss, loss_curvature);
     }
   }
   if (rotation_only) {
@@ -324,7 +325,7 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
 }
 
 CombinedSystem BuildCombinedSystem(const Correspondences& c, const SE3d& pose,
-                                   const ScanMatchingOptions& options) {
+                                   const ScanMatchingOptions& options, bool loss_curvature) {
   CombinedSystem combined;
   const double w = options.w_rcs;
   const auto add = [&](const LinearSystem& system, double weight) {
@@ -334,11 +335,11 @@ CombinedSystem BuildCombinedSystem(const Correspondences& c, const SE3d& pose,
     combined.cost += weight * system.rho_sum;
   };
   if (w < 1.0) {
-    const LinearSystem geometric = BuildGeometricSystem(c, pose, options);
+    const LinearSystem geometric = BuildGeometricSystem(c, pose, options, loss_curvature);
     add(geometric, (1.0 - w) / double(geometric.residuals));
   }
   if (w > 0.0) {
-    const LinearSystem rcs = BuildRcsSystem(c, pose, options);
+    const LinearSystem rcs = BuildRcsSystem(c, pose, options, loss_curvature);
     add(rcs, w / double(rcs.residuals));
   }
   return combined;
@@ -346,15 +347,13 @@ CombinedSystem BuildCombinedSystem(const Correspondences& c, const SE3d& pose,
 
 Eigen::Matrix<double, 6, 6> InformationMatrix(const Correspondences& c, const SE3d& pose,
                                               const ScanMatchingOptions& options) {
-  ScanMatchingOptions irls = options;
-  irls.loss_curvature = false;
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   const double w = options.w_rcs;
   if (w < 1.0 && !c.geometric.empty()) {
-    H += (1.0 - w) / double(c.geometric.size()) * BuildGeometricSystem(c, pose, irls).H;
+    H += (1.0 - w) / double(c.geometric.size()) * BuildGeometricSystem(c, pose, options).H;
   }
   if (w > 0.0 && !c.rcs.empty()) {
-    LinearSystem rcs = BuildRcsSystem(c, pose, irls);
+    LinearSystem rcs = BuildRcsSystem(c, pose, options);
     if (options.rcs_translation == RcsTranslation::kRotationOnly) {
       rcs.H.block<3, 3>(kTranslationOffset, kTranslationOffset).setZero();
     }

@@ -20,7 +20,7 @@ struct LinearSystem {
   Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
   std::size_t residuals = 0;
   double rho_sum = 0.0;  // sum of rho(s) over the residuals: the term's cost before eq. 2's weight
-  // With ScanMatchingOptions::loss_curvature: what the losses' curvature adds
+  // With `loss_curvature` (GaussNewtonOptions): what the losses' curvature adds
   // to H (sum of c (J^T r)(J^T r)^T, c = max(2 rho'', -rho'/s)); else zero.
   Eigen::Matrix<double, 6, 6> loss_curvature = Eigen::Matrix<double, 6, 6>::Zero();
 };
@@ -28,9 +28,9 @@ struct LinearSystem {
 // The geometric and RCS systems at `pose` for fixed correspondences (public
 // so that tests and benchmarks can compare the analytic and autodiff paths).
 LinearSystem BuildGeometricSystem(const Correspondences& correspondences, const SE3d& pose,
-                                  const ScanMatchingOptions& options);
+                                  const ScanMatchingOptions& options, bool loss_curvature = false);
 LinearSystem BuildRcsSystem(const Correspondences& correspondences, const SE3d& pose,
-                            const ScanMatchingOptions& options);
+                            const ScanMatchingOptions& options, bool loss_curvature = false);
 
 // Eq. 2's weighted sum: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs, likewise g,
 // the loss curvature and the cost f; a term with weight 0 is not built.
@@ -41,7 +41,7 @@ struct CombinedSystem {
   double cost = 0.0;  // f of eq. 2 at the pose, as EvaluateCost
 };
 CombinedSystem BuildCombinedSystem(const Correspondences& correspondences, const SE3d& pose,
-                                   const ScanMatchingOptions& options);
+                                   const ScanMatchingOptions& options, bool loss_curvature = false);
 
 // ScanMatchingResult::information: the combined H with IRLS weights, the
 // rotation-only RCS term's identity translation block left out.

@@ -23,7 +23,6 @@ void ValidateOptions(const ScanMatchingOptions& o) {
   require(o.max_iterations >= 1 && o.coarse_iterations >= 1, "iteration limits must be >= 1");
   require(o.coarse_voxel_per_sigma >= 0.0 && std::isfinite(o.coarse_voxel_per_sigma),
           "coarse voxel per sigma must be >= 0 and finite");
-  require(o.max_step_halvings >= 0, "max step halvings must be >= 0");
   require(o.translation_tolerance > 0.0 && o.rotation_tolerance > 0.0 && o.coarse_translation_tolerance > 0.0 &&
               o.coarse_rotation_tolerance > 0.0,
           "tolerances must be > 0");

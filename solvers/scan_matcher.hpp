@@ -52,7 +52,6 @@ struct ScanMatchingOptions {
   // leave; the optimum is eq. 2's either way. false: eq. 2 throughout (as
   // without reassociate, where the exact map has one association).
   bool geometric_first = true;
-  int max_step_halvings = 8;  // own GN: backtracking halvings of a step that raises the cost
   bool reassociate = true;    // false: associate once at the initial pose
   // Lazy re-association on the exact map: associate again only once the pose
   // has moved more than this (translation or rotation) since the last
@@ -61,14 +60,6 @@ struct ScanMatchingOptions {
   // keeps steps of a few mm going. 0 re-associates after every step.
   double reassociation_translation = 0.01;  // m
   double reassociation_rotation = 0.002;    // rad
-  // Own GN: the robust losses' curvature in the Hessian. Per term
-  // J^T (rho' I + 2 rho'' r r^T) J, the curvature along r clamped at 0, where
-  // IRLS takes J^T rho' J (the gradient is the same). For concave losses
-  // (Cauchy: rho'' < 0) IRLS overestimates the curvature and its steps come
-  // out short; this takes fewer iterations (RESULTS.md). When the system is
-  // not positive definite the step falls back to IRLS. Off: IRLS, as the
-  // paper and Ceres (whose Corrector ignores rho'' < 0).
-  bool loss_curvature = false;
   double translation_tolerance = 1e-3;         // m: stop when the update is smaller ...
   double rotation_tolerance = 1e-4;            // rad ... in both parts, on the exact map
   double coarse_translation_tolerance = 1e-2;  // m: the same on coarse levels, which

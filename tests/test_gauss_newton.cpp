@@ -124,16 +124,12 @@ TEST(GaussNewton, AnalyticAndAutodiffSystemsAgree) {
     // system (which it leaves as it was), zero unless asked.
     EXPECT_TRUE(ga.loss_curvature.isZero(0.0));
     EXPECT_TRUE(ra.loss_curvature.isZero(0.0));
-    ScanMatchingOptions curved = analytic;
-    curved.loss_curvature = true;
-    ScanMatchingOptions curved_autodiff = autodiff;
-    curved_autodiff.loss_curvature = true;
-    const LinearSystem gc = BuildGeometricSystem(c, pose, curved);
-    const LinearSystem rc = BuildRcsSystem(c, pose, curved);
+    const LinearSystem gc = BuildGeometricSystem(c, pose, analytic, true);
+    const LinearSystem rc = BuildRcsSystem(c, pose, analytic, true);
     EXPECT_GT(gc.loss_curvature.norm(), 1e-3 * gc.H.norm());  // Huber terms beyond a = 1
     EXPECT_GT(rc.loss_curvature.norm(), 1e-3 * rc.H.norm());  // Cauchy
-    EXPECT_LT(Relative(gc.loss_curvature, BuildGeometricSystem(c, pose, curved_autodiff).loss_curvature), 1e-8);
-    EXPECT_LT(Relative(rc.loss_curvature, BuildRcsSystem(c, pose, curved_autodiff).loss_curvature), 1e-8);
+    EXPECT_LT(Relative(gc.loss_curvature, BuildGeometricSystem(c, pose, autodiff, true).loss_curvature), 1e-8);
+    EXPECT_LT(Relative(rc.loss_curvature, BuildRcsSystem(c, pose, autodiff, true).loss_curvature), 1e-8);
     EXPECT_EQ(gc.H, ga.H);
     EXPECT_EQ(rc.H, ra.H);
   }
@@ -150,14 +146,13 @@ TEST(GaussNewton, LossCurvatureOfOneTerm) {
   ScanMatchingOptions options;
   options.geometric_loss = {LossType::kHuber, 1.0};
   options.rcs_loss = {LossType::kCauchy, 1.0};
-  options.loss_curvature = true;
   const Correspondences all =
       FindCorrespondences(world.simulated.scans[kTestScan], map, map.levels() - 1, pose, 3.0, true);
   int geometric_checked = 0, rcs_checked = 0;
   for (std::size_t k = 0; k < std::min<std::size_t>(all.geometric.size(), 40); ++k) {
     Correspondences one = all;
     one.geometric = {all.geometric[k]};
-    const LinearSystem system = BuildGeometricSystem(one, pose, options);
+    const LinearSystem system = BuildGeometricSystem(one, pose, options, true);
     const Eigen::Vector3d r = map.index().SqrtInformationT(all.geometric[k].gaussian) *
                               (pose * all.geometric[k].point_radar - map.index().Mean(all.geometric[k].gaussian));
     const double s = r.squaredNorm();
@@ -171,7 +166,7 @@ TEST(GaussNewton, LossCurvatureOfOneTerm) {
   for (std::size_t k = 0; k < std::min<std::size_t>(all.rcs.size(), 40); ++k) {
     Correspondences one = all;
     one.rcs = {all.rcs[k]};
-    const LinearSystem system = BuildRcsSystem(one, pose, options);
+    const LinearSystem system = BuildRcsSystem(one, pose, options, true);
     const double r = RcsResidualValue<double>(all.rcs[k], pose.rotation().data(), all.pose.translation());
     const double s = r * r;
     const double rho1 = 1.0 / (1.0 + s), rho2 = -1.0 / ((1.0 + s) * (1.0 + s));
@@ -203,12 +198,11 @@ TEST(GaussNewton, StepCheckKeepsTheCostFalling) {
   double checked = initial_cost, plain_highest = 0.0;
   for (int k = 1; k <= 12; ++k) {
     options.max_iterations = k;
-    options.max_step_halvings = 8;
-    const ScanMatchingResult result = MakeSolver("gn", options)->Match(world.scan, single, initial);
+    const ScanMatchingResult result = GaussNewtonSolver(options, {8, false}).Match(world.scan, single, initial);
     EXPECT_LE(result.final_cost, checked * (1.0 + 1e-12)) << k << " iterations";
     checked = result.final_cost;
-    options.max_step_halvings = 0;
-    plain_highest = std::max(plain_highest, MakeSolver("gn", options)->Match(world.scan, single, initial).final_cost);
+    plain_highest =
+        std::max(plain_highest, GaussNewtonSolver(options, {0, false}).Match(world.scan, single, initial).final_cost);
   }
   EXPECT_LT(checked, 0.75 * initial_cost);
   EXPECT_GT(plain_highest, initial_cost);

@@ -99,7 +99,7 @@ std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const 
       }
       for (const std::string& loss : s.losses) {
         for (const double w : s.w_rcs) {
-          const auto matcher = MakeScanMatcher(solver, s.MatchOptions(w, loss));
+          const auto matcher = MakeScanMatcher(s.Configuration(solver, w, loss));
           const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" +
                                    ToString(maps[m].incidence) + "-L" + std::to_string(degrees[m]);
           bar.Update("localize", done, total);

@@ -131,15 +131,17 @@ MatchingMapOptions LocalizeSettings::MatchingOptions() const {
   return options;
 }
 
-ScanMatchingOptions LocalizeSettings::MatchOptions(double w, const std::string& loss) const {
-  ScanMatchingOptions options;
-  options.w_rcs = w;
-  options.geometric_loss = {LossTypeFromString(loss), loss_scale};
-  options.rcs_loss = {LossTypeFromString(rcs_loss), rcs_loss_scale};
-  options.coarse_voxel_per_sigma = coarse_voxel;
-  options.coarse_points = coarse_points;
-  options.loss_curvature = loss_curvature;
-  options.geometric_first = geometric_first;
+radargauss::MatchOptions LocalizeSettings::Configuration(const std::string& solver, double w,
+                                                         const std::string& loss) const {
+  radargauss::MatchOptions options;
+  options.solver = SolverKindFromString(solver);
+  options.matching.w_rcs = w;
+  options.matching.geometric_loss = {LossTypeFromString(loss), loss_scale};
+  options.matching.rcs_loss = {LossTypeFromString(rcs_loss), rcs_loss_scale};
+  options.matching.coarse_voxel_per_sigma = coarse_voxel;
+  options.matching.coarse_points = coarse_points;
+  options.matching.geometric_first = geometric_first;
+  options.gauss_newton.loss_curvature = loss_curvature;
   return options;
 }
 

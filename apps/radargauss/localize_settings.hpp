@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "radargauss/solvers/factory.hpp"
 #include "radargauss/solvers/scan_matcher.hpp"
 
 namespace radargauss::cli {
@@ -40,8 +41,8 @@ struct LocalizeSettings {
   // w > 0 on scans without RCS), before any map is built.
   void CheckAgainst(const Sequence& sequence) const;
   MatchingMapOptions MatchingOptions() const;
-  // The matching options of one configuration: weight w and geometric loss.
-  ScanMatchingOptions MatchOptions(double w, const std::string& loss) const;
+  // The options of one configuration: solver, weight w and geometric loss.
+  radargauss::MatchOptions Configuration(const std::string& solver, double w, const std::string& loss) const;
 };
 
 void AddLocalizeOptions(CLI::App* app, LocalizeSettings& settings);
