@@ -25,8 +25,8 @@ struct PclPeerOptions {
   // GICP's target per scan: the map cloud voxel-downsampled (as the Gaussian
   // builder's input), within gicp_crop_radius of the initial position, in a
   // frame whose origin is there: GICP turns about the target's origin, which
-  // for a whole map is 50-220 m from the vehicle (bench/RESULTS.md has the
-  // measured difference). false: the whole map in the world frame.
+  // for a whole map is 50-220 m from the vehicle. false: the whole map in
+  // the world frame.
   bool gicp_local_target = true;
   double gicp_crop_radius = 80.0;       // m
   double gicp_target_voxel = 0.25;      // m; 0: every point

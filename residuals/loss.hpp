@@ -51,8 +51,8 @@ ceres::LossFunction* MakeLoss(const LossConfig& config);
 // A robust loss summed over the terms of one system or cost by the own
 // solvers: Add(s) adds rho(s) to the sum and returns rho'(s), the IRLS weight
 // (and rho''(s) when asked); Sum() is the sum of rho(s) so far. Ceres's loss
-// classes evaluate every loss but Cauchy. Cauchy's rho costs a log per term
-// (17% of a tracking match at w = 0.25), so it is summed here as one log of
+// classes evaluate every loss but Cauchy. Cauchy's rho costs a log per term,
+// a large part of a tracking match, so it is summed here as one log of
 // a product, sum a^2 log(x_i) = a^2 log(prod x_i) with x = 1 + s/a^2, and its
 // derivatives are Ceres's closed forms: rho' = 1/x, rho'' = -1/(a^2 x^2).
 class LossSum {

@@ -18,7 +18,7 @@ struct CeresSolverOptions {
   // steer (the coarse levels and, with geometric_first, the exact map's
   // geometric stage). Few: the outer loop re-associates after each solve
   // there, and iterating a fresh association to full convergence pays
-  // Jacobian evaluations for terms about to change. RESULTS.md has 1-5.
+  // Jacobian evaluations for terms about to change.
   int max_inner_iterations = 2;
   // In the match's last stage (eq. 2 on the exact map) a solve ends once the
   // pose has moved past the association's re-association thresholds (the
@@ -34,7 +34,7 @@ struct CeresSolverOptions {
   // How analytic terms enter the problem (see CeresScanProblem): by default
   // the terms of a kind share a residual block per thread, handed to Ceres in
   // its square-root form; kShared and kPerTerm are the plainer layouts, for
-  // comparison (RESULTS.md has all three).
+  // comparison (bench/RESULTS.md times all three).
   CeresBlocks blocks = CeresBlocks::kSquareRoot;
   int threads = 1;
   // Ceres's stopping rules per association (Ceres's defaults; the outer

@@ -40,7 +40,7 @@ struct ScanMatchingOptions {
   // Coarse levels: the scan reduced to the centroids of its voxels of side
   // coarse_voxel_per_sigma * sigma_k (the level's blur), so that each patch
   // of the scene steers once, however densely the radar sampled it (fewer
-  // points, fewer wrong basins: README); 0: the points themselves. Then at
+  // points, fewer wrong basins); 0: the points themselves. Then at
   // most coarse_points of them (evenly strided); 0: all.
   double coarse_voxel_per_sigma = 2.0;
   std::size_t coarse_points = 0;
@@ -100,8 +100,7 @@ inline constexpr double kMergeCellPerSigma = 3.0;
 // The index cell of a coarse level before MatchingMapOptions::index_cell's
 // floor: sigma_k for inflated levels (every Gaussian, blurred); half the merge
 // cell for merged ones, whose Gaussians are one per merge cell, so that a
-// query still has few candidates and the index is half the size (faster:
-// RESULTS.md).
+// query still has few candidates and the index is half the size.
 inline double CoarseIndexCell(CoarseLevels coarse, double sigma) {
   return coarse == CoarseLevels::kMerged ? 0.5 * kMergeCellPerSigma * sigma : sigma;
 }
@@ -124,8 +123,7 @@ struct MatchingMapOptions {
   // tau on the coarse levels (Mahalanobis distance to the blurred Gaussians;
   // the exact map uses ScanMatchingOptions::gate). Their indexes cover
   // +/- coarse_gate std, so a smaller gate means fewer candidates per query:
-  // faster coarse levels, less reach for large initial errors (measured
-  // trade-off in the README).
+  // faster coarse levels, less reach for large initial errors.
   double coarse_gate = 3.0;
 };
 // The exact map alone: one level, no coarse-to-fine.

@@ -218,8 +218,7 @@ void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t coun
   // cell and fetch its list of candidates; fetch the candidates' entries; score.
   constexpr std::size_t kAhead = 8;
   const double bound = GateBound(gate_sq);
-  // Written by the stages ahead before they are read: not value-initialised
-  // (zero-filling them was 2% of a match).
+  // Written by the stages ahead before they are read: not value-initialised.
   const std::unique_ptr<std::int64_t[]> keys(new std::int64_t[count]);
   const std::unique_ptr<const Cell*[]> cells(new const Cell*[count]);
   const auto fetch_cell = [&](std::size_t k) {
