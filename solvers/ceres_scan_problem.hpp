@@ -20,40 +20,8 @@ enum class CeresBlocks {
 };
 
 // The ceres::Problem of one match, kept across associations: the pose blocks
-// (rotation with SO3Manifold, translation) and the terms of the current
-// association, with eq. 2's weights as ScaledLoss.
-//
-// Shared blocks (analytic terms, CeresBlocks::kShared): kTermsPerBlock terms of a
-// kind per residual block, so that Ceres's per-block work (evaluator loop,
-// manifold product, loss correction, checks, preprocessing) is paid per
-// block of terms. Ceres applies a block's loss to the block's squared norm,
-// so each term's robust loss rho goes into its own residual instead:
-// r -> sqrt(rho(s)/s) r with s = |r|^2, whose squared norm is rho(s), and that
-// residual's exact Jacobian. Cost and gradient are eq. 2's, as with a block
-// per term; the Gauss-Newton model is that of the rescaled residual, where
-// Ceres's loss correction would take sqrt(rho') J (IRLS, for every loss here).
-//
-// Square-root blocks (the default for analytic terms): the terms of a kind
-// share `threads` blocks (so that Ceres can evaluate them in parallel), and
-// each block hands Ceres, instead of its rows r (loss applied as above) and
-// their Jacobian J on the tangent space, the residuals [z; sqrt(|r|^2 -
-// |z|^2)] with the Jacobian [R; 0], where R^T R = J^T J (Cholesky; on a
-// rank-deficient block R = Lambda^1/2 V^T from J^T J's eigenvectors) and
-// R^T z = J^T r. The cost |r|^2, the gradient J^T r and the Gauss-Newton
-// matrix J^T J, all that Levenberg-Marquardt and dogleg use (step, jacobi
-// scaling, model cost change, tolerances), are those of the shared rows, so
-// Ceres takes the same steps; it handles 7 (geometric) or 4 (rotation-only
-// RCS) rows per block instead of 3 per geometric and 1 per RCS term, which
-// saves it its per-row work (Jacobian writing, manifold products, normal
-// equations, scaling). A Jacobian from Problem::Evaluate is then R's, not
-// the terms' (use kShared to read theirs). With residuals only (the cost of
-// a candidate step) a block returns [|r|; 0].
-//
-// Otherwise (autodiff terms, or kPerTerm) a block per term under
-// ScaledLoss(its loss); Update re-targets the blocks it keeps at the new
-// terms and adds or removes blocks only for the change in count, so Ceres's
-// per-block set-up is paid about once per match instead of once per
-// association.
+// and the current association's terms, shared, square-root or one block per
+// term (docs/design.md, "The residual blocks"), with eq. 2's weights.
 class CeresScanProblem {
  public:
   static constexpr std::size_t kTermsPerBlock = 64;  // kShared

@@ -14,27 +14,13 @@ namespace radargauss {
 
 struct CeresSolverOptions {
   bool dogleg = false;           // Levenberg-Marquardt (default) or dogleg
-  // Ceres iterations per solve, i.e. per association, in the stages that
-  // steer (the coarse levels and, with geometric_first, the exact map's
-  // geometric stage). Few: the outer loop re-associates after each solve
-  // there, and iterating a fresh association to full convergence pays
-  // Jacobian evaluations for terms about to change.
+  // Iterations per solve (per association) in the stages that steer: few, as
+  // the outer loop re-associates after each solve there.
   int max_inner_iterations = 2;
-  // In the match's last stage (eq. 2 on the exact map) a solve ends once the
-  // pose has moved past the association's re-association thresholds (the
-  // outer loop's lazy rule, ScanMatchingOptions, checked after each
-  // iteration), once an accepted step is below the loop's step tolerances
-  // (as the own GN stops), once Ceres converges, or after this many
-  // iterations: what the loop would do over several solves on an
-  // association it keeps runs in one, without a solve's set-up and first
-  // Jacobian each time. A match ends only once such a solve settled (Ceres
-  // converged or the step was small) on an association the loop keeps (more
-  // solves on it when this limit cuts one short).
+  // In the last stage a solve also ends when the pose leaves the association
+  // or a step is below the loop's tolerances (docs/design.md, "Ceres").
   int max_exact_inner_iterations = 8;
-  // How analytic terms enter the problem (see CeresScanProblem): by default
-  // the terms of a kind share a residual block per thread, handed to Ceres in
-  // its square-root form; kShared and kPerTerm are the plainer layouts, for
-  // comparison (bench/RESULTS.md times all three).
+  // How analytic terms enter the problem (docs/design.md, "The residual blocks").
   CeresBlocks blocks = CeresBlocks::kSquareRoot;
   int threads = 1;
   // Ceres's stopping rules per association (Ceres's defaults; the outer

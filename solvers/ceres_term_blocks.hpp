@@ -191,16 +191,8 @@ class TermRangeCost final : public ceres::CostFunction {
 };
 
 // The residual blocks of one kind of term, kept across associations: cost
-// function k holds term k of the current association. A new association
-// re-targets the cost functions it keeps (Reset on the functor or the
-// analytic twin). Shared (analytic terms, kShared or kSquareRoot): the terms
-// sit in residual blocks (TermRangeCost) of kTermsPerBlock terms, or square
-// root, `threads` blocks, made afresh for each association (a handful per
-// match), with their loss inside and eq. 2's weight as the blocks'
-// ScaledLoss. Otherwise a block per term under the ScaledLoss of its loss
-// (Ceres's own loss handling), added or removed only for the change in
-// count, so that Ceres's per-block set-up is paid about once per match
-// instead of once per association.
+// function k holds term k of the current association, re-targeted by Reset
+// (docs/design.md, "The residual blocks").
 template <typename Functor, typename AnalyticCost>
 class TermBlocks {
  public:

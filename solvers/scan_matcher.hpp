@@ -37,27 +37,19 @@ struct ScanMatchingOptions {
   double gate = 3.0;          // tau: association gate (Mahalanobis distance)
   int max_iterations = 30;    // outer iterations (association + update) on the exact map
   int coarse_iterations = 15; // outer iterations on each coarse level of the MatchingMap
-  // Coarse levels: the scan reduced to the centroids of its voxels of side
-  // coarse_voxel_per_sigma * sigma_k (the level's blur), so that each patch
-  // of the scene steers once, however densely the radar sampled it (fewer
-  // points, fewer wrong basins); 0: the points themselves. Then at
-  // most coarse_points of them (evenly strided); 0: all.
+  // Coarse levels match the centroids of the scan's voxels of side
+  // coarse_voxel_per_sigma * sigma_k (0: the points), then at most
+  // coarse_points of them, evenly strided (0: all).
   double coarse_voxel_per_sigma = 2.0;
   std::size_t coarse_points = 0;
-  // With 0 < w < 1: on the exact map, match with the geometric term alone
-  // first (to the coarse tolerances, as a last coarse level), then with
-  // eq. 2's RCS term from there. The RCS terms (a third of an association,
-  // two thirds of a system at w = 0.25) then enter the last iterations only,
-  // not the re-associating steps that close the few cm the coarse levels
-  // leave; the optimum is eq. 2's either way. false: eq. 2 throughout (as
-  // without reassociate, where the exact map has one association).
+  // With 0 < w < 1: on the exact map the geometric term alone first, then
+  // eq. 2 from there, so the RCS terms enter the last iterations only (the
+  // same optimum); false: eq. 2 throughout.
   bool geometric_first = true;
   bool reassociate = true;    // false: associate once at the initial pose
-  // Lazy re-association on the exact map: associate again only once the pose
-  // has moved more than this (translation or rotation) since the last
-  // association; smaller steps refine on the current one, which ends the
-  // back-and-forth of points between overlapping Gaussians that otherwise
-  // keeps steps of a few mm going. 0 re-associates after every step.
+  // Lazy re-association on the exact map: again only once the pose has moved
+  // more than this since the last association (docs/design.md,
+  // "Association"); 0 re-associates after every step.
   double reassociation_translation = 0.01;  // m
   double reassociation_rotation = 0.002;    // rad
   double translation_tolerance = 1e-3;         // m: stop when the update is smaller ...
@@ -108,14 +100,9 @@ std::string ToString(CoarseLevels coarse);
 CoarseLevels CoarseLevelsFromString(const std::string& name);  // throws std::invalid_argument
 std::vector<std::string> CoarseLevelsNames();
 
-// The map as the solvers use it: the Gaussians and a coarse-to-fine list of
-// spatial indexes. Level k holds the Gaussians blurred by sigma_k (from
-// `inflation`, coarse first; see CoarseLevels); the last level is the map
-// itself. Solvers match level by level, so that points far from their
-// Gaussians (metres of initial error) still find candidates early on. Coarse
-// levels steer with the geometric term alone (their associations are too
-// rough for RCS); eq. 2 with the requested w is minimised on the exact map,
-// and with w = 1 the coarse levels are skipped.
+// The map as the solvers use it: the Gaussians and coarse-to-fine indexes,
+// level k blurred by sigma_k (coarse first), the exact map last
+// (docs/design.md, "Coarse to fine").
 struct MatchingMapOptions {
   std::vector<double> inflation = {1.0, 0.5, 0.25};  // sigma_k of the coarse levels (m), coarse first
   double index_cell = 0.5;  // m: cell of the exact level's index (coarse: max(cell, CoarseIndexCell))
@@ -217,17 +204,8 @@ struct EvaluatedCost {
   double cost = 0.0;
 };
 
-// The outer loop every single-scan solver shares (kiss-icp style): map level
-// by map level, coarse to fine (coarse levels with the geometric term only,
-// the scan's voxel centroids and at most coarse_points points
-// (ScanMatchingOptions) and the map's coarse gate; w = 1 without
-// them; then the exact map, with the geometric term alone first when
-// geometric_first and 0 < w < 1), associate (again each iteration on coarse levels; on the exact map
-// once the pose has moved past the re-association thresholds), check the
-// correspondences, and let `step` update result.pose. At the end: the final
-// association (the last one when it is within the thresholds of the final
-// pose), N_geo, N_rcs, the cost of eq. 2 (the one a step recorded at the
-// final pose on that association, if any; EvaluatedCost) and the time.
+// What a solver's step sees of one iteration of the outer loop that every
+// single-scan solver shares (RunCoarseToFine; docs/design.md, "Coarse to fine").
 struct LevelStep {
   const Correspondences& correspondences;
   const ScanMatchingOptions& options;  // with this level's w_rcs
@@ -245,6 +223,9 @@ struct LevelStep {
 enum class StepOutcome { kContinue, kConverged, kFailed };
 using SolverStep = std::function<StepOutcome(const LevelStep&, ScanMatchingResult&)>;
 
+// Matches level by level, associating as docs/design.md, "Association" says,
+// and lets `step` move result.pose; then fills in the final counts, eq. 2 and
+// the information matrix.
 ScanMatchingResult RunCoarseToFine(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
                                    const ScanMatchingOptions& options, const SolverStep& step);
 
