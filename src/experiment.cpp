@@ -41,23 +41,6 @@ void PoseErrors(const SE3d& estimate, const SE3d& reference, double& translation
   rotation_deg = (reference.rotation().Inverse() * estimate.rotation()).Log().norm() * 180.0 / M_PI;
 }
 
-ErrorStatistics Statistics(std::vector<double> values) {
-  ErrorStatistics s;
-  if (values.empty()) return s;
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  double sum = 0.0, sum_sq = 0.0;
-  for (const double v : values) {
-    sum += v;
-    sum_sq += v * v;
-  }
-  s.mean = sum / double(n);
-  s.median = MedianOfSorted(values);
-  s.rmse = std::sqrt(sum_sq / double(n));
-  s.max = values.back();
-  return s;
-}
-
 void ConfigurationRun::Summarise() {
   std::vector<double> t, r;
   double iterations = 0.0, time = 0.0, converged = 0.0;

@@ -100,6 +100,15 @@ expect_fail "localize with a map of another version" "map version" -- \
   bash -c "cp '$work/seq.rgm' '$work/v2.rgm' && printf '\\x02' | dd of='$work/v2.rgm' bs=1 seek=8 conv=notrunc 2>/dev/null && '$tool' localize --sequence '$work/seq' --gt '$work/seq/gt_radar_tum.txt' --map '$work/v2.rgm' --out '$work/r3'"
 expect_fail "localize --map with --degrees" "drop --map" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" --degrees 1 --out "$work/r4"
+"$tool" simulate --out "$work/seq10" --scans 10 >/dev/null
+expect_ok "evaluate a trajectory against itself" "ATE translation: RMSE 0.000 m" -- \
+  "$tool" evaluate --est "$work/seq10/gt_radar_tum.txt" --ref "$work/seq10/gt_radar_tum.txt" \
+  --align first --out "$work/evaluation"
+if [ -s "$work/evaluation/evaluation.json" ]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: evaluation.json"; fi
+expect_fail "evaluate with a missing reference" "cannot open" -- \
+  "$tool" evaluate --est "$work/results/reference.tum" --ref "$work/absent.tum"
+expect_fail "evaluate with an unknown alignment" "align" -- \
+  "$tool" evaluate --est "$work/results/reference.tum" --ref "$work/results/reference.tum" --align umeyama
 printf 'w-rcs: [0, 1]\nstride: 1\n' > "$work/loc.yaml"
 expect_ok "localize --config" "2 configurations" -- \
   "$tool" localize --config "$work/loc.yaml" --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" --out "$work/r5"

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "radargauss/lie/se3.hpp"
+#include "radargauss/stats.hpp"
 #include "radargauss/types.hpp"
 #include "radargauss/solvers/scan_matcher.hpp"
 
@@ -32,10 +33,6 @@ struct ScanOutcome {
   ScanMatchingResult result;
 };
 
-struct ErrorStatistics {
-  double mean = 0.0, median = 0.0, rmse = 0.0, max = 0.0;
-};
-ErrorStatistics Statistics(std::vector<double> values);
 
 struct ConfigurationRun {
   std::string name;  // e.g. gn-w0.25-trivial-offset-L3
