@@ -41,7 +41,8 @@ bool SolveLeastSquares(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
 // RANSAC over 3-point draws of the rows of H v = y: the largest consensus
 // set (row indices) over `iterations` draws.
 std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
-                                  const EgoVelocityOptions& options, int iterations) {
+                                  const EgoVelocityOptions& options, int iterations,
+                                  const std::optional<VelocityGate>& gate) {
   const int n = static_cast<int>(y.size());
   std::mt19937 rng(options.seed);
   std::uniform_int_distribution<int> pick(0, n - 1);
@@ -56,6 +57,7 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     const Eigen::FullPivLU<Eigen::Matrix3d> lu(h);
     if (!lu.isInvertible() || std::abs(h.determinant()) < 1e-6) continue;
     const Eigen::Vector3d v = lu.solve(Eigen::Vector3d(y[a], y[b], y[c]));
+    if (gate && !gate->Admits(v)) continue;
     consensus.clear();
     for (int k = 0; k < n; ++k) {
       if (std::abs(y[k] - H.row(k).dot(v)) < options.inlier_threshold) consensus.push_back(k);
@@ -67,7 +69,8 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
 
 }  // namespace
 
-EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOptions& options) {
+EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOptions& options,
+                                      const std::optional<VelocityGate>& gate) {
   EgoVelocityResult result;
   result.inlier.assign(scan.points.size(), false);
   if (!scan.has_doppler) {
@@ -102,7 +105,7 @@ EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOp
   std::vector<double> sorted = abs_doppler;
   const std::size_t q75 = static_cast<std::size_t>(0.75 * (n - 1));
   std::nth_element(sorted.begin(), sorted.begin() + q75, sorted.end());
-  if (sorted[q75] < options.zero_velocity_threshold) {
+  if (sorted[q75] < options.zero_velocity_threshold && (!gate || gate->Admits(Eigen::Vector3d::Zero()))) {
     result.success = true;
     result.zero_velocity = true;
     result.covariance = std::pow(options.zero_velocity_sigma, 2) * Eigen::Matrix3d::Identity();
@@ -115,9 +118,10 @@ EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOp
   // RANSAC over 3-point draws, keeping the largest consensus set.
   result.ransac_iterations = RansacIterations(options.outlier_probability,
                                               options.success_probability);
-  const std::vector<int> best = LargestConsensus(H, y, options, result.ransac_iterations);
+  const std::vector<int> best = LargestConsensus(H, y, options, result.ransac_iterations, gate);
   if (best.size() < 3) {
-    result.reason = "RANSAC found no consensus of 3 or more points";
+    result.reason = gate ? "RANSAC found no consensus of 3 or more points within the prediction gate"
+                         : "RANSAC found no consensus of 3 or more points";
     return result;
   }
   // Least-squares refit on all inliers, then the final inlier set.

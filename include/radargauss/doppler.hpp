@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,17 @@ struct EgoVelocityResult {
 // RANSAC iterations for 3-point draws: log(1 - p_success) / log(1 - (1 - p_outlier)^3).
 int RansacIterations(double outlier_probability, double success_probability);
 
-EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan,
-                                      const EgoVelocityOptions& options = {});
+// A predicted sensor velocity (a motion model's) and how far from it an
+// estimate may lie: hypotheses beyond the gate, the standstill branch
+// included, are not taken, so a moving object that fills the view is not
+// taken for the static world.
+struct VelocityGate {
+  Eigen::Vector3d predicted = Eigen::Vector3d::Zero();  // m/s, radar frame
+  double gate = 1.0;                                    // m/s
+  bool Admits(const Eigen::Vector3d& velocity) const { return (velocity - predicted).norm() <= gate; }
+};
+
+EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOptions& options = {},
+                                      const std::optional<VelocityGate>& gate = std::nullopt);
 
 }  // namespace radargauss
