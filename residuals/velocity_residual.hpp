@@ -28,6 +28,19 @@ inline Eigen::Matrix3d VelocitySqrtInformation(const Eigen::Matrix3d& velocity_c
   return L.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity());
 }
 
+// The term as scan matching adds it to eq. 2: weight * |r_v|^2.
+struct VelocityPrior {
+  SE3d previous;                                              // (R_prev, t_prev)
+  Eigen::Vector3d displacement = Eigen::Vector3d::Zero();     // v dt, previous radar frame
+  Eigen::Matrix3d sqrt_information = Eigen::Matrix3d::Identity();  // W
+  double weight = 1.0;                                        // 0: off
+  Eigen::Matrix3d Jacobian() const { return sqrt_information * previous.rotation().Matrix().transpose(); }
+  Eigen::Vector3d Residual(const Eigen::Vector3d& translation) const {
+    return sqrt_information *
+           (previous.rotation().Matrix().transpose() * (translation - previous.translation()) - displacement);
+  }
+};
+
 class VelocityResidual {
  public:
   VelocityResidual(const SE3d& previous, const Eigen::Vector3d& velocity, double dt,
@@ -66,6 +79,9 @@ class VelocityCostFunction final : public ceres::SizedCostFunction<3, 3> {
                        const Eigen::Matrix3d& sqrt_information)
       : jacobian_(sqrt_information * previous.rotation().Matrix().transpose()),
         offset_(-(jacobian_ * previous.translation()) - sqrt_information * velocity * dt) {}
+
+  explicit VelocityCostFunction(const VelocityPrior& prior)
+      : VelocityCostFunction(prior.previous, prior.displacement, 1.0, prior.sqrt_information) {}
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     Eigen::Map<Eigen::Vector3d> r(residuals);

@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/solvers/ceres_scan_problem.hpp"
 
+#include <ceres/loss_function.h>
+
+#include <memory>
+
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/residuals/geometric_residual.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
@@ -22,6 +26,11 @@ struct CeresScanProblem::Impl {
         problem_(ProblemOptions()) {
     problem_.AddParameterBlock(rotation, 4, &so3_);
     problem_.AddParameterBlock(translation, 3);
+    if (options.velocity && options.velocity->weight > 0.0) {  // the same for every association
+      velocity_cost_ = std::make_unique<VelocityCostFunction>(*options.velocity);
+      velocity_loss_ = std::make_unique<ceres::ScaledLoss>(nullptr, options.velocity->weight, ceres::TAKE_OWNERSHIP);
+      problem_.AddResidualBlock(velocity_cost_.get(), velocity_loss_.get(), translation);
+    }
   }
 
   void Update(const Correspondences& c, double w) {
@@ -66,6 +75,8 @@ struct CeresScanProblem::Impl {
   TermBlocks<GeometricResidual, GeometricCostFunction> geometric_;
   TermBlocks<RcsResidual, RcsCostFunction> rcs_full_;
   TermBlocks<RcsRotationResidual, RcsRotationCostFunction> rcs_rotation_;
+  std::unique_ptr<ceres::CostFunction> velocity_cost_;  // the velocity term, when set
+  std::unique_ptr<ceres::LossFunction> velocity_loss_;
   ceres::Problem problem_;  // last: destroyed before what it refers to
 };
 

@@ -342,6 +342,14 @@ CombinedSystem BuildCombinedSystem(const Correspondences& c, const SE3d& pose,
     const LinearSystem rcs = BuildRcsSystem(c, pose, options, loss_curvature);
     add(rcs, w / double(rcs.residuals));
   }
+  if (options.velocity && options.velocity->weight > 0.0) {  // linear in t: J = W R_prev^T
+    const VelocityPrior& prior = *options.velocity;
+    const Eigen::Matrix3d J = prior.Jacobian();
+    const Eigen::Vector3d r = prior.Residual(pose.translation());
+    combined.H.block<3, 3>(kTranslationOffset, kTranslationOffset) += prior.weight * J.transpose() * J;
+    combined.g.segment<3>(kTranslationOffset) += prior.weight * J.transpose() * r;
+    combined.cost += prior.weight * r.squaredNorm();
+  }
   return combined;
 }
 

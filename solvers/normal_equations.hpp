@@ -33,7 +33,8 @@ LinearSystem BuildRcsSystem(const Correspondences& correspondences, const SE3d& 
                             const ScanMatchingOptions& options, bool loss_curvature = false);
 
 // Eq. 2's weighted sum: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs, likewise g,
-// the loss curvature and the cost f; a term with weight 0 is not built.
+// the loss curvature and the cost f (with the velocity term when set); a
+// term with weight 0 is not built.
 struct CombinedSystem {
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 6> loss_curvature = Eigen::Matrix<double, 6, 6>::Zero();

@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "radargauss/conventions.hpp"
 #include "radargauss/map/builder.hpp"
 #include "radargauss/names.hpp"
 #include "radargauss/solvers/normal_equations.hpp"
@@ -178,6 +179,9 @@ double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchi
   double f = 0.0;
   if (options.w_rcs < 1.0 && !c.geometric.empty()) f += (1.0 - options.w_rcs) / c.geometric.size() * geometric.Sum();
   if (options.w_rcs > 0.0 && !c.rcs.empty()) f += options.w_rcs / c.rcs.size() * rcs.Sum();
+  if (options.velocity && options.velocity->weight > 0.0) {
+    f += options.velocity->weight * options.velocity->Residual(pose.translation()).squaredNorm();
+  }
   return f;
 }
 
@@ -255,6 +259,11 @@ void FinishResult(const RadarScan& scan, const MatchingMap& map, const SE3d& ini
       last_is_final && c.index == &map.index() && evaluated.known && SamePose(evaluated.pose, result.pose);
   result.final_cost = known ? evaluated.cost : EvaluateCost(final_c, result.pose, options);
   result.information = InformationMatrix(final_c, result.pose, options);
+  if (options.velocity && options.velocity->weight > 0.0) {
+    const Eigen::Matrix3d J = options.velocity->Jacobian();
+    result.velocity_information.block<3, 3>(kTranslationOffset, kTranslationOffset) =
+        options.velocity->weight * J.transpose() * J;
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "radargauss/types.hpp"
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
+#include "radargauss/residuals/velocity_residual.hpp"
 
 namespace radargauss {
 
@@ -52,6 +54,9 @@ struct ScanMatchingOptions {
   // "Association"); 0 re-associates after every step.
   double reassociation_translation = 0.01;  // m
   double reassociation_rotation = 0.002;    // rad
+  // Odometry's Doppler velocity term, added to eq. 2 as weight * |r_v|^2 on
+  // every level (docs/design.md, "The velocity term"); none: eq. 2 alone.
+  std::optional<VelocityPrior> velocity;
   double translation_tolerance = 1e-3;         // m: stop when the update is smaller ...
   double rotation_tolerance = 1e-4;            // rad ... in both parts, on the exact map
   double coarse_translation_tolerance = 1e-2;  // m: the same on coarse levels, which
@@ -77,6 +82,9 @@ struct ScanMatchingResult {
   // was made. Multiply by N_geo (w = 0) for the information of the pose in
   // the Gaussians' units; docs/design.md, "The information matrix".
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+  // The velocity term's Gauss-Newton matrix, weight J^T J on the translation
+  // block (zero without the term), kept apart from eq. 2's.
+  Eigen::Matrix<double, 6, 6> velocity_information = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
 // How the coarse levels of a MatchingMap are made from the map's Gaussians.
