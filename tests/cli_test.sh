@@ -105,6 +105,12 @@ expect_ok "evaluate a trajectory against itself" "ATE translation: RMSE 0.000 m"
   "$tool" evaluate --est "$work/seq10/gt_radar_tum.txt" --ref "$work/seq10/gt_radar_tum.txt" \
   --align first --out "$work/evaluation"
 if [ -s "$work/evaluation/evaluation.json" ]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: evaluation.json"; fi
+"$tool" build-map --sequence "$work/seq10" --gt "$work/seq10/gt_radar_tum.txt" --out "$work/seq10.rgm" >/dev/null
+expect_ok "refine a trajectory and its map" "wrote $work/refined/refined.tum" -- \
+  "$tool" refine --sequence "$work/seq10" --poses "$work/seq10/gt_radar_tum.txt" --gt "$work/seq10/gt_radar_tum.txt" \
+  --map "$work/seq10.rgm" --rounds 1 --iterations 5 --out "$work/refined"
+expect_fail "refine without --poses" "poses" -- \
+  "$tool" refine --sequence "$work/seq10" --map "$work/seq10.rgm" --out "$work/refined2"
 expect_fail "evaluate with a missing reference" "cannot open" -- \
   "$tool" evaluate --est "$work/results/reference.tum" --ref "$work/absent.tum"
 expect_fail "evaluate with an unknown alignment" "align" -- \

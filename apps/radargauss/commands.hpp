@@ -23,6 +23,7 @@ Subcommand AddBuildMap(CLI::App& parent);
 Subcommand AddMapInfo(CLI::App& parent);
 Subcommand AddLocalize(CLI::App& parent);
 Subcommand AddEvaluate(CLI::App& parent);
+Subcommand AddRefine(CLI::App& parent);
 
 // The flags every subcommand that reads a sequence shares.
 void AddSequenceOptions(CLI::App* app, SequenceOptions& options);

@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   CLI::App app{"radargauss: 4D radar Gaussian-RCS maps and scan matching"};
   app.require_subcommand(1);
   const std::vector<Subcommand> subcommands = {AddInfo(app), AddSimulate(app), AddBuildMap(app), AddMapInfo(app),
-                                               AddLocalize(app), AddEvaluate(app)};
+                                               AddLocalize(app), AddEvaluate(app), AddRefine(app)};
   int threads = 0;
   app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
   // info, build-map and localize read a YAML file of their flags with

@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// radargauss refine: joint refinement of a trajectory's poses and a map's SH
+// coefficients (docs/design.md, "Joint refinement"), evaluated against a
+// reference before and after when one is given.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "commands.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/evaluation.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/solvers/joint_refinement.hpp"
+
+namespace radargauss::cli {
+
+namespace {
+
+struct RefineSettings {
+  SequenceOptions sequence;  // ground_truth: the poses to refine
+  std::string map_path;
+  std::string reference;
+  std::string out;
+  JointRefinementOptions refinement;
+};
+
+Trajectory TrajectoryOf(const Sequence& sequence, const std::vector<SE3d>& poses) {
+  Trajectory trajectory;
+  for (std::size_t k = 0; k < poses.size(); ++k) trajectory.Append(sequence.scans[k].timestamp, poses[k]);
+  return trajectory;
+}
+
+void PrintEvaluation(const char* label, const Trajectory& estimate, const std::string& reference,
+                     const std::string& dir) {
+  const Evaluation e = EvaluateTrajectory(estimate, ReadTum(reference));
+  WriteEvaluation(dir, e);
+  std::printf("%s: ATE RMSE %.3f m / %.3f deg, RPE %.3f %% / %.5f deg/m\n", label, e.ate_translation.rmse,
+              e.ate_rotation.rmse, e.rpe_mean.translation, e.rpe_mean.rotation);
+}
+
+int RunRefine(const RefineSettings& s) {
+  if (s.sequence.ground_truth.empty()) throw DataError("refine needs --poses");
+  const Sequence sequence = LoadSequence(s.sequence);
+  const GaussianMap map = ReadMap(s.map_path);
+  const JointRefinementResult result = RefineJointly(sequence.scans, sequence.poses, map, s.refinement);
+  namespace fs = std::filesystem;
+  std::error_code error;
+  fs::create_directories(s.out, error);
+  if (error) throw FileError(s.out, "cannot create the output folder: " + error.message());
+  const Trajectory before = TrajectoryOf(sequence, sequence.poses), after = TrajectoryOf(sequence, result.poses);
+  WriteTum((fs::path(s.out) / "refined.tum").string(), after);
+  WriteMap((fs::path(s.out) / "refined.rgm").string(), result.map);
+  std::printf("refined %zu poses and %zu Gaussians' SH coefficients: cost %.6g -> %.6g in %d Ceres iterations "
+              "(%s), %.1f s\n",
+              result.poses.size(), result.map.gaussians.size(), result.initial_cost, result.final_cost,
+              result.iterations, result.converged ? "converged" : result.reason.c_str(), result.time_ms / 1000.0);
+  if (!s.reference.empty()) {
+    PrintEvaluation("before", before, s.reference, (fs::path(s.out) / "before").string());
+    PrintEvaluation("after", after, s.reference, (fs::path(s.out) / "after").string());
+  }
+  std::printf("wrote %s/refined.tum and refined.rgm\n", s.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Subcommand AddRefine(CLI::App& parent) {
+  auto s = std::make_shared<RefineSettings>();
+  s->refinement.matching.w_rcs = 0.25;
+  s->refinement.relative_pose_prior = 1.0;
+  CLI::App* app = parent.add_subcommand("refine", "Jointly refine a trajectory's poses and a map's SH coefficients");
+  AddSequenceOptions(app, s->sequence);
+  // The sequence's poses are the trajectory to refine; --gt is the reference.
+  app->remove_option(app->get_option("--gt"));
+  app->add_option("--poses", s->sequence.ground_truth, "Trajectory to refine (TUM, radar poses)")->required();
+  app->add_option("--gt", s->reference, "Reference trajectory (TUM) to evaluate against before and after");
+  app->add_option("--map", s->map_path, "Map file (.rgm)")->required();
+  app->add_option("--out", s->out, "Output folder (refined.tum, refined.rgm)")->required();
+  app->add_option("--w-rcs", s->refinement.matching.w_rcs, "Weight w_rcs of eq. 2 (0..1)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app->add_option("--rounds", s->refinement.rounds, "Association rounds")->check(CLI::PositiveNumber)->capture_default_str();
+  app->add_option("--iterations", s->refinement.max_iterations_per_round, "Ceres iterations per round")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--relative-pose-prior", s->refinement.relative_pose_prior,
+                  "Weight of the input's relative poses between consecutive scans (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app->add_option("--coefficient-prior", s->refinement.coefficient_prior,
+                  "Weight of the map's SH coefficients (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  return {app, [s] { return RunRefine(*s); }};
+}
+
+}  // namespace radargauss::cli
