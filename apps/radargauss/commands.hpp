@@ -25,8 +25,10 @@ Subcommand AddLocalize(CLI::App& parent);
 Subcommand AddEvaluate(CLI::App& parent);
 Subcommand AddRefine(CLI::App& parent);
 
-// The flags every subcommand that reads a sequence shares.
-void AddSequenceOptions(CLI::App* app, SequenceOptions& options);
+// The flags every subcommand that reads a sequence shares; the trajectory
+// that gives the scans their poses is `poses_flag` (refine: --poses).
+void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::string& poses_flag = "--gt",
+                        const std::string& poses_help = "Ground-truth trajectory (TUM)");
 
 // The map-building flags of build-map and localize.
 struct MapBuildSettings {

@@ -69,10 +69,9 @@ Subcommand AddRefine(CLI::App& parent) {
   s->refinement.matching.w_rcs = 0.25;
   s->refinement.relative_pose_prior = 1.0;
   CLI::App* app = parent.add_subcommand("refine", "Jointly refine a trajectory's poses and a map's SH coefficients");
-  AddSequenceOptions(app, s->sequence);
   // The sequence's poses are the trajectory to refine; --gt is the reference.
-  app->remove_option(app->get_option("--gt"));
-  app->add_option("--poses", s->sequence.ground_truth, "Trajectory to refine (TUM, radar poses)")->required();
+  AddSequenceOptions(app, s->sequence, "--poses", "Trajectory to refine (TUM, radar poses)");
+  app->get_option("--poses")->required();
   app->add_option("--gt", s->reference, "Reference trajectory (TUM) to evaluate against before and after");
   app->add_option("--map", s->map_path, "Map file (.rgm)")->required();
   app->add_option("--out", s->out, "Output folder (refined.tum, refined.rgm)")->required();

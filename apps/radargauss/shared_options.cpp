@@ -7,10 +7,11 @@
 
 namespace radargauss::cli {
 
-void AddSequenceOptions(CLI::App* app, SequenceOptions& options) {
+void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::string& poses_flag,
+                        const std::string& poses_help) {
   app->add_option("--sequence", options.sequence_dir,
                   "Sequence folder: Snail-Radar layout (ars548/points/*.pcd), *.pcd or *.bin");
-  app->add_option("--gt", options.ground_truth, "Ground-truth trajectory (TUM)");
+  app->add_option(poses_flag, options.ground_truth, poses_help);
   app->add_option("--extrinsic", options.extrinsic,
                   "T_gt_radar: auto, identity, snail-20231213, or a file 'x y z qx qy qz qw'")
       ->capture_default_str();
