@@ -22,6 +22,7 @@
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
 #include "radargauss/residuals/velocity_residual.hpp"
+#include "radargauss/solvers/matching_map.hpp"
 
 namespace radargauss {
 
@@ -85,67 +86,6 @@ struct ScanMatchingResult {
   // The velocity term's Gauss-Newton matrix, weight J^T J on the translation
   // block (zero without the term), kept apart from eq. 2's.
   Eigen::Matrix<double, 6, 6> velocity_information = Eigen::Matrix<double, 6, 6>::Zero();
-};
-
-// How the coarse levels of a MatchingMap are made from the map's Gaussians.
-// kMerged is the default: from the paper's errors it was faster and at least
-// as precise on every data set measured (bench/RESULTS.md, "Coarse levels").
-enum class CoarseLevels {
-  kInflated,  // every Gaussian, covariance Sigma + sigma_k^2 I
-  kMerged,    // per voxel of side kMergeCellPerSigma * sigma_k, the moment-matched
-              // mixture of the Gaussians whose means fall in it, + sigma_k^2 I:
-              // far fewer candidates per query
-};
-inline constexpr double kMergeCellPerSigma = 3.0;
-// The index cell of a coarse level before MatchingMapOptions::index_cell's
-// floor: sigma_k for inflated levels (every Gaussian, blurred); half the merge
-// cell for merged ones, whose Gaussians are one per merge cell, so that a
-// query still has few candidates and the index is half the size.
-inline double CoarseIndexCell(CoarseLevels coarse, double sigma) {
-  return coarse == CoarseLevels::kMerged ? 0.5 * kMergeCellPerSigma * sigma : sigma;
-}
-std::string ToString(CoarseLevels coarse);
-CoarseLevels CoarseLevelsFromString(const std::string& name);  // throws std::invalid_argument
-std::vector<std::string> CoarseLevelsNames();
-
-// The map as the solvers use it: the Gaussians and coarse-to-fine indexes,
-// level k blurred by sigma_k (coarse first), the exact map last
-// (docs/design.md, "Coarse to fine").
-struct MatchingMapOptions {
-  std::vector<double> inflation = {1.0, 0.5, 0.25};  // sigma_k of the coarse levels (m), coarse first
-  double index_cell = 0.5;  // m: cell of the exact level's index (coarse: max(cell, CoarseIndexCell))
-  CoarseLevels coarse = CoarseLevels::kMerged;
-  // tau on the coarse levels (Mahalanobis distance to the blurred Gaussians;
-  // the exact map uses ScanMatchingOptions::gate). Their indexes cover
-  // +/- coarse_gate std, so a smaller gate means fewer candidates per query:
-  // faster coarse levels, less reach for large initial errors.
-  double coarse_gate = 3.0;
-};
-// The exact map alone: one level, no coarse-to-fine.
-inline MatchingMapOptions ExactMapOnly() {
-  MatchingMapOptions options;
-  options.inflation.clear();
-  return options;
-}
-
-// A MatchingMap shares its GaussianMap: it takes one by value (move it in;
-// a temporary such as ReadMap(path) is kept alive) or a shared pointer.
-class MatchingMap {
- public:
-  explicit MatchingMap(GaussianMap map, const MatchingMapOptions& options = {});
-  explicit MatchingMap(std::shared_ptr<const GaussianMap> map, const MatchingMapOptions& options = {});
-  const GaussianMap& map() const { return *map_; }
-  std::size_t levels() const { return levels_.size(); }
-  const GaussianIndex& level(std::size_t k) const { return levels_[k]; }
-  const GaussianIndex& index() const { return levels_.back(); }  // the exact map
-  double sigma(std::size_t k) const { return k < sigmas_.size() ? sigmas_[k] : 0.0; }  // level k's blur (m)
-  double coarse_gate() const { return coarse_gate_; }
-
- private:
-  std::shared_ptr<const GaussianMap> map_;
-  std::vector<GaussianIndex> levels_;
-  std::vector<double> sigmas_;  // of the coarse levels
-  double coarse_gate_ = 3.0;
 };
 
 struct GeometricTerm {

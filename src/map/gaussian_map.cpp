@@ -115,38 +115,44 @@ std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
   return PackKey(v.x, v.y, v.z);
 }
 
+void GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys) {
+  IndexedGaussian& entry = gaussians_[id];
+  entry.mean = g.mean;
+  const Eigen::Matrix3d information = g.covariance.inverse();
+  entry.sqrt_information_t = Eigen::LLT<Eigen::Matrix3d>(information).matrixL().transpose();
+  const Eigen::Vector3d half = extent_sigmas_ * g.covariance.diagonal().cwiseSqrt();
+  // The cells as Key finds them (VoxelOf of the box's corners).
+  const VoxelKey lo = VoxelOf(g.mean - half, cell_size_);
+  const VoxelKey hi = VoxelOf(g.mean + half, cell_size_);
+  // Of the box's cells, those the ellipsoid itself meets: an oblique or
+  // round Gaussian leaves many of its box's cells empty (fewer candidates
+  // per query, the same answers).
+  for (auto x = lo.x; x <= hi.x; ++x) {
+    for (auto y = lo.y; y <= hi.y; ++y) {
+      for (auto z = lo.z; z <= hi.z; ++z) {
+        const Eigen::Vector3d corner = Eigen::Vector3d(double(x), double(y), double(z)) * cell_size_;
+        if (CellMeetsEllipsoid(corner, corner.array() + cell_size_, g.mean, g.covariance, information,
+                               extent_sigmas_)) {
+          cell_keys.push_back(PackKey(x, y, z));
+        }
+      }
+    }
+  }
+}
+
 GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size,
                              double extent_sigmas)
-    : cell_size_(cell_size) {
+    : cell_size_(cell_size), extent_sigmas_(extent_sigmas) {
   if (!(cell_size > 0.0)) throw std::invalid_argument("index cell size must be > 0");
   if (!(extent_sigmas > 0.0)) throw std::invalid_argument("index extent must be > 0 standard deviations");
   const std::size_t n = gaussians.size();
   gaussians_.resize(n);
   std::vector<std::pair<std::int64_t, std::uint32_t>> entries;
+  std::vector<std::int64_t> cell_keys;
   for (std::size_t i = 0; i < n; ++i) {
-    const Gaussian& g = gaussians[i];
-    IndexedGaussian& entry = gaussians_[i];
-    entry.mean = g.mean;
-    const Eigen::Matrix3d information = g.covariance.inverse();
-    entry.sqrt_information_t = Eigen::LLT<Eigen::Matrix3d>(information).matrixL().transpose();
-    const Eigen::Vector3d half = extent_sigmas * g.covariance.diagonal().cwiseSqrt();
-    // The cells as Key finds them (VoxelOf of the box's corners).
-    const VoxelKey lo = VoxelOf(g.mean - half, cell_size);
-    const VoxelKey hi = VoxelOf(g.mean + half, cell_size);
-    // Of the box's cells, those the ellipsoid itself meets: an oblique or
-    // round Gaussian leaves many of its box's cells empty (fewer candidates
-    // per query, the same answers).
-    for (auto x = lo.x; x <= hi.x; ++x) {
-      for (auto y = lo.y; y <= hi.y; ++y) {
-        for (auto z = lo.z; z <= hi.z; ++z) {
-          const Eigen::Vector3d corner = Eigen::Vector3d(double(x), double(y), double(z)) * cell_size;
-          if (CellMeetsEllipsoid(corner, corner.array() + cell_size, g.mean, g.covariance, information,
-                                 extent_sigmas)) {
-            entries.emplace_back(PackKey(x, y, z), static_cast<std::uint32_t>(i));
-          }
-        }
-      }
-    }
+    cell_keys.clear();
+    Index(gaussians[i], std::uint32_t(i), cell_keys);
+    for (const std::int64_t key : cell_keys) entries.emplace_back(key, static_cast<std::uint32_t>(i));
   }
   std::sort(entries.begin(), entries.end());
   cell_entries_.resize(entries.size());
@@ -250,9 +256,11 @@ void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t coun
 }
 
 std::size_t GaussianIndex::MemoryBytes() const {
+  std::size_t listed = listed_cells_.size() * sizeof(std::vector<std::int64_t>);
+  for (const std::vector<std::int64_t>& keys : listed_cells_) listed += keys.capacity() * sizeof(std::int64_t);
   return gaussians_.size() * sizeof(IndexedGaussian) +
          cell_entries_.size() * sizeof(std::uint32_t) +
-         cells_.size() * sizeof(Cell);
+         cells_.size() * sizeof(Cell) + listed;
 }
 
 }  // namespace radargauss

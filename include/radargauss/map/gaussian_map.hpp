@@ -97,6 +97,18 @@ class GaussianIndex {
   GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size = 1.0,
                 double extent_sigmas = 3.0);
 
+  // An empty index that Update can change (docs/design.md, "Odometry"): it
+  // also keeps the cells each Gaussian is listed in.
+  static GaussianIndex Updatable(double cell_size = 1.0, double extent_sigmas = 3.0);
+  // Lists gaussians[id] anew for every id of `changed` (ids may grow the
+  // index) and takes every id of `removed` out of all cells: then the index
+  // answers as one built from the listed Gaussians would. Only the cells of
+  // those Gaussians are touched; the cell lists are compacted when stale
+  // entries outnumber live ones. Throws std::logic_error on a static index.
+  void Update(const std::vector<Gaussian>& gaussians, const std::vector<std::uint32_t>& changed,
+              const std::vector<std::uint32_t>& removed);
+  bool updatable() const { return updatable_; }
+
   // Index of the associated Gaussian, or -1 if no candidate has
   // Mahalanobis^2 <= gate_sq (or the point is not finite). Writes the
   // Mahalanobis^2 when asked.
@@ -141,8 +153,19 @@ class GaussianIndex {
 
  private:
   std::int64_t Key(const Eigen::Vector3d& p) const;
+  // The entry of `g` (mean, L^T) and the keys of the cells its ellipsoid of
+  // extent_sigmas_ meets, in key order of the box's cells.
+  void Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys);
+  // Rebuilds the cell lists without stale entries or empty cells, with room
+  // for `extra_cells` more.
+  void Compact(std::size_t extra_cells);
 
   double cell_size_ = 1.0;
+  double extent_sigmas_ = 3.0;
+  bool updatable_ = false;
+  std::vector<std::vector<std::int64_t>> listed_cells_;  // updatable: the cells of each Gaussian
+  std::size_t cell_count_ = 0;     // occupied slots of cells_ (updatable)
+  std::size_t stale_entries_ = 0;  // entries of cell_entries_ no cell points to (updatable)
   // What a query reads per candidate, side by side in one entry; aligned so
   // that the mean and L^T a query scores fill two cache lines.
   struct alignas(64) IndexedGaussian {

@@ -1,0 +1,103 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The updatable spatial index of odometry's local map (docs/design.md,
+// "Odometry"): the cells a change touches get new lists appended to the
+// entries, and the entries are compacted once stale ones outnumber the live.
+#include <algorithm>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "radargauss/map/gaussian_map.hpp"
+
+namespace radargauss {
+
+GaussianIndex GaussianIndex::Updatable(double cell_size, double extent_sigmas) {
+  GaussianIndex index(std::vector<Gaussian>(), cell_size, extent_sigmas);
+  index.updatable_ = true;
+  return index;
+}
+
+void GaussianIndex::Compact(std::size_t extra_cells) {
+  std::vector<Cell> live;
+  if (!cells_.empty()) {
+    for (std::size_t slot = 0; slot < cells_.size(); ++slot) {
+      const Cell& cell = cells_[slot];
+      if (cell.key != kEmptyCell && cell.end > cell.begin) live.push_back(cell);
+    }
+  }
+  std::sort(live.begin(), live.end(), [](const Cell& a, const Cell& b) { return a.key < b.key; });
+  std::vector<std::uint32_t> entries;
+  std::size_t live_entries = 0;
+  for (const Cell& cell : live) live_entries += cell.end - cell.begin;
+  entries.reserve(2 * live_entries + 64);
+  // Room for twice the cells there will be: the table stays at most half full
+  // until the next compaction.
+  cells_.Reset(2 * (live.size() + extra_cells) + 8, Cell());
+  for (const Cell& cell : live) {
+    Cell& moved = cells_[Slot(cell.key)];
+    moved.key = cell.key;
+    moved.begin = std::uint32_t(entries.size());
+    entries.insert(entries.end(), cell_entries_.begin() + cell.begin, cell_entries_.begin() + cell.end);
+    moved.end = std::uint32_t(entries.size());
+  }
+  cell_entries_ = std::move(entries);
+  cell_count_ = live.size();
+  stale_entries_ = 0;
+}
+
+void GaussianIndex::Update(const std::vector<Gaussian>& gaussians, const std::vector<std::uint32_t>& changed,
+                           const std::vector<std::uint32_t>& removed) {
+  if (!updatable_) throw std::logic_error("GaussianIndex::Update needs an index made by GaussianIndex::Updatable");
+  std::uint32_t top = std::uint32_t(gaussians_.size());
+  for (const std::uint32_t id : changed) {
+    if (id >= gaussians.size()) throw std::out_of_range("GaussianIndex::Update: changed id beyond the Gaussians");
+    top = std::max(top, id + 1);
+  }
+  gaussians_.resize(top);
+  listed_cells_.resize(top);
+  // The ids leaving their cells, and the cells each changed Gaussian joins.
+  std::vector<char> leaving(top, 0);
+  std::vector<std::int64_t> dirty;
+  const auto leave = [&](std::uint32_t id) {
+    if (id >= top || leaving[id]) return;
+    leaving[id] = 1;
+    dirty.insert(dirty.end(), listed_cells_[id].begin(), listed_cells_[id].end());
+    listed_cells_[id] = {};  // frees its memory: a removed Gaussian may not come back
+  };
+  for (const std::uint32_t id : removed) leave(id);
+  for (const std::uint32_t id : changed) leave(id);
+  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> joining;
+  for (const std::uint32_t id : changed) {
+    if (!listed_cells_[id].empty()) continue;  // listed twice in `changed`
+    Index(gaussians[id], id, listed_cells_[id]);
+    for (const std::int64_t key : listed_cells_[id]) joining[key].push_back(id);
+    dirty.insert(dirty.end(), listed_cells_[id].begin(), listed_cells_[id].end());
+  }
+  std::sort(dirty.begin(), dirty.end());
+  dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
+  if (cells_.empty() || 2 * (cell_count_ + dirty.size()) > cells_.size()) Compact(dirty.size());
+  // Each touched cell's list: its entries that stay, then those that join,
+  // sorted by id as the static index lists them (ties go to the smallest id).
+  std::vector<std::uint32_t> list;
+  for (const std::int64_t key : dirty) {
+    Cell& cell = cells_[Slot(key)];
+    list.clear();
+    if (cell.key == key) {
+      for (std::uint32_t e = cell.begin; e < cell.end; ++e) {
+        if (cell_entries_[e] >= top || !leaving[cell_entries_[e]]) list.push_back(cell_entries_[e]);
+      }
+      stale_entries_ += cell.end - cell.begin;
+    } else {
+      cell.key = key;
+      ++cell_count_;
+    }
+    const auto joined = joining.find(key);
+    if (joined != joining.end()) list.insert(list.end(), joined->second.begin(), joined->second.end());
+    std::sort(list.begin(), list.end());
+    cell.begin = std::uint32_t(cell_entries_.size());
+    cell_entries_.insert(cell_entries_.end(), list.begin(), list.end());
+    cell.end = std::uint32_t(cell_entries_.size());
+  }
+  if (stale_entries_ > cell_entries_.size() - stale_entries_ + 1024) Compact(0);
+}
+
+}  // namespace radargauss
