@@ -8,6 +8,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include "radargauss/map/gaussian_map.hpp"
+
 namespace radargauss {
 
 int RansacIterations(double outlier_probability, double success_probability) {
@@ -38,20 +40,69 @@ bool SolveLeastSquares(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
   return v.allFinite();
 }
 
-// RANSAC over 3-point draws of the rows of H v = y: the largest consensus
-// set (row indices) over `iterations` draws.
+// For each row, an index of the voxel of side `voxel` its point lies in
+// (distinct voxels, distinct indices), to count the voxels a consensus covers.
+std::vector<int> VoxelIds(const std::vector<Eigen::Vector3d>& positions, double voxel, int& count) {
+  std::vector<std::pair<VoxelKey, int>> keyed;
+  for (std::size_t k = 0; k < positions.size(); ++k) keyed.emplace_back(VoxelOf(positions[k], voxel), int(k));
+  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<int> ids(positions.size());
+  count = 0;
+  for (std::size_t k = 0; k < keyed.size(); ++k) {
+    if (k > 0 && !(keyed[k].first == keyed[k - 1].first)) ++count;
+    ids[keyed[k].second] = count;
+  }
+  ++count;
+  return ids;
+}
+
+// RANSAC over 3-point draws of the rows of H v = y: the consensus set (row
+// indices) of largest support over `iterations` draws. Support is the
+// number of rows, or with options.consensus_voxel > 0 the number of voxels
+// they occupy (`voxel_ids`), then the number of rows.
 std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
                                   const EgoVelocityOptions& options, int iterations,
-                                  const std::optional<VelocityGate>& gate) {
+                                  const std::optional<VelocityGate>& gate, const std::vector<int>& voxel_ids,
+                                  int voxel_count) {
   const int n = static_cast<int>(y.size());
+  std::vector<int> seen(static_cast<std::size_t>(voxel_count), -1);
+  const auto voxels_of = [&](const std::vector<int>& rows, int stamp) {
+    int covered = 0;
+    for (const int k : rows) {
+      if (seen[voxel_ids[k]] != stamp) {
+        seen[voxel_ids[k]] = stamp;
+        ++covered;
+      }
+    }
+    return covered;
+  };
+  int best_voxels = 0;
   std::mt19937 rng(options.seed);
   std::uniform_int_distribution<int> pick(0, n - 1);
+  // With voxels, a draw takes three distinct voxels, then a row of each:
+  // the world's many sparse voxels are drawn as often as a car's few dense ones.
+  std::vector<std::vector<int>> rows_of(static_cast<std::size_t>(voxel_count));
+  for (int k = 0; k < n && !voxel_ids.empty(); ++k) rows_of[voxel_ids[k]].push_back(k);
+  const bool by_voxel = voxel_count >= 3;
+  std::uniform_int_distribution<int> pick_voxel(0, std::max(0, voxel_count - 1));
+  const auto row_in = [&](int voxel) {
+    const std::vector<int>& rows = rows_of[voxel];
+    return rows[std::uniform_int_distribution<std::size_t>(0, rows.size() - 1)(rng)];
+  };
   std::vector<int> best;
   std::vector<int> consensus;
   for (int iteration = 0; iteration < iterations; ++iteration) {
-    int a = pick(rng), b = pick(rng), c = pick(rng);
-    while (b == a) b = pick(rng);
-    while (c == a || c == b) c = pick(rng);
+    int a, b, c;
+    if (by_voxel) {
+      int va = pick_voxel(rng), vb = pick_voxel(rng), vc = pick_voxel(rng);
+      while (vb == va) vb = pick_voxel(rng);
+      while (vc == va || vc == vb) vc = pick_voxel(rng);
+      a = row_in(va), b = row_in(vb), c = row_in(vc);
+    } else {
+      a = pick(rng), b = pick(rng), c = pick(rng);
+      while (b == a) b = pick(rng);
+      while (c == a || c == b) c = pick(rng);
+    }
     Eigen::Matrix3d h;
     h << H.row(a), H.row(b), H.row(c);
     const Eigen::FullPivLU<Eigen::Matrix3d> lu(h);
@@ -62,7 +113,15 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     for (int k = 0; k < n; ++k) {
       if (std::abs(y[k] - H.row(k).dot(v)) < options.inlier_threshold) consensus.push_back(k);
     }
-    if (consensus.size() > best.size()) best.swap(consensus);
+    if (voxel_ids.empty()) {
+      if (consensus.size() > best.size()) best.swap(consensus);
+      continue;
+    }
+    const int covered = voxels_of(consensus, iteration);
+    if (covered > best_voxels || (covered == best_voxels && consensus.size() > best.size())) {
+      best_voxels = covered;
+      best.swap(consensus);
+    }
   }
   return best;
 }
@@ -118,7 +177,15 @@ EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOp
   // RANSAC over 3-point draws, keeping the largest consensus set.
   result.ransac_iterations = RansacIterations(options.outlier_probability,
                                               options.success_probability);
-  const std::vector<int> best = LargestConsensus(H, y, options, result.ransac_iterations, gate);
+  std::vector<int> voxel_ids;
+  int voxel_count = 0;
+  if (options.consensus_voxel > 0.0) {
+    std::vector<Eigen::Vector3d> positions(n);
+    for (int k = 0; k < n; ++k) positions[k] = scan.points[gated[k]].position;
+    voxel_ids = VoxelIds(positions, options.consensus_voxel, voxel_count);
+  }
+  const std::vector<int> best =
+      LargestConsensus(H, y, options, result.ransac_iterations, gate, voxel_ids, voxel_count);
   if (best.size() < 3) {
     result.reason = gate ? "RANSAC found no consensus of 3 or more points within the prediction gate"
                          : "RANSAC found no consensus of 3 or more points";

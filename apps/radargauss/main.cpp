@@ -18,7 +18,7 @@ namespace {
 std::string ConfigSection(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string word = argv[i];
-    if (word == "info" || word == "build-map" || word == "localize" || word == "map-info") return word;
+    if (word == "info" || word == "build-map" || word == "localize" || word == "map-info" || word == "odometry") return word;
   }
   return {};
 }
@@ -30,18 +30,19 @@ int main(int argc, char** argv) {
   CLI::App app{"radargauss: 4D radar Gaussian-RCS maps and scan matching"};
   app.require_subcommand(1);
   const std::vector<Subcommand> subcommands = {AddInfo(app), AddSimulate(app), AddBuildMap(app), AddMapInfo(app),
-                                               AddLocalize(app), AddEvaluate(app), AddRefine(app)};
+                                               AddLocalize(app), AddEvaluate(app), AddRefine(app),
+                                               AddOdometry(app)};
   int threads = 0;
   app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
   // info, build-map and localize read a YAML file of their flags with
   // --config (simulate's --config is the world's parameters); flags given on
   // the command line override the file.
-  app.set_config("--config", "", "YAML file of the subcommand's flags (info, build-map, localize)");
+  app.set_config("--config", "", "YAML file of the subcommand's flags (info, build-map, localize, odometry)");
   app.config_formatter(std::make_shared<radargauss::YamlConfig>(ConfigSection(argc, argv)));
   app.allow_config_extras(CLI::config_extras_mode::error);
   for (const Subcommand& command : subcommands) {
     const std::string name = command.app->get_name();
-    if (name == "info" || name == "build-map" || name == "localize") command.app->fallthrough();
+    if (name == "info" || name == "build-map" || name == "localize" || name == "odometry") command.app->fallthrough();
   }
   try {
     app.parse(argc, argv);

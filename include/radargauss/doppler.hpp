@@ -26,6 +26,11 @@ struct EgoVelocityOptions {
   double zero_velocity_threshold = 0.05; // m/s, 75th percentile of |v_d| below it: standing
   double zero_velocity_sigma = 0.025;    // m/s, std reported when standing
   std::uint32_t seed = 1;                // RANSAC draws are deterministic for a seed
+  // > 0 (m): draws take points of three distinct voxels of this edge and a
+  // hypothesis's support is the number of voxels its inliers occupy, so that
+  // a large close object (a car ahead) cannot outvote the wider static
+  // world; 0: points drawn uniformly, support = the number of inliers.
+  double consensus_voxel = 0.0;
 };
 
 struct EgoVelocityResult {

@@ -4,6 +4,7 @@
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/PointCloud2.h>
 
 #include <map>
@@ -79,6 +80,35 @@ std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::stri
   }
   if (!topic_seen) throw FileError(bag_path, "no messages on topic '" + topic + "'");
   return scans;
+}
+
+std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic) {
+  rosbag::Bag bag;
+  OpenBag(bag, bag_path);
+  std::vector<ImuSample> samples;
+  std::size_t index = 0;
+  try {
+    rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{topic}));
+    for (const rosbag::MessageInstance& message : view) {
+      const sensor_msgs::Imu::ConstPtr msg = message.instantiate<sensor_msgs::Imu>();
+      const std::string source = bag_path + ":" + topic + "#" + std::to_string(index++);
+      if (!msg) throw FileError(source, "message is " + message.getDataType() + ", not sensor_msgs/Imu");
+      ImuSample sample;
+      sample.stamp = msg->header.stamp.isZero() ? message.getTime().toSec() : msg->header.stamp.toSec();
+      sample.angular_velocity = {msg->angular_velocity.x, msg->angular_velocity.y, msg->angular_velocity.z};
+      if (!sample.angular_velocity.allFinite()) throw FileError(source, "angular velocity is not finite");
+      if (!samples.empty() && !(sample.stamp > samples.back().stamp)) {
+        throw FileError(source, "stamp " + std::to_string(sample.stamp) + " s is not after the previous message's");
+      }
+      samples.push_back(sample);
+    }
+  } catch (const DataError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw FileError(bag_path, std::string("corrupt ROS1 bag: ") + e.what());
+  }
+  if (samples.empty()) throw FileError(bag_path, "no messages on topic '" + topic + "'");
+  return samples;
 }
 
 }  // namespace radargauss

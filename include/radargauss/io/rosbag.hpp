@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "radargauss/io/field_mapping.hpp"
 #include "radargauss/types.hpp"
 
@@ -53,5 +55,15 @@ RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp,
 // ti_mmwave driver leaves it zero).
 std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
                                     const FieldMapping& mapping = {});
+
+// The angular velocity of a sensor_msgs/Imu message (rad/s, the IMU's frame).
+struct ImuSample {
+  double stamp = 0.0;  // s: header stamp, or the record time when zero
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+};
+// Every sensor_msgs/Imu message of `topic`, in bag order; throws DataError
+// for a missing topic, another message type, non-finite rates or stamps
+// that do not increase.
+std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic);
 
 }  // namespace radargauss

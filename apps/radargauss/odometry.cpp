@@ -1,0 +1,180 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// radargauss odometry: radar odometry on a map the run builds itself
+// (docs/design.md, "Odometry"), evaluated against a reference when one is given.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "commands.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/evaluation.hpp"
+#include "radargauss/io/rosbag.hpp"
+#include "radargauss/names.hpp"
+#include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/progress.hpp"
+
+namespace radargauss::cli {
+
+namespace {
+
+struct OdometrySettings {
+  SequenceOptions sequence;  // ground_truth: the reference, for evaluation only
+  OdometryOptions odometry;
+  std::string out;
+  std::string solver = "gn";
+  std::string loss = "trivial";
+  std::string incidence = "offset";
+  std::string coarse_levels = ToString(MatchingMapOptions().coarse);
+  std::string imu_topic;
+  std::vector<double> imu_rotation = {0, 0, 0, 1};  // q_radar_imu (x y z w)
+  std::size_t max_scans = 0;
+};
+
+OdometryOptions Resolved(const OdometrySettings& s) {
+  OdometryOptions o = s.odometry;
+  o.match.solver = SolverKindFromString(s.solver);
+  o.match.matching.geometric_loss.type = LossTypeFromString(s.loss);
+  o.map.rcs.incidence = IncidenceModelFromString(s.incidence);
+  o.map.matching.coarse = CoarseLevelsFromString(s.coarse_levels);
+  return o;
+}
+
+// The bag's gyro rates turned into the radar frame by q_radar_imu.
+std::vector<GyroSample> GyroOf(const OdometrySettings& s) {
+  if (s.sequence.bag.empty()) throw DataError("--imu-topic needs --bag");
+  const Eigen::Quaterniond q(s.imu_rotation[3], s.imu_rotation[0], s.imu_rotation[1], s.imu_rotation[2]);
+  if (!(std::abs(q.norm() - 1.0) < 1e-3)) throw DataError("--imu-rotation must be a unit quaternion (x y z w)");
+  const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
+  std::vector<GyroSample> samples;
+  for (const ImuSample& imu : ReadBagImu(s.sequence.bag, s.imu_topic)) samples.push_back({imu.stamp, R * imu.angular_velocity});
+  return samples;
+}
+
+void PrintSummary(const OdometrySummary& summary) {
+  std::printf("odometry: %zu scans (%zu matched, %zu keyframes, %zu with predicted velocity, %zu standing, %zu "
+              "with predicted pose), path %.1f m; %.2f ms per scan (median, p90 %.2f); %zu Gaussians active, %zu "
+              "in the map\n",
+              summary.scans, summary.matched, summary.keyframes, summary.velocity_predicted, summary.standstill,
+              summary.pose_predicted, summary.path_length, summary.median_ms, summary.p90_ms,
+              summary.active_gaussians, summary.global_gaussians);
+}
+
+int RunOdometry(const OdometrySettings& s) {
+  const OdometryOptions options = Resolved(s);
+  ValidateOptions(options);
+  SequenceOptions sequence_options = s.sequence;
+  sequence_options.ground_truth.clear();  // every scan, not only those the reference covers
+  Sequence sequence = LoadSequence(sequence_options);
+  if (s.max_scans > 0 && sequence.scans.size() > s.max_scans) sequence.scans.resize(s.max_scans);
+  if (sequence.scans.empty()) throw DataError("the sequence has no scans");
+  if (options.match.matching.w_rcs > 0.0 && !sequence.scans.front().has_rcs) {
+    throw DataError("--w-rcs " + std::to_string(options.match.matching.w_rcs) +
+                    " needs RCS, and the sequence has no RCS field (use --w-rcs 0)");
+  }
+  RadarOdometry odometry(options);
+  if (!s.imu_topic.empty()) odometry.AddGyro(GyroOf(s));
+  ProgressBar bar;
+  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
+    try {
+      odometry.Register(sequence.scans[k]);
+    } catch (const DataError& e) {
+      throw DataError(sequence.scan_sources[k] + ": " + e.what());
+    }
+    if (k % 16 == 0) bar.Update("odometry", k, sequence.scans.size());
+  }
+  bar.Update("odometry", sequence.scans.size(), sequence.scans.size());
+  bar.Finish();
+  WriteOdometry(s.out, odometry);
+  PrintSummary(Summarise(odometry));
+  if (!s.sequence.ground_truth.empty()) {
+    const Trajectory reference =
+        ReadTum(s.sequence.ground_truth).RightMultiplied(ResolveExtrinsic(s.sequence.extrinsic, s.sequence.ground_truth));
+    const Evaluation e = EvaluateTrajectory(odometry.trajectory(), reference);
+    std::printf("%s", WriteEvaluation(s.out, e).c_str());
+  }
+  std::printf("wrote %s (odometry.tum, per_scan.csv, summary.json, map.rgm, map.ply%s)\n", s.out.c_str(),
+              s.sequence.ground_truth.empty() ? "" : ", evaluation.json, evaluation.md");
+  return 0;
+}
+
+void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
+  OdometryOptions& o = s.odometry;
+  const auto finite = CLI::Validator(
+      [](std::string& text) { return std::isfinite(std::stod(text)) ? std::string() : "must be finite"; }, "FINITE");
+  app->add_option("--solver", s.solver, "Scan matcher: gn (own Gauss-Newton), gn-autodiff, ceres, ceres-dogleg, mh-gn")
+      ->check(CLI::IsMember(ScanMatcherNames()))
+      ->capture_default_str();
+  app->add_option("--w-rcs", o.match.matching.w_rcs, "Weight w_rcs of eq. 2 (0..1)")
+      ->check(CLI::Range(0.0, 1.0) & finite)
+      ->capture_default_str();
+  app->add_option("--loss", s.loss, "Geometric robust loss")->check(CLI::IsMember(LossNames()))->capture_default_str();
+  app->add_option("--loss-scale", o.match.matching.geometric_loss.scale, "Scale of the geometric loss")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--incidence", s.incidence, "Incidence vector of the RCS models: offset or view")
+      ->check(CLI::IsMember(IncidenceModelNames()))
+      ->capture_default_str();
+  app->add_option("--degree", o.map.rcs.max_degree, "SH degree of the RCS models (0..3)")
+      ->check(CLI::Range(0, kMaxShDegree))
+      ->capture_default_str();
+  app->add_option("--velocity-weight", o.velocity_weight, "Weight of the Doppler velocity term (0: off)")
+      ->check(CLI::NonNegativeNumber & finite)
+      ->capture_default_str();
+  app->add_option("--velocity-floor", o.velocity_floor, "Std of the velocity term's floor Q (m)")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--gate-sigmas", o.gate_sigmas, "Doppler gate around the predicted velocity (sigmas)")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--acceleration-std", o.acceleration_std, "Process noise of the velocity (m/s^2)")
+      ->check(CLI::NonNegativeNumber & finite)
+      ->capture_default_str();
+  app->add_option("--min-gate", o.min_gate, "Smallest Doppler gate (m/s)")->check(CLI::PositiveNumber & finite)->capture_default_str();
+  app->add_option("--keyframe-distance", o.keyframe_distance, "A scan enters the map after this distance (m) ...")
+      ->check(CLI::NonNegativeNumber & finite)
+      ->capture_default_str();
+  app->add_option("--keyframe-angle", o.keyframe_angle_deg, "... or this rotation (deg) since the last keyframe")
+      ->check(CLI::NonNegativeNumber & finite)
+      ->capture_default_str();
+  app->add_option("--active-radius", o.map.active_radius, "Radius of the active map around the radar (m)")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--region", o.map.region, "Edge of the map regions fitted together (m)")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--region-capacity", o.map.region_capacity, "Points a region keeps (the newest)")
+      ->check(CLI::Range(4, 1000000))
+      ->capture_default_str();
+  app->add_option("--refit-growth", o.map.refit_growth, "Refit a region once its new points reach this share")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--points-per-gaussian", o.map.gaussians.points_per_gaussian, "K = round(N_downsampled / this)")
+      ->check(CLI::Range(1.0, 1e6))
+      ->capture_default_str();
+  app->add_option("--min-std", o.map.gaussians.min_std, "Minimum principal std of a Gaussian (m)")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--coarse-levels", s.coarse_levels, "Coarse levels: merged or inflated")
+      ->check(CLI::IsMember(CoarseLevelsNames()))
+      ->capture_default_str();
+  app->add_option("--seed", o.ego_velocity.seed, "Seed of the Doppler RANSAC")->capture_default_str();
+  app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
+  app->add_option("--imu-rotation", s.imu_rotation, "q_radar_imu as x y z w (rotates gyro rates into the radar frame)")
+      ->expected(4)
+      ->capture_default_str();
+  app->add_option("--max-scans", s.max_scans, "Only the first N scans (0: all)")->capture_default_str();
+}
+
+}  // namespace
+
+Subcommand AddOdometry(CLI::App& parent) {
+  auto s = std::make_shared<OdometrySettings>();
+  CLI::App* app = parent.add_subcommand("odometry", "Radar odometry on a Gaussian-RCS map built on the way");
+  AddSequenceOptions(app, s->sequence, "--gt", "Reference trajectory (TUM), for the evaluation only");
+  app->add_option("--out", s->out, "Output folder")->required();
+  AddOdometryOptions(app, *s);
+  return {app, [s] { return RunOdometry(*s); }};
+}
+
+}  // namespace radargauss::cli

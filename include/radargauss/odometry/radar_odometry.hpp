@@ -1,0 +1,149 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Radar odometry on a Gaussian-RCS map it builds itself (docs/design.md,
+// "Odometry"). Per scan, in time order: the Doppler ego velocity gated by
+// the motion model's prediction; a predicted pose (translation from that
+// velocity, rotation at the last increment's rate, or from gyro rates);
+// scan-to-map matching of the static points with eq. 2 plus the Doppler
+// velocity term; the static points into the local map on keyframes.
+//
+//   RadarOdometry odometry(options);
+//   for (const RadarScan& scan : sequence.scans) odometry.Register(scan);
+//   WriteTum(path, odometry.trajectory());
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "radargauss/doppler.hpp"
+#include "radargauss/lie/se3.hpp"
+#include "radargauss/odometry/local_map.hpp"
+#include "radargauss/solvers/factory.hpp"
+#include "radargauss/trajectory.hpp"
+#include "radargauss/types.hpp"
+
+namespace radargauss {
+
+// Odometry's Doppler RANSAC-LSQ: support counted in 1 m voxels, so that the
+// car ahead does not pass for the world before any prediction can gate it.
+inline EgoVelocityOptions OdometryEgoVelocityOptions() {
+  EgoVelocityOptions options;
+  options.consensus_voxel = 1.0;
+  return options;
+}
+
+struct OdometryOptions {
+  EgoVelocityOptions ego_velocity = OdometryEgoVelocityOptions();
+  // The gate on Doppler hypotheses around the predicted velocity:
+  // gate_sigmas * sqrt(lambda_max(S) + (acceleration_std * dt)^2), at least
+  // min_gate; dt counts from the last scan whose velocity was measured.
+  double gate_sigmas = 3.0;
+  double acceleration_std = 3.0;  // m/s^2: process noise of the velocity
+  double min_gate = 0.5;          // m/s
+  std::size_t min_static_points = 10;  // fewer Doppler inliers: the prediction stands in
+  double velocity_weight = 1.0;        // of the velocity term in eq. 2 (0: off)
+  double velocity_floor = 0.05;        // m: std of the floor Q = floor^2 I of the term
+  MatchOptions match;                  // solver and eq. 2 (w_rcs, losses, incidence via map.rcs)
+  LocalMapOptions map;
+  double keyframe_distance = 0.5;      // m since the last keyframe ...
+  double keyframe_angle_deg = 2.0;     // ... or deg: the scan enters the map
+  std::size_t min_matched_points = 10; // fewer associated points: the prediction stands in
+  SE3d initial_pose;                   // T_world_radar of the first scan
+};
+
+// Throws std::invalid_argument naming the bad option.
+void ValidateOptions(const OdometryOptions& options);
+
+// What happened to one scan.
+struct OdometryStep {
+  double stamp = 0.0;
+  SE3d pose;                         // T_world_radar
+  std::size_t points = 0;
+  std::size_t static_points = 0;     // Doppler inliers (all points without Doppler)
+  bool velocity_measured = false;    // false: the prediction's velocity
+  bool standstill = false;           // the zero-velocity branch held the pose
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();      // m/s, radar frame
+  Eigen::Vector3d velocity_std = Eigen::Vector3d::Zero();  // m/s, sqrt of the covariance's diagonal
+  bool matched = false;              // the pose comes from scan matching
+  int iterations = 0;
+  double final_cost = 0.0;
+  bool converged = false;
+  std::string reason;                // why a stage fell back or did not converge; empty when all went well
+  bool keyframe = false;
+  std::size_t active_gaussians = 0;  // after the map update
+  double time_ms = 0.0;              // the whole step, map update included
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();           // eq. 2's
+  Eigen::Matrix<double, 6, 6> velocity_information = Eigen::Matrix<double, 6, 6>::Zero();  // the term's
+};
+
+// Gyro rates in the radar frame (rad/s), stamped; integrated between scans
+// instead of the constant-rate rotation when given.
+struct GyroSample {
+  double stamp = 0.0;
+  Eigen::Vector3d rate = Eigen::Vector3d::Zero();
+};
+
+class RadarOdometry {
+ public:
+  explicit RadarOdometry(const OdometryOptions& options = {});
+
+  // Registers the next scan. Throws DataError when its stamp is not after the
+  // previous one's or is not finite; every other fault becomes a reason.
+  const OdometryStep& Register(const RadarScan& scan);
+  // Adds gyro samples (radar frame, time order) used from the next scan on.
+  void AddGyro(const std::vector<GyroSample>& samples);
+
+  const std::vector<OdometryStep>& steps() const { return steps_; }
+  Trajectory trajectory() const;
+  const LocalMap& map() const { return map_; }
+  const OdometryOptions& options() const { return options_; }
+
+ private:
+  // The motion model's guess for the next scan.
+  struct Prediction {
+    SO3d increment;            // rotation since the last scan (gyro, or the last rate)
+    Eigen::Vector3d velocity;  // the last velocity, kept in the radar frame
+    Eigen::Matrix3d velocity_covariance;
+    double dt = 0.0;
+  };
+  Prediction Predict(double stamp) const;
+  SE3d PredictedPose(const Prediction& prediction, const Eigen::Vector3d& velocity) const;
+  // The translation since the last scan in its frame for a velocity of the new frame.
+  static Eigen::Vector3d Displacement(const Prediction& prediction, const Eigen::Vector3d& velocity);
+  // The rotation between two stamps from the gyro samples, if they cover it.
+  std::optional<SO3d> GyroIncrement(double from, double to) const;
+  // The gated ego velocity into `step` and `covariance`; the static points to match and insert.
+  std::vector<std::size_t> MeasureVelocity(const RadarScan& scan, const Prediction* prediction, OdometryStep& step,
+                                           Eigen::Matrix3d& covariance);
+  void Match(const RadarScan& scan, const std::vector<std::size_t>& static_points, const Prediction& prediction,
+             const Eigen::Matrix3d& velocity_covariance, OdometryStep& step);
+  void UpdateMap(const RadarScan& scan, const std::vector<std::size_t>& static_points, OdometryStep& step);
+
+  OdometryOptions options_;
+  LocalMap map_;
+  std::vector<OdometryStep> steps_;
+  std::vector<GyroSample> gyro_;
+  Eigen::Vector3d last_velocity_ = Eigen::Vector3d::Zero();  // the last step's, its radar frame
+  Eigen::Matrix3d last_velocity_covariance_ = Eigen::Matrix3d::Zero();
+  double last_measured_stamp_ = 0.0;  // of the last measured velocity
+  Eigen::Matrix3d last_measured_covariance_ = Eigen::Matrix3d::Zero();
+  bool any_measured_ = false;
+  SE3d last_keyframe_;
+};
+
+// Per-scan time (median, p90 in ms), scan and keyframe counts, fallbacks.
+struct OdometrySummary {
+  std::size_t scans = 0, keyframes = 0, matched = 0, velocity_predicted = 0, standstill = 0, pose_predicted = 0;
+  double median_ms = 0.0, p90_ms = 0.0, path_length = 0.0;  // path: m, of the estimate
+  std::size_t active_gaussians = 0, global_gaussians = 0, map_bytes = 0;
+};
+OdometrySummary Summarise(const RadarOdometry& odometry);
+
+// Writes odometry.tum (T_world_radar), per_scan.csv, summary.json, map.rgm
+// and map.ply into `dir` (created), each file whole or not at all.
+void WriteOdometry(const std::string& dir, const RadarOdometry& odometry);
+
+}  // namespace radargauss

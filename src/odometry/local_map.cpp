@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/odometry/local_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "radargauss/map/map_cloud.hpp"
+
+namespace radargauss {
+
+void ValidateOptions(const LocalMapOptions& o) {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(what);
+  };
+  require(o.region > 0.0 && std::isfinite(o.region), "map region must be > 0 m and finite");
+  require(o.region_capacity >= 4, "map region capacity must be >= 4 points");
+  require(o.min_points >= 1 && o.min_points <= o.region_capacity,
+          "map region minimum points must be in [1, region capacity]");
+  require(o.refit_growth > 0.0 && std::isfinite(o.refit_growth), "map refit growth must be > 0 and finite");
+  require(o.active_radius > 0.0, "active map radius must be > 0 m");
+  require(o.gaussians.min_std > 0.0, "minimum std must be > 0 m");
+}
+
+LocalMap::LocalMap(const LocalMapOptions& options) : options_(options), map_(std::make_shared<GaussianMap>()) {
+  ValidateOptions(options_);
+  options_.matching.updatable = true;
+  map_->incidence = options_.rcs.incidence;
+  matching_ = std::make_unique<MatchingMap>(std::shared_ptr<const GaussianMap>(map_), options_.matching);
+}
+
+std::uint32_t LocalMap::NewSlot() {
+  if (!free_slots_.empty()) {
+    const std::uint32_t slot = free_slots_.back();
+    free_slots_.pop_back();
+    return slot;
+  }
+  map_->gaussians.emplace_back();
+  return std::uint32_t(map_->gaussians.size() - 1);
+}
+
+std::size_t LocalMap::Insert(const std::vector<Eigen::Vector3d>& points, const std::vector<double>& rcs,
+                             bool has_rcs, const SE3d& pose) {
+  if (has_rcs && rcs.size() != points.size()) throw std::invalid_argument("LocalMap::Insert: one RCS per point");
+  const std::uint32_t pose_id = std::uint32_t(poses_.size());
+  poses_.push_back(pose);
+  std::vector<VoxelKey> touched;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite()) continue;
+    const VoxelKey key = VoxelOf(points[i], options_.region);
+    Region& region = regions_[key];
+    region.has_rcs = has_rcs;
+    const double value = has_rcs ? rcs[i] : 0.0;
+    if (region.points.size() < options_.region_capacity) {
+      region.points.push_back(points[i]);
+      region.rcs.push_back(value);
+      region.pose.push_back(pose_id);
+    } else {  // full: the newest point replaces the oldest
+      region.points[region.next] = points[i];
+      region.rcs[region.next] = value;
+      region.pose[region.next] = pose_id;
+      region.next = (region.next + 1) % options_.region_capacity;
+    }
+    ++region.added;
+    touched.push_back(key);
+  }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  std::vector<std::uint32_t> changed, removed;
+  std::size_t refitted = 0;
+  for (const VoxelKey& key : touched) {
+    Region& region = regions_[key];
+    const bool due = region.fitted == 0 ? region.points.size() >= options_.min_points
+                                        : double(region.added) >= options_.refit_growth * double(region.fitted);
+    if (!due) continue;
+    Refit(region, changed, removed);
+    ++refitted;
+  }
+  if (!changed.empty() || !removed.empty()) matching_->Update(changed, removed);
+  return refitted;
+}
+
+void LocalMap::Refit(Region& region, std::vector<std::uint32_t>& changed, std::vector<std::uint32_t>& removed) {
+  for (const std::uint32_t slot : region.gaussians) {
+    removed.push_back(slot);
+    free_slots_.push_back(slot);
+    map_->gaussians[slot] = Gaussian();
+  }
+  region.gaussians.clear();
+  region.fitted = region.points.size();
+  region.added = 0;
+  std::vector<int> association;
+  GaussianMap fitted;
+  fitted.gaussians = BuildGaussians(region.points, options_.gaussians, {}, &association);
+  if (region.has_rcs) {
+    // The members' poses, renumbered for a cloud of this region alone.
+    MapCloud cloud;
+    cloud.points = region.points;
+    cloud.rcs = region.rcs;
+    cloud.has_rcs = true;
+    std::unordered_map<std::uint32_t, std::uint32_t> local;
+    for (const std::uint32_t id : region.pose) {
+      const auto [it, inserted] = local.try_emplace(id, std::uint32_t(cloud.poses.size()));
+      if (inserted) cloud.poses.push_back(poses_[id]);
+      cloud.scan.push_back(it->second);
+    }
+    FitRcsModels(fitted, cloud, association, options_.rcs);
+  }
+  for (Gaussian& g : fitted.gaussians) {
+    const std::uint32_t slot = NewSlot();
+    map_->gaussians[slot] = g;
+    region.gaussians.push_back(slot);
+    changed.push_back(slot);
+  }
+}
+
+std::size_t LocalMap::Evict(const Eigen::Vector3d& position) {
+  std::vector<std::uint32_t> removed;
+  std::size_t left = 0;
+  const double half = 0.5 * options_.region;
+  for (auto it = regions_.begin(); it != regions_.end();) {
+    const Eigen::Vector3d centre =
+        Eigen::Vector3d(double(it->first.x), double(it->first.y), double(it->first.z)) * options_.region +
+        Eigen::Vector3d::Constant(half);
+    if ((centre - position).norm() <= options_.active_radius) {
+      ++it;
+      continue;
+    }
+    for (const std::uint32_t slot : it->second.gaussians) {
+      evicted_.push_back(map_->gaussians[slot]);
+      map_->gaussians[slot] = Gaussian();
+      removed.push_back(slot);
+      free_slots_.push_back(slot);
+    }
+    it = regions_.erase(it);
+    ++left;
+  }
+  if (!removed.empty()) matching_->Update({}, removed);
+  return left;
+}
+
+std::size_t LocalMap::points() const {
+  std::size_t n = 0;
+  for (const auto& entry : regions_) n += entry.second.points.size();
+  return n;
+}
+
+GaussianMap LocalMap::GlobalMap() const {
+  GaussianMap global;
+  global.incidence = map_->incidence;
+  global.gaussians = evicted_;
+  for (const auto& entry : regions_) {
+    for (const std::uint32_t slot : entry.second.gaussians) global.gaussians.push_back(map_->gaussians[slot]);
+  }
+  return global;
+}
+
+std::size_t LocalMap::MemoryBytes() const {
+  std::size_t bytes = matching_->MemoryBytes() + map_->gaussians.capacity() * sizeof(Gaussian) +
+                      poses_.capacity() * sizeof(SE3d);
+  for (const auto& entry : regions_) {
+    const Region& r = entry.second;
+    bytes += 96 + r.points.capacity() * sizeof(Eigen::Vector3d) + r.rcs.capacity() * sizeof(double) +
+             r.pose.capacity() * sizeof(std::uint32_t) + r.gaussians.capacity() * sizeof(std::uint32_t);
+  }
+  return bytes;
+}
+
+}  // namespace radargauss
