@@ -57,7 +57,7 @@ std::vector<int> VoxelIds(const std::vector<Eigen::Vector3d>& positions, double 
 }
 
 // RANSAC over 3-point draws of the rows of H v = y: the consensus set (row
-// indices) of largest support over `iterations` draws. Support is the
+// indices) of largest support over `iterations` counted draws. Support is the
 // number of rows, or with options.consensus_voxel > 0 the number of voxels
 // they occupy (`voxel_ids`), then the number of rows.
 std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
@@ -91,7 +91,11 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
   };
   std::vector<int> best;
   std::vector<int> consensus;
-  for (int iteration = 0; iteration < iterations; ++iteration) {
+  // Hypotheses the gate turns away do not count: up to kGatedDrawFactor
+  // times as many draws find the world's hypotheses among a car's.
+  constexpr int kGatedDrawFactor = 50;
+  int counted = 0;
+  for (int draw = 0; counted < iterations && draw < kGatedDrawFactor * iterations; ++draw) {
     int a, b, c;
     if (by_voxel) {
       int va = pick_voxel(rng), vb = pick_voxel(rng), vc = pick_voxel(rng);
@@ -106,9 +110,13 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     Eigen::Matrix3d h;
     h << H.row(a), H.row(b), H.row(c);
     const Eigen::FullPivLU<Eigen::Matrix3d> lu(h);
-    if (!lu.isInvertible() || std::abs(h.determinant()) < 1e-6) continue;
+    if (!lu.isInvertible() || std::abs(h.determinant()) < 1e-6) {
+      ++counted;
+      continue;
+    }
     const Eigen::Vector3d v = lu.solve(Eigen::Vector3d(y[a], y[b], y[c]));
     if (gate && !gate->Admits(v)) continue;
+    ++counted;
     consensus.clear();
     for (int k = 0; k < n; ++k) {
       if (std::abs(y[k] - H.row(k).dot(v)) < options.inlier_threshold) consensus.push_back(k);
@@ -117,7 +125,7 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
       if (consensus.size() > best.size()) best.swap(consensus);
       continue;
     }
-    const int covered = voxels_of(consensus, iteration);
+    const int covered = voxels_of(consensus, draw);
     if (covered > best_voxels || (covered == best_voxels && consensus.size() > best.size())) {
       best_voxels = covered;
       best.swap(consensus);
