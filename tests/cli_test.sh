@@ -111,6 +111,40 @@ expect_ok "refine a trajectory and its map" "wrote $work/refined/refined.tum" --
   --map "$work/seq10.rgm" --rounds 1 --iterations 5 --out "$work/refined"
 expect_fail "refine without --poses" "poses" -- \
   "$tool" refine --sequence "$work/seq10" --map "$work/seq10.rgm" --out "$work/refined2"
+expect_ok "odometry with its evaluation" "wrote $work/odometry" -- \
+  "$tool" odometry --sequence "$work/seq10" --gt "$work/seq10/gt_radar_tum.txt" --out "$work/odometry"
+for file in odometry.tum per_scan.csv summary.json map.rgm map.ply evaluation.json; do
+  [[ -s "$work/odometry/$file" ]] || { echo "FAIL: odometry wrote no $file"; failed=1; }
+done
+cp -r "$work/seq10" "$work/backwards"
+second=$(ls "$work/backwards/ars548/points" | grep pcd | sed -n 2p)
+cp "$work/backwards/ars548/points/$second" "$work/backwards/ars548/points/${second%%.*}.1.pcd"
+expect_fail "odometry on a scan folder with a repeated stamp" "does not increase" -- \
+  "$tool" odometry --sequence "$work/backwards" --out "$work/odometry_backwards"
+[[ ! -e "$work/odometry_backwards/odometry.tum" ]] || { echo "FAIL: a failed odometry left outputs"; failed=1; }
+expect_fail "odometry with RCS weights on a sequence without RCS" "has no RCS field" -- \
+  "$tool" odometry --sequence "$work/seq10" --rcs-field none --w-rcs 0.25 --out "$work/odometry_rcs"
+expect_fail "odometry with a NaN velocity weight" "velocity-weight" -- \
+  "$tool" odometry --sequence "$work/seq10" --velocity-weight nan --out "$work/odometry_nan"
+expect_fail "odometry with an IMU topic but no bag" "needs --bag" -- \
+  "$tool" odometry --sequence "$work/seq10" --imu-topic /imu --out "$work/odometry_imu"
+ti_bag="$(cd "$(dirname "$0")/.." && pwd)/../shared/data/ti_mmwave_demo/demo_ti_mmwave_rospkg_format.bag"
+if [[ -f "$ti_bag" ]] && "$tool" info --bag "$ti_bag" >/dev/null 2>&1; then
+  expect_ok "odometry on the TI bag with its IMU" "wrote $work/ti" -- \
+    "$tool" odometry --bag "$ti_bag" --topic /ti_mmwave/radar_scan_pcl --rcs-field none --max-scans 60 \
+    --imu-topic /sensor_platform/imu --imu-stamps record --out "$work/ti"
+  expect_fail "odometry on a bag without the topic" "no messages on topic" -- \
+    "$tool" odometry --bag "$ti_bag" --topic /absent --out "$work/ti_absent"
+  expect_fail "odometry with an IMU topic of the wrong type" "not sensor_msgs/Imu" -- \
+    "$tool" odometry --bag "$ti_bag" --topic /ti_mmwave/radar_scan_pcl --rcs-field none \
+    --imu-topic /sensor_platform/baro --out "$work/ti_baro"
+  expect_fail "odometry with IMU stamps on another clock" "do not overlap" -- \
+    "$tool" odometry --bag "$ti_bag" --topic /ti_mmwave/radar_scan_pcl --rcs-field none \
+    --imu-topic /sensor_platform/imu --out "$work/ti_clock"
+  [[ ! -e "$work/ti_clock" ]] || { echo "FAIL: a failed odometry left its output folder"; failed=1; }
+else
+  echo "skip: the TI mmWave bag or ROS1 bag support is absent"
+fi
 expect_fail "evaluate with a missing reference" "cannot open" -- \
   "$tool" evaluate --est "$work/results/reference.tum" --ref "$work/absent.tum"
 expect_fail "evaluate with an unknown alignment" "align" -- \

@@ -27,6 +27,7 @@ struct OdometrySettings {
   std::string incidence = "offset";
   std::string coarse_levels = ToString(MatchingMapOptions().coarse);
   std::string imu_topic;
+  std::string imu_stamps = "header";
   std::vector<double> imu_rotation = {0, 0, 0, 1};  // q_radar_imu (x y z w)
   std::size_t max_scans = 0;
 };
@@ -47,8 +48,20 @@ std::vector<GyroSample> GyroOf(const OdometrySettings& s) {
   if (!(std::abs(q.norm() - 1.0) < 1e-3)) throw DataError("--imu-rotation must be a unit quaternion (x y z w)");
   const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
   std::vector<GyroSample> samples;
-  for (const ImuSample& imu : ReadBagImu(s.sequence.bag, s.imu_topic)) samples.push_back({imu.stamp, R * imu.angular_velocity});
+  for (const ImuSample& imu : ReadBagImu(s.sequence.bag, s.imu_topic, s.imu_stamps == "record")) {
+    samples.push_back({imu.stamp, R * imu.angular_velocity});
+  }
   return samples;
+}
+
+// Gyro samples that cover none of the scans' time span are a clock mismatch, not data.
+void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence) {
+  const double first = sequence.scans.front().timestamp, last = sequence.scans.back().timestamp;
+  if (gyro.back().stamp < first || gyro.front().stamp > last) {
+    throw DataError("the IMU's stamps (" + std::to_string(gyro.front().stamp) + " to " +
+                    std::to_string(gyro.back().stamp) + " s) do not overlap the scans' (" + std::to_string(first) +
+                    " to " + std::to_string(last) + " s); try --imu-stamps record");
+  }
 }
 
 void PrintSummary(const OdometrySummary& summary) {
@@ -73,7 +86,11 @@ int RunOdometry(const OdometrySettings& s) {
                     " needs RCS, and the sequence has no RCS field (use --w-rcs 0)");
   }
   RadarOdometry odometry(options);
-  if (!s.imu_topic.empty()) odometry.AddGyro(GyroOf(s));
+  if (!s.imu_topic.empty()) {
+    const std::vector<GyroSample> gyro = GyroOf(s);
+    CheckOverlap(gyro, sequence);
+    odometry.AddGyro(gyro);
+  }
   ProgressBar bar;
   for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
     try {
@@ -160,6 +177,9 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
       ->capture_default_str();
   app->add_option("--seed", o.ego_velocity.seed, "Seed of the Doppler RANSAC")->capture_default_str();
   app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
+  app->add_option("--imu-stamps", s.imu_stamps, "Stamp the IMU by its header or by the bag's record time")
+      ->check(CLI::IsMember({"header", "record"}))
+      ->capture_default_str();
   app->add_option("--imu-rotation", s.imu_rotation, "q_radar_imu as x y z w (rotates gyro rates into the radar frame)")
       ->expected(4)
       ->capture_default_str();

@@ -82,7 +82,7 @@ std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::stri
   return scans;
 }
 
-std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic) {
+std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic, bool record_time) {
   rosbag::Bag bag;
   OpenBag(bag, bag_path);
   std::vector<ImuSample> samples;
@@ -94,7 +94,7 @@ std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string
       const std::string source = bag_path + ":" + topic + "#" + std::to_string(index++);
       if (!msg) throw FileError(source, "message is " + message.getDataType() + ", not sensor_msgs/Imu");
       ImuSample sample;
-      sample.stamp = msg->header.stamp.isZero() ? message.getTime().toSec() : msg->header.stamp.toSec();
+      sample.stamp = record_time || msg->header.stamp.isZero() ? message.getTime().toSec() : msg->header.stamp.toSec();
       sample.angular_velocity = {msg->angular_velocity.x, msg->angular_velocity.y, msg->angular_velocity.z};
       if (!sample.angular_velocity.allFinite()) throw FileError(source, "angular velocity is not finite");
       if (!samples.empty() && !(sample.stamp > samples.back().stamp)) {

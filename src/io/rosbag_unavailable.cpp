@@ -18,6 +18,6 @@ std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::stri
                                     const FieldMapping&) {
   throw Unavailable(bag_path);
 }
-std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string&) { throw Unavailable(bag_path); }
+std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string&, bool) { throw Unavailable(bag_path); }
 
 }  // namespace radargauss

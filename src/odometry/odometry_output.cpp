@@ -44,7 +44,7 @@ OdometrySummary Summarise(const RadarOdometry& odometry) {
 namespace {
 
 void WritePerScan(std::ostream& out, const std::vector<OdometryStep>& steps) {
-  out << "scan,stamp,points,static_points,velocity_measured,vx,vy,vz,vx_std,vy_std,vz_std,standstill,matched,"
+  out << "scan,stamp,points,static_points,velocity_measured,vx,vy,vz,vx_std,vy_std,vz_std,standstill,gyro,matched,"
          "iterations,final_cost,converged,reason,keyframe,active_gaussians,time_ms\n";
   out << std::setprecision(9);
   for (std::size_t k = 0; k < steps.size(); ++k) {
@@ -54,7 +54,7 @@ void WritePerScan(std::ostream& out, const std::vector<OdometryStep>& steps) {
     out << k << ',' << std::fixed << std::setprecision(9) << s.stamp << std::defaultfloat << std::setprecision(9)
         << ',' << s.points << ',' << s.static_points << ',' << s.velocity_measured << ',' << s.velocity.x() << ','
         << s.velocity.y() << ',' << s.velocity.z() << ',' << s.velocity_std.x() << ',' << s.velocity_std.y() << ','
-        << s.velocity_std.z() << ',' << s.standstill << ',' << s.matched << ',' << s.iterations << ','
+        << s.velocity_std.z() << ',' << s.standstill << ',' << s.gyro << ',' << s.matched << ',' << s.iterations << ','
         << s.final_cost << ',' << s.converged << ",\"" << reason << "\"," << s.keyframe << ','
         << s.active_gaussians << ',' << s.time_ms << '\n';
   }

@@ -71,6 +71,7 @@ RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
   SO3d increment;
   if (const std::optional<SO3d> gyro = GyroIncrement(last.stamp, stamp)) {
     increment = *gyro;
+    p.gyro = true;
   } else if (steps_.size() >= 2) {  // the last increment's rate, constant
     const OdometryStep& before = steps_[steps_.size() - 2];
     const Eigen::Vector3d rate =
@@ -145,7 +146,10 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& scan) {
   std::optional<Prediction> prediction;
   if (!steps_.empty()) prediction = Predict(scan.timestamp);
   Eigen::Matrix3d covariance = prediction ? prediction->velocity_covariance : Eigen::Matrix3d::Zero();
-  if (prediction) step.velocity = prediction->velocity;
+  if (prediction) {
+    step.velocity = prediction->velocity;
+    step.gyro = prediction->gyro;
+  }
   const std::vector<std::size_t> static_points =
       MeasureVelocity(scan, prediction ? &*prediction : nullptr, step, covariance);
   step.static_points = static_points.size();

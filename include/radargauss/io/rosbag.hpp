@@ -61,9 +61,10 @@ struct ImuSample {
   double stamp = 0.0;  // s: header stamp, or the record time when zero
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
 };
-// Every sensor_msgs/Imu message of `topic`, in bag order; throws DataError
-// for a missing topic, another message type, non-finite rates or stamps
-// that do not increase.
-std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic);
+// Every sensor_msgs/Imu message of `topic`, in bag order, stamped by the
+// header or, with `record_time`, by the bag's record time (the clock of
+// scans whose header stamp is zero); throws DataError for a missing topic,
+// another message type, non-finite rates or stamps that do not increase.
+std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic, bool record_time = false);
 
 }  // namespace radargauss

@@ -65,6 +65,7 @@ struct OdometryStep {
   std::size_t static_points = 0;     // Doppler inliers (all points without Doppler)
   bool velocity_measured = false;    // false: the prediction's velocity
   bool standstill = false;           // the zero-velocity branch held the pose
+  bool gyro = false;                 // the predicted rotation comes from gyro rates
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();      // m/s, radar frame
   Eigen::Vector3d velocity_std = Eigen::Vector3d::Zero();  // m/s, sqrt of the covariance's diagonal
   bool matched = false;              // the pose comes from scan matching
@@ -108,6 +109,7 @@ class RadarOdometry {
     Eigen::Vector3d velocity;  // the last velocity, kept in the radar frame
     Eigen::Matrix3d velocity_covariance;
     double dt = 0.0;
+    bool gyro = false;         // the increment comes from gyro rates
   };
   Prediction Predict(double stamp) const;
   SE3d PredictedPose(const Prediction& prediction, const Eigen::Vector3d& velocity) const;
