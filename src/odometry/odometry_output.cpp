@@ -45,7 +45,7 @@ namespace {
 
 void WritePerScan(std::ostream& out, const std::vector<OdometryStep>& steps) {
   out << "scan,stamp,points,static_points,velocity_measured,vx,vy,vz,vx_std,vy_std,vz_std,standstill,gyro,matched,"
-         "iterations,final_cost,converged,reason,keyframe,active_gaussians,time_ms\n";
+         "iterations,final_cost,converged,reason,keyframe,active_gaussians,active_map_bytes,time_ms\n";
   out << std::setprecision(9);
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const OdometryStep& s = steps[k];
@@ -56,7 +56,7 @@ void WritePerScan(std::ostream& out, const std::vector<OdometryStep>& steps) {
         << s.velocity.y() << ',' << s.velocity.z() << ',' << s.velocity_std.x() << ',' << s.velocity_std.y() << ','
         << s.velocity_std.z() << ',' << s.standstill << ',' << s.gyro << ',' << s.matched << ',' << s.iterations << ','
         << s.final_cost << ',' << s.converged << ",\"" << reason << "\"," << s.keyframe << ','
-        << s.active_gaussians << ',' << s.time_ms << '\n';
+        << s.active_gaussians << ',' << s.active_map_bytes << ',' << s.time_ms << '\n';
   }
 }
 

@@ -176,6 +176,8 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& scan) {
   if (!step.standstill) UpdateMap(scan, static_points, step);
   step.active_gaussians = map_.gaussians();
   step.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  // Counted outside the step's time: the map changes on keyframes only.
+  step.active_map_bytes = step.keyframe || steps_.empty() ? map_.MemoryBytes() : steps_.back().active_map_bytes;
   steps_.push_back(step);
   return steps_.back();
 }

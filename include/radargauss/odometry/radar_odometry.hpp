@@ -75,6 +75,7 @@ struct OdometryStep {
   std::string reason;                // why a stage fell back or did not converge; empty when all went well
   bool keyframe = false;
   std::size_t active_gaussians = 0;  // after the map update
+  std::size_t active_map_bytes = 0;  // LocalMap::MemoryBytes after the map update
   double time_ms = 0.0;              // the whole step, map update included
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();           // eq. 2's
   Eigen::Matrix<double, 6, 6> velocity_information = Eigen::Matrix<double, 6, 6>::Zero();  // the term's

@@ -1,0 +1,85 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""Odometry figures of bench/RESULTS.md, "Odometry": `radargauss odometry` on
+the NTU Eagle sample, the demo's simulated sequence and a 3000-scan
+simulated drive, for w_rcs 0 and 0.25 (simulated: RCS) and the velocity
+term on and off, one thread. Prints a Markdown table: RPE (10-50 % of the
+path; translation and horizontal %, deg/m), ATE RMSE, per-scan time
+(median, p90), peak memory, and for the long drive the first and last
+tenth's median time and active map size.
+
+    scripts/odometry_table.py [--tool build/release/bin/radargauss] [--work /tmp/odometry_table] [--quick]
+"""
+import argparse
+import csv
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+NTU = os.path.join(ROOT, "..", "shared", "data", "ntu4dradlm_loop1_eagle")
+
+
+def run(command):
+    """Runs a command; returns its peak resident memory in MB (the child's own)."""
+    child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(child.pid, 0)
+    child.returncode = os.waitstatus_to_exitcode(status)
+    if child.returncode != 0:
+        sys.exit(f"odometry_table: {' '.join(command)} failed: {child.stderr.read().decode().strip()}")
+    return usage.ru_maxrss / 1024.0
+
+
+def tenths(out):
+    with open(os.path.join(out, "per_scan.csv"), newline="") as f:
+        rows = list(csv.DictReader(f))
+    n = max(1, len(rows) // 10)
+    first, last = rows[:n], rows[-n:]
+    def median(rows, key):
+        return statistics.median(float(r[key]) for r in rows)
+    return (median(first, "time_ms"), median(last, "time_ms"),
+            median(first, "active_map_bytes") / 1e6, median(last, "active_map_bytes") / 1e6)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--tool", default=os.path.join(ROOT, "build", "release", "bin", "radargauss"))
+    parser.add_argument("--work", default="/tmp/odometry_table")
+    parser.add_argument("--quick", action="store_true", help="the demo sequence only")
+    args = parser.parse_args()
+    tool = [args.tool, "--threads", "1"]
+    os.makedirs(args.work, exist_ok=True)
+    demo, long_drive = os.path.join(args.work, "demo"), os.path.join(args.work, "long")
+    run(tool + ["simulate", "--out", demo, "--config", os.path.join(ROOT, "configs", "synthetic_world.yaml"), "--force"])
+    sets = [("demo (simulated, 300 scans)", ["--sequence", demo, "--gt", os.path.join(demo, "gt_radar_tum.txt")], True)]
+    if not args.quick:
+        run(tool + ["simulate", "--out", long_drive, "--scans", "3000", "--force"])
+        sets.append(("long drive (simulated, 3000 scans)",
+                     ["--sequence", long_drive, "--gt", os.path.join(long_drive, "gt_radar_tum.txt")], True))
+        if os.path.isdir(NTU):
+            sets.insert(0, ("NTU Eagle sample", ["--config", os.path.join(ROOT, "configs", "ntu_eagle_odometry.yaml"),
+                                                 "--sequence", os.path.join(NTU, "points"),
+                                                 "--gt", os.path.join(NTU, "gt_tum.txt")], False))
+    print("| data | w_rcs | velocity term | RPE t % | RPE horizontal % | RPE r deg/m | ATE t RMSE m "
+          "| ms/scan median | p90 | peak MB | first / last tenth: ms, active map MB |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for label, flags, has_rcs in sets:
+        for w in ([0, 0.25] if has_rcs else [0]):
+            for velocity in (1, 0):
+                out = os.path.join(args.work, f"{label.split()[0]}-w{w}-v{velocity}")
+                peak = run(tool + ["odometry"] + flags + ["--w-rcs", str(w), "--velocity-weight", str(velocity),
+                                                          "--out", out])
+                e = json.load(open(os.path.join(out, "evaluation.json")))
+                s = json.load(open(os.path.join(out, "summary.json")))
+                t0, t1, m0, m1 = tenths(out)
+                rpe = e["rpe"]
+                print(f"| {label} | {w} | {'on' if velocity else 'off'} | {rpe['translation_percent']:.2f} "
+                      f"| {rpe['horizontal_percent']:.2f} | {rpe['rotation_deg_per_m']:.4f} "
+                      f"| {e['ate_translation_m']['rmse']:.3f} | {s['median_time_ms']:.2f} | {s['p90_time_ms']:.2f} "
+                      f"| {peak:.0f} | {t0:.2f} / {t1:.2f} ms, {m0:.1f} / {m1:.1f} MB |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
