@@ -83,7 +83,7 @@ void GaussianIndex::Update(const std::vector<Gaussian>& gaussians, const std::ve
     list.clear();
     if (cell.key == key) {
       for (std::uint32_t e = cell.begin; e < cell.end; ++e) {
-        if (cell_entries_[e] >= top || !leaving[cell_entries_[e]]) list.push_back(cell_entries_[e]);
+        if (!leaving[cell_entries_[e]]) list.push_back(cell_entries_[e]);
       }
       stale_entries_ += cell.end - cell.begin;
     } else {

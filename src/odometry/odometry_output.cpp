@@ -36,7 +36,7 @@ OdometrySummary Summarise(const RadarOdometry& odometry) {
     s.p90_ms = times[std::min(times.size() - 1, std::size_t(0.9 * double(times.size())))];
   }
   s.active_gaussians = odometry.map().gaussians();
-  s.global_gaussians = odometry.map().GlobalMap().gaussians.size();
+  s.global_gaussians = odometry.map().global_gaussians();
   s.map_bytes = odometry.map().MemoryBytes();
   return s;
 }
@@ -49,12 +49,13 @@ void WritePerScan(std::ostream& out, const std::vector<OdometryStep>& steps) {
   out << std::setprecision(9);
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const OdometryStep& s = steps[k];
+    const Eigen::Vector3d velocity_std = s.velocity_covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
     std::string reason = s.reason;
     std::replace(reason.begin(), reason.end(), '"', '\'');
     out << k << ',' << std::fixed << std::setprecision(9) << s.stamp << std::defaultfloat << std::setprecision(9)
         << ',' << s.points << ',' << s.static_points << ',' << s.velocity_measured << ',' << s.velocity.x() << ','
-        << s.velocity.y() << ',' << s.velocity.z() << ',' << s.velocity_std.x() << ',' << s.velocity_std.y() << ','
-        << s.velocity_std.z() << ',' << s.standstill << ',' << s.gyro << ',' << s.matched << ',' << s.iterations << ','
+        << s.velocity.y() << ',' << s.velocity.z() << ',' << velocity_std.x() << ',' << velocity_std.y() << ','
+        << velocity_std.z() << ',' << s.standstill << ',' << s.gyro << ',' << s.matched << ',' << s.iterations << ','
         << s.final_cost << ',' << s.converged << ",\"" << reason << "\"," << s.keyframe << ','
         << s.active_gaussians << ',' << s.active_map_bytes << ',' << s.time_ms << '\n';
   }

@@ -80,9 +80,9 @@ RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
   }
   p.increment = increment;
   // A vehicle keeps its velocity in its own frame: the last one, unrotated.
-  p.velocity = last.standstill ? Eigen::Vector3d::Zero() : last_velocity_;
+  p.velocity = last.velocity;
   p.velocity_covariance =
-      last_velocity_covariance_ + std::pow(options_.acceleration_std * p.dt, 2) * Eigen::Matrix3d::Identity();
+      last.velocity_covariance + std::pow(options_.acceleration_std * p.dt, 2) * Eigen::Matrix3d::Identity();
   return p;
 }
 
@@ -98,7 +98,7 @@ Eigen::Vector3d RadarOdometry::Displacement(const Prediction& p, const Eigen::Ve
 }
 
 std::vector<std::size_t> RadarOdometry::MeasureVelocity(const RadarScan& scan, const Prediction* prediction,
-                                                        OdometryStep& step, Eigen::Matrix3d& covariance) {
+                                                        OdometryStep& step) {
   std::vector<std::size_t> static_points;
   if (!scan.has_doppler) {
     step.reason = "no Doppler field: velocity predicted, every point matched";
@@ -106,9 +106,11 @@ std::vector<std::size_t> RadarOdometry::MeasureVelocity(const RadarScan& scan, c
     return static_points;
   }
   std::optional<VelocityGate> gate;
-  if (prediction && any_measured_) {
-    const double dt = scan.timestamp - last_measured_stamp_;
-    const double spread = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(last_measured_covariance_).eigenvalues().maxCoeff();
+  if (prediction && last_measured_) {
+    const OdometryStep& measured = steps_[*last_measured_];
+    const double dt = scan.timestamp - measured.stamp;
+    const double spread =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(measured.velocity_covariance).eigenvalues().maxCoeff();
     gate = VelocityGate{prediction->velocity,
                         std::max(options_.min_gate, options_.gate_sigmas *
                                                         std::sqrt(std::max(spread, 0.0) +
@@ -128,7 +130,7 @@ std::vector<std::size_t> RadarOdometry::MeasureVelocity(const RadarScan& scan, c
   step.velocity_measured = true;
   step.standstill = ego.zero_velocity;
   step.velocity = ego.velocity;
-  covariance = ego.covariance;
+  step.velocity_covariance = ego.covariance;
   return static_points;
 }
 
@@ -145,34 +147,22 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& scan) {
   step.points = scan.points.size();
   std::optional<Prediction> prediction;
   if (!steps_.empty()) prediction = Predict(scan.timestamp);
-  Eigen::Matrix3d covariance = prediction ? prediction->velocity_covariance : Eigen::Matrix3d::Zero();
   if (prediction) {
     step.velocity = prediction->velocity;
+    step.velocity_covariance = prediction->velocity_covariance;
     step.gyro = prediction->gyro;
   }
-  const std::vector<std::size_t> static_points =
-      MeasureVelocity(scan, prediction ? &*prediction : nullptr, step, covariance);
+  const std::vector<std::size_t> static_points = MeasureVelocity(scan, prediction ? &*prediction : nullptr, step);
   step.static_points = static_points.size();
   if (!prediction) {
     step.pose = options_.initial_pose;
-    if (step.velocity_measured) step.reason.clear();
   } else if (step.standstill) {
     step.pose = steps_.back().pose;  // standing: the pose holds
   } else {
-    const SE3d predicted = PredictedPose(*prediction, step.velocity);
-    step.pose = predicted;
-    if (static_points.size() >= options_.min_static_points) {
-      Match(scan, static_points, *prediction, covariance, step);
-    }
+    step.pose = PredictedPose(*prediction, step.velocity);
+    if (static_points.size() >= options_.min_static_points) Match(scan, static_points, *prediction, step);
   }
-  if (step.velocity_measured) {
-    last_measured_stamp_ = scan.timestamp;
-    last_measured_covariance_ = covariance;
-    any_measured_ = true;
-  }
-  last_velocity_ = step.velocity;
-  last_velocity_covariance_ = covariance;
-  step.velocity_std = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  if (step.velocity_measured) last_measured_ = steps_.size();
   if (!step.standstill) UpdateMap(scan, static_points, step);
   step.active_gaussians = map_.gaussians();
   step.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -183,8 +173,7 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& scan) {
 }
 
 void RadarOdometry::Match(const RadarScan& scan, const std::vector<std::size_t>& static_points,
-                          const Prediction& prediction, const Eigen::Matrix3d& velocity_covariance,
-                          OdometryStep& step) {
+                          const Prediction& prediction, OdometryStep& step) {
   RadarScan matched;
   matched.timestamp = scan.timestamp;
   matched.has_doppler = scan.has_doppler;
@@ -197,7 +186,7 @@ void RadarOdometry::Match(const RadarScan& scan, const std::vector<std::size_t>&
     prior.previous = steps_.back().pose;
     prior.displacement = Displacement(prediction, step.velocity);
     prior.sqrt_information = VelocitySqrtInformation(
-        velocity_covariance, prediction.dt,
+        step.velocity_covariance, prediction.dt,
         options_.velocity_floor * options_.velocity_floor * Eigen::Matrix3d::Identity());
     prior.weight = options_.velocity_weight;
     match.matching.velocity = prior;

@@ -59,6 +59,7 @@ class LocalMap {
   std::size_t points() const;
   // The Gaussians that left the active map, then the active ones.
   GaussianMap GlobalMap() const;
+  std::size_t global_gaussians() const { return evicted_.size() + gaussians(); }
   // Points, Gaussians and indexes held (bytes, approximate).
   std::size_t MemoryBytes() const;
 

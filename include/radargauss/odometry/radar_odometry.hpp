@@ -67,7 +67,7 @@ struct OdometryStep {
   bool standstill = false;           // the zero-velocity branch held the pose
   bool gyro = false;                 // the predicted rotation comes from gyro rates
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();      // m/s, radar frame
-  Eigen::Vector3d velocity_std = Eigen::Vector3d::Zero();  // m/s, sqrt of the covariance's diagonal
+  Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();  // (m/s)^2: measured, or the prediction's
   bool matched = false;              // the pose comes from scan matching
   int iterations = 0;
   double final_cost = 0.0;
@@ -118,22 +118,17 @@ class RadarOdometry {
   static Eigen::Vector3d Displacement(const Prediction& prediction, const Eigen::Vector3d& velocity);
   // The rotation between two stamps from the gyro samples, if they cover it.
   std::optional<SO3d> GyroIncrement(double from, double to) const;
-  // The gated ego velocity into `step` and `covariance`; the static points to match and insert.
-  std::vector<std::size_t> MeasureVelocity(const RadarScan& scan, const Prediction* prediction, OdometryStep& step,
-                                           Eigen::Matrix3d& covariance);
+  // The gated ego velocity and its covariance into `step`; the static points to match and insert.
+  std::vector<std::size_t> MeasureVelocity(const RadarScan& scan, const Prediction* prediction, OdometryStep& step);
   void Match(const RadarScan& scan, const std::vector<std::size_t>& static_points, const Prediction& prediction,
-             const Eigen::Matrix3d& velocity_covariance, OdometryStep& step);
+             OdometryStep& step);
   void UpdateMap(const RadarScan& scan, const std::vector<std::size_t>& static_points, OdometryStep& step);
 
   OdometryOptions options_;
   LocalMap map_;
   std::vector<OdometryStep> steps_;
   std::vector<GyroSample> gyro_;
-  Eigen::Vector3d last_velocity_ = Eigen::Vector3d::Zero();  // the last step's, its radar frame
-  Eigen::Matrix3d last_velocity_covariance_ = Eigen::Matrix3d::Zero();
-  double last_measured_stamp_ = 0.0;  // of the last measured velocity
-  Eigen::Matrix3d last_measured_covariance_ = Eigen::Matrix3d::Zero();
-  bool any_measured_ = false;
+  std::optional<std::size_t> last_measured_;  // the last step whose velocity was measured: the gate's centre of trust
   SE3d last_keyframe_;
 };
 
