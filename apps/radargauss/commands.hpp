@@ -6,6 +6,8 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <string>
+#include <vector>
 
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/map/pipeline.hpp"
@@ -30,6 +32,14 @@ Subcommand AddOdometry(CLI::App& parent);
 // that gives the scans their poses is `poses_flag` (refine: --poses).
 void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::string& poses_flag = "--gt",
                         const std::string& poses_help = "Ground-truth trajectory (TUM)");
+
+// Throws DataError when a weight w > 0 needs RCS and no scan of the sequence
+// has it: before any map is built or scan matched.
+void CheckRcsWeights(const Sequence& sequence, const std::vector<double>& weights);
+// A weight as configuration names show it (%g).
+std::string FormatWeight(double w);
+// A check that a number flag is finite (CLI11's ranges let NaN through).
+const CLI::Validator& FiniteNumber();
 
 // The map-building flags of build-map and localize.
 struct MapBuildSettings {

@@ -113,16 +113,7 @@ const SequenceOptions& LocalizeSettings::CheckedSequenceOptions() const {
   return sequence;
 }
 
-void LocalizeSettings::CheckAgainst(const Sequence& sequence) const {
-  const bool any_rcs = std::any_of(sequence.scans.begin(), sequence.scans.end(),
-                                   [](const RadarScan& scan) { return scan.has_rcs; });
-  const auto rcs_weight = std::find_if(w_rcs.begin(), w_rcs.end(), [](double w) { return w > 0.0; });
-  if (!any_rcs && rcs_weight != w_rcs.end()) {
-    throw DataError("--w-rcs " + FormatWeight(*rcs_weight) +
-                    " needs RCS, and the sequence has no RCS field (--rcs-field names it; --w-rcs 0 matches "
-                    "geometry alone)");
-  }
-}
+void LocalizeSettings::CheckAgainst(const Sequence& sequence) const { CheckRcsWeights(sequence, w_rcs); }
 
 MatchingMapOptions LocalizeSettings::MatchingOptions() const {
   MatchingMapOptions options;

@@ -47,7 +47,4 @@ struct LocalizeSettings {
 
 void AddLocalizeOptions(CLI::App* app, LocalizeSettings& settings);
 
-// A weight as configuration names show it (%g).
-std::string FormatWeight(double w);
-
 }  // namespace radargauss::cli

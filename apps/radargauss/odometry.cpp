@@ -81,10 +81,7 @@ int RunOdometry(const OdometrySettings& s) {
   Sequence sequence = LoadSequence(sequence_options);
   if (s.max_scans > 0 && sequence.scans.size() > s.max_scans) sequence.scans.resize(s.max_scans);
   if (sequence.scans.empty()) throw DataError("the sequence has no scans");
-  if (options.match.matching.w_rcs > 0.0 && !sequence.scans.front().has_rcs) {
-    throw DataError("--w-rcs " + std::to_string(options.match.matching.w_rcs) +
-                    " needs RCS, and the sequence has no RCS field (use --w-rcs 0)");
-  }
+  CheckRcsWeights(sequence, {options.match.matching.w_rcs});
   RadarOdometry odometry(options);
   if (!s.imu_topic.empty()) {
     const std::vector<GyroSample> gyro = GyroOf(s);
@@ -117,8 +114,7 @@ int RunOdometry(const OdometrySettings& s) {
 
 void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   OdometryOptions& o = s.odometry;
-  const auto finite = CLI::Validator(
-      [](std::string& text) { return std::isfinite(std::stod(text)) ? std::string() : "must be finite"; }, "FINITE");
+  const CLI::Validator& finite = FiniteNumber();
   app->add_option("--solver", s.solver, "Scan matcher: gn (own Gauss-Newton), gn-autodiff, ceres, ceres-dogleg, mh-gn")
       ->check(CLI::IsMember(ScanMatcherNames()))
       ->capture_default_str();

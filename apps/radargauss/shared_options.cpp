@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The flags shared by several subcommands: the sequence, the map pipeline.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "commands.hpp"
+#include "radargauss/error.hpp"
 #include "radargauss/progress.hpp"
 
 namespace radargauss::cli {
@@ -29,6 +32,30 @@ void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::stri
                   "Multiplies the file's Doppler to get 'positive receding' (+1 or -1)")
       ->check(CLI::IsMember({1.0, -1.0}))
       ->capture_default_str();
+}
+
+void CheckRcsWeights(const Sequence& sequence, const std::vector<double>& weights) {
+  const bool any_rcs = std::any_of(sequence.scans.begin(), sequence.scans.end(),
+                                   [](const RadarScan& scan) { return scan.has_rcs; });
+  const auto rcs_weight = std::find_if(weights.begin(), weights.end(), [](double w) { return w > 0.0; });
+  if (!any_rcs && rcs_weight != weights.end()) {
+    throw DataError("--w-rcs " + FormatWeight(*rcs_weight) +
+                    " needs RCS, and the sequence has no RCS field (--rcs-field names it; --w-rcs 0 matches "
+                    "geometry alone)");
+  }
+}
+
+const CLI::Validator& FiniteNumber() {
+  static const CLI::Validator finite(
+      [](std::string& text) {
+        try {
+          return std::isfinite(std::stod(text)) ? std::string() : std::string("must be finite");
+        } catch (const std::exception&) {
+          return std::string("must be a number");
+        }
+      },
+      "FINITE");
+  return finite;
 }
 
 MapOptions MapBuildSettings::Resolved() const {
