@@ -47,67 +47,72 @@ std::vector<BagTopic> ListBagTopics(const std::string& bag_path) {
   return result;
 }
 
-std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
-                                    const FieldMapping& mapping) {
+namespace {
+
+// Calls read(message, source) for every message of `topic` in bag order,
+// `source` naming it ("<bag>:<topic>#<index>"); a missing topic and
+// the library's own exceptions become DataError naming the bag.
+template <typename Read>
+void ForEachMessage(const std::string& bag_path, const std::string& topic, Read&& read) {
   rosbag::Bag bag;
   OpenBag(bag, bag_path);
-  std::vector<RadarScan> scans;
   std::size_t index = 0;
-  bool topic_seen = false;
   try {
     rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{topic}));
     for (const rosbag::MessageInstance& message : view) {
-      topic_seen = true;
-      const sensor_msgs::PointCloud2::ConstPtr msg = message.instantiate<sensor_msgs::PointCloud2>();
-      const std::string source = bag_path + ":" + topic + "#" + std::to_string(index++);
-      if (!msg) throw FileError(source, "message is " + message.getDataType() + ", not sensor_msgs/PointCloud2");
-      PointCloud2Data cloud;
-      cloud.height = msg->height;
-      cloud.width = msg->width;
-      for (const auto& f : msg->fields) cloud.fields.push_back({f.name, f.offset, f.datatype, f.count});
-      cloud.is_bigendian = msg->is_bigendian;
-      cloud.point_step = msg->point_step;
-      cloud.row_step = msg->row_step;
-      cloud.data = msg->data;
-      const double stamp = msg->header.stamp.isZero() ? message.getTime().toSec()
-                                                      : msg->header.stamp.toSec();
-      scans.push_back(DecodePointCloud2(cloud, stamp, mapping, source));
+      read(message, bag_path + ":" + topic + "#" + std::to_string(index++));
     }
   } catch (const DataError&) {
     throw;
   } catch (const std::exception& e) {
     throw FileError(bag_path, std::string("corrupt ROS1 bag: ") + e.what());
   }
-  if (!topic_seen) throw FileError(bag_path, "no messages on topic '" + topic + "'");
+  if (index == 0) throw FileError(bag_path, "no messages on topic '" + topic + "'");
+}
+
+// The message as `Message`, or DataError naming `source` and the type it holds.
+template <typename Message>
+typename Message::ConstPtr Instantiate(const rosbag::MessageInstance& message, const std::string& source,
+                                       const char* type) {
+  const typename Message::ConstPtr msg = message.instantiate<Message>();
+  if (!msg) throw FileError(source, "message is " + message.getDataType() + ", not " + type);
+  return msg;
+}
+
+}  // namespace
+
+std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
+                                    const FieldMapping& mapping) {
+  std::vector<RadarScan> scans;
+  ForEachMessage(bag_path, topic, [&](const rosbag::MessageInstance& message, const std::string& source) {
+    const auto msg = Instantiate<sensor_msgs::PointCloud2>(message, source, "sensor_msgs/PointCloud2");
+    PointCloud2Data cloud;
+    cloud.height = msg->height;
+    cloud.width = msg->width;
+    for (const auto& f : msg->fields) cloud.fields.push_back({f.name, f.offset, f.datatype, f.count});
+    cloud.is_bigendian = msg->is_bigendian;
+    cloud.point_step = msg->point_step;
+    cloud.row_step = msg->row_step;
+    cloud.data = msg->data;
+    const double stamp = msg->header.stamp.isZero() ? message.getTime().toSec() : msg->header.stamp.toSec();
+    scans.push_back(DecodePointCloud2(cloud, stamp, mapping, source));
+  });
   return scans;
 }
 
 std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic, bool record_time) {
-  rosbag::Bag bag;
-  OpenBag(bag, bag_path);
   std::vector<ImuSample> samples;
-  std::size_t index = 0;
-  try {
-    rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{topic}));
-    for (const rosbag::MessageInstance& message : view) {
-      const sensor_msgs::Imu::ConstPtr msg = message.instantiate<sensor_msgs::Imu>();
-      const std::string source = bag_path + ":" + topic + "#" + std::to_string(index++);
-      if (!msg) throw FileError(source, "message is " + message.getDataType() + ", not sensor_msgs/Imu");
-      ImuSample sample;
-      sample.stamp = record_time || msg->header.stamp.isZero() ? message.getTime().toSec() : msg->header.stamp.toSec();
-      sample.angular_velocity = {msg->angular_velocity.x, msg->angular_velocity.y, msg->angular_velocity.z};
-      if (!sample.angular_velocity.allFinite()) throw FileError(source, "angular velocity is not finite");
-      if (!samples.empty() && !(sample.stamp > samples.back().stamp)) {
-        throw FileError(source, "stamp " + std::to_string(sample.stamp) + " s is not after the previous message's");
-      }
-      samples.push_back(sample);
+  ForEachMessage(bag_path, topic, [&](const rosbag::MessageInstance& message, const std::string& source) {
+    const auto msg = Instantiate<sensor_msgs::Imu>(message, source, "sensor_msgs/Imu");
+    ImuSample sample;
+    sample.stamp = record_time || msg->header.stamp.isZero() ? message.getTime().toSec() : msg->header.stamp.toSec();
+    sample.angular_velocity = {msg->angular_velocity.x, msg->angular_velocity.y, msg->angular_velocity.z};
+    if (!sample.angular_velocity.allFinite()) throw FileError(source, "angular velocity is not finite");
+    if (!samples.empty() && !(sample.stamp > samples.back().stamp)) {
+      throw FileError(source, "stamp " + std::to_string(sample.stamp) + " s is not after the previous message's");
     }
-  } catch (const DataError&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw FileError(bag_path, std::string("corrupt ROS1 bag: ") + e.what());
-  }
-  if (samples.empty()) throw FileError(bag_path, "no messages on topic '" + topic + "'");
+    samples.push_back(sample);
+  });
   return samples;
 }
 
