@@ -8,7 +8,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
-#include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/map/builder.hpp"
 
 namespace radargauss {
 
@@ -40,32 +40,21 @@ bool SolveLeastSquares(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
   return v.allFinite();
 }
 
-// For each row, an index of the voxel of side `voxel` its point lies in
-// (distinct voxels, distinct indices), to count the voxels a consensus covers.
-std::vector<int> VoxelIds(const std::vector<Eigen::Vector3d>& positions, double voxel, int& count) {
-  std::vector<std::pair<VoxelKey, int>> keyed;
-  for (std::size_t k = 0; k < positions.size(); ++k) keyed.emplace_back(VoxelOf(positions[k], voxel), int(k));
-  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<int> ids(positions.size());
-  count = 0;
-  for (std::size_t k = 0; k < keyed.size(); ++k) {
-    if (k > 0 && !(keyed[k].first == keyed[k - 1].first)) ++count;
-    ids[keyed[k].second] = count;
-  }
-  ++count;
-  return ids;
-}
-
 // RANSAC over 3-point draws of the rows of H v = y: the consensus set (row
 // indices) of largest support over `iterations` counted draws. Support is the
 // number of rows, or with options.consensus_voxel > 0 the number of voxels
-// they occupy (`voxel_ids`), then the number of rows.
+// they occupy (`voxels`: the rows of each, GroupByVoxel), then the number of rows.
 std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
                                   const EgoVelocityOptions& options, int iterations,
-                                  const std::optional<VelocityGate>& gate, const std::vector<int>& voxel_ids,
-                                  int voxel_count) {
+                                  const std::optional<VelocityGate>& gate,
+                                  const std::vector<std::vector<std::uint32_t>>& voxels) {
   const int n = static_cast<int>(y.size());
-  std::vector<int> seen(static_cast<std::size_t>(voxel_count), -1);
+  const int voxel_count = static_cast<int>(voxels.size());
+  std::vector<int> voxel_ids(voxels.empty() ? 0 : y.size());
+  for (int v = 0; v < voxel_count; ++v) {
+    for (const std::uint32_t k : voxels[v]) voxel_ids[k] = v;
+  }
+  std::vector<int> seen(voxels.size(), -1);
   const auto voxels_of = [&](const std::vector<int>& rows, int stamp) {
     int covered = 0;
     for (const int k : rows) {
@@ -81,13 +70,11 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
   std::uniform_int_distribution<int> pick(0, n - 1);
   // With voxels, a draw takes three distinct voxels, then a row of each:
   // the world's many sparse voxels are drawn as often as a car's few dense ones.
-  std::vector<std::vector<int>> rows_of(static_cast<std::size_t>(voxel_count));
-  for (int k = 0; k < n && !voxel_ids.empty(); ++k) rows_of[voxel_ids[k]].push_back(k);
   const bool by_voxel = voxel_count >= 3;
   std::uniform_int_distribution<int> pick_voxel(0, std::max(0, voxel_count - 1));
   const auto row_in = [&](int voxel) {
-    const std::vector<int>& rows = rows_of[voxel];
-    return rows[std::uniform_int_distribution<std::size_t>(0, rows.size() - 1)(rng)];
+    const std::vector<std::uint32_t>& rows = voxels[voxel];
+    return int(rows[std::uniform_int_distribution<std::size_t>(0, rows.size() - 1)(rng)]);
   };
   std::vector<int> best;
   std::vector<int> consensus;
@@ -185,15 +172,13 @@ EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOp
   // RANSAC over 3-point draws, keeping the largest consensus set.
   result.ransac_iterations = RansacIterations(options.outlier_probability,
                                               options.success_probability);
-  std::vector<int> voxel_ids;
-  int voxel_count = 0;
+  std::vector<std::vector<std::uint32_t>> voxels;
   if (options.consensus_voxel > 0.0) {
     std::vector<Eigen::Vector3d> positions(n);
     for (int k = 0; k < n; ++k) positions[k] = scan.points[gated[k]].position;
-    voxel_ids = VoxelIds(positions, options.consensus_voxel, voxel_count);
+    voxels = GroupByVoxel(positions, options.consensus_voxel);
   }
-  const std::vector<int> best =
-      LargestConsensus(H, y, options, result.ransac_iterations, gate, voxel_ids, voxel_count);
+  const std::vector<int> best = LargestConsensus(H, y, options, result.ransac_iterations, gate, voxels);
   if (best.size() < 3) {
     result.reason = gate ? "RANSAC found no consensus of 3 or more points within the prediction gate"
                          : "RANSAC found no consensus of 3 or more points";

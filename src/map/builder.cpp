@@ -27,19 +27,6 @@ std::vector<std::string> MapBuilderNames() { return NamesOf(kBuilderNames); }
 
 namespace {
 
-// Points grouped by voxel: (key, point index) sorted.
-std::vector<std::pair<VoxelKey, std::uint32_t>> SortedByVoxel(
-    const std::vector<Eigen::Vector3d>& points, double voxel) {
-  std::vector<std::pair<VoxelKey, std::uint32_t>> keyed(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    keyed[i] = {VoxelOf(points[i], voxel), static_cast<std::uint32_t>(i)};
-  }
-  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) {
-    return a.first < b.first || (a.first == b.first && a.second < b.second);
-  });
-  return keyed;
-}
-
 // Mean and (ML) covariance of the points listed by `members`, clamped.
 Gaussian FitGaussian(const std::vector<Eigen::Vector3d>& points,
                      const std::vector<std::uint32_t>& members, double min_std) {
@@ -209,20 +196,11 @@ std::vector<Gaussian> HardEm(const std::vector<Eigen::Vector3d>& points,
 
 std::vector<Gaussian> VoxelGaussians(const std::vector<Eigen::Vector3d>& points,
                                      const GaussianMapOptions& options) {
-  const auto keyed = SortedByVoxel(points, options.ndt_voxel);
   std::vector<Gaussian> gaussians;
-  std::vector<std::uint32_t> members;
-  for (std::size_t begin = 0; begin < keyed.size();) {
-    std::size_t end = begin;
-    members.clear();
-    while (end < keyed.size() && keyed[end].first == keyed[begin].first) {
-      members.push_back(keyed[end].second);
-      ++end;
-    }
+  for (const std::vector<std::uint32_t>& members : GroupByVoxel(points, options.ndt_voxel)) {
     if (int(members.size()) >= options.ndt_min_points) {
       gaussians.push_back(FitGaussian(points, members, options.min_std));
     }
-    begin = end;
   }
   return gaussians;
 }
@@ -241,6 +219,20 @@ void ValidateOptions(const GaussianMapOptions& o) {
 }
 
 }  // namespace
+
+std::vector<std::vector<std::uint32_t>> GroupByVoxel(const std::vector<Eigen::Vector3d>& points, double voxel) {
+  std::vector<std::pair<VoxelKey, std::uint32_t>> keyed(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) keyed[i] = {VoxelOf(points[i], voxel), std::uint32_t(i)};
+  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) {
+    return a.first < b.first || (a.first == b.first && a.second < b.second);
+  });
+  std::vector<std::vector<std::uint32_t>> groups;
+  for (std::size_t k = 0; k < keyed.size(); ++k) {
+    if (k == 0 || !(keyed[k].first == keyed[k - 1].first)) groups.emplace_back();
+    groups.back().push_back(keyed[k].second);
+  }
+  return groups;
+}
 
 std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points, double voxel,
                                              VoxelOrder order) {

@@ -52,6 +52,10 @@ std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
                                      const ProgressCallback& progress = {},
                                      std::vector<int>* association = nullptr);
 
+// The indices of `points` grouped by voxel of edge `voxel`: groups in voxel
+// key order, indices ascending within each.
+std::vector<std::vector<std::uint32_t>> GroupByVoxel(const std::vector<Eigen::Vector3d>& points, double voxel);
+
 // Centroids of the occupied voxels of edge `voxel` (non-finite points
 // skipped), ordered by voxel key or, cheaper, by each voxel's first point.
 enum class VoxelOrder { kByKey, kFirstPoint };
