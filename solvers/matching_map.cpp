@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "radargauss/map/builder.hpp"
 #include "radargauss/names.hpp"
 
 namespace radargauss {
@@ -36,11 +37,12 @@ Gaussian MergeOf(const std::vector<Gaussian>& gaussians, const std::vector<std::
 // One Gaussian per voxel of side `cell` (the voxel of its mean), in voxel
 // order: the mixture of the Gaussians whose means fall in it.
 std::vector<Gaussian> MergedGaussians(const std::vector<Gaussian>& gaussians, double cell) {
-  std::map<VoxelKey, std::vector<std::uint32_t>> voxels;
-  for (std::size_t i = 0; i < gaussians.size(); ++i) voxels[VoxelOf(gaussians[i].mean, cell)].push_back(std::uint32_t(i));
+  std::vector<Eigen::Vector3d> means(gaussians.size());
+  for (std::size_t i = 0; i < gaussians.size(); ++i) means[i] = gaussians[i].mean;
+  const std::vector<std::vector<std::uint32_t>> voxels = GroupByVoxel(means, cell);
   std::vector<Gaussian> merged;
   merged.reserve(voxels.size());
-  for (const auto& [key, members] : voxels) merged.push_back(MergeOf(gaussians, members));
+  for (const std::vector<std::uint32_t>& members : voxels) merged.push_back(MergeOf(gaussians, members));
   return merged;
 }
 
