@@ -122,6 +122,9 @@ cp "$work/backwards/ars548/points/$second" "$work/backwards/ars548/points/${seco
 expect_fail "odometry on a scan folder with a repeated stamp" "does not increase" -- \
   "$tool" odometry --sequence "$work/backwards" --out "$work/odometry_backwards"
 [[ ! -e "$work/odometry_backwards/odometry.tum" ]] || { echo "FAIL: a failed odometry left outputs"; failed=1; }
+expect_fail "odometry with a missing reference" "cannot open" -- \
+  "$tool" odometry --sequence "$work/seq10" --gt "$work/absent.tum" --out "$work/odometry_nogt"
+[[ ! -e "$work/odometry_nogt" ]] || { echo "FAIL: odometry with a bad reference left its output folder"; failed=1; }
 expect_fail "odometry with RCS weights on a sequence without RCS" "has no RCS field" -- \
   "$tool" odometry --sequence "$work/seq10" --rcs-field none --w-rcs 0.25 --out "$work/odometry_rcs"
 expect_fail "odometry with a NaN velocity weight" "velocity-weight" -- \

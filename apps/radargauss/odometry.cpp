@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "commands.hpp"
 #include "radargauss/error.hpp"
@@ -82,6 +83,13 @@ int RunOdometry(const OdometrySettings& s) {
   if (s.max_scans > 0 && sequence.scans.size() > s.max_scans) sequence.scans.resize(s.max_scans);
   if (sequence.scans.empty()) throw DataError("the sequence has no scans");
   CheckRcsWeights(sequence, {options.match.matching.w_rcs});
+  // The reference is read before the run, and the evaluation made before any
+  // output is written: a bad reference fails early and leaves nothing behind.
+  std::optional<Trajectory> reference;
+  if (!s.sequence.ground_truth.empty()) {
+    reference = ReadRadarTrajectory(s.sequence.ground_truth,
+                                    ResolveExtrinsic(s.sequence.extrinsic, s.sequence.ground_truth));
+  }
   RadarOdometry odometry(options);
   if (!s.imu_topic.empty()) {
     const std::vector<GyroSample> gyro = GyroOf(s);
@@ -99,16 +107,13 @@ int RunOdometry(const OdometrySettings& s) {
   }
   bar.Update("odometry", sequence.scans.size(), sequence.scans.size());
   bar.Finish();
+  std::optional<Evaluation> evaluation;
+  if (reference) evaluation = EvaluateTrajectory(odometry.trajectory(), *reference);
   WriteOdometry(s.out, odometry);
   PrintSummary(Summarise(odometry));
-  if (!s.sequence.ground_truth.empty()) {
-    const Trajectory reference =
-        ReadTum(s.sequence.ground_truth).RightMultiplied(ResolveExtrinsic(s.sequence.extrinsic, s.sequence.ground_truth));
-    const Evaluation e = EvaluateTrajectory(odometry.trajectory(), reference);
-    std::printf("%s", WriteEvaluation(s.out, e).c_str());
-  }
+  if (evaluation) std::printf("%s", WriteEvaluation(s.out, *evaluation).c_str());
   std::printf("wrote %s (odometry.tum, per_scan.csv, summary.json, map.rgm, map.ply%s)\n", s.out.c_str(),
-              s.sequence.ground_truth.empty() ? "" : ", evaluation.json, evaluation.md");
+              evaluation ? ", evaluation.json, evaluation.md" : "");
   return 0;
 }
 

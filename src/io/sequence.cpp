@@ -33,6 +33,12 @@ SE3d SnailRadar20231213Extrinsic() {
   return T_body_xt32.Inverse() * T_body_ars548;
 }
 
+Trajectory ReadRadarTrajectory(const std::string& ground_truth, const SE3d& extrinsic) {
+  const Trajectory trajectory = ReadTum(ground_truth);
+  if (trajectory.size() < 2) throw FileError(ground_truth, "needs at least 2 poses");
+  return trajectory.RightMultiplied(extrinsic);
+}
+
 SE3d ResolveExtrinsic(const std::string& spec, const std::string& ground_truth_path) {
   if (spec == "identity") return SE3d();
   if (spec == "snail-20231213") return SnailRadar20231213Extrinsic();
@@ -167,9 +173,7 @@ Sequence LoadSequence(const SequenceOptions& options) {
     return sequence;
   }
   sequence.extrinsic = ResolveExtrinsic(options.extrinsic, options.ground_truth);
-  const Trajectory ground_truth = ReadTum(options.ground_truth);
-  if (ground_truth.size() < 2) throw FileError(options.ground_truth, "needs at least 2 poses");
-  sequence.trajectory = ground_truth.RightMultiplied(sequence.extrinsic);
+  sequence.trajectory = ReadRadarTrajectory(options.ground_truth, sequence.extrinsic);
   for (std::size_t i = 0; i < scans.size(); ++i) {
     const std::optional<SE3d> pose = sequence.trajectory.Interpolate(scans[i].timestamp);
     if (!pose) {

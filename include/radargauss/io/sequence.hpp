@@ -51,6 +51,10 @@ Sequence LoadSequence(const SequenceOptions& options);
 // T_xt32_ars548 of the Snail-Radar 2023-12-13 sequences (docs/design.md, "Data in and out").
 SE3d SnailRadar20231213Extrinsic();
 
+// A ground-truth TUM file as T_world_radar samples (times the extrinsic
+// T_gt_radar), as LoadSequence reads it; throws DataError for a bad file or
+// fewer than 2 poses.
+Trajectory ReadRadarTrajectory(const std::string& ground_truth, const SE3d& extrinsic);
 // Resolves SequenceOptions::extrinsic; throws DataError for an unknown preset
 // or a malformed file.
 SE3d ResolveExtrinsic(const std::string& spec, const std::string& ground_truth_path);
