@@ -175,7 +175,7 @@ TEST(LocalMap, RegionFitIsTheBuildMapEstimator) {
   LocalMapOptions options;
   options.region = 50.0;  // one region holds them all
   LocalMap map(options);
-  map.Insert(points, {}, false, SE3d());
+  map.Insert(points, {}, SE3d());
   const std::vector<Gaussian> expected = BuildGaussians(points, options.gaussians);
   const GaussianMap global = map.GlobalMap();
   ASSERT_EQ(global.gaussians.size(), expected.size());
@@ -199,7 +199,7 @@ TEST(LocalMap, ActiveRadiusBoundsTheMap) {
     const Eigen::Vector3d position(2.0 * step, 0.0, 0.0);
     std::vector<Eigen::Vector3d> points;
     for (int k = 0; k < 200; ++k) points.emplace_back(position.x() + spread(rng), spread(rng), 0.2 * spread(rng));
-    map.Insert(points, {}, false, SE3d(SO3d(), position));
+    map.Insert(points, {}, SE3d(SO3d(), position));
     map.Evict(position);
     largest = std::max(largest, map.gaussians());
     for (const Gaussian& g : map.GlobalMap().gaussians) ASSERT_TRUE(g.mean.allFinite());

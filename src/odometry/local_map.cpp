@@ -41,7 +41,8 @@ std::uint32_t LocalMap::NewSlot() {
 }
 
 std::size_t LocalMap::Insert(const std::vector<Eigen::Vector3d>& points, const std::vector<double>& rcs,
-                             bool has_rcs, const SE3d& pose) {
+                             const SE3d& pose) {
+  const bool has_rcs = !rcs.empty();
   if (has_rcs && rcs.size() != points.size()) throw std::invalid_argument("LocalMap::Insert: one RCS per point");
   const std::uint32_t pose_id = std::uint32_t(poses_.size());
   poses_.push_back(pose);

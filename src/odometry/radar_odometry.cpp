@@ -223,9 +223,9 @@ void RadarOdometry::UpdateMap(const RadarScan& scan, const std::vector<std::size
   points.reserve(static_points.size());
   for (const std::size_t i : static_points) {
     points.push_back(step.pose * scan.points[i].position);
-    rcs.push_back(scan.points[i].rcs);
+    if (scan.has_rcs) rcs.push_back(scan.points[i].rcs);
   }
-  map_.Insert(points, rcs, scan.has_rcs, step.pose);
+  map_.Insert(points, rcs, step.pose);
   map_.Evict(step.pose.translation());
   last_keyframe_ = step.pose;
   step.keyframe = true;

@@ -44,11 +44,10 @@ class LocalMap {
  public:
   explicit LocalMap(const LocalMapOptions& options = {});
 
-  // Adds `points` (world frame; rcs[i] in dBsm when has_rcs) seen from `pose`
-  // (T_world_radar), then refits the regions that gained enough. Returns the
-  // number of regions refitted.
-  std::size_t Insert(const std::vector<Eigen::Vector3d>& points, const std::vector<double>& rcs, bool has_rcs,
-                     const SE3d& pose);
+  // Adds `points` (world frame; rcs[i] in dBsm, or `rcs` empty when the scan
+  // has none) seen from `pose` (T_world_radar), then refits the regions that
+  // gained enough. Returns the number of regions refitted.
+  std::size_t Insert(const std::vector<Eigen::Vector3d>& points, const std::vector<double>& rcs, const SE3d& pose);
   // Hands the regions whose centre lies beyond the active radius of
   // `position` to the global map. Returns how many left.
   std::size_t Evict(const Eigen::Vector3d& position);
