@@ -110,12 +110,16 @@ ScanMatchingResult PclPeerMatcher::Match(const RadarScan& scan, const MatchingMa
   registration->align(aligned, guess.cast<float>());
   Eigen::Matrix4d T = registration->getFinalTransformation().cast<double>();
   T.topRightCorner<3, 1>() += origin;
-  if (T.allFinite()) {
+  // PCL stops at its iteration limit as converged: not converging is a
+  // failure (NDT over a target too sparse for its grid, a divergence), whose
+  // transformation is no result. The pose stays where the match began.
+  result.converged = registration->hasConverged() && T.allFinite();
+  if (result.converged) {
     Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
     result.pose = SE3d(SO3d::FromMatrix(R), T.topRightCorner<3, 1>());
+  } else {
+    result.reason = "PCL registration did not converge";
   }
-  result.converged = registration->hasConverged() && T.allFinite();
-  if (!result.converged) result.reason = "PCL registration did not converge";
   result.final_cost = registration->getFitnessScore();
   if (impl_->method == PclMethod::kNdt) {
     result.iterations = static_cast<pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ>*>(

@@ -3,12 +3,12 @@
 """Odometry figures of bench/RESULTS.md, "Odometry": `radargauss odometry` on
 the NTU Eagle sample, the demo's simulated sequence and a 3000-scan
 simulated drive, for w_rcs 0 and 0.25 (simulated: RCS) and the velocity
-term on and off, one thread. Prints a Markdown table: RPE (10-50 % of the
+term on and off, and with --pcl the PCL peers as the loop's matcher, one thread. Prints a Markdown table: RPE (10-50 % of the
 path; translation and horizontal %, deg/m), ATE RMSE, per-scan time
 (median, p90), peak memory, and for the long drive the first and last
 tenth's median time and active map size.
 
-    scripts/odometry_table.py [--tool build/release/bin/radargauss] [--work /tmp/odometry_table] [--quick]
+    scripts/odometry_table.py [--tool build/release/bin/radargauss] [--work /tmp/odometry_table] [--quick] [--pcl]
 """
 import argparse
 import csv
@@ -48,6 +48,7 @@ def main():
     parser.add_argument("--tool", default=os.path.join(ROOT, "build", "release", "bin", "radargauss"))
     parser.add_argument("--work", default="/tmp/odometry_table")
     parser.add_argument("--quick", action="store_true", help="the demo sequence only")
+    parser.add_argument("--pcl", action="store_true", help="rows with pcl-ndt and pcl-gicp as the matcher")
     args = parser.parse_args()
     tool = [args.tool, "--threads", "1"]
     os.makedirs(args.work, exist_ok=True)
@@ -62,23 +63,25 @@ def main():
             sets.insert(0, ("NTU Eagle sample", ["--config", os.path.join(ROOT, "configs", "ntu_eagle_odometry.yaml"),
                                                  "--sequence", os.path.join(NTU, "points"),
                                                  "--gt", os.path.join(NTU, "gt_tum.txt")], False))
-    print("| data | w_rcs | velocity term | RPE t % | RPE horizontal % | RPE r deg/m | ATE t RMSE m "
+    print("| data | matcher | w_rcs | velocity term | RPE t % | RPE horizontal % | RPE r deg/m | ATE t RMSE m "
           "| ms/scan median | p90 | peak MB | first / last tenth: ms, active map MB |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for label, flags, has_rcs in sets:
-        for w in ([0, 0.25] if has_rcs else [0]):
-            for velocity in (1, 0):
-                out = os.path.join(args.work, f"{label.split()[0]}-w{w}-v{velocity}")
-                peak = run(tool + ["odometry"] + flags + ["--w-rcs", str(w), "--velocity-weight", str(velocity),
-                                                          "--out", out])
-                e = json.load(open(os.path.join(out, "evaluation.json")))
-                s = json.load(open(os.path.join(out, "summary.json")))
-                t0, t1, m0, m1 = tenths(out)
-                rpe = e["rpe"]
-                print(f"| {label} | {w} | {'on' if velocity else 'off'} | {rpe['translation_percent']:.2f} "
-                      f"| {rpe['horizontal_percent']:.2f} | {rpe['rotation_deg_per_m']:.4f} "
-                      f"| {e['ate_translation_m']['rmse']:.3f} | {s['median_time_ms']:.2f} | {s['p90_time_ms']:.2f} "
-                      f"| {peak:.0f} | {t0:.2f} / {t1:.2f} ms, {m0:.1f} / {m1:.1f} MB |", flush=True)
+        runs = [("gaussians", w, velocity) for w in ([0, 0.25] if has_rcs else [0]) for velocity in (1, 0)]
+        if args.pcl:
+            runs += [("pcl-ndt", 0, 0), ("pcl-gicp", 0, 0)]
+        for matcher, w, velocity in runs:
+            out = os.path.join(args.work, f"{label.split()[0]}-{matcher}-w{w}-v{velocity}")
+            peak = run(tool + ["odometry"] + flags + ["--matcher", matcher, "--w-rcs", str(w),
+                                                      "--velocity-weight", str(velocity), "--out", out])
+            e = json.load(open(os.path.join(out, "evaluation.json")))
+            s = json.load(open(os.path.join(out, "summary.json")))
+            t0, t1, m0, m1 = tenths(out)
+            rpe = e["rpe"]
+            print(f"| {label} | {matcher} | {w} | {'on' if velocity else 'off'} | {rpe['translation_percent']:.2f} "
+                  f"| {rpe['horizontal_percent']:.2f} | {rpe['rotation_deg_per_m']:.4f} "
+                  f"| {e['ate_translation_m']['rmse']:.3f} | {s['median_time_ms']:.2f} | {s['p90_time_ms']:.2f} "
+                  f"| {peak:.0f} | {t0:.2f} / {t1:.2f} ms, {m0:.1f} / {m1:.1f} MB |", flush=True)
 
 
 if __name__ == "__main__":

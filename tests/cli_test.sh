@@ -122,6 +122,13 @@ cp "$work/backwards/ars548/points/$second" "$work/backwards/ars548/points/${seco
 expect_fail "odometry on a scan folder with a repeated stamp" "does not increase" -- \
   "$tool" odometry --sequence "$work/backwards" --out "$work/odometry_backwards"
 [[ ! -e "$work/odometry_backwards/odometry.tum" ]] || { echo "FAIL: a failed odometry left outputs"; failed=1; }
+if "$tool" odometry --sequence "$work/seq10" --matcher pcl-gicp --max-scans 2 --out "$work/odometry_probe" \
+     2>&1 | grep -q "RADARGAUSS_WITH_PCL"; then
+  echo "skip: radargauss built without PCL"
+else
+  expect_ok "odometry with PCL GICP as the loop's matcher" "wrote $work/odometry_gicp" -- \
+    "$tool" odometry --sequence "$work/seq10" --matcher pcl-gicp --out "$work/odometry_gicp"
+fi
 expect_fail "odometry with a missing reference" "cannot open" -- \
   "$tool" odometry --sequence "$work/seq10" --gt "$work/absent.tum" --out "$work/odometry_nogt"
 [[ ! -e "$work/odometry_nogt" ]] || { echo "FAIL: odometry with a bad reference left its output folder"; failed=1; }

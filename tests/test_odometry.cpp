@@ -152,6 +152,28 @@ TEST(RadarOdometry, ScansWithoutVelocityGiveAReasonAndAPredictedPose) {
   EXPECT_LT(off(odometry.steps().back(), 59), 0.5);
 }
 
+// Another matcher in the same loop: the factory's matcher makes every match,
+// and one that wraps the default gives the default's trajectory.
+TEST(RadarOdometry, MatchesWithTheFactorysMatcher) {
+  const SimulatedSequence& drive = Drive();
+  std::size_t calls = 0;
+  RadarOdometry wrapped(StartingAtTruth(drive), [&calls](const LocalMap&, const MatchOptions& match) {
+    ++calls;
+    return std::shared_ptr<const ScanMatcher>(MakeScanMatcher(match));
+  });
+  RadarOdometry plain(StartingAtTruth(drive));
+  std::size_t matches = 0;
+  for (std::size_t k = 0; k < 30; ++k) {
+    wrapped.Register(drive.scans[k]);
+    plain.Register(drive.scans[k]);
+    matches += wrapped.steps().back().iterations > 0;
+    ASSERT_EQ(wrapped.steps().back().pose.translation(), plain.steps().back().pose.translation()) << k;
+  }
+  EXPECT_EQ(calls, matches);
+  EXPECT_GT(calls, 25u);
+  EXPECT_THROW(RadarOdometry(OdometryOptions(), MatcherFactory()), std::invalid_argument);
+}
+
 TEST(RadarOdometry, RefusesStampsThatDoNotIncrease) {
   const SimulatedSequence& drive = Drive();
   RadarOdometry odometry;

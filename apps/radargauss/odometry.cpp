@@ -14,6 +14,9 @@
 #include "radargauss/names.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/progress.hpp"
+#ifdef RADARGAUSS_HAVE_PCL
+#include "radargauss/peers/pcl_peers.hpp"
+#endif
 
 namespace radargauss::cli {
 
@@ -31,7 +34,35 @@ struct OdometrySettings {
   std::string imu_stamps = "header";
   std::vector<double> imu_rotation = {0, 0, 0, 1};  // q_radar_imu (x y z w)
   std::size_t max_scans = 0;
+  std::string matcher = "gaussians";  // or a PCL peer
 };
+
+// The step's matcher: the Gaussian solvers, or a PCL peer over the active
+// map's points, made again only when the map changed.
+MatcherFactory MatcherOf(const std::string& matcher) {
+  if (matcher == "gaussians") {
+    return [](const LocalMap&, const MatchOptions& match) {
+      return std::shared_ptr<const ScanMatcher>(MakeScanMatcher(match));
+    };
+  }
+#ifdef RADARGAUSS_HAVE_PCL
+  const PclMethod method = matcher == "pcl-ndt" ? PclMethod::kNdt : PclMethod::kGicp;
+  struct Cache {
+    std::size_t version = 0;
+    std::shared_ptr<const ScanMatcher> matcher;
+  };
+  auto cache = std::make_shared<Cache>();
+  return [method, cache](const LocalMap& map, const MatchOptions&) {
+    if (!cache->matcher || cache->version != map.version()) {
+      cache->matcher = std::make_shared<PclPeerMatcher>(method, map.ActivePoints());
+      cache->version = map.version();
+    }
+    return cache->matcher;
+  };
+#else
+  throw DataError("--matcher " + matcher + " needs radargauss built with RADARGAUSS_WITH_PCL");
+#endif
+}
 
 OdometryOptions Resolved(const OdometrySettings& s) {
   OdometryOptions o = s.odometry;
@@ -90,7 +121,7 @@ int RunOdometry(const OdometrySettings& s) {
     reference = ReadRadarTrajectory(s.sequence.ground_truth,
                                     ResolveExtrinsic(s.sequence.extrinsic, s.sequence.ground_truth));
   }
-  RadarOdometry odometry(options);
+  RadarOdometry odometry(options, MatcherOf(s.matcher));
   if (!s.imu_topic.empty()) {
     const std::vector<GyroSample> gyro = GyroOf(s);
     CheckOverlap(gyro, sequence);
@@ -122,6 +153,11 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   const CLI::Validator& finite = FiniteNumber();
   app->add_option("--solver", s.solver, "Scan matcher: gn (own Gauss-Newton), gn-autodiff, ceres, ceres-dogleg, mh-gn")
       ->check(CLI::IsMember(ScanMatcherNames()))
+      ->capture_default_str();
+  app->add_option("--matcher", s.matcher,
+                  "gaussians (the Gaussian-RCS map and --solver), or pcl-ndt / pcl-gicp on the active map's points "
+                  "(no w_rcs, no velocity term; needs PCL)")
+      ->check(CLI::IsMember({"gaussians", "pcl-ndt", "pcl-gicp"}))
       ->capture_default_str();
   app->add_option("--w-rcs", o.match.matching.w_rcs, "Weight w_rcs of eq. 2 (0..1)")
       ->check(CLI::Range(0.0, 1.0) & finite)

@@ -79,6 +79,7 @@ std::size_t LocalMap::Insert(const std::vector<Eigen::Vector3d>& points, const s
     ++refitted;
   }
   if (!changed.empty() || !removed.empty()) matching_->Update(changed, removed);
+  ++version_;  // the points changed, refitted or not
   return refitted;
 }
 
@@ -138,6 +139,7 @@ std::size_t LocalMap::Evict(const Eigen::Vector3d& position) {
     ++left;
   }
   if (!removed.empty()) matching_->Update({}, removed);
+  if (left > 0) ++version_;
   return left;
 }
 
@@ -145,6 +147,13 @@ std::size_t LocalMap::points() const {
   std::size_t n = 0;
   for (const auto& entry : regions_) n += entry.second.points.size();
   return n;
+}
+
+std::vector<Eigen::Vector3d> LocalMap::ActivePoints() const {
+  std::vector<Eigen::Vector3d> all;
+  all.reserve(points());
+  for (const auto& entry : regions_) all.insert(all.end(), entry.second.points.begin(), entry.second.points.end());
+  return all;
 }
 
 GaussianMap LocalMap::GlobalMap() const {

@@ -31,8 +31,15 @@ void ValidateOptions(const OdometryOptions& o) {
   ValidateOptions(o.map);
 }
 
-RadarOdometry::RadarOdometry(const OdometryOptions& options) : options_(options), map_(options.map) {
+RadarOdometry::RadarOdometry(const OdometryOptions& options)
+    : RadarOdometry(options, [](const LocalMap&, const MatchOptions& match) {
+        return std::shared_ptr<const ScanMatcher>(MakeScanMatcher(match));
+      }) {}
+
+RadarOdometry::RadarOdometry(const OdometryOptions& options, MatcherFactory matcher)
+    : options_(options), matcher_(std::move(matcher)), map_(options.map) {
   ValidateOptions(options_);
+  if (!matcher_) throw std::invalid_argument("RadarOdometry needs a matcher factory");
 }
 
 void RadarOdometry::AddGyro(const std::vector<GyroSample>& samples) {
@@ -191,7 +198,7 @@ void RadarOdometry::Match(const RadarScan& scan, const std::vector<std::size_t>&
     prior.weight = options_.velocity_weight;
     match.matching.velocity = prior;
   }
-  const ScanMatchingResult result = MakeScanMatcher(match)->Match(matched, map_.matching(), step.pose);
+  const ScanMatchingResult result = matcher_(map_, match)->Match(matched, map_.matching(), step.pose);
   step.iterations = result.iterations;
   step.final_cost = result.final_cost;
   step.converged = result.converged;

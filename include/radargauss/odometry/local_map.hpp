@@ -56,6 +56,10 @@ class LocalMap {
   std::size_t gaussians() const { return matching_->indexed(); }  // in the active map
   std::size_t regions() const { return regions_.size(); }
   std::size_t points() const;
+  // The active regions' points (world frame), in region order.
+  std::vector<Eigen::Vector3d> ActivePoints() const;
+  // Changes with every Insert or Evict that changed the map.
+  std::size_t version() const { return version_; }
   // The Gaussians that left the active map, then the active ones.
   GaussianMap GlobalMap() const;
   std::size_t global_gaussians() const { return evicted_.size() + gaussians(); }
@@ -84,6 +88,7 @@ class LocalMap {
   std::map<VoxelKey, Region> regions_;
   std::vector<SE3d> poses_;                 // the poses points were inserted from
   std::vector<Gaussian> evicted_;           // the global map's Gaussians that left
+  std::size_t version_ = 0;
 };
 
 }  // namespace radargauss

@@ -12,6 +12,8 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -88,9 +90,17 @@ struct GyroSample {
   Eigen::Vector3d rate = Eigen::Vector3d::Zero();
 };
 
+// The scan matcher of one step, for the active map and the step's options
+// (the velocity term included): by default MakeScanMatcher(options). Another
+// factory puts other matchers (the PCL peers) in the same loop, map policy
+// and Doppler filter; it may keep one matcher per LocalMap::version().
+using MatcherFactory =
+    std::function<std::shared_ptr<const ScanMatcher>(const LocalMap& map, const MatchOptions& options)>;
+
 class RadarOdometry {
  public:
   explicit RadarOdometry(const OdometryOptions& options = {});
+  RadarOdometry(const OdometryOptions& options, MatcherFactory matcher);
 
   // Registers the next scan. Throws DataError when its stamp is not after the
   // previous one's or is not finite; every other fault becomes a reason.
@@ -125,6 +135,7 @@ class RadarOdometry {
   void UpdateMap(const RadarScan& scan, const std::vector<std::size_t>& static_points, OdometryStep& step);
 
   OdometryOptions options_;
+  MatcherFactory matcher_;
   LocalMap map_;
   std::vector<OdometryStep> steps_;
   std::vector<GyroSample> gyro_;
