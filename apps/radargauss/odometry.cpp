@@ -70,6 +70,7 @@ OdometryOptions Resolved(const OdometrySettings& s) {
   o.match.matching.geometric_loss.type = LossTypeFromString(s.loss);
   o.map.rcs.incidence = IncidenceModelFromString(s.incidence);
   o.map.matching.coarse = CoarseLevelsFromString(s.coarse_levels);
+  if (o.map.matching.inflation == std::vector<double>{0.0}) o.map.matching.inflation.clear();  // the exact map alone
   return o;
 }
 
@@ -148,6 +149,40 @@ int RunOdometry(const OdometrySettings& s) {
   return 0;
 }
 
+// The local map's flags (docs/design.md, "Odometry").
+void AddLocalMapOptions(CLI::App* app, OdometrySettings& s, const CLI::Validator& finite) {
+  OdometryOptions& o = s.odometry;
+  app->add_option("--active-radius", o.map.active_radius, "Radius of the active map around the radar (m)")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--region", o.map.region, "Edge of the map regions fitted together (m)")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--region-capacity", o.map.region_capacity, "Points a region keeps (the newest)")
+      ->check(CLI::Range(4, 1000000))
+      ->capture_default_str();
+  app->add_option("--refit-growth", o.map.refit_growth, "Refit a region once its new points reach this share")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--points-per-gaussian", o.map.gaussians.points_per_gaussian, "K = round(N_downsampled / this)")
+      ->check(CLI::Range(1.0, 1e6))
+      ->capture_default_str();
+  app->add_option("--min-std", o.map.gaussians.min_std, "Minimum principal std of a Gaussian (m)")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+  app->add_option("--coarse-levels", s.coarse_levels, "Coarse levels: merged or inflated")
+      ->check(CLI::IsMember(CoarseLevelsNames()))
+      ->capture_default_str();
+  app->add_option("--coarse-sigmas", o.map.matching.inflation,
+                  "Blur sigma_k of the coarse levels (m), coarse first; 0: the exact map alone")
+      ->expected(1, 8)
+      ->check(CLI::NonNegativeNumber & finite)
+      ->capture_default_str();
+  app->add_option("--index-cell", o.map.matching.index_cell, "Cell of the active map's spatial index (m)")
+      ->check(CLI::PositiveNumber & finite)
+      ->capture_default_str();
+}
+
 void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   OdometryOptions& o = s.odometry;
   const CLI::Validator& finite = FiniteNumber();
@@ -191,27 +226,7 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   app->add_option("--keyframe-angle", o.keyframe_angle_deg, "... or this rotation (deg) since the last keyframe")
       ->check(CLI::NonNegativeNumber & finite)
       ->capture_default_str();
-  app->add_option("--active-radius", o.map.active_radius, "Radius of the active map around the radar (m)")
-      ->check(CLI::PositiveNumber & finite)
-      ->capture_default_str();
-  app->add_option("--region", o.map.region, "Edge of the map regions fitted together (m)")
-      ->check(CLI::PositiveNumber & finite)
-      ->capture_default_str();
-  app->add_option("--region-capacity", o.map.region_capacity, "Points a region keeps (the newest)")
-      ->check(CLI::Range(4, 1000000))
-      ->capture_default_str();
-  app->add_option("--refit-growth", o.map.refit_growth, "Refit a region once its new points reach this share")
-      ->check(CLI::PositiveNumber & finite)
-      ->capture_default_str();
-  app->add_option("--points-per-gaussian", o.map.gaussians.points_per_gaussian, "K = round(N_downsampled / this)")
-      ->check(CLI::Range(1.0, 1e6))
-      ->capture_default_str();
-  app->add_option("--min-std", o.map.gaussians.min_std, "Minimum principal std of a Gaussian (m)")
-      ->check(CLI::PositiveNumber & finite)
-      ->capture_default_str();
-  app->add_option("--coarse-levels", s.coarse_levels, "Coarse levels: merged or inflated")
-      ->check(CLI::IsMember(CoarseLevelsNames()))
-      ->capture_default_str();
+  AddLocalMapOptions(app, s, finite);
   app->add_option("--seed", o.ego_velocity.seed, "Seed of the Doppler RANSAC")->capture_default_str();
   app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
   app->add_option("--imu-stamps", s.imu_stamps, "Stamp the IMU by its header or by the bag's record time")

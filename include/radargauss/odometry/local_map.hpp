@@ -26,6 +26,17 @@
 
 namespace radargauss {
 
+// The local map's matching levels: the prediction starts a match within
+// centimetres, so one coarse level of 0.25 m suffices (three cost 2.5x the
+// map update and gained nothing, bench/RESULTS.md, "Odometry"), and 1 m index
+// cells let an update touch 8x fewer cells than 0.5 m for the same answers.
+inline MatchingMapOptions LocalMatchingMapOptions() {
+  MatchingMapOptions options;
+  options.inflation = {0.25};
+  options.index_cell = 1.0;
+  return options;
+}
+
 struct LocalMapOptions {
   double region = 4.0;                // m: edge of the cubes whose points are fitted together
   std::size_t region_capacity = 256;  // points a region keeps (the newest)
@@ -34,7 +45,7 @@ struct LocalMapOptions {
   double active_radius = 100.0;       // m: regions whose centre is farther from the radar leave
   GaussianMapOptions gaussians;       // the estimator of build-map
   RcsFitOptions rcs;                  // incidence model and SH degree of the RCS models
-  MatchingMapOptions matching;        // coarse levels and index cells (always updatable)
+  MatchingMapOptions matching = LocalMatchingMapOptions();  // coarse levels, index cells (always updatable)
 };
 
 // Throws std::invalid_argument naming the bad option.
