@@ -59,6 +59,12 @@ struct PclPeerMatcher::Impl {
   }
 };
 
+namespace {
+
+constexpr std::size_t kGicpNeighbours = 20;  // PCL's k_correspondences default, kept
+
+}  // namespace
+
 PclPeerMatcher::PclPeerMatcher(PclMethod method, const std::vector<Eigen::Vector3d>& map_cloud,
                                const PclPeerOptions& options)
     : impl_(std::make_unique<Impl>()) {
@@ -82,8 +88,11 @@ ScanMatchingResult PclPeerMatcher::Match(const RadarScan& scan, const MatchingMa
   const auto start = std::chrono::steady_clock::now();
   ScanMatchingResult result;
   result.pose = initial;
-  if (scan.points.size() < 3) {
-    result.reason = "too few points";
+  // GICP fits each point's covariance from its kGicpNeighbours nearest
+  // neighbours in either cloud, and PCL aborts the process for fewer.
+  const std::size_t needed = impl_->method == PclMethod::kGicp ? kGicpNeighbours : 3;
+  if (scan.points.size() < needed) {
+    result.reason = "too few points (" + std::to_string(scan.points.size()) + ", needs " + std::to_string(needed) + ")";
     return result;
   }
   std::shared_ptr<Registration>& registration = impl_->registrations.local();
@@ -98,8 +107,8 @@ ScanMatchingResult PclPeerMatcher::Match(const RadarScan& scan, const MatchingMa
   if (impl_->method == PclMethod::kGicp && impl_->options.gicp_local_target) {
     origin = initial.translation();
     const Cloud::Ptr local = impl_->LocalTarget(origin.cast<float>(), impl_->options.gicp_crop_radius);
-    if (local->size() < 3) {
-      result.reason = "no map points around the initial pose";
+    if (local->size() < needed) {
+      result.reason = "too few map points around the initial pose";
       return result;
     }
     registration->setInputTarget(local);
