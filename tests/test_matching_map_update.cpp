@@ -125,6 +125,30 @@ TEST(MatchingMapUpdateTest, RemovingEverythingEmptiesEveryLevel) {
   EXPECT_LT(updated.index().MemoryBytes(), full_bytes / 2);
 }
 
+// Gaussians that grow and shrink back leave the index no larger than it
+// was: a Gaussian's list of cells gives its memory back when it changes.
+TEST(MatchingMapUpdateTest, MemoryFollowsTheLiveGaussians) {
+  std::mt19937 rng(5);
+  auto map = std::make_shared<GaussianMap>();
+  for (int i = 0; i < 400; ++i) map->gaussians.push_back(RandomGaussian(rng, 30.0));
+  const std::vector<Gaussian> small = map->gaussians;
+  MatchingMapOptions options;
+  options.updatable = true;
+  MatchingMap updated(std::shared_ptr<const GaussianMap>(map), options);
+  std::vector<std::uint32_t> all;
+  for (std::uint32_t i = 0; i < 400; ++i) all.push_back(i);
+  updated.Update(all, {});  // the same Gaussians again: the steady state
+  const std::size_t small_bytes = updated.index().MemoryBytes();
+  for (Gaussian& g : map->gaussians) g.covariance *= 4.0;
+  updated.Update(all, {});
+  const std::size_t large_bytes = updated.index().MemoryBytes();
+  map->gaussians = small;
+  updated.Update(all, {});
+  updated.Update(all, {});
+  EXPECT_GT(large_bytes, 2 * small_bytes);
+  EXPECT_LT(updated.index().MemoryBytes(), small_bytes * 11 / 10);
+}
+
 TEST(MatchingMapUpdateTest, StaticMapRefusesUpdates) {
   MatchingMap map{GaussianMap()};
   EXPECT_THROW(map.Update({}, {}), std::logic_error);

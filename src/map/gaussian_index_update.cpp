@@ -61,7 +61,7 @@ void GaussianIndex::Update(const std::vector<Gaussian>& gaussians, const std::ve
     if (id >= top || leaving[id]) return;
     leaving[id] = 1;
     dirty.insert(dirty.end(), listed_cells_[id].begin(), listed_cells_[id].end());
-    listed_cells_[id] = {};  // frees its memory: a removed Gaussian may not come back
+    std::vector<std::int64_t>().swap(listed_cells_[id]);  // frees the capacity (`= {}` keeps it)
   };
   for (const std::uint32_t id : removed) leave(id);
   for (const std::uint32_t id : changed) leave(id);
