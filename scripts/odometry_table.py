@@ -1,12 +1,15 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
 """Odometry figures of bench/RESULTS.md, "Odometry": `radargauss odometry` on
-the NTU Eagle sample, the demo's simulated sequence and a 3000-scan
-simulated drive, for w_rcs 0 and 0.25 (simulated: RCS) and the velocity
-term on and off, and with --pcl the PCL peers as the loop's matcher, one thread. Prints a Markdown table: RPE (10-50 % of the
-path; translation and horizontal %, deg/m), ATE RMSE, per-scan time
-(median, p90), peak memory, and for the long drive the first and last
-tenth's median time and active map size.
+the NTU Eagle sample, the demo's simulated sequence and two simulated drives
+of 3000 scans: five laps of the demo's loop (inside the active radius, so the
+active map is the whole world) and one 1.8 km lap that leaves the radius
+behind (configs/synthetic_long_drive.yaml). For w_rcs 0 and 0.25
+(simulated: RCS), the velocity term on and off, and with --pcl the PCL peers
+as the loop's matcher, one thread. Prints a Markdown table: RPE (10-50 % of
+the path; translation and horizontal %, deg/m), ATE RMSE, per-scan time
+(median, p90), peak memory, and the first and last tenth's median time and
+active map size.
 
     scripts/odometry_table.py [--tool build/release/bin/radargauss] [--work /tmp/odometry_table] [--quick] [--pcl]
 """
@@ -53,12 +56,17 @@ def main():
     tool = [args.tool, "--threads", "1"]
     os.makedirs(args.work, exist_ok=True)
     demo, long_drive = os.path.join(args.work, "demo"), os.path.join(args.work, "long")
+    route = os.path.join(args.work, "route")
     run(tool + ["simulate", "--out", demo, "--config", os.path.join(ROOT, "configs", "synthetic_world.yaml"), "--force"])
     sets = [("demo (simulated, 300 scans)", ["--sequence", demo, "--gt", os.path.join(demo, "gt_radar_tum.txt")], True)]
     if not args.quick:
         run(tool + ["simulate", "--out", long_drive, "--scans", "3000", "--force"])
-        sets.append(("long drive (simulated, 3000 scans)",
+        sets.append(("long loop (simulated, 3000 scans, 5 laps)",
                      ["--sequence", long_drive, "--gt", os.path.join(long_drive, "gt_radar_tum.txt")], True))
+        run(tool + ["simulate", "--out", route, "--config",
+                    os.path.join(ROOT, "configs", "synthetic_long_drive.yaml"), "--force"])
+        sets.append(("route (simulated, 3000 scans, 1.8 km)",
+                     ["--sequence", route, "--gt", os.path.join(route, "gt_radar_tum.txt")], True))
         if os.path.isdir(NTU):
             sets.insert(0, ("NTU Eagle sample", ["--config", os.path.join(ROOT, "configs", "ntu_eagle_odometry.yaml"),
                                                  "--sequence", os.path.join(NTU, "points"),

@@ -12,6 +12,7 @@
 
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/io/read_file.hpp"
 
 namespace radargauss {
 
@@ -71,8 +72,7 @@ Trajectory Trajectory::RightMultiplied(const SE3d& frame_to_new) const {
 }
 
 Trajectory ReadTum(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw FileError(path, "cannot open TUM trajectory");
+  std::istringstream in(ReadFileBytes(path, "TUM trajectory"));
   Trajectory trajectory;
   std::string line;
   std::size_t line_number = 0;

@@ -153,7 +153,7 @@ TEST_F(Pcd, MalformedFilesGiveClearErrors) {
       {corrupt_lzf, "corrupt LZF"},
       {replace(compressed, "POINTS 40", "POINTS 39"), "differs from POINTS"},
       {header_ascii + "1 2 3\n", "truncated"},
-      {header_ascii + "1 2 3\n4 5\n", "has 2 values"},
+      {header_ascii + "1 2 3\n4 5   \n", "has 2 values"},
       {header_ascii + "1 2 3\n4 5 x\n", "not a number"},
       {header_ascii + "1 2 3\n4 5 nan\n", "non-finite position"},
       {header_ascii + "1 2 3\n4 5 6\n7 8 9\n", "more data lines"},

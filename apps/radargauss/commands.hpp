@@ -38,8 +38,14 @@ void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::stri
 void CheckRcsWeights(const Sequence& sequence, const std::vector<double>& weights);
 // A weight as configuration names show it (%g).
 std::string FormatWeight(double w);
-// A check that a number flag is finite (CLI11's ranges let NaN through).
+// Checks of number flags that refuse NaN and inf (CLI11's ranges let them
+// through) and state the range briefly: "[0, 1]", "(0, inf)".
 const CLI::Validator& FiniteNumber();
+CLI::Validator InRange(double lo, double hi, bool open_below = false);
+CLI::Validator Positive();
+CLI::Validator NonNegative();
+// Adds FiniteNumber to every floating-point flag of `app` and its subcommands.
+void CheckEveryNumberIsFinite(CLI::App& app);
 
 // The map-building flags of build-map and localize.
 struct MapBuildSettings {

@@ -53,7 +53,7 @@ Subcommand AddEvaluate(CLI::App& parent) {
       ->check(CLI::IsMember(AlignmentNames()))
       ->capture_default_str();
   app->add_option("--time-tolerance", s->time_tolerance, "Largest time difference of a pose pair (s)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   app->add_option("--out", s->out, "Folder for evaluation.json and evaluation.md");
   return {app, [s] { return RunEvaluate(*s); }};

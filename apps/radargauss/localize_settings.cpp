@@ -41,7 +41,7 @@ std::string Joined(const std::vector<std::string>& names, const char* separator 
 void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--w-rcs", s.w_rcs, "Weights w_rcs of eq. 2 to sweep (0..1)")
       ->delimiter(',')
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(InRange(0.0, 1.0))
       ->capture_default_str();
   app->add_option("--solver", s.solvers,
                   "Solvers: " + Joined(ScanMatcherNames()) + " (and pcl-ndt, pcl-gicp when built "
@@ -54,32 +54,32 @@ void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
       ->check(CLI::IsMember(LossNames()))
       ->capture_default_str();
   app->add_option("--loss-scale", s.loss_scale, "Scale of the geometric loss")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--rcs-loss", s.rcs_loss, "RCS loss (the paper: cauchy)")
       ->check(CLI::IsMember(LossNames()))
       ->capture_default_str();
   app->add_option("--rcs-loss-scale", s.rcs_loss_scale, "Scale of the RCS loss")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--incidences", s.incidences, "Incidence models to sweep (map built here)")
       ->delimiter(',')
       ->check(CLI::IsMember(IncidenceModelNames()));
   app->add_option("--degrees", s.degrees, "SH degrees to sweep (map built here)")
       ->delimiter(',')
-      ->check(CLI::Range(0, kMaxShDegree));
+      ->check(InRange(0, kMaxShDegree));
 }
 
 void AddInitialErrorOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--max-translation", s.max_translation, "Initial translation error bound (m)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   app->add_option("--max-rotation", s.max_rotation, "Initial rotation error bound (deg)")
-      ->check(CLI::Range(0.0, 180.0))
+      ->check(InRange(0.0, 180.0))
       ->capture_default_str();
   app->add_option("--seed", s.seed, "Seed of the initial errors")->capture_default_str();
   app->add_option("--stride", s.stride, "Match every n-th scan (the map uses all)")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
 }
 
@@ -91,14 +91,14 @@ void AddCoarseOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--coarse-voxel", s.coarse_voxel,
                   "Coarse levels match the scan's voxel centroids, voxel side this times the level's blur "
                   "(0: the points)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   app->add_option("--coarse-points", s.coarse_points, "Points used on the coarse levels (0: all)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   app->add_option("--coarse-gate", s.coarse_gate,
                   "Association gate on the coarse levels (Mahalanobis; smaller: faster, less reach)")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   app->add_flag("--loss-curvature", s.loss_curvature,
                 "Own GN: the robust losses' curvature in the Hessian instead of IRLS weights alone");

@@ -23,6 +23,16 @@ std::string ConfigSection(int argc, char** argv) {
   return {};
 }
 
+// The file given to the main app's --config, for the messages.
+std::string ConfigPath(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "--config" && i + 1 < argc) return argv[i + 1];
+    if (word.rfind("--config=", 0) == 0) return word.substr(9);
+  }
+  return "config file";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -33,19 +43,27 @@ int main(int argc, char** argv) {
                                                AddLocalize(app), AddEvaluate(app), AddRefine(app),
                                                AddOdometry(app)};
   int threads = 0;
-  app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(NonNegative());
   // info, build-map and localize read a YAML file of their flags with
   // --config (simulate's --config is the world's parameters); flags given on
   // the command line override the file.
   app.set_config("--config", "", "YAML file of the subcommand's flags (info, build-map, localize, odometry)");
-  app.config_formatter(std::make_shared<radargauss::YamlConfig>(ConfigSection(argc, argv)));
+  app.config_formatter(std::make_shared<radargauss::YamlConfig>(ConfigSection(argc, argv), ConfigPath(argc, argv)));
   app.allow_config_extras(CLI::config_extras_mode::error);
   for (const Subcommand& command : subcommands) {
     const std::string name = command.app->get_name();
     if (name == "info" || name == "build-map" || name == "localize" || name == "odometry") command.app->fallthrough();
   }
+  CheckEveryNumberIsFinite(app);
   try {
     app.parse(argc, argv);
+  } catch (const CLI::ConfigError& e) {
+    // CLI11 names the file "INI" and the key section.key.
+    const std::string extra = "INI was not able to parse ";
+    std::string what = e.what();
+    if (what.rfind(extra, 0) == 0) what = "unknown flag '" + what.substr(what.find('.') + 1) + "'";
+    std::fprintf(stderr, "radargauss: error: %s: %s\n", ConfigPath(argc, argv).c_str(), what.c_str());
+    return 2;
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }

@@ -150,25 +150,25 @@ int RunOdometry(const OdometrySettings& s) {
 }
 
 // The local map's flags (docs/design.md, "Odometry").
-void AddLocalMapOptions(CLI::App* app, OdometrySettings& s, const CLI::Validator& finite) {
+void AddLocalMapOptions(CLI::App* app, OdometrySettings& s) {
   OdometryOptions& o = s.odometry;
   app->add_option("--active-radius", o.map.active_radius, "Radius of the active map around the radar (m)")
-      ->check(CLI::PositiveNumber & finite)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--region", o.map.region, "Edge of the map regions fitted together (m)")
-      ->check(CLI::PositiveNumber & finite)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--region-capacity", o.map.region_capacity, "Points a region keeps (the newest)")
-      ->check(CLI::Range(4, 1000000))
+      ->check(InRange(4, 1000000))
       ->capture_default_str();
   app->add_option("--refit-growth", o.map.refit_growth, "Refit a region once its new points reach this share")
-      ->check(CLI::PositiveNumber & finite)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--points-per-gaussian", o.map.gaussians.points_per_gaussian, "K = round(N_downsampled / this)")
-      ->check(CLI::Range(1.0, 1e6))
+      ->check(InRange(1.0, 1e6))
       ->capture_default_str();
   app->add_option("--min-std", o.map.gaussians.min_std, "Minimum principal std of a Gaussian (m)")
-      ->check(CLI::PositiveNumber & finite)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--coarse-levels", s.coarse_levels, "Coarse levels: merged or inflated")
       ->check(CLI::IsMember(CoarseLevelsNames()))
@@ -176,16 +176,15 @@ void AddLocalMapOptions(CLI::App* app, OdometrySettings& s, const CLI::Validator
   app->add_option("--coarse-sigmas", o.map.matching.inflation,
                   "Blur sigma_k of the coarse levels (m), coarse first; 0: the exact map alone")
       ->expected(1, 8)
-      ->check(CLI::NonNegativeNumber & finite)
+      ->check(NonNegative())
       ->capture_default_str();
   app->add_option("--index-cell", o.map.matching.index_cell, "Cell of the active map's spatial index (m)")
-      ->check(CLI::PositiveNumber & finite)
+      ->check(Positive())
       ->capture_default_str();
 }
 
 void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   OdometryOptions& o = s.odometry;
-  const CLI::Validator& finite = FiniteNumber();
   app->add_option("--solver", s.solver, "Scan matcher: gn (own Gauss-Newton), gn-autodiff, ceres, ceres-dogleg, mh-gn")
       ->check(CLI::IsMember(ScanMatcherNames()))
       ->capture_default_str();
@@ -195,38 +194,38 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
       ->check(CLI::IsMember({"gaussians", "pcl-ndt", "pcl-gicp"}))
       ->capture_default_str();
   app->add_option("--w-rcs", o.match.matching.w_rcs, "Weight w_rcs of eq. 2 (0..1)")
-      ->check(CLI::Range(0.0, 1.0) & finite)
+      ->check(InRange(0.0, 1.0))
       ->capture_default_str();
   app->add_option("--loss", s.loss, "Geometric robust loss")->check(CLI::IsMember(LossNames()))->capture_default_str();
   app->add_option("--loss-scale", o.match.matching.geometric_loss.scale, "Scale of the geometric loss")
-      ->check(CLI::PositiveNumber & finite)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--incidence", s.incidence, "Incidence vector of the RCS models: offset or view")
       ->check(CLI::IsMember(IncidenceModelNames()))
       ->capture_default_str();
   app->add_option("--degree", o.map.rcs.max_degree, "SH degree of the RCS models (0..3)")
-      ->check(CLI::Range(0, kMaxShDegree))
+      ->check(InRange(0, kMaxShDegree))
       ->capture_default_str();
   app->add_option("--velocity-weight", o.velocity_weight, "Weight of the Doppler velocity term (0: off)")
-      ->check(CLI::NonNegativeNumber & finite)
+      ->check(NonNegative())
       ->capture_default_str();
   app->add_option("--velocity-floor", o.velocity_floor, "Std of the velocity term's floor Q (m)")
-      ->check(CLI::PositiveNumber & finite)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--gate-sigmas", o.gate_sigmas, "Doppler gate around the predicted velocity (sigmas)")
-      ->check(CLI::PositiveNumber & finite)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--acceleration-std", o.acceleration_std, "Process noise of the velocity (m/s^2)")
-      ->check(CLI::NonNegativeNumber & finite)
+      ->check(NonNegative())
       ->capture_default_str();
-  app->add_option("--min-gate", o.min_gate, "Smallest Doppler gate (m/s)")->check(CLI::PositiveNumber & finite)->capture_default_str();
+  app->add_option("--min-gate", o.min_gate, "Smallest Doppler gate (m/s)")->check(Positive())->capture_default_str();
   app->add_option("--keyframe-distance", o.keyframe_distance, "A scan enters the map after this distance (m) ...")
-      ->check(CLI::NonNegativeNumber & finite)
+      ->check(NonNegative())
       ->capture_default_str();
   app->add_option("--keyframe-angle", o.keyframe_angle_deg, "... or this rotation (deg) since the last keyframe")
-      ->check(CLI::NonNegativeNumber & finite)
+      ->check(NonNegative())
       ->capture_default_str();
-  AddLocalMapOptions(app, s, finite);
+  AddLocalMapOptions(app, s);
   app->add_option("--seed", o.ego_velocity.seed, "Seed of the Doppler RANSAC")->capture_default_str();
   app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
   app->add_option("--imu-stamps", s.imu_stamps, "Stamp the IMU by its header or by the bag's record time")

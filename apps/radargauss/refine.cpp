@@ -76,19 +76,19 @@ Subcommand AddRefine(CLI::App& parent) {
   app->add_option("--map", s->map_path, "Map file (.rgm)")->required();
   app->add_option("--out", s->out, "Output folder (refined.tum, refined.rgm)")->required();
   app->add_option("--w-rcs", s->refinement.matching.w_rcs, "Weight w_rcs of eq. 2 (0..1)")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(InRange(0.0, 1.0))
       ->capture_default_str();
-  app->add_option("--rounds", s->refinement.rounds, "Association rounds")->check(CLI::PositiveNumber)->capture_default_str();
+  app->add_option("--rounds", s->refinement.rounds, "Association rounds")->check(Positive())->capture_default_str();
   app->add_option("--iterations", s->refinement.max_iterations_per_round, "Ceres iterations per round")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--relative-pose-prior", s->refinement.relative_pose_prior,
                   "Weight of the input's relative poses between consecutive scans (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   app->add_option("--coefficient-prior", s->refinement.coefficient_prior,
                   "Weight of the map's SH coefficients (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   return {app, [s] { return RunRefine(*s); }};
 }

@@ -49,13 +49,42 @@ const CLI::Validator& FiniteNumber() {
   static const CLI::Validator finite(
       [](std::string& text) {
         try {
-          return std::isfinite(std::stod(text)) ? std::string() : std::string("must be finite");
+          return std::isfinite(std::stod(text)) ? std::string() : text + " is not a finite number";
         } catch (const std::exception&) {
-          return std::string("must be a number");
+          return text + " is not a number";
         }
       },
       "FINITE");
   return finite;
+}
+
+CLI::Validator InRange(double lo, double hi, bool open_below) {
+  const std::string range = (open_below ? "(" : "[") + FormatWeight(lo) + ", " +
+                            (std::isinf(hi) ? std::string("inf)") : FormatWeight(hi) + "]");
+  return CLI::Validator(
+      [=](std::string& text) {
+        double value = 0.0;
+        try {
+          value = std::stod(text);
+        } catch (const std::exception&) {
+          return text + " is not a number";
+        }
+        if (!std::isfinite(value)) return text + " is not a finite number";
+        const bool below = open_below ? value <= lo : value < lo;
+        return below || value > hi ? text + " is not in " + range : std::string();
+      },
+      range);
+}
+
+CLI::Validator Positive() { return InRange(0.0, INFINITY, true); }
+CLI::Validator NonNegative() { return InRange(0.0, INFINITY); }
+
+void CheckEveryNumberIsFinite(CLI::App& app) {
+  for (CLI::Option* option : app.get_options()) {
+    const std::string type = option->get_type_name();
+    if (type.rfind("FLOAT", 0) == 0) option->check(CLI::Validator(FiniteNumber()).description(""));
+  }
+  for (CLI::App* sub : app.get_subcommands({})) CheckEveryNumberIsFinite(*sub);
 }
 
 MapOptions MapBuildSettings::Resolved() const {
@@ -74,26 +103,26 @@ void AddMapBuildOptions(CLI::App* app, MapBuildSettings& s) {
       ->capture_default_str();
   app->add_option("--points-per-gaussian", gaussians.points_per_gaussian,
                   "K = round(N_downsampled / this) (about 4 for ARS548, 16 for Oculii Eagle)")
-      ->check(CLI::Range(1.0, 1e6))
+      ->check(InRange(1.0, 1e6))
       ->capture_default_str();
   app->add_option("--downsample", gaussians.downsample_voxel, "Voxel downsample edge (m)")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--em-iterations", gaussians.em_iterations, "Hard-EM rounds")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   app->add_option("--min-std", gaussians.min_std, "Minimum principal std of a Gaussian (m)")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--ndt-voxel", gaussians.ndt_voxel, "Voxel edge of the voxel builder (m)")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--gate", gaussians.association_gate, "Association gate tau (Mahalanobis distance)")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   app->add_option("--map-seed", gaussians.seed, "Seed of the bisecting k-means")->capture_default_str();
   app->add_option("--degree", s.map.rcs.max_degree, "SH degree of the RCS models (0..3)")
-      ->check(CLI::Range(0, kMaxShDegree))
+      ->check(InRange(0, kMaxShDegree))
       ->capture_default_str();
   app->add_option("--incidence", s.incidence, "Incidence vector: offset (paper) or view")
       ->check(CLI::IsMember(IncidenceModelNames()))

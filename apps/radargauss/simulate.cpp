@@ -50,7 +50,7 @@ Subcommand AddSimulate(CLI::App& parent) {
   app->add_option("--out", s->out, "Output folder (Snail-Radar layout)")->required();
   app->add_option("--config", s->config, "YAML parameters (see configs/synthetic_world.yaml)");
   CLI::Option* seed = app->add_option("--seed", s->seed, "Random seed");
-  app->add_option("--scans", s->scans, "Number of scans (overrides the config)")->check(CLI::PositiveNumber);
+  app->add_option("--scans", s->scans, "Number of scans (overrides the config)")->check(Positive());
   app->add_flag("--force", s->force, "Overwrite an existing sequence in --out");
   return {app, [s, seed] {
             s->seed_given = seed->count() > 0;

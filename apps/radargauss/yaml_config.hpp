@@ -21,34 +21,43 @@ namespace radargauss {
 class YamlConfig final : public CLI::Config {
  public:
   // `section`: the subcommand the keys belong to (CLI11 2.1 reads config
-  // files on the main app only, so the items are addressed to it).
-  explicit YamlConfig(std::string section) : section_(std::move(section)) {}
+  // files on the main app only, so the items are addressed to it); `path`:
+  // the file, for the messages.
+  YamlConfig(std::string section, std::string path) : section_(std::move(section)), path_(std::move(path)) {}
 
   std::string to_config(const CLI::App*, bool, bool, std::string) const override { return {}; }
 
   std::vector<CLI::ConfigItem> from_config(std::istream& input) const override {
     std::stringstream text;
-    text << input.rdbuf();
+    try {
+      text << input.rdbuf();
+    } catch (const std::exception&) {
+      throw Error("cannot be read (a directory?)");
+    }
     YAML::Node root;
     try {
       root = YAML::Load(text.str());
     } catch (const YAML::Exception& e) {
-      throw CLI::ConversionError(std::string("config file: YAML: ") + e.what());
+      throw Error("YAML: " + e.msg + " at line " + std::to_string(e.mark.line + 1));
     }
     std::vector<CLI::ConfigItem> items;
     if (root.IsNull()) return items;
-    if (!root.IsMap()) throw CLI::ConversionError("config file: expected a map of flag: value");
+    if (!root.IsMap()) throw Error("expected a map of flag: value");
     for (const auto& entry : root) {
       CLI::ConfigItem item;
       if (!section_.empty()) item.parents = {section_};
-      item.name = entry.first.as<std::string>();
       const YAML::Node& value = entry.second;
+      if (!entry.first.IsScalar()) throw Error("line " + Line(entry.first) + ": a key must be a flag name");
+      item.name = entry.first.Scalar();
       if (value.IsSequence()) {
-        for (const auto& element : value) item.inputs.push_back(element.as<std::string>());
+        for (const auto& element : value) {
+          if (!element.IsScalar()) throw Error("'" + item.name + "' (line " + Line(element) + "): a list of values");
+          item.inputs.push_back(element.Scalar());
+        }
       } else if (value.IsScalar()) {
-        item.inputs.push_back(value.as<std::string>());
+        item.inputs.push_back(value.Scalar());
       } else {
-        throw CLI::ConversionError("config file: '" + item.name + "' must be a value or a list");
+        throw Error("'" + item.name + "' must be a value or a list");
       }
       items.push_back(std::move(item));
     }
@@ -56,7 +65,11 @@ class YamlConfig final : public CLI::Config {
   }
 
  private:
+  CLI::ConversionError Error(const std::string& what) const { return CLI::ConversionError(path_ + ": " + what); }
+  static std::string Line(const YAML::Node& node) { return std::to_string(node.Mark().line + 1); }
+
   std::string section_;
+  std::string path_;
 };
 
 }  // namespace radargauss

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Writing output files so that a reader never sees a half-written file: the
 // content goes to "<path>.tmp.<pid>" and is renamed over <path> when complete.
+// The first write into a folder removes the temporaries there of processes
+// that have ended (killed during a write).
 #pragma once
 
 #include <functional>

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "radargauss/error.hpp"
+#include "radargauss/io/read_file.hpp"
 #include "radargauss/io/pcd.hpp"
 
 namespace radargauss {
@@ -35,9 +36,8 @@ std::vector<std::string> ParseBinLayout(const std::string& layout) {
 
 RadarScan ReadKittiBin(const std::string& path, const std::vector<std::string>& layout,
                        const FieldMapping& mapping) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open");
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (layout.empty()) throw std::invalid_argument("ReadKittiBin: the layout has no fields");
+  const std::string bytes = ReadFileBytes(path, "scan file");
   const std::size_t record = layout.size() * sizeof(float);
   if (bytes.size() % record != 0) {
     throw FileError(path, "truncated: " + std::to_string(bytes.size()) +

@@ -15,19 +15,12 @@
 
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/io/read_file.hpp"
 #include "pcd_header.hpp"
 
 namespace radargauss {
 
 namespace {
-
-std::string ReadWholeFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw FileError(path, "read error");
-  return bytes;
-}
 
 // Rejects POINTS that the file cannot hold before anything is allocated for
 // them (a corrupt header must not turn into a huge allocation).
@@ -39,14 +32,16 @@ void CheckSizeAgainstFile(const std::string& path, const std::string& bytes, con
   const std::size_t needed = h.points * h.point_step;
   std::size_t bound = 0;
   if (h.data == "ascii") {
-    bound = available / 2;  // at least one digit and a separator per point
+    bound = available / 2;  // at least one digit and a separator per value
   } else if (h.data == "binary") {
     bound = available;
   } else {
     // LZF expands at most ~88x (a 3-byte back-reference covers 264 bytes).
     bound = available * 100 + 1024;
   }
-  const std::size_t demand = h.data == "ascii" ? h.points : needed;
+  std::size_t values_per_point = 0;
+  for (const PcdField& f : h.fields) values_per_point += f.count;
+  const std::size_t demand = h.data == "ascii" ? h.points * values_per_point : needed;
   if (demand > bound) {
     throw FileError(path, "truncated: POINTS " + std::to_string(h.points) + " cannot fit in " +
                               std::to_string(available) + " bytes of data");
@@ -174,7 +169,7 @@ std::vector<std::string> PcdCloud::FieldNames() const {
 }
 
 PcdCloud ReadPcdCloud(const std::string& path) {
-  const std::string bytes = ReadWholeFile(path);
+  const std::string bytes = ReadFileBytes(path, "PCD file");
   PcdCloud cloud;
   cloud.header = internal::ParsePcdHeader(path, bytes);
   CheckSizeAgainstFile(path, bytes, cloud.header);

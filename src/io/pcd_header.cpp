@@ -2,6 +2,7 @@
 #include "pcd_header.hpp"
 
 #include <charconv>
+#include <cstdint>
 #include <sstream>
 
 #include "radargauss/error.hpp"
@@ -17,6 +18,12 @@ std::vector<std::string> SplitWords(const std::string& line) {
 }
 
 namespace {
+
+// Bounds on a header (docs/design.md, "Bounds on input"): radar and lidar
+// PCDs have tens of fields of a few values; these stop a hostile header from
+// turning into large allocations before any data is read.
+constexpr std::size_t kMaxPcdFields = 256;
+constexpr std::size_t kMaxPcdValuesPerPoint = 1024;  // the sum of COUNT
 
 
 std::size_t ParseCount(const std::string& path, const std::string& key, const std::string& word) {
@@ -40,17 +47,24 @@ void ResolveFields(const std::string& path, const std::vector<std::string>& size
                    const std::vector<std::string>& types, const std::vector<std::string>& counts,
                    PcdHeader& header) {
   std::size_t offset = 0;
+  std::size_t values = 0;
   for (std::size_t i = 0; i < header.fields.size(); ++i) {
     PcdField& field = header.fields[i];
     if (types[i].size() != 1) throw FileError(path, "unknown TYPE '" + types[i] + "'");
     field.type = types[i][0];
     field.size = static_cast<int>(ParseCount(path, "SIZE", sizes[i]));
-    field.count = counts.empty() ? 1 : static_cast<int>(ParseCount(path, "COUNT", counts[i]));
+    const std::size_t count = counts.empty() ? 1 : ParseCount(path, "COUNT", counts[i]);
+    if (count > kMaxPcdValuesPerPoint) throw FileError(path, "COUNT of field '" + field.name + "' is too large");
+    field.count = static_cast<int>(count);
     if (!ValidTypeSize(field.type, field.size)) {
       throw FileError(path, "unknown TYPE/SIZE " + types[i] + "/" + sizes[i] + " of field '" +
                                 field.name + "'");
     }
     if (field.count < 1) throw FileError(path, "COUNT of field '" + field.name + "' is 0");
+    values += static_cast<std::size_t>(field.count);
+    if (values > kMaxPcdValuesPerPoint) {
+      throw FileError(path, "more than " + std::to_string(kMaxPcdValuesPerPoint) + " values per point");
+    }
     field.offset = offset;
     offset += static_cast<std::size_t>(field.size) * field.count;
   }
@@ -82,6 +96,10 @@ PcdHeader ParsePcdHeader(const std::string& path, const std::string& bytes) {
         throw FileError(path, "unsupported PCD VERSION (0.7 only)");
       }
     } else if (key == "FIELDS") {
+      if (!header.fields.empty()) throw FileError(path, "a second FIELDS line");
+      if (rest.size() > kMaxPcdFields) {
+        throw FileError(path, std::to_string(rest.size()) + " FIELDS, more than " + std::to_string(kMaxPcdFields));
+      }
       for (const std::string& name : rest) header.fields.push_back({name, 'F', 4, 1, 0});
     } else if (key == "SIZE") {
       sizes = rest;
@@ -119,6 +137,7 @@ PcdHeader ParsePcdHeader(const std::string& path, const std::string& bytes) {
   }
   if (!have_width || !have_height) throw FileError(path, "PCD header lacks WIDTH or HEIGHT");
   if (!have_points) header.points = header.width * header.height;
+  if (header.height != 0 && header.width > SIZE_MAX / header.height) throw FileError(path, "WIDTH x HEIGHT overflows");
   if (header.width * header.height != header.points) {
     throw FileError(path, "WIDTH x HEIGHT (" + std::to_string(header.width * header.height) +
                               ") differs from POINTS (" + std::to_string(header.points) + ")");

@@ -51,6 +51,9 @@ RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp,
     }
     names.push_back(field.name);
   }
+  if (cloud.width == 0 && cloud.height > 1) {
+    throw FileError(source, "height " + std::to_string(cloud.height) + " rows of width 0");
+  }
   if (std::size_t(cloud.width) * cloud.point_step > cloud.row_step) {
     throw FileError(source, "row_step is smaller than width x point_step");
   }

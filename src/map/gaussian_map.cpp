@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -11,6 +13,7 @@
 #include <Eigen/LU>
 #include <Eigen/Eigenvalues>
 
+#include "radargauss/error.hpp"
 #include "radargauss/names.hpp"
 
 namespace radargauss {
@@ -62,8 +65,19 @@ std::int64_t PackVoxelKey(const VoxelKey& key) { return PackKey(key.x, key.y, ke
 
 namespace {
 
-// floor(x) as an integer, inline (std::floor is a library call without SSE4.1).
+// A number in a message, %.3g.
+std::string Brief(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
+// floor(x) as an integer, inline (std::floor is a library call without
+// SSE4.1); saturated at +-2^62, where the conversion would be undefined
+// (cells alias there, which costs candidates, not answers).
 std::int64_t FloorToInt(double x) {
+  constexpr double kLimit = 4.611686018427387904e18;  // 2^62
+  x = std::min(std::max(x, -kLimit), kLimit);
   const auto truncated = static_cast<std::int64_t>(x);
   return truncated - (static_cast<double>(truncated) > x);
 }
@@ -115,7 +129,7 @@ std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
   return PackKey(v.x, v.y, v.z);
 }
 
-void GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys) {
+std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys) {
   IndexedGaussian& entry = gaussians_[id];
   entry.mean = g.mean;
   const Eigen::Matrix3d information = g.covariance.inverse();
@@ -124,6 +138,12 @@ void GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vector<std::
   // The cells as Key finds them (VoxelOf of the box's corners).
   const VoxelKey lo = VoxelOf(g.mean - half, cell_size_);
   const VoxelKey hi = VoxelOf(g.mean + half, cell_size_);
+  const double box = double(hi.x - lo.x + 1) * double(hi.y - lo.y + 1) * double(hi.z - lo.z + 1);
+  if (!(box <= double(kMaxIndexCellsPerGaussian))) {
+    throw DataError("Gaussian " + std::to_string(id) + " spans " + Brief(box) + " index cells of " +
+                    Brief(cell_size_) + " m (at most " + std::to_string(kMaxIndexCellsPerGaussian) +
+                    "): too large a Gaussian, or too small an index cell");
+  }
   // Of the box's cells, those the ellipsoid itself meets: an oblique or
   // round Gaussian leaves many of its box's cells empty (fewer candidates
   // per query, the same answers).
@@ -138,6 +158,7 @@ void GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vector<std::
       }
     }
   }
+  return std::size_t(box);
 }
 
 GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size,
@@ -149,9 +170,14 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
   gaussians_.resize(n);
   std::vector<std::pair<std::int64_t, std::uint32_t>> entries;
   std::vector<std::int64_t> cell_keys;
+  std::size_t box_cells = 0;
   for (std::size_t i = 0; i < n; ++i) {
     cell_keys.clear();
-    Index(gaussians[i], std::uint32_t(i), cell_keys);
+    box_cells += Index(gaussians[i], std::uint32_t(i), cell_keys);
+    if (box_cells > kMaxIndexCells) {
+      throw DataError("the map spans more than " + std::to_string(kMaxIndexCells) + " index cells of " +
+                      Brief(cell_size_) + " m: too many large Gaussians, or too small an index cell");
+    }
     for (const std::int64_t key : cell_keys) entries.emplace_back(key, static_cast<std::uint32_t>(i));
   }
   std::sort(entries.begin(), entries.end());

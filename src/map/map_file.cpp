@@ -3,6 +3,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -10,11 +11,13 @@
 #include <sstream>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/Geometry>
 
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/io/read_file.hpp"
 
 namespace radargauss {
 
@@ -85,10 +88,33 @@ void WriteMap(const std::string& path, const GaussianMap& map) {
                       /*binary=*/true);
 }
 
+namespace {
+
+// The bounds of map_file.hpp; `fail` makes the error naming the Gaussian.
+template <typename Fail>
+void ValidateGaussian(const Gaussian& g, const Fail& fail) {
+  if (!g.mean.allFinite() || !g.covariance.allFinite()) throw fail("non-finite mean or covariance");
+  if (g.mean.cwiseAbs().maxCoeff() > kMaxMapCoordinate) {
+    throw fail("mean beyond " + std::to_string(int(kMaxMapCoordinate)) + " m of the origin");
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(g.covariance, Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d variances = solver.eigenvalues();
+  if (!(variances.minCoeff() >= kMinMapStd * kMinMapStd) || !(variances.maxCoeff() <= kMaxMapStd * kMaxMapStd)) {
+    throw fail("covariance with principal stds outside [1e-4, 100] m (or not positive definite)");
+  }
+  if (g.rcs.degree < -1 || g.rcs.degree > kMaxShDegree) throw fail("SH degree out of range");
+  const bool rcs_finite = std::isfinite(g.rcs.median) && std::isfinite(g.rcs.scale) &&
+                          std::isfinite(g.rcs.fit_rmse) &&
+                          std::all_of(g.rcs.coefficients.begin(), g.rcs.coefficients.end(),
+                                      [](double c) { return std::isfinite(c); });
+  if (!rcs_finite) throw fail("non-finite RCS model");
+  if (g.rcs.degree >= 0 && !(g.rcs.scale > 0.0)) throw fail("RCS model with scale <= 0");
+}
+
+}  // namespace
+
 GaussianMap ReadMap(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, "cannot open map");
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bytes = ReadFileBytes(path, "map");
   if (bytes.size() < kHeaderBytes + 4 || std::memcmp(bytes.data(), kMagic, 8) != 0) {
     throw FileError(path, "not a radargauss map (bad magic or too short)");
   }
@@ -133,12 +159,7 @@ GaussianMap ReadMap(const std::string& path) {
     const auto fail = [&](const std::string& what) {
       return FileError(path, "Gaussian " + std::to_string(k) + ": " + what);
     };
-    if (!g.mean.allFinite() || !g.covariance.allFinite()) throw fail("non-finite values");
-    if (Eigen::LLT<Eigen::Matrix3d>(g.covariance).info() != Eigen::Success) {
-      throw fail("covariance is not positive definite");
-    }
-    if (g.rcs.degree < -1 || g.rcs.degree > kMaxShDegree) throw fail("SH degree out of range");
-    if (g.rcs.degree >= 0 && !(g.rcs.scale > 0.0)) throw fail("RCS model with scale <= 0");
+    ValidateGaussian(g, fail);
   }
   return map;
 }

@@ -63,6 +63,12 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
   const auto require = [&](bool ok, const std::string& what) {
     if (!ok) throw FileError(source, what);
   };
+  SimulationConfig copy = c;
+  for (const auto& [key, value] : ConfigFields(copy)) {
+    if (const double* number = std::get_if<double*>(&value) ? *std::get_if<double*>(&value) : nullptr) {
+      require(std::isfinite(*number), key + " must be a finite number");
+    }
+  }
   require(c.scans >= 1, "scans must be >= 1");
   require(c.rate_hz > 0.0, "rate_hz must be > 0");
   require(std::isfinite(c.start_time) && c.start_time >= 0.0, "start_time must be >= 0");
@@ -89,6 +95,9 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
   for (const char* name : {"ground", "wall", "pole", "car"}) {
     const auto it = c.materials.find(name);
     require(it != c.materials.end(), std::string("material '") + name + "' missing");
+    require(std::isfinite(it->second.diffuse) && std::isfinite(it->second.specular) &&
+                std::isfinite(it->second.lobe_width_deg),
+            std::string("material '") + name + "' needs finite numbers");
     require(it->second.diffuse >= 0.0 && it->second.specular >= 0.0 &&
                 it->second.lobe_width_deg > 0.0 &&
                 it->second.diffuse + it->second.specular > 0.0,
@@ -104,24 +113,30 @@ SimulationConfig LoadSimulationConfig(const std::string& path) {
   } catch (const YAML::BadFile&) {
     throw FileError(path, "cannot open simulation config");
   } catch (const YAML::Exception& e) {
-    throw FileError(path, std::string("YAML: ") + e.what());
+    throw FileError(path, e.mark.line + 1, "YAML: " + e.msg);
+  } catch (const std::exception&) {
+    throw FileError(path, "cannot be read (a directory?)");
   }
   if (root.IsNull()) return config;
   if (!root.IsMap()) throw FileError(path, "expected a map of parameters");
   auto fields = ConfigFields(config);
   for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
+    if (!entry.first.IsScalar()) {
+      throw FileError(path, entry.first.Mark().line + 1, "a key must be a parameter name");
+    }
+    const std::string key = entry.first.Scalar();
     try {
       if (key == "materials") {
         if (!entry.second.IsMap()) throw FileError(path, "materials must be a map");
         for (const auto& material : entry.second) {
-          const std::string name = material.first.as<std::string>();
+          const std::string name = material.first.IsScalar() ? material.first.Scalar() : "";
           if (!config.materials.count(name)) {
             throw FileError(path, "unknown material '" + name + "' (ground, wall, pole, car)");
           }
           Material& m = config.materials[name];
+          if (!material.second.IsMap()) throw FileError(path, "material '" + name + "' must be a map");
           for (const auto& property : material.second) {
-            const std::string property_name = property.first.as<std::string>();
+            const std::string property_name = property.first.IsScalar() ? property.first.Scalar() : "";
             if (property_name == "diffuse") m.diffuse = property.second.as<double>();
             else if (property_name == "specular") m.specular = property.second.as<double>();
             else if (property_name == "lobe_width_deg") m.lobe_width_deg = property.second.as<double>();
@@ -135,8 +150,8 @@ SimulationConfig LoadSimulationConfig(const std::string& path) {
       if (it == fields.end()) throw FileError(path, "unknown parameter '" + key + "'");
       std::visit([&](auto* target) { *target = entry.second.as<std::remove_pointer_t<decltype(target)>>(); },
                  it->second);
-    } catch (const YAML::Exception&) {
-      throw FileError(path, "parameter '" + key + "' has the wrong type");
+    } catch (const YAML::Exception& e) {
+      throw FileError(path, e.mark.line + 1, "parameter '" + key + "' has the wrong type");
     }
   }
   ValidateSimulationConfig(config, path);

@@ -91,9 +91,17 @@ void InformationFromSqrtInformationT(const T u[6], T information[6]) {
 // ellipsoid of `extent_sigmas` standard deviations (Mahalanobis distance)
 // meets, so a query point has a few candidates; association is the candidate
 // of smallest Mahalanobis^2, gated by tau^2 (complete for tau <= extent).
+// Bounds on the work of indexing (docs/design.md, "Bounds on input"): the
+// cells of the box around one Gaussian's ellipsoid (each is tested; 2^24 take
+// about half a second), and those of all Gaussians of a static index.
+inline constexpr std::size_t kMaxIndexCellsPerGaussian = std::size_t(1) << 24;
+inline constexpr std::size_t kMaxIndexCells = std::size_t(1) << 30;
+
 class GaussianIndex {
  public:
   GaussianIndex() = default;
+  // Throws DataError when a Gaussian, or all of them, span more cells than
+  // the bounds above.
   GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size = 1.0,
                 double extent_sigmas = 3.0);
 
@@ -154,8 +162,9 @@ class GaussianIndex {
  private:
   std::int64_t Key(const Eigen::Vector3d& p) const;
   // The entry of `g` (mean, L^T) and the keys of the cells its ellipsoid of
-  // extent_sigmas_ meets, in key order of the box's cells.
-  void Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys);
+  // extent_sigmas_ meets, in key order of the box's cells. Returns the
+  // number of the box's cells; throws DataError beyond kMaxIndexCellsPerGaussian.
+  std::size_t Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys);
   // Rebuilds the cell lists without stale entries or empty cells, with room
   // for `extra_cells` more.
   void Compact(std::size_t extra_cells);

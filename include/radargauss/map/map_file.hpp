@@ -28,9 +28,18 @@ namespace radargauss {
 
 inline constexpr std::uint32_t kMapFileVersion = 1;
 
+// What ReadMap accepts of a Gaussian (docs/design.md, "Bounds on input"):
+// every mean coordinate within kMaxMapCoordinate of the origin (UTM
+// northings fit), principal stds within [kMinMapStd, kMaxMapStd] (a radar
+// map's Gaussians are centimetres to metres; a kilometre one would list
+// itself in millions of index cells), and finite RCS numbers.
+inline constexpr double kMaxMapCoordinate = 1e7;  // m
+inline constexpr double kMinMapStd = 1e-4;        // m
+inline constexpr double kMaxMapStd = 100.0;       // m
+
 void WriteMap(const std::string& path, const GaussianMap& map);
 // Throws DataError naming the file for a missing or truncated file, a wrong
-// magic or version, a CRC mismatch, or an invalid Gaussian.
+// magic or version, a CRC mismatch, or a Gaussian outside the bounds above.
 GaussianMap ReadMap(const std::string& path);
 
 void ExportPly(const std::string& path, const GaussianMap& map);
