@@ -12,6 +12,7 @@ the path; translation and horizontal %, deg/m), ATE RMSE, per-scan time
 active map size.
 
     scripts/odometry_table.py [--tool build/release/bin/radargauss] [--work /tmp/odometry_table] [--quick] [--pcl]
+                              [--only NTU,demo,long,route]
 """
 import argparse
 import csv
@@ -52,29 +53,32 @@ def main():
     parser.add_argument("--work", default="/tmp/odometry_table")
     parser.add_argument("--quick", action="store_true", help="the demo sequence only")
     parser.add_argument("--pcl", action="store_true", help="rows with pcl-ndt and pcl-gicp as the matcher")
+    parser.add_argument("--only", default="", help="comma-separated first words of the data sets to run (NTU,demo,long,route)")
     args = parser.parse_args()
     tool = [args.tool, "--threads", "1"]
     os.makedirs(args.work, exist_ok=True)
-    demo, long_drive = os.path.join(args.work, "demo"), os.path.join(args.work, "long")
-    route = os.path.join(args.work, "route")
-    run(tool + ["simulate", "--out", demo, "--config", os.path.join(ROOT, "configs", "synthetic_world.yaml"), "--force"])
-    sets = [("demo (simulated, 300 scans)", ["--sequence", demo, "--gt", os.path.join(demo, "gt_radar_tum.txt")], True)]
-    if not args.quick:
-        run(tool + ["simulate", "--out", long_drive, "--scans", "3000", "--force"])
-        sets.append(("long loop (simulated, 3000 scans, 5 laps)",
-                     ["--sequence", long_drive, "--gt", os.path.join(long_drive, "gt_radar_tum.txt")], True))
-        run(tool + ["simulate", "--out", route, "--config",
-                    os.path.join(ROOT, "configs", "synthetic_long_drive.yaml"), "--force"])
-        sets.append(("route (simulated, 3000 scans, 1.8 km)",
-                     ["--sequence", route, "--gt", os.path.join(route, "gt_radar_tum.txt")], True))
-        if os.path.isdir(NTU):
-            sets.insert(0, ("NTU Eagle sample", ["--config", os.path.join(ROOT, "configs", "ntu_eagle_odometry.yaml"),
-                                                 "--sequence", os.path.join(NTU, "points"),
-                                                 "--gt", os.path.join(NTU, "gt_tum.txt")], False))
+    only = [word for word in args.only.split(",") if word]
+    simulated = [("demo", "demo (simulated, 300 scans)", ["--config", os.path.join(ROOT, "configs", "synthetic_world.yaml")]),
+                 ("long", "long loop (simulated, 3000 scans, 5 laps)", ["--scans", "3000"]),
+                 ("route", "route (simulated, 3000 scans, 1.8 km)",
+                  ["--config", os.path.join(ROOT, "configs", "synthetic_long_drive.yaml")])]
+    sets = []
+    if os.path.isdir(NTU) and not args.quick:
+        sets.append(("NTU Eagle sample", ["--config", os.path.join(ROOT, "configs", "ntu_eagle_odometry.yaml"),
+                                          "--sequence", os.path.join(NTU, "points"),
+                                          "--gt", os.path.join(NTU, "gt_tum.txt")], False))
+    for name, label, config in simulated[:1] if args.quick else simulated:
+        if only and name not in only:
+            continue
+        folder = os.path.join(args.work, name)
+        run(tool + ["simulate", "--out", folder, "--force"] + config)
+        sets.append((label, ["--sequence", folder, "--gt", os.path.join(folder, "gt_radar_tum.txt")], True))
     print("| data | matcher | w_rcs | velocity term | RPE t % | RPE horizontal % | RPE r deg/m | ATE t RMSE m "
           "| ms/scan median | p90 | peak MB | first / last tenth: ms, active map MB |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for label, flags, has_rcs in sets:
+        if only and label.split()[0] not in only:
+            continue
         runs = [("gaussians", w, velocity) for w in ([0, 0.25] if has_rcs else [0]) for velocity in (1, 0)]
         if args.pcl:
             runs += [("pcl-ndt", 0, 0), ("pcl-gicp", 0, 0)]

@@ -45,13 +45,25 @@ void CheckRcsWeights(const Sequence& sequence, const std::vector<double>& weight
   }
 }
 
+namespace {
+
+// The message for a flag value stod cannot read; YAML spells NaN and inf
+// as .nan and .inf.
+std::string NotANumber(const std::string& text) {
+  const bool yaml_special = text.find(".nan") != std::string::npos || text.find(".inf") != std::string::npos ||
+                            text.find(".NaN") != std::string::npos || text.find(".Inf") != std::string::npos;
+  return text + (yaml_special ? " is not a finite number" : " is not a number");
+}
+
+}  // namespace
+
 const CLI::Validator& FiniteNumber() {
   static const CLI::Validator finite(
       [](std::string& text) {
         try {
           return std::isfinite(std::stod(text)) ? std::string() : text + " is not a finite number";
         } catch (const std::exception&) {
-          return text + " is not a number";
+          return NotANumber(text);
         }
       },
       "FINITE");
@@ -67,7 +79,7 @@ CLI::Validator InRange(double lo, double hi, bool open_below) {
         try {
           value = std::stod(text);
         } catch (const std::exception&) {
-          return text + " is not a number";
+          return NotANumber(text);
         }
         if (!std::isfinite(value)) return text + " is not a finite number";
         const bool below = open_below ? value <= lo : value < lo;

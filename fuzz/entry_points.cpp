@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "entry_points.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "../apps/radargauss/yaml_config.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/io/kitti_bin.hpp"
+#include "radargauss/io/pcd.hpp"
+#include "radargauss/io/rosbag.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/simulator.hpp"
+#include "radargauss/trajectory.hpp"
+
+namespace radargauss::fuzz {
+
+namespace {
+
+// The readers take paths: the input goes to a file of this process first.
+std::string WriteInput(const std::uint8_t* data, std::size_t size, const std::string& name) {
+  const std::string path = "/tmp/radargauss_fuzz_" + std::to_string(::getpid()) + "_" + name;
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
+  return path;
+}
+
+template <typename Read>
+void Expecting(const Read& read) {
+  try {
+    read();
+  } catch (const DataError&) {
+  }
+}
+
+void Pcd(const std::uint8_t* data, std::size_t size) {
+  const std::string path = WriteInput(data, size, "1702450000.500000000.pcd");
+  Expecting([&] { ReadPcdScan(path); });
+}
+
+// The first byte picks a layout; the rest is the file.
+void KittiBin(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return;
+  static const char* kLayouts[] = {kViewOfDelftLayout, "x y z", "x,y,z,rcs,doppler", "time x doppler y z"};
+  const std::vector<std::string> layout = ParseBinLayout(kLayouts[data[0] % 4]);
+  const std::string path = WriteInput(data + 1, size - 1, "1702450000.5.bin");
+  Expecting([&] { ReadKittiBin(path, layout); });
+}
+
+void Tum(const std::uint8_t* data, std::size_t size) {
+  const std::string path = WriteInput(data, size, "trajectory.txt");
+  Expecting([&] { ReadTum(path); });
+}
+
+// A map that reads is also indexed: the index is where a huge Gaussian hangs.
+void MapFile(const std::uint8_t* data, std::size_t size) {
+  const std::string path = WriteInput(data, size, "map.rgm");
+  Expecting([&] {
+    const GaussianMap map = ReadMap(path);
+    const GaussianIndex index(map.gaussians);
+    for (const Gaussian& g : map.gaussians) index.Associate(g.mean, 9.0);
+  });
+}
+
+// Little-endian fields as a bag stores sensor_msgs/PointCloud2 (without the
+// header): height, width, field count, fields (name length, name, offset,
+// datatype, count), is_bigendian, point_step, row_step, then the data.
+class Bytes {
+ public:
+  Bytes(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
+  bool U32(std::uint32_t& value) { return Copy(&value, 4); }
+  bool U8(std::uint8_t& value) { return Copy(&value, 1); }
+  bool Text(std::string& text) {
+    std::uint8_t length = 0;
+    if (!U8(length) || length > size_ - used_) return false;
+    text.assign(reinterpret_cast<const char*>(data_ + used_), length);
+    used_ += length;
+    return true;
+  }
+  std::vector<std::uint8_t> Rest() const { return {data_ + used_, data_ + size_}; }
+
+ private:
+  bool Copy(void* value, std::size_t n) {
+    if (n > size_ - used_) return false;
+    std::memcpy(value, data_ + used_, n);
+    used_ += n;
+    return true;
+  }
+  const std::uint8_t* data_;
+  std::size_t size_;
+  std::size_t used_ = 0;
+};
+
+void PointCloud2(const std::uint8_t* data, std::size_t size) {
+  Bytes bytes(data, size);
+  PointCloud2Data cloud;
+  std::uint8_t field_count = 0, big_endian = 0;
+  if (!bytes.U32(cloud.height) || !bytes.U32(cloud.width) || !bytes.U8(field_count)) return;
+  cloud.fields.resize(field_count);
+  for (PointCloud2Field& field : cloud.fields) {
+    if (!bytes.Text(field.name) || !bytes.U32(field.offset) || !bytes.U8(field.datatype) ||
+        !bytes.U32(field.count)) {
+      return;
+    }
+  }
+  if (!bytes.U8(big_endian) || !bytes.U32(cloud.point_step) || !bytes.U32(cloud.row_step)) return;
+  cloud.is_bigendian = big_endian != 0;
+  cloud.data = bytes.Rest();
+  Expecting([&] { DecodePointCloud2(cloud, 1702450000.5, FieldMapping(), "message"); });
+}
+
+void SimulatorYaml(const std::uint8_t* data, std::size_t size) {
+  const std::string path = WriteInput(data, size, "world.yaml");
+  Expecting([&] { LoadSimulationConfig(path); });
+}
+
+void CliYaml(const std::uint8_t* data, std::size_t size) {
+  std::istringstream input(std::string(reinterpret_cast<const char*>(data), size));
+  try {
+    YamlConfig("localize", "config.yaml").from_config(input);
+  } catch (const CLI::ConversionError&) {
+  }
+}
+
+}  // namespace
+
+const std::vector<Target>& Targets() {
+  static const std::vector<Target> targets = {
+      {"pcd", Pcd},         {"kitti_bin", KittiBin},           {"tum", Tum},          {"map_file", MapFile},
+      {"pointcloud2", PointCloud2}, {"simulator_yaml", SimulatorYaml}, {"cli_yaml", CliYaml}};
+  return targets;
+}
+
+}  // namespace radargauss::fuzz

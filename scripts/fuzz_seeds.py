@@ -1,0 +1,143 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""Seed corpora of the fuzz targets (fuzz/entry_points.hpp), one folder per
+target under OUT: small valid inputs of every format, written here from
+scratch, plus the project's YAML configs and a few files of the real samples
+in ../shared/data when that folder is there. Nothing of it is committed.
+
+    scripts/fuzz_seeds.py OUT
+"""
+import glob
+import math
+import os
+import random
+import struct
+import sys
+import zlib
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SHARED = os.path.join(ROOT, "..", "shared", "data")
+
+
+def points(n, rng):
+    return [(rng.uniform(-40, 40), rng.uniform(-40, 40), rng.uniform(-2, 5), rng.uniform(-10, 20),
+             rng.uniform(-8, 8)) for _ in range(n)]
+
+
+def pcd_header(fields, n, data, sizes=None, types=None):
+    sizes = sizes or ["4"] * len(fields)
+    types = types or ["F"] * len(fields)
+    return (f"# .PCD v0.7\nVERSION 0.7\nFIELDS {' '.join(fields)}\nSIZE {' '.join(sizes)}\n"
+            f"TYPE {' '.join(types)}\nCOUNT {' '.join(['1'] * len(fields))}\nWIDTH {n}\nHEIGHT 1\n"
+            f"VIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {data}\n").encode()
+
+
+def lzf_literals(raw):
+    """LZF of literal runs only (a valid stream the reader must decode)."""
+    out = bytearray()
+    for i in range(0, len(raw), 32):
+        chunk = raw[i:i + 32]
+        out += bytes([len(chunk) - 1]) + chunk
+    return bytes(out)
+
+
+def pcd_seeds(rng):
+    fields = ["x", "y", "z", "rcs", "doppler"]
+    cloud = points(12, rng)
+    ascii_body = "".join(" ".join(f"{v:.3f}" for v in p) + "\n" for p in cloud).encode()
+    binary_body = b"".join(struct.pack("<5f", *p) for p in cloud)
+    columns = b"".join(struct.pack(f"<{len(cloud)}f", *[p[k] for p in cloud]) for k in range(5))
+    packed = lzf_literals(columns)
+    yield "ascii.pcd", pcd_header(fields, len(cloud), "ascii") + ascii_body
+    yield "binary.pcd", pcd_header(fields, len(cloud), "binary") + binary_body
+    yield "compressed.pcd", (pcd_header(fields, len(cloud), "binary_compressed") +
+                             struct.pack("<II", len(packed), len(columns)) + packed)
+    mixed = pcd_header(["x", "y", "z", "intensity", "velocity"], 2, "binary", ["8", "8", "8", "2", "1"],
+                       ["F", "F", "F", "U", "I"])
+    yield "mixed.pcd", mixed + b"".join(struct.pack("<dddHb", 1.0, 2.0, 3.0, 7, -3) for _ in range(2))
+    for path in sorted(glob.glob(os.path.join(SHARED, "ntu4dradlm_loop1_eagle", "points", "*.pcd")))[:3]:
+        with open(path, "rb") as f:
+            yield "ntu_" + os.path.basename(path), f.read()
+
+
+def kitti_seeds(rng):
+    cloud = points(10, rng)
+    yield "vod.bin", bytes([0]) + b"".join(struct.pack("<7f", *p, p[4], 0.1) for p in cloud)
+    yield "xyz.bin", bytes([1]) + b"".join(struct.pack("<3f", *p[:3]) for p in cloud)
+
+
+def tum_seeds(rng):
+    lines = ["# timestamp tx ty tz qx qy qz qw"]
+    for k in range(20):
+        yaw = 0.05 * k
+        lines.append(f"{1702450000 + 0.1 * k:.9f} {k * 0.6:.4f} {0.1 * k:.4f} 0.8 0 0 "
+                     f"{math.sin(yaw / 2):.9f} {math.cos(yaw / 2):.9f}")
+    yield "drive.txt", ("\n".join(lines) + "\n").encode()
+    gt = os.path.join(SHARED, "ntu4dradlm_loop1_eagle", "gt_tum.txt")
+    if os.path.exists(gt):
+        with open(gt, "rb") as f:
+            yield "ntu_gt.txt", b"".join(f.readlines()[:40])
+
+
+def map_bytes(gaussians, incidence=1):
+    """A .rgm (include/radargauss/map/map_file.hpp) with a valid CRC."""
+    body = b"RGAUSMAP" + struct.pack("<IB3xQ", 1, incidence, len(gaussians))
+    for mean, cov, degree in gaussians:
+        coefficients = [0.0] * 16
+        coefficients[0] = 1.0
+        body += struct.pack("<3d6dIiddd I16d", *mean, *cov, 12, degree, -3.0, 2.0, 0.5, 10, *coefficients)
+    return body + struct.pack("<I", zlib.crc32(body) & 0xFFFFFFFF)
+
+
+def map_seeds(rng):
+    gaussians = [((rng.uniform(-20, 20), rng.uniform(-20, 20), rng.uniform(0, 3)),
+                  (0.3, 0.01, 0.0, 0.2, 0.0, 0.05), rng.choice([-1, 0, 2])) for _ in range(6)]
+    yield "six.rgm", map_bytes(gaussians)
+    yield "empty.rgm", map_bytes([], 0)
+
+
+def pointcloud2_bytes(height, width, fields, point_step, rows):
+    out = struct.pack("<IIB", height, width, len(fields))
+    for name, offset, datatype in fields:
+        out += struct.pack("<B", len(name)) + name.encode() + struct.pack("<IBI", offset, datatype, 1)
+    return out + struct.pack("<BII", 0, point_step, point_step * width) + rows
+
+
+def pointcloud2_seeds(rng):
+    cloud = points(8, rng)
+    fields = [("x", 0, 7), ("y", 4, 7), ("z", 8, 7), ("intensity", 12, 7), ("velocity", 16, 7)]
+    yield "ti_like.bin", pointcloud2_bytes(1, len(cloud), fields, 20,
+                                           b"".join(struct.pack("<5f", *p) for p in cloud))
+    wide = [("x", 0, 8), ("y", 8, 8), ("z", 16, 8), ("rcs", 24, 3), ("doppler", 26, 7)]
+    yield "doubles.bin", pointcloud2_bytes(2, 1, wide, 30, b"".join(
+        struct.pack("<dddhf", *p[:3], int(p[3]), p[4]) for p in cloud[:2]))
+
+
+def files(*patterns):
+    for path in sorted(p for pattern in patterns for p in glob.glob(os.path.join(ROOT, pattern))):
+        with open(path, "rb") as f:
+            yield os.path.basename(path), f.read()
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    rng = random.Random(1)
+    seeds = {
+        "pcd": pcd_seeds(rng), "kitti_bin": kitti_seeds(rng), "tum": tum_seeds(rng), "map_file": map_seeds(rng),
+        "pointcloud2": pointcloud2_seeds(rng), "simulator_yaml": files("configs/synthetic_world.yaml", "configs/synthetic_long_drive.yaml"),
+        "cli_yaml": files("configs/*_localize.yaml", "configs/*_odometry.yaml"),
+    }
+    for target, items in seeds.items():
+        folder = os.path.join(sys.argv[1], target)
+        os.makedirs(folder, exist_ok=True)
+        count = 0
+        for name, data in items:
+            with open(os.path.join(folder, "seed_" + name), "wb") as f:
+                f.write(data)
+            count += 1
+        print(f"fuzz_seeds: {target}: {count} seeds")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,182 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Inputs built to hurt (docs/design.md, "Bounds on input"): each is refused
+// with a message naming the file and the fault, at once and without a large
+// allocation, instead of crashing, hanging or running into UB.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "radargauss/atomic_file.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/io/kitti_bin.hpp"
+#include "radargauss/io/pcd.hpp"
+#include "radargauss/io/rosbag.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/simulator.hpp"
+#include "temp_dir.hpp"
+
+namespace radargauss {
+namespace {
+
+using HostileInput = testing::TempDirTest;
+
+// The message of the DataError `read` throws ("" when it throws none).
+template <typename Read>
+std::string ErrorOf(const Read& read) {
+  try {
+    read();
+  } catch (const DataError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Growth of this process's peak resident memory while `run` runs, in MB.
+template <typename Run>
+double PeakGrowthMb(const Run& run) {
+  rusage before{}, after{};
+  getrusage(RUSAGE_SELF, &before);
+  run();
+  getrusage(RUSAGE_SELF, &after);
+  return double(after.ru_maxrss - before.ru_maxrss) / 1024.0;
+}
+
+TEST_F(HostileInput, SimulatorYamlNamesFileLineAndRefusesNan) {
+  const std::string key = WriteFile("key.yaml", "[]: 1\n");
+  EXPECT_EQ(ErrorOf([&] { LoadSimulationConfig(key); }), key + ":1: a key must be a parameter name");
+  const std::string nan = WriteFile("nan.yaml", "attitude_wobble_deg: .nan\n");
+  EXPECT_EQ(ErrorOf([&] { LoadSimulationConfig(nan); }), nan + ": attitude_wobble_deg must be a finite number");
+  const std::string inf = WriteFile("inf.yaml", "materials: {wall: {diffuse: .inf}}\n");
+  EXPECT_NE(ErrorOf([&] { LoadSimulationConfig(inf); }).find("material 'wall' needs finite numbers"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { LoadSimulationConfig(dir_.string()); }).find("a directory"), std::string::npos);
+}
+
+Gaussian RoundGaussian(const Eigen::Vector3d& mean, double std) {
+  Gaussian g;
+  g.mean = mean;
+  g.covariance = Eigen::Matrix3d::Identity() * std * std;
+  return g;
+}
+
+// A map file (valid CRC) holding one Gaussian, and the error reading it gives.
+std::string ReadOne(const std::string& path, const Gaussian& g) {
+  GaussianMap map;
+  map.gaussians = {RoundGaussian(Eigen::Vector3d::Zero(), 0.3), g};
+  WriteMap(path, map);
+  return ErrorOf([&] { ReadMap(path); });
+}
+
+TEST_F(HostileInput, MapFileBoundsMeansStdsAndRcs) {
+  const std::string path = Path("m.rgm");
+  EXPECT_NE(ReadOne(path, RoundGaussian(Eigen::Vector3d::Zero(), 1e4)).find(path + ": Gaussian 1: covariance with "
+                                                                            "principal stds outside"),
+            std::string::npos);  // 10 km: hung the index
+  EXPECT_NE(ReadOne(path, RoundGaussian(Eigen::Vector3d(1e300, 0, 0), 0.3)).find("mean beyond"), std::string::npos);
+  EXPECT_NE(ReadOne(path, RoundGaussian(Eigen::Vector3d::Zero(), 1e-6)).find("principal stds"), std::string::npos);
+  Gaussian nan_rcs = RoundGaussian(Eigen::Vector3d::Zero(), 0.3);
+  nan_rcs.rcs.degree = 0;
+  nan_rcs.rcs.scale = 1.0;
+  nan_rcs.rcs.median = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(ReadOne(path, nan_rcs).find("non-finite RCS model"), std::string::npos);
+  nan_rcs.rcs.median = 0.0;
+  nan_rcs.rcs.coefficients[3] = std::numeric_limits<double>::infinity();
+  EXPECT_NE(ReadOne(path, nan_rcs).find("non-finite RCS model"), std::string::npos);
+  // The largest std the file allows indexes at the default cell.
+  EXPECT_EQ(ReadOne(path, RoundGaussian(Eigen::Vector3d(5, 5, 5), 20.0)), "");
+  EXPECT_NO_THROW(GaussianIndex(ReadMap(path).gaussians));
+  EXPECT_EQ(ErrorOf([&] { ReadMap(dir_.string()); }), dir_.string() + ": is a directory, not a map");
+}
+
+TEST(HostileIndex, RefusesAGaussianOfTooManyCellsAndSurvivesFarQueries) {
+  const std::vector<Gaussian> huge = {RoundGaussian(Eigen::Vector3d::Zero(), 100.0)};
+  EXPECT_NE(ErrorOf([&] { GaussianIndex(huge, 0.1); }).find("Gaussian 0 spans 2.16e+11 index cells"),
+            std::string::npos);
+  const GaussianIndex index({RoundGaussian(Eigen::Vector3d::Zero(), 0.3)});
+  for (const double far : {1e300, -1e300, 1e19, std::numeric_limits<double>::max()}) {
+    EXPECT_EQ(index.Associate(Eigen::Vector3d(far, 0.0, far), 9.0), -1);  // UB before saturation
+  }
+  EXPECT_EQ(index.Associate(Eigen::Vector3d(0.1, 0.0, 0.0), 9.0), 0);
+}
+
+// An ASCII PCD with `fields` fields and POINTS as large as its bytes allowed
+// when only one digit and one separator per point were required.
+std::string WideAsciiPcd(std::size_t fields, std::size_t data_bytes) {
+  std::string names, sizes, types, counts;
+  for (std::size_t i = 0; i < fields; ++i) {
+    names += " f" + std::to_string(i);
+    sizes += " 4";
+    types += " F";
+    counts += " 1";
+  }
+  const std::size_t points = data_bytes / 2;
+  std::string text = "VERSION 0.7\nFIELDS" + names + "\nSIZE" + sizes + "\nTYPE" + types + "\nCOUNT" + counts +
+                     "\nWIDTH " + std::to_string(points) + "\nHEIGHT 1\nPOINTS " + std::to_string(points) +
+                     "\nDATA ascii\n";
+  return text + std::string(data_bytes, '1');
+}
+
+TEST_F(HostileInput, WidePcdHeadersAreRefusedBeforeAllocating) {
+  for (const std::size_t fields : {std::size_t(4096), std::size_t(20000)}) {
+    const std::string path = WriteFile("wide.pcd", WideAsciiPcd(fields, 64 * 1024));
+    std::string message;
+    const double growth = PeakGrowthMb([&] { message = ErrorOf([&] { ReadPcdScan(path); }); });
+    EXPECT_EQ(message, path + ": " + std::to_string(fields) + " FIELDS, more than 256");
+    EXPECT_LT(growth, 100.0) << fields << " fields";
+  }
+  // Within the field bound, POINTS x values against the data's bytes.
+  const std::string path = WriteFile("tall.pcd", WideAsciiPcd(200, 64 * 1024));
+  std::string message;
+  const double growth = PeakGrowthMb([&] { message = ErrorOf([&] { ReadPcdScan(path); }); });
+  EXPECT_NE(message.find(path + ": truncated: POINTS 32768"), std::string::npos) << message;
+  EXPECT_LT(growth, 100.0);
+}
+
+TEST(HostilePointCloud2, RowsOfWidthZeroAreRefusedAtOnce) {
+  PointCloud2Data cloud;
+  cloud.height = std::numeric_limits<std::uint32_t>::max();
+  cloud.width = 0;
+  cloud.fields = {{"x", 0, 7, 1}, {"y", 4, 7, 1}, {"z", 8, 7, 1}};
+  cloud.point_step = 12;
+  EXPECT_EQ(ErrorOf([&] { DecodePointCloud2(cloud, 0.0, FieldMapping(), "bag:/radar"); }),
+            "bag:/radar: height 4294967295 rows of width 0");
+  cloud.height = 1;  // an empty cloud is a scan without points
+  EXPECT_EQ(ErrorOf([&] { DecodePointCloud2(cloud, 0.0, FieldMapping(), "bag:/radar"); }).find("height"),
+            std::string::npos);
+}
+
+TEST_F(HostileInput, KittiBinNeedsALayout) {
+  const std::string path = WriteFile("1.0.bin", std::string(28, '\0'));
+  EXPECT_THROW(ReadKittiBin(path, {}), std::invalid_argument);
+}
+
+// A process that has ended: its pid is free (until the system reuses it).
+pid_t EndedPid() {
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  waitpid(child, nullptr, 0);
+  return child;
+}
+
+TEST_F(HostileInput, WritesRemoveTemporariesOfEndedProcesses) {
+  const std::string stale = WriteFile("map.rgm.tmp." + std::to_string(EndedPid()), "half a map");
+  const std::string live = WriteFile("map.rgm.tmp." + std::to_string(getppid()), "a writer at work");
+  const std::string other = WriteFile("notes.tmp.x", "not ours");
+  WriteFileAtomically(Path("map.rgm"), [](std::ostream& out) { out << "whole"; });
+  EXPECT_FALSE(std::filesystem::exists(stale));
+  EXPECT_TRUE(std::filesystem::exists(live));
+  EXPECT_TRUE(std::filesystem::exists(other));
+  EXPECT_TRUE(std::filesystem::exists(Path("map.rgm")));
+}
+
+}  // namespace
+}  // namespace radargauss
