@@ -14,9 +14,11 @@ jobs=$(nproc)
 trees=${RADARGAUSS_TEST_TREES:-"release sanitize"}
 
 # The optional components are on here (and required): the ROS1 bag reader in
-# both trees, the PCL NDT/GICP peers in the Release tree (Debian's PCL is not
-# built with the sanitizers, so the sanitizer tree leaves the peers out).
-RADARGAUSS_DEPS_EXTRA="librosbag-storage-dev libsensor-msgs-dev libpcl-dev ${RADARGAUSS_DEPS_EXTRA:-}" \
+# both trees, the PCL NDT/GICP peers and the Python module in the Release tree
+# (Debian's PCL and Python are not built with the sanitizers, so the
+# sanitizer tree leaves them out).
+RADARGAUSS_DEPS_EXTRA="librosbag-storage-dev libsensor-msgs-dev libpcl-dev python3-dev python3-numpy
+  python3-pybind11 pybind11-dev python3-pytest python3-matplotlib python3-distributed ${RADARGAUSS_DEPS_EXTRA:-}" \
   "$root/scripts/deps.sh"
 
 # The product's own rules: file and function lengths, README and RESULTS
@@ -28,7 +30,7 @@ for tree in $trees; do
   case "$tree" in
     release)
       cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DRADARGAUSS_WITH_ROSBAG=ON \
-        -DRADARGAUSS_WITH_PCL=ON ;;
+        -DRADARGAUSS_WITH_PCL=ON -DRADARGAUSS_WITH_PYTHON=ON ;;
     sanitize)
       # Debug keeps Eigen's and our assertions on; -O1 keeps it fast enough.
       cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug \

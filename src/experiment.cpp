@@ -117,7 +117,7 @@ void WriteSummaryAndTrajectories(const std::filesystem::path& dir, const std::ve
     for (const ScanOutcome& o : run.outcomes) {
       if (trajectory.empty() || o.time > trajectory.EndTime()) trajectory.Append(o.time, o.result.pose);
     }
-    WriteTum((dir / "trajectories" / (run.name + ".tum")).string(), trajectory);
+    WriteTum((dir / "trajectories" / (run.name + ".tum")).string(), trajectory, TumPrecision::kRoundTrip);
   }
   WriteFileAtomically((dir / "summary.json").string(), [&](std::ostream& out) { out << summary.dump(2) << "\n"; });
 }

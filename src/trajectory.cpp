@@ -111,14 +111,15 @@ Trajectory ReadTum(const std::string& path) {
   return trajectory;
 }
 
-void WriteTum(const std::string& path, const Trajectory& trajectory) {
+void WriteTum(const std::string& path, const Trajectory& trajectory, TumPrecision precision) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     char buffer[256];
     for (const StampedPose& sample : trajectory) {
       const Eigen::Vector3d& t = sample.pose.translation();
       const Eigen::Quaterniond& q = sample.pose.rotation().quaternion();
-      std::snprintf(buffer, sizeof(buffer), "%.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n",
-                    sample.time, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+      const char* format = precision == TumPrecision::kRoundTrip ? "%.9f %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n"
+                                                                 : "%.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n";
+      std::snprintf(buffer, sizeof(buffer), format, sample.time, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
       out << buffer;
     }
   });

@@ -3,7 +3,8 @@
 # Installs radargauss into a temporary prefix, builds examples/ against it
 # as another project would (find_package, nothing but the prefix), and runs
 # build_map and match_scan on a simulated sequence: the match must end
-# within 5 cm and 0.2 deg of the reference.
+# within 5 cm and 0.2 deg of the reference; the Python package, when built,
+# imports from the prefix.
 #   install_test.sh <build dir> <source dir>
 set -euo pipefail
 build=$1
@@ -29,4 +30,12 @@ output=$("$work/examples/match_scan" "$work/sequence" "$work/sequence/gt_radar_t
 echo "$output"
 echo "$output" | awk '/^error:/ { found = 1; ok = ($3 <= 0.05 && $6 <= 0.2) }
                       END { if (!found || !ok) { print "FAIL: match outside 5 cm / 0.2 deg"; exit 1 } }'
+# The Python package, when built, is importable from the prefix's site-packages.
+module=$(find "$prefix" -name '_radargauss*.so' | head -1)
+if [ -n "$module" ]; then
+  site=$(dirname "$(dirname "$module")")
+  PYTHONPATH="$site" /usr/bin/python3 -c "import radargauss; print(len(radargauss.simulate(scans=2)))" |
+    grep -qx 2 || { echo "FAIL: the installed Python package does not import"; exit 1; }
+  echo "python package importable from $site"
+fi
 echo "1 passed, 0 failed"

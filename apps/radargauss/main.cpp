@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,9 @@ int main(int argc, char** argv) {
     for (const Subcommand& command : subcommands) {
       if (command.app->parsed()) return command.run();
     }
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "radargauss: error: out of memory (an input larger than this machine can hold?)\n");
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "radargauss: error: %s\n", e.what());
     return 1;

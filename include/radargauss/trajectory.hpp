@@ -58,8 +58,12 @@ inline constexpr double kTumQuaternionNormTolerance = 1e-3;
 // off by more than kTumQuaternionNormTolerance, or a non-increasing time.
 Trajectory ReadTum(const std::string& path);
 
-// Writes a TUM file with 9 decimals, through a temporary file renamed into
-// place (never a half-written file). Throws DataError if it cannot write.
-void WriteTum(const std::string& path, const Trajectory& trajectory);
+// Writes a TUM file with 9 decimals (kRoundTrip: the pose numbers with 17
+// significant digits, which read back to the same doubles, as the
+// localisation results are written for comparison), through a temporary
+// file renamed into place. Throws DataError if it cannot write.
+enum class TumPrecision { kNineDecimals, kRoundTrip };
+void WriteTum(const std::string& path, const Trajectory& trajectory,
+              TumPrecision precision = TumPrecision::kNineDecimals);
 
 }  // namespace radargauss

@@ -1,0 +1,169 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Scans, sequences, trajectories and the simulator in Python.
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "radargauss/io/pcd.hpp"
+#include "radargauss/io/sequence.hpp"
+#include "radargauss/simulator.hpp"
+#include "radargauss/trajectory.hpp"
+
+namespace radargauss::python {
+
+namespace {
+
+// One column of a scan's points as an (N,) array.
+template <typename Get>
+Array Column(const RadarScan& scan, const Get& get) {
+  Array out = NewArray({py::ssize_t(scan.points.size())});
+  double* p = out.mutable_data();
+  for (const RadarPoint& point : scan.points) *p++ = get(point);
+  return out;
+}
+
+Array Positions(const RadarScan& scan) {
+  Array out = NewArray({py::ssize_t(scan.points.size()), 3});
+  double* p = out.mutable_data();
+  for (const RadarPoint& point : scan.points) {
+    for (int k = 0; k < 3; ++k) *p++ = point.position[k];
+  }
+  return out;
+}
+
+Array Poses(const std::vector<SE3d>& poses) {
+  Array out = NewArray({py::ssize_t(poses.size()), 7});
+  auto view = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const Array tum = PoseToTum(poses[i]);
+    for (int k = 0; k < 7; ++k) view(py::ssize_t(i), k) = tum.at(k);
+  }
+  return out;
+}
+
+void BindScan(py::module_& m) {
+  py::class_<RadarScan>(m, "Scan", "One radar scan: points (N, 3) in the radar frame, Doppler (m/s, positive "
+                                   "receding) and RCS (dBsm), each a copy as a numpy array.")
+      .def(py::init([](const py::handle& points, const py::object& doppler, const py::object& rcs, double stamp) {
+             return ScanFromArrays(points, doppler, rcs, stamp);
+           }),
+           py::arg("points"), py::arg("doppler") = py::none(), py::arg("rcs") = py::none(), py::arg("stamp") = 0.0)
+      .def_readonly("stamp", &RadarScan::timestamp)
+      .def_readonly("has_doppler", &RadarScan::has_doppler)
+      .def_readonly("has_rcs", &RadarScan::has_rcs)
+      .def_property_readonly("points", &Positions)
+      .def_property_readonly("doppler", [](const RadarScan& s) { return Column(s, [](const RadarPoint& p) { return p.doppler; }); })
+      .def_property_readonly("rcs", [](const RadarScan& s) { return Column(s, [](const RadarPoint& p) { return p.rcs; }); })
+      .def("__len__", [](const RadarScan& s) { return s.points.size(); })
+      .def("__repr__", [](const RadarScan& s) {
+        return "<radargauss.Scan " + std::to_string(s.points.size()) + " points at " + std::to_string(s.timestamp) + ">";
+      });
+}
+
+void BindSequence(py::module_& m) {
+  py::class_<Sequence>(m, "Sequence", "Scans in time order and, with ground truth, the pose of each.")
+      .def_readonly("scans", &Sequence::scans)
+      .def_readonly("layout", &Sequence::layout)
+      .def_readonly("sources", &Sequence::scan_sources)
+      .def_property_readonly("poses", [](const Sequence& s) { return Poses(s.poses); },
+                             "T_world_radar of each scan as (N, 7) [x y z qx qy qz qw]; empty without ground truth")
+      .def_property_readonly("stamps", [](const Sequence& s) {
+        Array out = NewArray({py::ssize_t(s.scans.size())});
+        for (std::size_t i = 0; i < s.scans.size(); ++i) out.mutable_at(py::ssize_t(i)) = s.scans[i].timestamp;
+        return out;
+      })
+      .def("__len__", [](const Sequence& s) { return s.scans.size(); });
+  m.def(
+      "read_sequence",
+      [](const std::string& path, const std::string& gt, const std::string& extrinsic, const std::string& bag,
+         const std::string& topic, const std::string& rcs_field, const std::string& doppler_field) {
+        SequenceOptions options;
+        options.sequence_dir = path;
+        options.ground_truth = gt;
+        options.extrinsic = extrinsic;
+        options.bag = bag;
+        options.topic = topic;
+        options.fields.rcs_field = rcs_field;
+        options.fields.doppler_field = doppler_field;
+        py::gil_scoped_release release;
+        return LoadSequence(options);
+      },
+      py::arg("path") = "", py::arg("gt") = "", py::arg("extrinsic") = "auto", py::arg("bag") = "",
+      py::arg("topic") = "", py::arg("rcs_field") = "", py::arg("doppler_field") = "",
+      "Reads a sequence as `radargauss info` does: a Snail-Radar folder, a folder of .pcd or .bin scans "
+      "(path), or a ROS1 bag (bag, topic); gt: a TUM file of reference poses, extrinsic T_gt_radar.");
+  m.def("read_pcd", [](const std::string& path) { return ReadPcdScan(path); }, py::arg("path"),
+        "One PCD scan (ascii, binary or binary_compressed); the stamp from a <secs>.<nsecs>.pcd name.");
+}
+
+void BindTrajectories(py::module_& m) {
+  m.def(
+      "read_tum",
+      [](const std::string& path) {
+        const Trajectory trajectory = ReadTum(path);
+        return TrajectoryToArrays(trajectory);
+      },
+      py::arg("path"), "A TUM file as (stamps (N,), poses (N, 7) [x y z qx qy qz qw]).");
+  m.def(
+      "write_tum",
+      [](const std::string& path, const py::handle& stamps, const py::handle& poses) {
+        WriteTum(path, TrajectoryFromArrays(stamps, poses, "poses"));
+      },
+      py::arg("path"), py::arg("stamps"), py::arg("poses"),
+      "Writes stamps (N,) and poses (N, 7) or (N, 4, 4) as a TUM file (9 decimals), atomically.");
+}
+
+void BindSimulator(py::module_& m) {
+  m.def(
+      "simulate",
+      [](std::uint32_t seed, int scans, const std::string& config) {
+        SimulationConfig c = config.empty() ? SimulationConfig() : LoadSimulationConfig(config);
+        c.seed = seed;
+        if (scans > 0) c.scans = scans;
+        ValidateSimulationConfig(c, "simulate");
+        py::gil_scoped_release release;
+        return AsSequence(Simulate(c));
+      },
+      py::arg("seed") = 1, py::arg("scans") = 0, py::arg("config") = "",
+      "The synthetic 4D radar drive of `radargauss simulate` (configs/synthetic_world.yaml) as a Sequence with "
+      "its ground-truth poses; scans > 0 overrides the config's count.");
+}
+
+}  // namespace
+
+py::tuple TrajectoryToArrays(const Trajectory& trajectory) {
+  Array stamps = NewArray({py::ssize_t(trajectory.size())});
+  std::vector<SE3d> poses;
+  for (std::size_t i = 0; i < trajectory.size(); ++i) {
+    stamps.mutable_at(py::ssize_t(i)) = trajectory[i].time;
+    poses.push_back(trajectory[i].pose);
+  }
+  return py::make_tuple(stamps, Poses(poses));
+}
+
+Trajectory TrajectoryFromArrays(const py::handle& stamps, const py::handle& poses, const std::string& name) {
+  const Array times = CheckedArray(stamps, {-1}, name + " stamps");
+  const py::ssize_t n = times.shape(0);
+  const py::array array = py::array::ensure(poses);
+  if (!array || array.ndim() < 2 || array.shape(0) != n) {
+    throw py::value_error(name + " must be (N, 7) or (N, 4, 4) with N = " + std::to_string(n) + " stamps");
+  }
+  Trajectory trajectory;
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const SE3d pose = PoseFromPython(array[py::int_(i)], name + "[" + std::to_string(i) + "]");
+    try {
+      trajectory.Append(times.at(i), pose);
+    } catch (const std::invalid_argument&) {
+      throw py::value_error(name + " stamps must increase strictly");
+    }
+  }
+  return trajectory;
+}
+
+void BindData(py::module_& m) {
+  BindScan(m);
+  BindSequence(m);
+  BindTrajectories(m);
+  BindSimulator(m);
+}
+
+}  // namespace radargauss::python

@@ -1,0 +1,132 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""The Python module against independent references: arrays equal the bytes
+of the files they came from, match equals the command-line tool, bad
+arguments raise ValueError with the library's message."""
+import os
+import struct
+import subprocess
+
+import numpy as np
+import pytest
+
+import radargauss as rg
+
+
+def test_scan_arrays_round_trip_exactly():
+    rng = np.random.default_rng(1)
+    points, doppler, rcs = rng.normal(size=(50, 3)) * 30, rng.normal(size=50), rng.normal(size=50) * 10
+    scan = rg.Scan(points, doppler=doppler, rcs=rcs, stamp=12.5)
+    assert np.array_equal(scan.points, points) and np.array_equal(scan.doppler, doppler)
+    assert np.array_equal(scan.rcs, rcs) and scan.stamp == 12.5 and scan.has_rcs and len(scan) == 50
+    assert not rg.Scan(points).has_doppler
+
+
+def test_read_pcd_gives_the_files_floats(tmp_path):
+    values = np.random.default_rng(2).normal(size=(7, 5)).astype(np.float32)
+    header = ("VERSION 0.7\nFIELDS x y z rcs doppler\nSIZE 4 4 4 4 4\nTYPE F F F F F\nCOUNT 1 1 1 1 1\n"
+              "WIDTH 7\nHEIGHT 1\nPOINTS 7\nDATA binary\n")
+    path = tmp_path / "1702450000.250000000.pcd"
+    path.write_bytes(header.encode() + values.tobytes())
+    scan = rg.read_pcd(str(path))
+    assert np.array_equal(scan.points, values[:, :3].astype(np.float64))
+    assert np.array_equal(scan.rcs, values[:, 3]) and np.array_equal(scan.doppler, values[:, 4])
+    assert scan.stamp == pytest.approx(1702450000.25, abs=1e-6)
+
+
+def parse_map(path):
+    """Means, covariances and SH coefficients of a .rgm, read with struct
+    (the layout of include/radargauss/map/map_file.hpp)."""
+    data = open(path, "rb").read()
+    count = struct.unpack_from("<Q", data, 16)[0]
+    means, covariances, coefficients = [], [], []
+    for k in range(count):
+        record = struct.unpack_from("<3d6dIiddd I16d", data, 24 + k * 236)
+        means.append(record[0:3])
+        xx, xy, xz, yy, yz, zz = record[3:9]
+        covariances.append([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+        coefficients.append(record[15:31])
+    return np.array(means), np.array(covariances), np.array(coefficients)
+
+
+def test_map_arrays_equal_the_file(written, tmp_path):
+    world = rg.read_map(written["map"])
+    means, covariances, coefficients = parse_map(written["map"])
+    assert len(world) == len(means) > 100
+    assert np.array_equal(world.means, means) and np.array_equal(world.covariances, covariances)
+    assert np.array_equal(world.rcs_coefficients, coefficients)
+    copy = str(tmp_path / "copy.rgm")
+    rg.write_map(copy, world)
+    assert open(copy, "rb").read() == open(written["map"], "rb").read()
+
+
+def test_tum_round_trip_is_byte_exact(written, tmp_path):
+    stamps, poses = rg.read_tum(written["gt"])
+    assert poses.shape == (len(stamps), 7)
+    copy = str(tmp_path / "gt.txt")
+    rg.write_tum(copy, stamps, poses)
+    assert open(copy).read() == open(written["gt"]).read()
+
+
+def test_build_map_in_python_equals_build_map_of_the_cli(written):
+    sequence = rg.read_sequence(written["sequence"], gt=written["gt"])
+    built, read = rg.build_map(sequence), rg.read_map(written["map"])
+    assert np.array_equal(built.means, read.means) and np.array_equal(built.rcs_medians, read.rcs_medians)
+
+
+def test_match_equals_localize_of_the_cli(cli, written):
+    out = str(written["root"] / "localize")
+    subprocess.run([cli, "localize", "--sequence", written["sequence"], "--gt", written["gt"], "--map",
+                    written["map"], "--w-rcs", "0.25", "--out", out], check=True, stdout=subprocess.DEVNULL)
+    _, expected = rg.read_tum(os.path.join(out, "trajectories", "gn-w0.25-trivial-offset-L3.tum"))
+    sequence, world = rg.read_sequence(written["sequence"], gt=written["gt"]), rg.read_map(written["map"])
+    errors = rg.initial_errors(len(sequence))  # localize's defaults: 2 m, 5 deg, seed 42
+    for i, scan in enumerate(sequence.scans):
+        result = rg.match(scan, world, rg.compose(sequence.poses[i], errors[i]), w_rcs=0.25)
+        assert np.max(np.abs(result.pose_tum - expected[i])) < 1e-12, i
+
+
+def test_odometry_and_evaluate():
+    sequence = rg.simulate(seed=1, scans=60)
+    odometry = rg.RadarOdometry(w_rcs=0.25)
+    steps = [odometry.register(scan) for scan in sequence.scans]
+    assert len(odometry) == 60 and sum(step["matched"] for step in steps) > 50
+    assert all(np.isfinite(step["pose"]).all() for step in steps)
+    evaluation = rg.evaluate(odometry.trajectory(), (sequence.stamps, sequence.poses))
+    assert evaluation["matched"] == 60 and evaluation["rpe"]["horizontal_percent"] < 2.0
+    perfect = rg.evaluate((sequence.stamps, sequence.poses), (sequence.stamps, sequence.poses))
+    assert perfect["ate_translation_m"]["rmse"] < 1e-9
+    assert len(odometry.map()) > 100
+
+
+def test_errors_carry_the_library_message(tmp_path):
+    missing = str(tmp_path / "absent.rgm")
+    with pytest.raises(rg.DataError, match="absent.rgm: cannot open map"):
+        rg.read_map(missing)
+    assert issubclass(rg.DataError, ValueError)
+    bad = tmp_path / "bad.txt"
+    bad.write_text("1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n")
+    with pytest.raises(rg.DataError, match="bad.txt:2: time does not increase"):
+        rg.read_tum(str(bad))
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda s, m: rg.match(s, m, np.eye(3)), r"must have shape \(4, 4\), not \(3, 3\)"),
+    (lambda s, m: rg.match(s, m, np.eye(4).astype(np.int64)), "must be float64"),
+    (lambda s, m: rg.match(s, m, np.full((4, 4), np.nan)), "not finite"),
+    (lambda s, m: rg.match(s, m, np.diag([2.0, 1, 1, 1])), "not a rigid transform"),
+    (lambda s, m: rg.match(s, m, np.eye(4), solver="newton"), "unknown solver 'newton'"),
+    (lambda s, m: rg.match(s, m, np.eye(4), loss="l3"), "l3"),
+    (lambda s, m: rg.match(s, m, np.eye(4), w_rcs=float("nan")), r"w_rcs must be in \[0, 1\]"),
+    (lambda s, m: rg.Scan(np.zeros((4, 2))), r"points must have shape \(N, 3\)"),
+    (lambda s, m: rg.Scan(np.zeros((4, 3)), doppler=np.zeros(3)), r"doppler must have shape \(4,\)"),
+    (lambda s, m: rg.Scan("points"), "points must be an array"),
+])
+def test_bad_arguments_raise_value_error(call, message):
+    sequence = rg.simulate(seed=2, scans=3)
+    world = rg.build_map(sequence)
+    with pytest.raises(ValueError, match=message):
+        call(sequence.scans[0], world)
+
+
+def test_help_explains_the_arguments():
+    assert "initial" in rg.match.__doc__ and "w_rcs" in rg.match.__doc__ and "solver" in rg.match.__doc__
