@@ -61,14 +61,15 @@ void ConfigurationRun::Summarise() {
 
 ConfigurationRun RunConfiguration(const std::string& name, double w_rcs, const ScanMatcher& matcher,
                                   const MatchingMap& map, const std::vector<RadarScan>& scans,
-                                  const std::vector<SE3d>& references, const std::vector<SE3d>& errors) {
+                                  const std::vector<SE3d>& references, const std::vector<SE3d>& errors,
+                                  std::size_t first_scan) {
   ConfigurationRun run;
   run.name = name;
   run.w_rcs = w_rcs;
   run.outcomes.resize(scans.size());
   tbb::parallel_for(std::size_t(0), scans.size(), [&](std::size_t k) {
     ScanOutcome& o = run.outcomes[k];
-    o.scan = k;
+    o.scan = first_scan + k;
     o.time = scans[k].timestamp;
     const SE3d initial = references[k] * errors[k];
     PoseErrors(initial, references[k], o.initial_translation_error, o.initial_rotation_error_deg);

@@ -20,6 +20,7 @@ struct Subcommand {
 };
 
 Subcommand AddInfo(CLI::App& parent);
+Subcommand AddMerge(CLI::App& parent);
 Subcommand AddSimulate(CLI::App& parent);
 Subcommand AddBuildMap(CLI::App& parent);
 Subcommand AddMapInfo(CLI::App& parent);
@@ -66,5 +67,10 @@ MapGeometry BuildGeometry(const Sequence& sequence, const MapBuildSettings& sett
 // summary when `verbose`.
 GaussianMap FitRcsModelsOf(const MapGeometry& geometry, const MapBuildSettings& settings,
                            IncidenceModel incidence, int degree, bool verbose);
+
+// reference.tum of a localisation experiment into `out`: the reference pose
+// of each matched scan (times in scan order; repeated times once).
+void WriteReferenceTrajectory(const std::string& out, const std::vector<double>& times,
+                              const std::vector<SE3d>& references);
 
 }  // namespace radargauss::cli

@@ -49,11 +49,14 @@ std::vector<GaussianMap> MapsToMatch(const Sequence& sequence, LocalizeSettings&
   return maps;
 }
 
-// The matched scans (every stride-th), their references and initial errors.
+// The matched scans (every stride-th; with --shard, the shard's part of
+// them), their references and initial errors.
 struct Experiment {
   std::vector<RadarScan> scans;
   std::vector<SE3d> references;
   std::vector<SE3d> errors;
+  std::size_t first_scan = 0;   // of the shard, in the experiment's numbering
+  std::size_t total_scans = 0;  // of the whole experiment
 };
 
 Experiment MakeExperiment(const Sequence& sequence, const LocalizeSettings& s) {
@@ -63,6 +66,16 @@ Experiment MakeExperiment(const Sequence& sequence, const LocalizeSettings& s) {
     e.references.push_back(sequence.poses[k]);
   }
   e.errors = InitialErrors(e.scans.size(), s.max_translation, s.max_rotation, s.seed);
+  e.total_scans = e.scans.size();
+  if (!s.shard.empty()) {  // the errors of the whole experiment, then the shard's part
+    const Shard shard = ParseShard(s.shard);
+    const std::size_t begin = shard.Begin(e.total_scans), end = shard.End(e.total_scans);
+    if (begin == end) throw DataError("shard " + s.shard + " of " + std::to_string(e.total_scans) + " scans is empty");
+    e.scans = std::vector<RadarScan>(e.scans.begin() + begin, e.scans.begin() + end);
+    e.references = std::vector<SE3d>(e.references.begin() + begin, e.references.begin() + end);
+    e.errors = std::vector<SE3d>(e.errors.begin() + begin, e.errors.begin() + end);
+    e.first_scan = begin;
+  }
   return e;
 }
 
@@ -72,7 +85,7 @@ ConfigurationRun RunPeer(const std::string& solver, const Sequence& sequence, co
 #ifdef RADARGAUSS_HAVE_PCL
   if (map_cloud.empty()) map_cloud = BuildMapCloud(sequence).points;
   const PclPeerMatcher peer(solver == "pcl-ndt" ? PclMethod::kNdt : PclMethod::kGicp, map_cloud);
-  return RunConfiguration(solver, 0.0, peer, matching, e.scans, e.references, e.errors);
+  return RunConfiguration(solver, 0.0, peer, matching, e.scans, e.references, e.errors, e.first_scan);
 #else
   (void)sequence, (void)matching, (void)e, (void)map_cloud;
   throw DataError("solver '" + solver + "' needs radargauss built with RADARGAUSS_WITH_PCL");
@@ -103,7 +116,8 @@ std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const 
           const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" +
                                    ToString(maps[m].incidence) + "-L" + std::to_string(degrees[m]);
           bar.Update("localize", done, total);
-          runs.push_back(RunConfiguration(name, w, *matcher, matching, e.scans, e.references, e.errors));
+          runs.push_back(
+              RunConfiguration(name, w, *matcher, matching, e.scans, e.references, e.errors, e.first_scan));
           ++done;
         }
       }
@@ -117,14 +131,10 @@ std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const 
 // The outputs beside the experiment's: the reference trajectory and the
 // map's Gaussian means, for the plots.
 void WritePlotInputs(const std::string& out, const Experiment& e, const GaussianMap& map) {
-  Trajectory reference;
-  for (std::size_t k = 0; k < e.scans.size(); ++k) {
-    if (reference.empty() || e.scans[k].timestamp > reference.EndTime()) {
-      reference.Append(e.scans[k].timestamp, e.references[k]);
-    }
-  }
+  std::vector<double> times;
+  for (const RadarScan& scan : e.scans) times.push_back(scan.timestamp);
+  WriteReferenceTrajectory(out, times, e.references);
   namespace fs = std::filesystem;
-  WriteTum((fs::path(out) / "reference.tum").string(), reference);
   WriteFileAtomically((fs::path(out) / "map_means.csv").string(), [&](std::ostream& stream) {
     stream << "x,y,z\n";
     for (const Gaussian& g : map.gaussians) {
@@ -142,6 +152,7 @@ int RunLocalize(LocalizeSettings s) {
   const std::vector<ConfigurationRun> runs = RunConfigurations(sequence, s, maps, degrees, e);
   const std::string table = WriteExperimentResults(s.out, runs);
   WritePlotInputs(s.out, e, maps.front());
+  if (!s.shard.empty()) WriteShard(s.out, ParseShard(s.shard), e.total_scans, runs, e.references);
   double initial_t = 0.0;
   for (const ScanOutcome& o : runs.front().outcomes) initial_t += o.initial_translation_error;
   std::printf("%zu scans, %zu configurations; initial errors: mean %.3f m (uniform in [0, %g] m, [0, %g] deg)\n\n%s\n",
@@ -154,6 +165,15 @@ int RunLocalize(LocalizeSettings s) {
 }
 
 }  // namespace
+
+void WriteReferenceTrajectory(const std::string& out, const std::vector<double>& times,
+                              const std::vector<SE3d>& references) {
+  Trajectory reference;
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    if (reference.empty() || times[k] > reference.EndTime()) reference.Append(times[k], references[k]);
+  }
+  WriteTum((std::filesystem::path(out) / "reference.tum").string(), reference);
+}
 
 Subcommand AddLocalize(CLI::App& parent) {
   auto s = std::make_shared<LocalizeSettings>();

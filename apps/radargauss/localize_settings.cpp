@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "radargauss/error.hpp"
+#include "radargauss/experiment.hpp"
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/solvers/factory.hpp"
 
@@ -141,6 +142,17 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
   AddMapBuildOptions(app, s.build);
   app->add_option("--map", s.map_path, "Map file (.rgm); without it the map is built from the sequence");
   app->add_option("--out", s.out, "Results folder")->required();
+  app->add_option("--shard", s.shard,
+                  "I/N: match the I-th of N equal parts of the scans and write shard.json too; "
+                  "`radargauss merge` joins the N folders into one run's results")
+      ->check([](const std::string& text) {
+        try {
+          ParseShard(text);
+          return std::string();
+        } catch (const std::invalid_argument& e) {
+          return std::string(e.what());
+        }
+      });
   AddSweepOptions(app, s);
   AddInitialErrorOptions(app, s);
   AddCoarseOptions(app, s);

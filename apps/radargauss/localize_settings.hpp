@@ -28,6 +28,7 @@ struct LocalizeSettings {
   double max_rotation = 5.0;
   std::uint32_t seed = 42;
   int stride = 1;
+  std::string shard;  // "I/N": this run matches the I-th of N parts of the scans
   std::string coarse_levels = ToString(MatchingMapOptions().coarse);
   double coarse_voxel = ScanMatchingOptions().coarse_voxel_per_sigma;
   std::size_t coarse_points = ScanMatchingOptions().coarse_points;

@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   const std::vector<Subcommand> subcommands = {AddInfo(app), AddSimulate(app), AddBuildMap(app), AddMapInfo(app),
                                                AddLocalize(app), AddEvaluate(app), AddRefine(app),
-                                               AddOdometry(app)};
+                                               AddOdometry(app), AddMerge(app)};
   int threads = 0;
   app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(NonNegative());
   // info, build-map and localize read a YAML file of their flags with

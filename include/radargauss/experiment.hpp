@@ -6,6 +6,7 @@
 // match against the map, and report errors per configuration.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -44,10 +45,32 @@ struct ConfigurationRun {
 };
 
 // Matches every scan from reference * error with `matcher`; parallel over
-// scans, the same results for any thread count.
+// scans, the same results for any thread count. Outcome k is numbered
+// first_scan + k (a shard's scans keep the experiment's numbers).
 ConfigurationRun RunConfiguration(const std::string& name, double w_rcs, const ScanMatcher& matcher,
                                   const MatchingMap& map, const std::vector<RadarScan>& scans,
-                                  const std::vector<SE3d>& references, const std::vector<SE3d>& errors);
+                                  const std::vector<SE3d>& references, const std::vector<SE3d>& errors,
+                                  std::size_t first_scan = 0);
+
+// One shard of an experiment (docs/design.md, "Shards"): shard `index` of
+// `count` (1-based) matches scans [Begin, End) of `scans` in all.
+struct Shard {
+  std::size_t index = 1, count = 1;
+  std::size_t Begin(std::size_t scans) const { return (index - 1) * scans / count; }
+  std::size_t End(std::size_t scans) const { return index * scans / count; }
+};
+// "I/N" with 1 <= I <= N; throws std::invalid_argument.
+Shard ParseShard(const std::string& text);
+
+// shard.json in `dir`: which shard, and every outcome's numbers and poses
+// exactly (doubles that read back bit for bit), with the reference pose of
+// each scan, so that merged shards give the files one run writes.
+void WriteShard(const std::string& dir, const Shard& shard, std::size_t total_scans,
+                const std::vector<ConfigurationRun>& runs, const std::vector<SE3d>& references);
+// The runs of the whole experiment from the folders of all its shards (any
+// order), and the reference pose of every scan. Throws DataError naming the
+// folder for a missing, repeated or inconsistent shard.
+std::vector<ConfigurationRun> MergeShards(const std::vector<std::string>& dirs, std::vector<SE3d>& references);
 
 // Writes per_scan.csv, summary.json, table.md and trajectories/<name>.tum into
 // `dir` (created). Returns the Markdown table (best per column in bold).

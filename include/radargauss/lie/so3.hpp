@@ -37,6 +37,14 @@ class SO3 {
     return SO3(Quaternion(xyzw[3], xyzw[0], xyzw[1], xyzw[2]));
   }
 
+  // A quaternion of unit norm kept as it is, without normalising again (which
+  // may move the last bit): a stored rotation reads back bit for bit.
+  static SO3 FromUnitQuaternion(const Quaternion& q) {
+    SO3 r;
+    r.quaternion_ = q;
+    return r;
+  }
+
   // From a rotation matrix (orthonormal, det +1).
   static SO3 FromMatrix(const Matrix3& R) { return SO3(Quaternion(R)); }
 

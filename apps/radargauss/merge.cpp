@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// radargauss merge: the folders of `localize --shard I/N`, joined into the
+// results one run writes (docs/design.md, "Shards").
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "commands.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/experiment.hpp"
+
+namespace radargauss::cli {
+
+namespace {
+
+struct MergeSettings {
+  std::vector<std::string> shards;
+  std::string out;
+};
+
+int RunMerge(const MergeSettings& s) {
+  std::vector<SE3d> references;
+  const std::vector<ConfigurationRun> runs = MergeShards(s.shards, references);
+  const std::string table = WriteExperimentResults(s.out, runs);
+  std::vector<double> times;
+  for (const ScanOutcome& o : runs.front().outcomes) times.push_back(o.time);
+  WriteReferenceTrajectory(s.out, times, references);
+  // The map's means are the same in every shard.
+  namespace fs = std::filesystem;
+  const fs::path means = fs::path(s.shards.front()) / "map_means.csv";
+  std::error_code error;
+  if (fs::exists(means)) fs::copy_file(means, fs::path(s.out) / "map_means.csv", fs::copy_options::overwrite_existing, error);
+  if (error) throw FileError(s.out, "cannot write map_means.csv: " + error.message());
+  std::printf("%zu shards, %zu scans, %zu configurations\n\n%s\nresults: %s\n", s.shards.size(), references.size(),
+              runs.size(), table.c_str(), s.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Subcommand AddMerge(CLI::App& parent) {
+  auto s = std::make_shared<MergeSettings>();
+  CLI::App* app = parent.add_subcommand("merge", "Joins the results of localize --shard I/N into one run's");
+  app->add_option("shards", s->shards, "The N folders of localize --shard 1/N ... N/N, any order")->required();
+  app->add_option("--out", s->out, "Results folder")->required();
+  return {app, [s] { return RunMerge(*s); }};
+}
+
+}  // namespace radargauss::cli

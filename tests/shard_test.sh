@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
+# localize --shard I/N and merge (docs/design.md, "Shards"): three shards
+# merged, given in any order, equal the unsharded run in every file (the
+# timing columns aside); a missing, repeated or foreign shard is refused.
+#   shard_test.sh <path to radargauss>
+set -u
+tool=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+failed=0
+fail() { echo "FAIL: $*"; failed=1; }
+
+"$tool" simulate --out "$work/seq" --scans 40 --seed 6 >/dev/null
+"$tool" build-map --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --out "$work/map.rgm" >/dev/null
+localize=("$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/map.rgm"
+          --w-rcs 0,0.25 --solver gn,ceres --stride 2)
+"${localize[@]}" --out "$work/full" >/dev/null
+for i in 1 2 3; do "${localize[@]}" --shard "$i/3" --out "$work/s$i" >/dev/null; done
+"$tool" merge "$work/s2" "$work/s3" "$work/s1" --out "$work/merged" >/dev/null || fail "merge failed"
+
+for file in reference.tum map_means.csv trajectories/gn-w0-trivial-offset-L3.tum \
+            trajectories/ceres-w0.25-trivial-offset-L3.tum; do
+  cmp -s "$work/full/$file" "$work/merged/$file" || fail "$file differs"
+done
+without_time() { rev "$1" | cut -d, -f2- | rev; }
+diff <(without_time "$work/full/per_scan.csv") <(without_time "$work/merged/per_scan.csv") >/dev/null ||
+  fail "per_scan.csv differs"
+diff <(grep -v time_ms "$work/full/summary.json") <(grep -v time_ms "$work/merged/summary.json") >/dev/null ||
+  fail "summary.json differs"
+without_ms() { awk -F'|' '{ $12 = ""; print }' "$1"; }
+diff <(without_ms "$work/full/table.md") <(without_ms "$work/merged/table.md") >/dev/null || fail "table.md differs"
+[ "$(wc -l <"$work/merged/per_scan.csv")" -eq 81 ] || fail "merged per_scan.csv has not 4 x 20 rows"
+
+expect_refusal() {
+  local needle=$1
+  shift
+  if "$@" >"$work/out" 2>"$work/err" || ! grep -q -- "$needle" "$work/err"; then
+    fail "expected '$needle' from: $*"; cat "$work/err"
+  fi
+}
+expect_refusal "shard 2 of 3 is missing" "$tool" merge "$work/s1" "$work/s3" --out "$work/m2"
+expect_refusal "given twice" "$tool" merge "$work/s1" "$work/s1" "$work/s2" "$work/s3" --out "$work/m3"
+"${localize[@]}" --shard 1/2 --out "$work/h1" >/dev/null
+expect_refusal "another experiment" "$tool" merge "$work/h1" "$work/s2" "$work/s3" --out "$work/m4"
+expect_refusal "shard.json" "$tool" merge "$work/seq" --out "$work/m5"
+expect_refusal "needs 1 <= I <= N" "${localize[@]}" --shard 4/3 --out "$work/x"
+expect_refusal "is not I/N" "${localize[@]}" --shard 1-3 --out "$work/x"
+expect_refusal "is empty" "${localize[@]}" --shard 1/30 --out "$work/x"
+
+[ "$failed" -eq 0 ] && echo "shards: merged equal the unsharded run; 7 refusals"
+[ "$failed" -eq 0 ]
