@@ -12,7 +12,8 @@ function's help() lists its arguments; docs/python.md tells the rest.
 from ._radargauss import (DataError, GaussianMap, MatchResult, RadarOdometry, Scan, Sequence, build_map, compose,
                           evaluate, initial_errors, match, read_map, read_pcd, read_sequence, read_tum, set_threads,
                           simulate, write_map, write_tum)
+from .sweep import Task, plan, run_task, sweep
 
 __all__ = ["DataError", "GaussianMap", "MatchResult", "RadarOdometry", "Scan", "Sequence", "build_map", "compose",
            "evaluate", "initial_errors", "match", "read_map", "read_pcd", "read_sequence", "read_tum",
-           "set_threads", "simulate", "write_map", "write_tum"]
+           "set_threads", "simulate", "write_map", "write_tum", "Task", "plan", "run_task", "sweep"]
