@@ -6,8 +6,10 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/experiment.hpp"
+#include "radargauss/io/read_file.hpp"
 
 namespace radargauss::cli {
 
@@ -25,12 +27,13 @@ int RunMerge(const MergeSettings& s) {
   std::vector<double> times;
   for (const ScanOutcome& o : runs.front().outcomes) times.push_back(o.time);
   WriteReferenceTrajectory(s.out, times, references);
-  // The map's means are the same in every shard.
+  // The map's means are the same in every shard (copied through a temporary, as every output).
   namespace fs = std::filesystem;
   const fs::path means = fs::path(s.shards.front()) / "map_means.csv";
-  std::error_code error;
-  if (fs::exists(means)) fs::copy_file(means, fs::path(s.out) / "map_means.csv", fs::copy_options::overwrite_existing, error);
-  if (error) throw FileError(s.out, "cannot write map_means.csv: " + error.message());
+  if (fs::exists(means)) {
+    const std::string bytes = ReadFileBytes(means.string(), "map means file");
+    WriteFileAtomically((fs::path(s.out) / "map_means.csv").string(), [&](std::ostream& out) { out << bytes; });
+  }
   std::printf("%zu shards, %zu scans, %zu configurations\n\n%s\nresults: %s\n", s.shards.size(), references.size(),
               runs.size(), table.c_str(), s.out.c_str());
   return 0;
