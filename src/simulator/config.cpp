@@ -13,6 +13,7 @@
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/pcd.hpp"
+#include "radargauss/io/read_file.hpp"
 
 namespace radargauss {
 
@@ -107,15 +108,13 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
 
 SimulationConfig LoadSimulationConfig(const std::string& path) {
   SimulationConfig config;
+  // Read here, not by YAML::LoadFile, which leaks its buffer when the read fails.
+  const std::string text = ReadFileBytes(path, "simulation config");
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw FileError(path, "cannot open simulation config");
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw FileError(path, e.mark.line + 1, "YAML: " + e.msg);
-  } catch (const std::exception&) {
-    throw FileError(path, "cannot be read (a directory?)");
   }
   if (root.IsNull()) return config;
   if (!root.IsMap()) throw FileError(path, "expected a map of parameters");
