@@ -5,38 +5,7 @@
 #   cli_test.sh <path to radargauss>
 set -u
 tool=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-passed=0
-failed=0
-
-# expect_fail <description> <stderr substring> -- command...
-expect_fail() {
-  local description=$1 needle=$2
-  shift 3
-  "$@" >"$work/out" 2>"$work/err"
-  local status=$?
-  local lines
-  lines=$(wc -l <"$work/err")
-  if [ "$status" -ne 0 ] && grep -q -- "$needle" "$work/err" && [ "$lines" -le 2 ]; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAIL: $description (exit $status, $lines stderr lines)"; cat "$work/err"
-  fi
-}
-
-# expect_ok <description> <stdout substring> -- command...
-expect_ok() {
-  local description=$1 needle=$2
-  shift 3
-  if "$@" >"$work/out" 2>"$work/err" && grep -q -- "$needle" "$work/out"; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAIL: $description"; cat "$work/out" "$work/err"
-  fi
-}
+source "$(dirname "${BASH_SOURCE[0]}")/cli_expect.sh"
 
 expect_fail "no subcommand" "subcommand" -- "$tool"
 expect_fail "unknown flag" "bogus" -- "$tool" info --bogus

@@ -6,29 +6,9 @@
 set -u
 tool=$1
 data=$2/tests/data/fuzz
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-passed=0
-failed=0
-
-# expect_fail <description> <stderr substring> -- command...: the error is
-# one line (CLI11 adds a second, "Run with --help"), under 200 characters.
-expect_fail() {
-  local description=$1 needle=$2
-  shift 3
-  timeout 20 "$@" >"$work/out" 2>"$work/err"
-  local status=$?
-  local lines longest
-  lines=$(wc -l <"$work/err")
-  longest=$(awk '{ if (length($0) > n) n = length($0) } END { print n + 0 }' "$work/err")
-  if [ "$status" -ne 0 ] && [ "$status" -ne 124 ] && grep -q -- "$needle" "$work/err" && [ "$lines" -le 2 ] &&
-     [ "$longest" -lt 200 ]; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAIL: $description (exit $status, $lines stderr lines, longest $longest)"; head -c 600 "$work/err"
-  fi
-}
+timeout_s=20   # every refusal comes at once
+max_length=200
+source "$(dirname "${BASH_SOURCE[0]}")/cli_expect.sh"
 
 "$tool" simulate --out "$work/seq" --scans 4 --seed 2 >/dev/null
 seq=(--sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt")

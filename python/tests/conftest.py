@@ -7,7 +7,7 @@ import subprocess
 import pytest
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def cli():
     path = os.environ.get("RADARGAUSS_CLI", "")
     if not path or not os.path.exists(path):
@@ -15,7 +15,7 @@ def cli():
     return path
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def written(cli, tmp_path_factory):
     """A 20-scan simulated sequence and its map, both written by the CLI."""
     root = tmp_path_factory.mktemp("sequence")
