@@ -9,7 +9,10 @@ behind (configs/synthetic_long_drive.yaml). For w_rcs 0 and 0.25
 as the loop's matcher, one thread. Prints a Markdown table: RPE (10-50 % of
 the path; translation and horizontal %, deg/m), ATE RMSE, per-scan time
 (median, p90), peak memory, and the first and last tenth's median time and
-active map size.
+active map size (and the second tenth's map: the first is the fill-up of
+the active radius). "sim3 horizontal" is the horizontal RPE of the
+estimate scaled by its Sim3 alignment (`evaluate --align sim3`): the drift
+that is not a uniform scale.
 
     scripts/odometry_table.py [--tool build/release/bin/radargauss] [--work /tmp/odometry_table] [--quick] [--pcl]
                               [--only NTU,demo,long,route]
@@ -40,11 +43,20 @@ def tenths(out):
     with open(os.path.join(out, "per_scan.csv"), newline="") as f:
         rows = list(csv.DictReader(f))
     n = max(1, len(rows) // 10)
-    first, last = rows[:n], rows[-n:]
+    first, second, last = rows[:n], rows[n:2 * n], rows[-n:]
     def median(rows, key):
         return statistics.median(float(r[key]) for r in rows)
-    return (median(first, "time_ms"), median(last, "time_ms"),
-            median(first, "active_map_bytes") / 1e6, median(last, "active_map_bytes") / 1e6)
+    return (median(first, "time_ms"), median(last, "time_ms"), median(first, "active_map_bytes") / 1e6,
+            median(second, "active_map_bytes") / 1e6, median(last, "active_map_bytes") / 1e6)
+
+
+def sim3_horizontal(tool, out, reference):
+    """Horizontal RPE (%) of the odometry in OUT after a Sim3 alignment to REFERENCE."""
+    folder = os.path.join(out, "sim3")
+    run(tool + ["evaluate", "--est", os.path.join(out, "odometry.tum"), "--ref", reference,
+                "--align", "sim3", "--out", folder])
+    e = json.load(open(os.path.join(folder, "evaluation.json")))
+    return e["rpe"]["horizontal_percent"], e["scale"]
 
 
 def main():
@@ -73,12 +85,14 @@ def main():
         folder = os.path.join(args.work, name)
         run(tool + ["simulate", "--out", folder, "--force"] + config)
         sets.append((label, ["--sequence", folder, "--gt", os.path.join(folder, "gt_radar_tum.txt")], True))
-    print("| data | matcher | w_rcs | velocity term | RPE t % | RPE horizontal % | RPE r deg/m | ATE t RMSE m "
-          "| ms/scan median | p90 | peak MB | first / last tenth: ms, active map MB |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| data | matcher | w_rcs | velocity term | RPE t % | RPE horizontal % | sim3 horizontal % (scale) "
+          "| RPE r deg/m | ATE t RMSE m | ms/scan median | p90 | peak MB "
+          "| tenths: ms first / last, active map MB first / second / last |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for label, flags, has_rcs in sets:
         if only and label.split()[0] not in only:
             continue
+        reference = flags[flags.index("--gt") + 1]
         runs = [("gaussians", w, velocity) for w in ([0, 0.25] if has_rcs else [0]) for velocity in (1, 0)]
         if args.pcl:
             runs += [("pcl-ndt", 0, 0), ("pcl-gicp", 0, 0)]
@@ -88,12 +102,14 @@ def main():
                                                       "--velocity-weight", str(velocity), "--out", out])
             e = json.load(open(os.path.join(out, "evaluation.json")))
             s = json.load(open(os.path.join(out, "summary.json")))
-            t0, t1, m0, m1 = tenths(out)
+            t0, t1, m0, m1, m2 = tenths(out)
+            horizontal, scale = sim3_horizontal(tool, out, reference)
             rpe = e["rpe"]
             print(f"| {label} | {matcher} | {w} | {'on' if velocity else 'off'} | {rpe['translation_percent']:.2f} "
-                  f"| {rpe['horizontal_percent']:.2f} | {rpe['rotation_deg_per_m']:.4f} "
-                  f"| {e['ate_translation_m']['rmse']:.3f} | {s['median_time_ms']:.2f} | {s['p90_time_ms']:.2f} "
-                  f"| {peak:.0f} | {t0:.2f} / {t1:.2f} ms, {m0:.1f} / {m1:.1f} MB |", flush=True)
+                  f"| {rpe['horizontal_percent']:.2f} | {horizontal:.2f} ({scale:.4f}) "
+                  f"| {rpe['rotation_deg_per_m']:.4f} | {e['ate_translation_m']['rmse']:.3f} "
+                  f"| {s['median_time_ms']:.2f} | {s['p90_time_ms']:.2f} | {peak:.0f} "
+                  f"| {t0:.2f} / {t1:.2f} ms, {m0:.1f} / {m1:.1f} / {m2:.1f} MB |", flush=True)
 
 
 if __name__ == "__main__":

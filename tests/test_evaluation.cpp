@@ -91,7 +91,7 @@ TEST(Evaluation, ConstantRotationOffset) {
 }
 
 // ATE after SE3 alignment does not change under a rigid transform of the
-// estimate; Sim3 also undoes a scale; the first-pose alignment undoes a
+// estimate; Sim3 also undoes a scale, in the ATE and the RPE; the first-pose alignment undoes a
 // transform exactly; RPE ignores a rigid transform altogether.
 TEST(Evaluation, AlignmentsUndoTransformsOfTheEstimate) {
   const Trajectory reference = CurvedDrive();
@@ -116,6 +116,7 @@ TEST(Evaluation, AlignmentsUndoTransformsOfTheEstimate) {
   EXPECT_NEAR(scaled.scale, 1.25, 1e-9);
   EXPECT_LT(scaled.ate_translation.max, 1e-9);
   EXPECT_LT(scaled.ate_rotation.max, 1e-6);
+  EXPECT_LT(scaled.rpe_mean.translation, 1e-7);  // the scale is undone in the RPE too
 
   EvaluationOptions first;
   first.alignment = Alignment::kFirst;

@@ -49,7 +49,7 @@ Subcommand AddEvaluate(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand("evaluate", "ATE and RPE of an estimated trajectory against a reference");
   app->add_option("--est", s->estimate, "Estimated trajectory (TUM)")->required();
   app->add_option("--ref", s->reference, "Reference trajectory (TUM)")->required();
-  app->add_option("--align", s->alignment, "Alignment of the estimate before ATE")
+  app->add_option("--align", s->alignment, "Alignment of the estimate (sim3 rescales the RPE too)")
       ->check(CLI::IsMember(AlignmentNames()))
       ->capture_default_str();
   app->add_option("--time-tolerance", s->time_tolerance, "Largest time difference of a pose pair (s)")
