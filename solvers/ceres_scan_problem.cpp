@@ -31,6 +31,11 @@ struct CeresScanProblem::Impl {
       velocity_loss_ = std::make_unique<ceres::ScaledLoss>(nullptr, options.velocity->weight, ceres::TAKE_OWNERSHIP);
       problem_.AddResidualBlock(velocity_cost_.get(), velocity_loss_.get(), translation);
     }
+    if (options.rotation && options.rotation->weight > 0.0) {
+      rotation_cost_ = std::make_unique<RotationCostFunction>(*options.rotation);
+      rotation_loss_ = std::make_unique<ceres::ScaledLoss>(nullptr, options.rotation->weight, ceres::TAKE_OWNERSHIP);
+      problem_.AddResidualBlock(rotation_cost_.get(), rotation_loss_.get(), rotation);
+    }
   }
 
   void Update(const Correspondences& c, double w) {
@@ -77,6 +82,8 @@ struct CeresScanProblem::Impl {
   TermBlocks<RcsRotationResidual, RcsRotationCostFunction> rcs_rotation_;
   std::unique_ptr<ceres::CostFunction> velocity_cost_;  // the velocity term, when set
   std::unique_ptr<ceres::LossFunction> velocity_loss_;
+  std::unique_ptr<ceres::CostFunction> rotation_cost_;  // the rotation term, when set
+  std::unique_ptr<ceres::LossFunction> rotation_loss_;
   ceres::Problem problem_;  // last: destroyed before what it refers to
 };
 

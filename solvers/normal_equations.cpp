@@ -350,6 +350,14 @@ CombinedSystem BuildCombinedSystem(const Correspondences& c, const SE3d& pose,
     combined.g.segment<3>(kTranslationOffset) += prior.weight * J.transpose() * r;
     combined.cost += prior.weight * r.squaredNorm();
   }
+  if (options.rotation && options.rotation->weight > 0.0) {  // J = W Jr^-1(Log(R_pred^T R))
+    const RotationPrior& prior = *options.rotation;
+    const Eigen::Matrix3d J = prior.Jacobian(pose.rotation());
+    const Eigen::Vector3d r = prior.Residual(pose.rotation());
+    combined.H.block<3, 3>(kRotationOffset, kRotationOffset) += prior.weight * J.transpose() * J;
+    combined.g.segment<3>(kRotationOffset) += prior.weight * J.transpose() * r;
+    combined.cost += prior.weight * r.squaredNorm();
+  }
   return combined;
 }
 

@@ -112,6 +112,9 @@ double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchi
   if (options.velocity && options.velocity->weight > 0.0) {
     f += options.velocity->weight * options.velocity->Residual(pose.translation()).squaredNorm();
   }
+  if (options.rotation && options.rotation->weight > 0.0) {
+    f += options.rotation->weight * options.rotation->Residual(pose.rotation()).squaredNorm();
+  }
   return f;
 }
 
@@ -193,6 +196,11 @@ void FinishResult(const RadarScan& scan, const MatchingMap& map, const SE3d& ini
     const Eigen::Matrix3d J = options.velocity->Jacobian();
     result.velocity_information.block<3, 3>(kTranslationOffset, kTranslationOffset) =
         options.velocity->weight * J.transpose() * J;
+  }
+  if (options.rotation && options.rotation->weight > 0.0) {
+    const Eigen::Matrix3d J = options.rotation->Jacobian(result.pose.rotation());
+    result.rotation_information.block<3, 3>(kRotationOffset, kRotationOffset) =
+        options.rotation->weight * J.transpose() * J;
   }
 }
 

@@ -21,6 +21,7 @@
 #include "radargauss/types.hpp"
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
+#include "radargauss/residuals/rotation_residual.hpp"
 #include "radargauss/residuals/velocity_residual.hpp"
 #include "radargauss/solvers/matching_map.hpp"
 
@@ -58,6 +59,9 @@ struct ScanMatchingOptions {
   // Odometry's Doppler velocity term, added to eq. 2 as weight * |r_v|^2 on
   // every level (docs/design.md, "The velocity term"); none: eq. 2 alone.
   std::optional<VelocityPrior> velocity;
+  // Odometry's rotation term, weight * |r_w|^2 on every level (docs/design.md,
+  // "The rotation term"); none: no prior on the rotation.
+  std::optional<RotationPrior> rotation;
   double translation_tolerance = 1e-3;         // m: stop when the update is smaller ...
   double rotation_tolerance = 1e-4;            // rad ... in both parts, on the exact map
   double coarse_translation_tolerance = 1e-2;  // m: the same on coarse levels, which
@@ -86,6 +90,8 @@ struct ScanMatchingResult {
   // The velocity term's Gauss-Newton matrix, weight J^T J on the translation
   // block (zero without the term), kept apart from eq. 2's.
   Eigen::Matrix<double, 6, 6> velocity_information = Eigen::Matrix<double, 6, 6>::Zero();
+  // The rotation term's, weight J^T J on the rotation block at the final pose.
+  Eigen::Matrix<double, 6, 6> rotation_information = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
 struct GeometricTerm {

@@ -29,6 +29,7 @@
 #include "radargauss/solvers/gauss_newton.hpp"
 #include "radargauss/solvers/multi_hypothesis.hpp"
 #include "radargauss/solvers/joint_refinement.hpp"
+#include "radargauss/residuals/rotation_residual.hpp"
 #include "radargauss/residuals/velocity_residual.hpp"
 #include "scan_matching_fixtures.hpp"
 
@@ -169,6 +170,36 @@ TEST(ResidualJacobians, VelocityTermAnalyticAutodiffNumeric) {
     EXPECT_LT(Relative(r_analytic, r_autodiff), 1e-12);
     EXPECT_LT(Relative(J_analytic[0], J_autodiff[0]), 1e-8);
     EXPECT_LT(Relative(J_analytic[0], NumericBlockJacobian(analytic, {t.data()}, 0)), 1e-5);
+  }
+}
+
+// The rotation term: analytic twin against autodiff and central differences
+// in the ambient quaternion, zero at the prediction, and its tangent
+// Jacobian W Jr^-1 against central differences along R Exp(dphi).
+TEST(ResidualJacobians, RotationTermAnalyticAutodiffNumeric) {
+  std::mt19937 rng(23);
+  for (int trial = 0; trial < 20; ++trial) {
+    RotationPrior prior;
+    prior.predicted = SO3d::Exp(2.0 * RandomUnitVector(rng));
+    prior.sqrt_information = Eigen::Vector3d(300.0, 200.0, 5.0).asDiagonal();
+    const RotationCostFunction analytic(prior);
+    const std::unique_ptr<ceres::CostFunction> autodiff(
+        RotationResidual::Create(prior.predicted, prior.sqrt_information));
+    Eigen::Vector4d q = prior.predicted.quaternion().coeffs();
+    std::vector<Eigen::MatrixXd> J_analytic, J_autodiff;
+    EXPECT_LT(EvaluateWithJacobians(analytic, {q.data()}, J_analytic).norm(), 1e-9);
+    const SO3d rotation = prior.predicted * SO3d::Exp(0.4 * RandomUnitVector(rng));
+    q = rotation.quaternion().coeffs();
+    const Eigen::VectorXd r_analytic = EvaluateWithJacobians(analytic, {q.data()}, J_analytic);
+    const Eigen::VectorXd r_autodiff = EvaluateWithJacobians(*autodiff, {q.data()}, J_autodiff);
+    EXPECT_LT(Relative(r_analytic, r_autodiff), 1e-12);
+    EXPECT_LT(Relative(J_analytic[0], J_autodiff[0]), 1e-8);
+    EXPECT_LT(Relative(J_analytic[0], NumericBlockJacobian(analytic, {q.data()}, 0)), 1e-5);
+    const auto along_tangent = [&](const Eigen::VectorXd& dphi) {
+      return Eigen::VectorXd(prior.Residual(rotation * SO3d::Exp(Eigen::Vector3d(dphi))));
+    };
+    const Eigen::MatrixXd numeric = NumericJacobian(along_tangent, Eigen::VectorXd::Zero(3));
+    EXPECT_LT(Relative(Eigen::MatrixXd(prior.Jacobian(rotation)), numeric), 1e-5);
   }
 }
 

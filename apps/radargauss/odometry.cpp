@@ -22,6 +22,8 @@ namespace radargauss::cli {
 
 namespace {
 
+std::vector<double> Values(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
 struct OdometrySettings {
   SequenceOptions sequence;  // ground_truth: the reference, for evaluation only
   OdometryOptions odometry;
@@ -33,6 +35,7 @@ struct OdometrySettings {
   std::string imu_topic;
   std::string imu_stamps = "header";
   std::vector<double> imu_rotation = {0, 0, 0, 1};  // q_radar_imu (x y z w)
+  std::vector<double> rotation_rate_std = Values(OdometryOptions().rotation_rate_std_deg);  // deg/s
   std::size_t max_scans = 0;
   std::string matcher = "gaussians";  // or a PCL peer
 };
@@ -70,6 +73,7 @@ OdometryOptions Resolved(const OdometrySettings& s) {
   o.match.matching.geometric_loss.type = LossTypeFromString(s.loss);
   o.map.rcs.incidence = IncidenceModelFromString(s.incidence);
   o.map.matching.coarse = CoarseLevelsFromString(s.coarse_levels);
+  o.rotation_rate_std_deg = Eigen::Vector3d(s.rotation_rate_std[0], s.rotation_rate_std[1], s.rotation_rate_std[2]);
   if (o.map.matching.inflation == std::vector<double>{0.0}) o.map.matching.inflation.clear();  // the exact map alone
   return o;
 }
@@ -210,6 +214,14 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
       ->check(NonNegative())
       ->capture_default_str();
   app->add_option("--velocity-floor", o.velocity_floor, "Std of the velocity term's floor Q (m)")
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--rotation-weight", o.rotation_weight, "Weight of the rotation term (0: off)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  app->add_option("--rotation-rate-std", s.rotation_rate_std,
+                  "Rotation term: change of the rate between scans about x y z (roll pitch yaw, deg/s)")
+      ->expected(3)
       ->check(Positive())
       ->capture_default_str();
   app->add_option("--gate-sigmas", o.gate_sigmas, "Doppler gate around the predicted velocity (sigmas)")

@@ -69,21 +69,24 @@ void BindOdometry(py::module_& m) {
   py::class_<RadarOdometry>(m, "RadarOdometry",
                             "Radar odometry on a map it builds as it goes (docs/design.md, \"Odometry\"): "
                             "register scans in time order.")
-      .def(py::init([](double w_rcs, const std::string& solver, double velocity_weight, double keyframe_distance,
-                       double active_radius, const py::object& initial_pose) {
+      .def(py::init([](double w_rcs, const std::string& solver, double velocity_weight, double rotation_weight,
+                       double keyframe_distance, double active_radius, const py::object& initial_pose) {
              OdometryOptions options;
              if (!initial_pose.is_none()) options.initial_pose = PoseFromPython(initial_pose, "initial_pose");
              options.match = MatchOptionsFrom(w_rcs, solver, "trivial", 1.0, "cauchy", 1.0);
              options.velocity_weight = velocity_weight;
+             options.rotation_weight = rotation_weight;
              options.keyframe_distance = keyframe_distance;
              options.map.active_radius = active_radius;
              ValidateOptions(options);
              return std::make_unique<RadarOdometry>(options);
            }),
-           py::arg("w_rcs") = 0.0, py::arg("solver") = "gn", py::arg("velocity_weight") = 1.0,
+           py::arg("w_rcs") = 0.0, py::arg("solver") = "gn", py::arg("velocity_weight") = OdometryOptions().velocity_weight,
+           py::arg("rotation_weight") = OdometryOptions().rotation_weight,
            py::arg("keyframe_distance") = OdometryOptions().keyframe_distance,
            py::arg("active_radius") = LocalMapOptions().active_radius, py::arg("initial_pose") = py::none(),
-           "w_rcs and solver as in match; velocity_weight of the Doppler term (0: off); keyframe_distance (m); "
+           "w_rcs and solver as in match; velocity_weight of the Doppler term and rotation_weight of the "
+           "rotation term (0: off); keyframe_distance (m); "
            "active_radius (m) of the map kept for matching; initial_pose: T_world_radar of the first scan.")
       .def(
           "register",

@@ -24,6 +24,9 @@ void ValidateOptions(const OdometryOptions& o) {
   require(o.min_static_points >= 3, "minimum static points must be >= 3");
   require(finite_non_negative(o.velocity_weight), "velocity weight must be >= 0 and finite");
   require(finite_non_negative(o.velocity_floor) && o.velocity_floor > 0.0, "velocity floor must be > 0 m and finite");
+  require(finite_non_negative(o.rotation_weight), "rotation weight must be >= 0 and finite");
+  require(o.rotation_rate_std_deg.allFinite() && (o.rotation_rate_std_deg.array() > 0.0).all(),
+          "rotation rate stds must be > 0 deg/s and finite");
   require(finite_non_negative(o.keyframe_distance), "keyframe distance must be >= 0 m and finite");
   require(finite_non_negative(o.keyframe_angle_deg), "keyframe angle must be >= 0 deg and finite");
   require(o.min_matched_points >= 3, "minimum matched points must be >= 3");
@@ -79,11 +82,11 @@ RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
   if (const std::optional<SO3d> gyro = GyroIncrement(last.stamp, stamp)) {
     increment = *gyro;
     p.gyro = true;
-  } else if (steps_.size() >= 2) {  // the last increment's rate, constant
+  } else if (steps_.size() >= 2) {  // the last increment's yaw rate; roll and pitch held
     const OdometryStep& before = steps_[steps_.size() - 2];
     const Eigen::Vector3d rate =
         (before.pose.rotation().Inverse() * last.pose.rotation()).Log() / (last.stamp - before.stamp);
-    increment = SO3d::Exp(rate * p.dt);
+    increment = SO3d::Exp(Eigen::Vector3d(0.0, 0.0, rate.z() * p.dt));
   }
   p.increment = increment;
   // A vehicle keeps its velocity in its own frame: the last one, unrotated.
@@ -198,6 +201,14 @@ void RadarOdometry::Match(const RadarScan& scan, const std::vector<std::size_t>&
     prior.weight = options_.velocity_weight;
     match.matching.velocity = prior;
   }
+  if (options_.rotation_weight > 0.0) {
+    RotationPrior prior;
+    prior.predicted = steps_.back().pose.rotation() * prediction.increment;
+    const Eigen::Vector3d sigma = options_.rotation_rate_std_deg * (M_PI / 180.0 * prediction.dt);
+    prior.sqrt_information = sigma.cwiseInverse().asDiagonal();
+    prior.weight = options_.rotation_weight;
+    match.matching.rotation = prior;
+  }
   const ScanMatchingResult result = matcher_(map_, match)->Match(matched, map_.matching(), step.pose);
   step.iterations = result.iterations;
   step.final_cost = result.final_cost;
@@ -213,6 +224,7 @@ void RadarOdometry::Match(const RadarScan& scan, const std::vector<std::size_t>&
   step.matched = true;
   step.information = result.information;
   step.velocity_information = result.velocity_information;
+  step.rotation_information = result.rotation_information;
   if (!result.converged) step.reason = (step.reason.empty() ? "" : step.reason + "; ") + "matching: " + result.reason;
 }
 

@@ -2,9 +2,10 @@
 // Radar odometry on a Gaussian-RCS map it builds itself (docs/design.md,
 // "Odometry"). Per scan, in time order: the Doppler ego velocity gated by
 // the motion model's prediction; a predicted pose (translation from that
-// velocity, rotation at the last increment's rate, or from gyro rates);
+// velocity, rotation from gyro rates or at the last yaw rate, roll and pitch
+// held);
 // scan-to-map matching of the static points with eq. 2 plus the Doppler
-// velocity term; the static points into the local map on keyframes.
+// velocity and rotation terms; the static points into the local map on keyframes.
 //
 //   RadarOdometry odometry(options);
 //   for (const RadarScan& scan : sequence.scans) odometry.Register(scan);
@@ -48,6 +49,11 @@ struct OdometryOptions {
   std::size_t min_static_points = 10;  // fewer Doppler inliers: the prediction stands in
   double velocity_weight = 1.0;        // of the velocity term in eq. 2 (0: off)
   double velocity_floor = 0.05;        // m: std of the floor Q = floor^2 I of the term
+  // The rotation term: the match's rotation against the predicted one, with
+  // sigma = rotation_rate_std * dt about the radar's x, y, z (roll, pitch,
+  // yaw); docs/design.md, "The rotation term".
+  double rotation_weight = 1.0;  // 0: off
+  Eigen::Vector3d rotation_rate_std_deg{1.0, 1.0, 90.0};  // deg/s: rate changes the prediction allows
   MatchOptions match;                  // solver and eq. 2 (w_rcs, losses, incidence via map.rcs)
   LocalMapOptions map;
   double keyframe_distance = 0.5;      // m since the last keyframe ...
@@ -81,6 +87,7 @@ struct OdometryStep {
   double time_ms = 0.0;              // the whole step, map update included
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();           // eq. 2's
   Eigen::Matrix<double, 6, 6> velocity_information = Eigen::Matrix<double, 6, 6>::Zero();  // the term's
+  Eigen::Matrix<double, 6, 6> rotation_information = Eigen::Matrix<double, 6, 6>::Zero();  // the rotation term's
 };
 
 // Gyro rates in the radar frame (rad/s), stamped; integrated between scans
@@ -116,7 +123,7 @@ class RadarOdometry {
  private:
   // The motion model's guess for the next scan.
   struct Prediction {
-    SO3d increment;            // rotation since the last scan (gyro, or the last rate)
+    SO3d increment;            // rotation since the last scan (gyro, or the last yaw rate)
     Eigen::Vector3d velocity;  // the last velocity, kept in the radar frame
     Eigen::Matrix3d velocity_covariance;
     double dt = 0.0;
