@@ -91,7 +91,7 @@ struct OdometryStep {
 };
 
 // Gyro rates in the radar frame (rad/s), stamped; integrated between scans
-// instead of the constant-rate rotation when given.
+// instead of the last yaw rate when given.
 struct GyroSample {
   double stamp = 0.0;
   Eigen::Vector3d rate = Eigen::Vector3d::Zero();
