@@ -105,6 +105,10 @@ expect_fail "odometry with RCS weights on a sequence without RCS" "has no RCS fi
   "$tool" odometry --sequence "$work/seq10" --rcs-field none --w-rcs 0.25 --out "$work/odometry_rcs"
 expect_fail "odometry with a NaN velocity weight" "velocity-weight" -- \
   "$tool" odometry --sequence "$work/seq10" --velocity-weight nan --out "$work/odometry_nan"
+expect_fail "odometry with a zero rotation rate std" "rotation-rate-std" -- \
+  "$tool" odometry --sequence "$work/seq10" --rotation-rate-std 1 0 90 --out "$work/odometry_tilt"
+expect_fail "odometry with two rotation rate stds" "rotation-rate-std" -- \
+  "$tool" odometry --sequence "$work/seq10" --rotation-rate-std 1 1 --out "$work/odometry_tilt2"
 expect_fail "odometry with an IMU topic but no bag" "needs --bag" -- \
   "$tool" odometry --sequence "$work/seq10" --imu-topic /imu --out "$work/odometry_imu"
 ti_bag="$(cd "$(dirname "$0")/.." && pwd)/../shared/data/ti_mmwave_demo/demo_ti_mmwave_rospkg_format.bag"
