@@ -98,6 +98,28 @@ struct World {
   std::unique_ptr<MatchingMap> exact;  // the map alone (ExactMapOnly): one association at a time
 };
 
+// One association (no re-association) solved to tight tolerances, eq. 2 at
+// w = 0.25: the options under which two solvers must reach the same optimum.
+inline ScanMatchingOptions OneAssociationToConvergence() {
+  ScanMatchingOptions options;
+  options.w_rcs = 0.25;
+  options.reassociate = false;
+  options.translation_tolerance = 1e-7;
+  options.rotation_tolerance = 1e-8;
+  options.max_iterations = 100;
+  return options;
+}
+
+// Ceres to its optimum, not to its default tolerances.
+inline CeresSolverOptions CeresToItsOptimum() {
+  CeresSolverOptions tight;
+  tight.max_exact_inner_iterations = 200;
+  tight.function_tolerance = 1e-12;
+  tight.gradient_tolerance = 1e-12;
+  tight.parameter_tolerance = 1e-10;
+  return tight;
+}
+
 inline const World& SimulatedWorld() {
   static const World* world = [] {
     auto* w = new World;

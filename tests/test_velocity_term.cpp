@@ -56,21 +56,11 @@ TEST(VelocityTerm, SolversAgreeAndFollowAStrongTerm) {
   const RadarScan& scan = world.simulated.scans[kTestScan];
   const SE3d truth = world.simulated.ground_truth[kTestScan].pose;
   const SE3d initial = Perturbed(truth, 0.1, 0.3, 6);
-  ScanMatchingOptions options;
-  options.w_rcs = 0.25;
-  options.reassociate = false;
-  options.translation_tolerance = 1e-7;
-  options.rotation_tolerance = 1e-8;
-  options.max_iterations = 100;
+  ScanMatchingOptions options = OneAssociationToConvergence();
   const Eigen::Vector3d target = truth.translation() + Eigen::Vector3d(0.3, -0.2, 0.1);
   options.velocity = PriorTowards(Perturbed(truth, 1.0, 1.0, 7), target, 0.05);
   const ScanMatchingResult gn = MakeSolver("gn", options)->Match(scan, *world.exact, initial);
-  CeresSolverOptions tight;  // Ceres to its optimum, not to its default tolerances
-  tight.max_exact_inner_iterations = 200;
-  tight.function_tolerance = 1e-12;
-  tight.gradient_tolerance = 1e-12;
-  tight.parameter_tolerance = 1e-10;
-  const ScanMatchingResult lm = CeresSolver(options, tight).Match(scan, *world.exact, initial);
+  const ScanMatchingResult lm = CeresSolver(options, CeresToItsOptimum()).Match(scan, *world.exact, initial);
   ASSERT_TRUE(gn.converged) << gn.reason;
   ASSERT_TRUE(lm.converged) << lm.reason;
   ExpectPoseNear(gn.pose, lm.pose, 1e-4, 1e-4, "gn against ceres with the velocity term");

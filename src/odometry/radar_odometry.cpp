@@ -84,9 +84,9 @@ RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
     p.gyro = true;
   } else if (steps_.size() >= 2) {  // the last increment's yaw rate; roll and pitch held
     const OdometryStep& before = steps_[steps_.size() - 2];
-    const Eigen::Vector3d rate =
-        (before.pose.rotation().Inverse() * last.pose.rotation()).Log() / (last.stamp - before.stamp);
-    increment = SO3d::Exp(Eigen::Vector3d(0.0, 0.0, rate.z() * p.dt));
+    const double yaw_rate =
+        (before.pose.rotation().Inverse() * last.pose.rotation()).Log().z() / (last.stamp - before.stamp);
+    increment = SO3d::Exp(Eigen::Vector3d(0.0, 0.0, yaw_rate * p.dt));
   }
   p.increment = increment;
   // A vehicle keeps its velocity in its own frame: the last one, unrotated.
