@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "entry_points.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -10,6 +11,7 @@
 
 #include "../apps/radargauss/yaml_config.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/experiment.hpp"
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/rosbag.hpp"
@@ -118,12 +120,27 @@ void SimulatorYaml(const std::uint8_t* data, std::size_t size) {
   Expecting([&] { LoadSimulationConfig(path); });
 }
 
+// The configuration reader reads its file by path (the stream is unused).
 void CliYaml(const std::uint8_t* data, std::size_t size) {
-  std::istringstream input(std::string(reinterpret_cast<const char*>(data), size));
+  const std::string path = WriteInput(data, size, "config.yaml");
+  std::istringstream unused;
   try {
-    YamlConfig("localize", "config.yaml").from_config(input);
+    YamlConfig("localize", path).from_config(unused);
   } catch (const CLI::ConversionError&) {
   }
+}
+
+// One shard folder merged alone: every field of shard.json is read.
+void ShardJson(const std::uint8_t* data, std::size_t size) {
+  const std::string dir = "/tmp/radargauss_fuzz_" + std::to_string(::getpid()) + "_shard";
+  ::mkdir(dir.c_str(), 0700);
+  std::ofstream out(dir + "/shard.json", std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
+  out.close();
+  Expecting([&] {
+    std::vector<SE3d> references;
+    MergeShards({dir}, references);
+  });
 }
 
 }  // namespace
@@ -131,7 +148,8 @@ void CliYaml(const std::uint8_t* data, std::size_t size) {
 const std::vector<Target>& Targets() {
   static const std::vector<Target> targets = {
       {"pcd", Pcd},         {"kitti_bin", KittiBin},           {"tum", Tum},          {"map_file", MapFile},
-      {"pointcloud2", PointCloud2}, {"simulator_yaml", SimulatorYaml}, {"cli_yaml", CliYaml}};
+      {"pointcloud2", PointCloud2}, {"simulator_yaml", SimulatorYaml}, {"cli_yaml", CliYaml},
+      {"shard_json", ShardJson}};
   return targets;
 }
 

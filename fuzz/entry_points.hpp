@@ -21,7 +21,8 @@ struct Target {
   EntryPoint run;
 };
 
-// pcd, kitti_bin, tum, map_file, pointcloud2, simulator_yaml, cli_yaml.
+// pcd, kitti_bin, tum, map_file, pointcloud2, simulator_yaml, cli_yaml,
+// shard_json.
 const std::vector<Target>& Targets();
 
 }  // namespace radargauss::fuzz

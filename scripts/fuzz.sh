@@ -12,7 +12,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 which=${1:-all}
 seconds=${2:-60}
-targets=(pcd kitti_bin tum map_file pointcloud2 simulator_yaml cli_yaml)
+targets=(pcd kitti_bin tum map_file pointcloud2 simulator_yaml cli_yaml shard_json)
 if [ "$which" != all ]; then
   if [[ ! " ${targets[*]} " =~ " $which " ]]; then
     echo "fuzz.sh: unknown target '$which' (all, ${targets[*]})" >&2
@@ -64,5 +64,5 @@ for target in "${targets[@]}"; do
     status=1
   fi
 done
-rm -f /tmp/radargauss_fuzz_*
+rm -rf /tmp/radargauss_fuzz_*
 exit $status

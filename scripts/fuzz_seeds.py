@@ -113,6 +113,30 @@ def pointcloud2_seeds(rng):
         struct.pack("<dddhf", *p[:3], int(p[3]), p[4]) for p in cloud[:2]))
 
 
+def shard_json_seeds(rng):
+    """Valid shard.json files (one shard of one and the first of two)."""
+    import json
+
+    def pose():
+        q = [rng.gauss(0, 1) for _ in range(4)]
+        n = math.sqrt(sum(v * v for v in q))
+        return [rng.uniform(-50, 50) for _ in range(3)] + [v / n for v in q]
+
+    def outcome(scan):
+        return {"scan": scan, "time": 1702450000.0 + scan / 10, "initial": [1.2, 3.4], "error": [0.01, 0.2],
+                "pose": pose(), "iterations": 7, "cost": 0.5, "n_geo": 300, "n_rcs": 280, "converged": True,
+                "reason": "", "time_ms": 0.4}
+
+    for index, count, scans in ((1, 1, 3), (1, 2, 4)):
+        first, end = (index - 1) * scans // count, index * scans // count
+        shard = {"shard": index, "of": count, "scans": scans, "first_scan": first, "end_scan": end,
+                 "experiment": {"--seed": "1", "--w-rcs": "0,0.25", "scans": f"{scans} scans, crc32 0badf00d"},
+                 "references": [pose() for _ in range(first, end)],
+                 "runs": [{"name": f"gn-w{w}-trivial-offset-L3", "w_rcs": w,
+                           "outcomes": [outcome(k) for k in range(first, end)]} for w in (0, 0.25)]}
+        yield f"shard_{index}_of_{count}.json", json.dumps(shard).encode()
+
+
 def files(*patterns):
     for path in sorted(p for pattern in patterns for p in glob.glob(os.path.join(ROOT, pattern))):
         with open(path, "rb") as f:
@@ -127,6 +151,7 @@ def main():
         "pcd": pcd_seeds(rng), "kitti_bin": kitti_seeds(rng), "tum": tum_seeds(rng), "map_file": map_seeds(rng),
         "pointcloud2": pointcloud2_seeds(rng), "simulator_yaml": files("configs/synthetic_world.yaml", "configs/synthetic_long_drive.yaml"),
         "cli_yaml": files("configs/*_localize.yaml", "configs/*_odometry.yaml"),
+        "shard_json": shard_json_seeds(rng),
     }
     for target, items in seeds.items():
         folder = os.path.join(sys.argv[1], target)

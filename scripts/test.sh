@@ -18,7 +18,7 @@ trees=${RADARGAUSS_TEST_TREES:-"release sanitize"}
 # (Debian's PCL and Python are not built with the sanitizers, so the
 # sanitizer tree leaves them out).
 RADARGAUSS_DEPS_EXTRA="librosbag-storage-dev libsensor-msgs-dev libpcl-dev python3-dev python3-numpy
-  python3-pybind11 pybind11-dev python3-pytest python3-matplotlib python3-distributed ${RADARGAUSS_DEPS_EXTRA:-}" \
+  python3-pybind11 pybind11-dev python3-pytest python3-hypothesis python3-matplotlib python3-distributed ${RADARGAUSS_DEPS_EXTRA:-}" \
   "$root/scripts/deps.sh"
 
 # The product's own rules: file and function lengths, README and RESULTS

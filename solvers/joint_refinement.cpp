@@ -6,10 +6,12 @@
 #include <ceres/solver.h>
 
 #include <chrono>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <stdexcept>
 
+#include "radargauss/error.hpp"
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/residuals/geometric_residual.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
@@ -64,8 +66,9 @@ void CheckOptions(const std::vector<RadarScan>& scans, const std::vector<SE3d>& 
     throw std::invalid_argument("joint refinement needs one initial pose per scan (and a scan)");
   }
   if (options.rounds < 1 || options.max_iterations_per_round < 1 || options.relative_pose_prior < 0.0 ||
-      options.coefficient_prior < 0.0) {
-    throw std::invalid_argument("joint refinement: rounds and iterations must be >= 1, priors >= 0");
+      options.coefficient_prior < 0.0 || !(options.min_associated_share >= 0.0 && options.min_associated_share <= 1.0)) {
+    throw std::invalid_argument("joint refinement: rounds and iterations must be >= 1, priors >= 0, the associated "
+                                "share in [0, 1]");
   }
 }
 
@@ -191,6 +194,18 @@ class JointProblem {
   std::map<std::uint32_t, bool> used_coefficients_;
 };
 
+// The scans must lie on the map at their initial poses (a map of another
+// sequence associates almost nothing and would "refine" into noise).
+void CheckCoverage(std::size_t associated, std::size_t points, double min_share) {
+  const double share = points ? double(associated) / double(points) : 0.0;
+  if (share < min_share) {
+    char text[200];
+    std::snprintf(text, sizeof(text), "%.1f %% of the scans' points lie near the map at their poses (at least %.0f %% "
+                  "needed): a map of another sequence, or poses in another frame?", 100.0 * share, 100.0 * min_share);
+    throw DataError(text);
+  }
+}
+
 }  // namespace
 
 JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
@@ -210,10 +225,15 @@ JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
   solver_options.logging_type = ceres::SILENT;
   for (int round = 0; round < options.rounds; ++round) {
     JointProblem problem(blocks, options);
+    std::size_t points = 0, associated = 0;
     for (std::size_t k = 0; k < scans.size(); ++k) {
-      problem.AddScan(k, FindCorrespondences(scans[k], matching, 0, blocks.Pose(k), options.matching.gate,
-                                             options.matching.w_rcs > 0.0));
+      const Correspondences c = FindCorrespondences(scans[k], matching, 0, blocks.Pose(k), options.matching.gate,
+                                                    options.matching.w_rcs > 0.0);
+      points += scans[k].points.size();
+      associated += c.geometric.size();
+      problem.AddScan(k, c);
     }
+    if (round == 0) CheckCoverage(associated, points, options.min_associated_share);
     problem.AddPriors(initial_poses, map);
     const ceres::Solver::Summary summary = problem.Solve(solver_options);
     if (round == 0) result.initial_cost = summary.initial_cost;

@@ -26,6 +26,10 @@ struct JointRefinementOptions {
   double coefficient_prior = 0.0;     // weight of (c - c0); 0: off
   bool schur = true;                  // SPARSE_SCHUR, else SPARSE_NORMAL_CHOLESKY
   int threads = 1;
+  // Fewer of the scans' points within the gate of a Gaussian at the initial
+  // poses than this share is a map of another place (or poses in another
+  // frame): refused before any work (0: never).
+  double min_associated_share = 0.1;
 };
 
 struct JointRefinementResult {
@@ -39,7 +43,8 @@ struct JointRefinementResult {
   double time_ms = 0.0;
 };
 
-// Throws std::invalid_argument for mismatched sizes or bad options.
+// Throws std::invalid_argument for mismatched sizes or bad options, and
+// DataError when the map does not cover the scans (min_associated_share).
 JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
                                     const std::vector<SE3d>& initial_poses, const GaussianMap& map,
                                     const JointRefinementOptions& options);

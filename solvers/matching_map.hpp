@@ -39,6 +39,11 @@ std::vector<std::string> CoarseLevelsNames();
 // The map as the solvers use it: the Gaussians and coarse-to-fine indexes,
 // level k blurred by sigma_k (coarse first), the exact map last
 // (docs/design.md, "Coarse to fine").
+// Bounds of the matching structures' sizes: a blur or an index cell beyond
+// these is a wrong number (and squared, could overflow the cell counts).
+constexpr double kMaxCoarseSigma = 100.0;  // m
+constexpr double kMaxIndexCell = 100.0;    // m
+
 struct MatchingMapOptions {
   std::vector<double> inflation = {1.0, 0.5, 0.25};  // sigma_k of the coarse levels (m), coarse first
   double index_cell = 0.5;  // m: cell of the exact level's index (coarse: max(cell, CoarseIndexCell))

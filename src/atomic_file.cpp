@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <signal.h>
+#include <stdio.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -19,7 +22,23 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Removes the "<name>.tmp.<pid>" files of `directory` whose process has
+// The temporaries' mark: "<name>.radargauss-tmp.<pid>", a name no other
+// program's temporaries have, so that only ours are ever removed.
+const std::string kMark = ".radargauss-tmp.";
+
+std::string TemporaryOf(const std::string& path) { return path + kMark + std::to_string(::getpid()); }
+
+// Whether `name` is a temporary of a process that has ended.
+bool IsStaleTemporary(const std::string& name) {
+  const std::size_t mark = name.rfind(kMark);
+  if (mark == std::string::npos || mark + kMark.size() == name.size()) return false;
+  const std::string digits = name.substr(mark + kMark.size());
+  if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) return false;
+  const pid_t pid = pid_t(std::stol(digits));
+  return pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH;
+}
+
+// Removes the temporary files and folders of `directory` whose process has
 // ended (killed during a write), once per directory and process.
 void RemoveStaleTemporaries(const fs::path& directory) {
   static std::mutex mutex;
@@ -29,25 +48,107 @@ void RemoveStaleTemporaries(const fs::path& directory) {
   std::error_code error;
   for (fs::directory_iterator it(directory.empty() ? fs::path(".") : directory, error), end; !error && it != end;
        it.increment(error)) {
-    const std::string name = it->path().filename().string();
-    const std::size_t mark = name.rfind(".tmp.");
-    if (mark == std::string::npos || mark + 5 == name.size()) continue;
-    const std::string digits = name.substr(mark + 5);
-    if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) continue;
-    const pid_t pid = pid_t(std::stol(digits));
-    if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH) {
+    if (IsStaleTemporary(it->path().filename().string())) {
       std::error_code ignored;
-      fs::remove(it->path(), ignored);
+      fs::remove_all(it->path(), ignored);  // a file, or a staged folder
     }
   }
 }
 
+// The files and folders of `old_dir` that `new_dir` lacks, hard-linked there
+// (copied where links cannot be made): what a run did not write. A folder
+// the run wrote replaces the old one whole.
+void CarryOver(const fs::path& old_dir, const fs::path& new_dir) {
+  for (const fs::directory_entry& entry : fs::directory_iterator(old_dir)) {
+    const fs::path there = new_dir / entry.path().filename();
+    std::error_code error;
+    if (fs::exists(fs::symlink_status(there, error)) || IsStaleTemporary(there.filename().string())) continue;
+    if (entry.is_symlink(error)) {
+      fs::copy_symlink(entry.path(), there, error);
+    } else {
+      fs::copy(entry.path(), there, fs::copy_options::recursive | fs::copy_options::create_hard_links, error);
+      if (error) fs::copy(entry.path(), there, fs::copy_options::recursive, error);
+    }
+    if (error) throw FileError(entry.path().string(), "cannot keep it in the new results: " + error.message());
+  }
+}
+
+// The folder a path names, absolute and without a trailing separator.
+fs::path FolderPath(const std::string& target) {
+  if (target.empty()) throw DataError("an output folder needs a name");
+  std::error_code error;
+  fs::path path = fs::weakly_canonical(fs::absolute(target), error);
+  if (error) path = fs::absolute(target).lexically_normal();
+  if (!path.has_filename()) path = path.parent_path();
+  return path;
+}
+
 }  // namespace
+
+void CheckOutputFile(const std::string& path) {
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (fs::exists(status) && !fs::is_regular_file(status)) {
+    throw FileError(path, fs::is_directory(status) ? "is a folder, not a file to write"
+                                                   : "is not a regular file (a device or FIFO?); refused as an output");
+  }
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent, error)) throw FileError(path, "its folder does not exist");
+}
+
+StagedFolder::StagedFolder(const std::string& target) {
+  const fs::path path = FolderPath(target);
+  std::error_code error;
+  if (fs::exists(path, error) && !fs::is_directory(path, error)) {
+    throw FileError(target, "exists and is not a folder; refused as an output folder");
+  }
+  fs::create_directories(path.parent_path(), error);
+  if (error) throw FileError(target, "cannot create the output folder: " + error.message());
+  RemoveStaleTemporaries(path.parent_path());
+  target_ = path.string();
+  staging_ = TemporaryOf(target_);
+  fs::remove_all(staging_, error);
+  if (!fs::create_directory(staging_, error)) {
+    throw FileError(target, "cannot create the output folder: " + error.message());
+  }
+}
+
+StagedFolder::~StagedFolder() {
+  if (committed_) return;
+  std::error_code ignored;
+  fs::remove_all(staging_, ignored);
+}
+
+void StagedFolder::Commit() {
+  std::error_code error;
+  if (!fs::exists(target_, error)) {
+    if (std::rename(staging_.c_str(), target_.c_str()) != 0) {
+      throw FileError(target_, std::string("cannot move the results into place: ") + std::strerror(errno));
+    }
+    committed_ = true;
+    return;
+  }
+  CarryOver(target_, staging_);
+  // One exchange: the target is the old folder or the new one, never a mix.
+  // A file system without exchanges gets two renames (the old folder set
+  // aside under the staging name's pattern, removed as stale if killed).
+  if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) != 0) {
+    const std::string aside = staging_ + "-old";
+    if ((errno != EINVAL && errno != ENOSYS) || std::rename(target_.c_str(), aside.c_str()) != 0 ||
+        std::rename(staging_.c_str(), target_.c_str()) != 0) {
+      throw FileError(target_, std::string("cannot move the results into place: ") + std::strerror(errno));
+    }
+    staging_ = aside;
+  }
+  committed_ = true;
+  fs::remove_all(staging_, error);  // the old content
+}
 
 void WriteFileAtomically(const std::string& path,
                          const std::function<void(std::ostream&)>& write, bool binary) {
+  CheckOutputFile(path);
   RemoveStaleTemporaries(fs::path(path).parent_path());
-  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
+  const std::string temporary = TemporaryOf(path);
   try {
     {
       std::ofstream out(temporary, binary ? std::ios::out | std::ios::binary : std::ios::out);

@@ -48,9 +48,18 @@ SE3d AlignmentOf(const std::vector<SE3d>& est, const std::vector<SE3d>& ref, Ali
   if (alignment == Alignment::kNone) return SE3d();
   if (alignment == Alignment::kFirst) return ref.front() * est.front().Inverse();
   std::vector<Eigen::Vector3d> p, q;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < est.size(); ++k) {
     p.push_back(est[k].translation());
     q.push_back(ref[k].translation());
+    mean += p.back() / double(est.size());
+  }
+  // A scale is the ratio of the two spreads: none exists for an estimate that stays put.
+  double spread = 0.0;
+  for (const Eigen::Vector3d& point : p) spread = std::max(spread, (point - mean).norm());
+  if (alignment == Alignment::kSim3 && !(spread > 1e-9)) {
+    throw DataError("a sim3 alignment needs an estimate that moves (its positions spread " + std::to_string(spread) +
+                    " m); use se3 or first");
   }
   return AlignPoints(p, q, alignment == Alignment::kSim3, scale);
 }

@@ -45,5 +45,137 @@ mkdir -p "$work/wide"
 cp "$data/pcd/fields_4096.pcd" "$work/wide/1702450000.000000000.pcd"
 expect_fail "a PCD of 4096 fields" "4096 FIELDS, more than 256" -- "$tool" info --sequence "$work/wide"
 
+# Configuration files: bounded, one document, no key twice, no special file.
+head -c 2000000 /dev/zero | tr '\0' '#' >"$work/big.yaml"
+expect_fail "a 2 MB config" "big.yaml: configuration file of 2000000 bytes, more than 1048576" -- \
+  "$tool" build-map --config "$work/big.yaml" "${seq[@]}" --out "$work/m.rgm"
+expect_fail "/dev/zero as config" "/dev/zero: is a character device, not a configuration file" -- \
+  "$tool" build-map --config /dev/zero "${seq[@]}" --out "$work/m.rgm"
+mkfifo "$work/fifo.yaml"
+expect_fail "a FIFO as config, at once" "fifo.yaml: is a FIFO, not a configuration file" -- \
+  "$tool" odometry --config "$work/fifo.yaml" "${seq[@]}" --out "$work/o"
+printf 'w-rcs: 0.25\nseed: 3\nw-rcs: 0.5\n' >"$work/twice.yaml"
+expect_fail "a key given twice" "twice.yaml:3: key 'w-rcs' given twice (first on line 1)" -- \
+  "$tool" localize --config "$work/twice.yaml" "${seq[@]}" --out "$work/l"
+printf 'seed: 3\n---\nseed: 4\n' >"$work/two.yaml"
+expect_fail "a second YAML document" "two.yaml: a second YAML document after '---'" -- \
+  "$tool" localize --config "$work/two.yaml" "${seq[@]}" --out "$work/l"
+printf 'b\033]0;retitled\007ogus: 1\n' >"$work/escape.yaml"
+expect_fail "escape sequences in a key are escaped" "unknown flag 'b.x1b]0;retitled.x07ogus'" -- \
+  "$tool" localize --config "$work/escape.yaml" "${seq[@]}"
+if grep -q $'\033' "$work/err"; then echo "FAIL: a raw escape byte reached the terminal"; failed=$((failed + 1)); fi
+printf 'align: first\n' >"$work/evaluate.yaml"
+expect_ok "evaluate reads --config" "first alignment" -- \
+  "$tool" evaluate --config "$work/evaluate.yaml" --est "$work/seq/gt_radar_tum.txt" --ref "$work/seq/gt_radar_tum.txt"
+printf 'bogus: 1\n' >"$work/evaluate_bogus.yaml"
+expect_fail "evaluate names an unknown config key" "evaluate_bogus.yaml: unknown flag 'bogus'" -- \
+  "$tool" evaluate --config "$work/evaluate_bogus.yaml" --est "$work/seq/gt_radar_tum.txt" --ref "$work/seq/gt_radar_tum.txt"
+
+# Numbers: bounded where a square or a cell count follows, unit quaternions.
+for sigma in 1e300 1e160 101; do
+  expect_fail "coarse sigma $sigma, at once" "coarse-sigmas: $sigma is not in \[0, 100\]" -- \
+    "$tool" odometry --coarse-sigmas "$sigma" "${seq[@]}" --out "$work/o"
+done
+expect_fail "an index cell of 1e300" "index-cell: 1e300 is not in (0, 100\]" -- \
+  "$tool" odometry --index-cell 1e300 "${seq[@]}" --out "$work/o"
+expect_fail "a zero quaternion without an IMU" "--imu-rotation: not a unit quaternion (x y z w), its norm is 0" -- \
+  "$tool" odometry --imu-rotation 0 0 0 0 "${seq[@]}" --out "$work/o"
+awk '{ $2 = 5; $3 = 5; $4 = 5; print }' "$work/seq/gt_radar_tum.txt" >"$work/still.tum"
+expect_fail "sim3 of an estimate that never moves" "a sim3 alignment needs an estimate that moves" -- \
+  "$tool" evaluate --align sim3 --est "$work/still.tum" --ref "$work/seq/gt_radar_tum.txt"
+awk '{ $1 = sprintf("%.9f", $1 + 1000); print }' "$work/seq/gt_radar_tum.txt" >"$work/later.tum"
+expect_fail "odometry's --gt of another time" "later.tum: --gt: 0 of the 4 scans lie in the reference's time span" -- \
+  "$tool" odometry --sequence "$work/seq" --gt "$work/later.tum" --out "$work/o"
+[[ ! -e "$work/o" ]] || { echo "FAIL: a refused odometry left its output"; failed=$((failed + 1)); }
+
+# Every unbounded number flag at both extremes: a result or a one-line
+# refusal within the timeout, never a hang or a crash (squares, cell counts
+# and region counts derive from them).
+for command in odometry localize build-map; do
+  while read -r flag count; do
+    for value in 1e300 1e-300; do
+      values=()
+      for ((k = 0; k < count; ++k)); do values+=("$value"); done
+      out="$work/sweep.rgm"; [ "$command" = build-map ] || out="$work/sweep"
+      timeout "$timeout_s" "$tool" "$command" "${seq[@]}" "$flag" "${values[@]}" --out "$out" >/dev/null 2>"$work/err"
+      status=$?
+      if [ "$status" -ge 124 ] || [ "$(wc -l <"$work/err")" -gt 2 ]; then
+        failed=$((failed + 1)); echo "FAIL: $command $flag $value: exit $status"; head -c 600 "$work/err"
+      else
+        passed=$((passed + 1))
+      fi
+    done
+  done < <("$tool" "$command" --help |
+    awk '$0 ~ /^ *--[a-z-]+ FLOAT:[[(]0, inf\)/ { n = 1; if (match($0, / x [0-9]+/)) n = substr($0, RSTART + 3, RLENGTH - 3); print $1, n }')
+done
+
+# Special files as inputs: named by type, at once.
+expect_fail "map-info /dev/zero" "/dev/zero: is a character device, not a map" -- "$tool" map-info /dev/zero
+expect_fail "info --gt /dev/zero" "/dev/zero: is a character device, not a TUM trajectory" -- \
+  "$tool" info --sequence "$work/seq" --gt /dev/zero
+expect_fail "evaluate --est /dev/zero" "/dev/zero: is a character device, not a TUM trajectory" -- \
+  "$tool" evaluate --est /dev/zero --ref "$work/seq/gt_radar_tum.txt"
+expect_fail "an extrinsic from /dev/zero" "/dev/zero: is a character device, not a pose file (extrinsic)" -- \
+  "$tool" info "${seq[@]}" --extrinsic /dev/zero
+
+# A map of another place: refine refuses it before refining.
+"$tool" build-map "${seq[@]}" --out "$work/map.rgm" >/dev/null
+awk '{ $2 = sprintf("%.9f", $2 + 1000); print }' "$work/seq/gt_radar_tum.txt" >"$work/far.tum"
+expect_fail "refine on a map the scans miss" "0.0 % of the scans' points lie near the map" -- \
+  "$tool" refine --sequence "$work/seq" --poses "$work/far.tum" --extrinsic identity --map "$work/map.rgm" --out "$work/r"
+[[ ! -e "$work/r" ]] || { echo "FAIL: a refused refine left its output"; failed=$((failed + 1)); }
+
+# Negative stamps order numerically (as text -1 would come before -2).
+mkdir -p "$work/negative"
+stamps=(-2.000000000 -1.000000000 0.500000000)
+i=0
+for name in $(ls "$work/seq/ars548/points" | grep '\.pcd$' | head -3); do
+  cp "$work/seq/ars548/points/$name" "$work/negative/${stamps[$i]}.pcd"
+  i=$((i + 1))
+done
+expect_ok "negative stamps in numeric order" "time span: -2.000000000 .. 0.500000000" -- "$tool" info --sequence "$work/negative"
+
+# Outputs: only regular files or nothing are replaced; two-file outputs
+# check both destinations first.
+mkfifo "$work/out.fifo"
+expect_fail "build-map --out a FIFO" "out.fifo: is not a regular file" -- \
+  "$tool" build-map "${seq[@]}" --out "$work/out.fifo"
+[[ -p "$work/out.fifo" ]] || { echo "FAIL: the FIFO was replaced"; failed=$((failed + 1)); }
+if mknod "$work/null" c 1 3 2>/dev/null; then
+  expect_fail "build-map --out a device node" "null: is not a regular file" -- "$tool" build-map "${seq[@]}" --out "$work/null"
+  [[ -c "$work/null" ]] || { echo "FAIL: the device node was replaced"; failed=$((failed + 1)); }
+else
+  echo "skipped: build-map --out a device node (mknod not permitted here)"
+fi
+expect_fail "build-map --ply into a missing folder" "absent/map.ply: its folder does not exist" -- \
+  "$tool" build-map "${seq[@]}" --out "$work/two.rgm" --ply "$work/absent/map.ply"
+[[ ! -e "$work/two.rgm" ]] || { echo "FAIL: the .rgm was written before the --ply was checked"; failed=$((failed + 1)); }
+touch "$work/a_file"
+expect_fail "odometry --out a file" "a_file: exists and is not a folder" -- "$tool" odometry "${seq[@]}" --out "$work/a_file"
+
+# A full disk: the results folder is the old one or none, never a part.
+disk="$work/disk"
+mkdir -p "$disk"
+if mount -t tmpfs -o size=16k tmpfs "$disk" 2>/dev/null; then
+  "$tool" simulate --out "$work/big" --scans 30 --seed 4 >/dev/null
+  for command in odometry localize; do
+    extra=()
+    [ "$command" = localize ] && extra=(--map "$work/map.rgm" --w-rcs 0,0.5,1 --solver gn,ceres)
+    expect_fail "$command on a full disk" "No space left\|write failed\|cannot" -- \
+      "$tool" "$command" --sequence "$work/big" --gt "$work/big/gt_radar_tum.txt" "${extra[@]}" --out "$disk/$command"
+    [[ ! -e "$disk/$command" ]] || { echo "FAIL: $command left part of its folder"; failed=$((failed + 1)); }
+  done
+  mkdir -p "$disk/old" && echo "the old results" >"$disk/old/odometry.tum"
+  expect_fail "odometry over old results on a full disk" "" -- \
+    "$tool" odometry --sequence "$work/big" --gt "$work/big/gt_radar_tum.txt" --out "$disk/old"
+  [ "$(cat "$disk/old/odometry.tum")" = "the old results" ] && [ "$(ls "$disk/old")" = odometry.tum ] ||
+    { echo "FAIL: the old results were changed"; failed=$((failed + 1)); }
+  leftovers=$(find "$disk" -maxdepth 1 -name '*.radargauss-tmp.*' | wc -l)
+  [ "$leftovers" -eq 0 ] || { echo "FAIL: $leftovers staging folders left on the full disk"; failed=$((failed + 1)); }
+  umount "$disk"
+else
+  echo "skipped: the full-disk cases (mounting a tmpfs is not permitted here)"
+fi
+
 echo "hostile cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -3,7 +3,8 @@
 # build-map and localize killed with SIGKILL at moments spread over their run
 # (docs/design.md, "Bounds on input"): every output file is then absent or
 # whole (the same bytes, or for files with timings the same lines, as an
-# undisturbed run), and once a run ends no temporary is left.
+# undisturbed run), and once a run ends no temporary file or staged results
+# folder is left.
 #   kill_test.sh <path to radargauss>
 set -u
 tool=$1
@@ -62,9 +63,9 @@ for percent in 5 20 40 60 75 85 90 94 97 99; do
     checked=$((checked + 1))
     whole "$file" "$work/ref/${file#"$work/loc/"}" ||
       { echo "FAIL: localize killed at $percent %: partial ${file#"$work/"}"; failed=1; }
-  done < <(find "$work/loc" -type f ! -name '*.tmp.*' 2>/dev/null)
+  done < <(find "$work/loc" -type f ! -name '*.radargauss-tmp.*' 2>/dev/null)
 done
-stale=$(find "$work/out" "$work/loc" -name '*.tmp.*' 2>/dev/null | wc -l)
+stale=$(find "$work/out" "$work/loc" -name '*.radargauss-tmp.*' 2>/dev/null | wc -l)
 # The next runs that end remove what the killed ones left, and what a
 # process killed in the middle of a write leaves (planted: such a moment is
 # rarely hit).
@@ -73,11 +74,12 @@ ended=$!
 wait "$ended"
 mkdir -p "$work/loc/trajectories"
 for planted in out/map.rgm loc/per_scan.csv loc/trajectories/reference.tum; do
-  echo "half" >"$work/$planted.tmp.$ended"
+  echo "half" >"$work/$planted.radargauss-tmp.$ended"
 done
 "${build[@]}" --out "$work/out/map.rgm" >/dev/null
 "${localize[@]}" --out "$work/loc" >/dev/null
-left=$(find "$work/out" "$work/loc" -name '*.tmp.*' | wc -l)
+left=$( (find "$work/out" "$work/loc" -name '*.radargauss-tmp.*'; find "$work" -maxdepth 1 -name '*.radargauss-tmp.*') |
+  wc -l)
 [ "$left" -eq 0 ] || { echo "FAIL: $left temporaries left after complete runs"; failed=1; }
 echo "kill: build-map ${build_ms} ms, localize ${localize_ms} ms per run; $checked files checked after kills," \
   "$stale temporaries left by them"

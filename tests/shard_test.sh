@@ -2,7 +2,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # localize --shard I/N and merge (docs/design.md, "Shards"): three shards
 # merged, given in any order, equal the unsharded run in every file (the
-# timing columns aside); a missing, repeated or foreign shard is refused.
+# timing columns aside); a missing, repeated or foreign shard (another count,
+# seed or map) is refused, and so is a shard.json whose fields do not hold
+# what their types, ranges and the shard's index say.
 #   shard_test.sh <path to radargauss>
 set -u
 tool=$1
@@ -48,5 +50,41 @@ expect_refusal "needs 1 <= I <= N" "${localize[@]}" --shard 4/3 --out "$work/x"
 expect_refusal "is not I/N" "${localize[@]}" --shard 1-3 --out "$work/x"
 expect_refusal "is empty" "${localize[@]}" --shard 1/30 --out "$work/x"
 
-[ "$failed" -eq 0 ] && echo "shards: merged equal the unsharded run; 7 refusals"
+# Shards know their experiment: another seed, another map.
+"${localize[@]}" --seed 9 --shard 2/3 --out "$work/seed9" >/dev/null
+expect_refusal "another experiment than $work/s1 ('--seed' is '9'" "$tool" merge "$work/s1" "$work/seed9" "$work/s3" --out "$work/m6"
+"$tool" build-map --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --points-per-gaussian 8 \
+  --out "$work/other.rgm" >/dev/null
+"$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/other.rgm" \
+  --w-rcs 0,0.25 --solver gn,ceres --stride 2 --shard 2/3 --out "$work/other_map" >/dev/null
+expect_refusal "('map' is '[0-9]* bytes, adler32" "$tool" merge "$work/s1" "$work/other_map" "$work/s3" --out "$work/m7"
+[[ ! -e "$work/m6" && ! -e "$work/m7" ]] || fail "a refused merge wrote its folder"
+
+# shard.json read field by field: every fault names the folder and the field.
+# mutated <name> <python statement on the dict j>: a copy of shard 2 changed.
+mutated() {
+  rm -rf "$work/$1" && cp -r "$work/s2" "$work/$1"
+  /usr/bin/python3 -c "import json, sys; j = json.load(open(sys.argv[1])); $2; json.dump(j, open(sys.argv[1], 'w'))" \
+    "$work/$1/shard.json"
+}
+mutated fewer 'j["runs"][0]["outcomes"].pop()'
+expect_refusal "fewer: shard.json: 'runs\[0\].outcomes' must be a list of 7" "$tool" merge "$work/s1" "$work/fewer" "$work/s3" --out "$work/m8"
+mutated shifted 'j["first_scan"] += 1'
+expect_refusal "are not shard 2 of 3's range of 20 scans" "$tool" merge "$work/s1" "$work/shifted" "$work/s3" --out "$work/m8"
+mutated huge 'j["of"] = 1e308'
+expect_refusal "huge: shard.json: 'of' must be a whole number in \[0, 1000000\]" "$tool" merge "$work/s1" "$work/huge" "$work/s3" --out "$work/m8"
+mutated typed 'j["runs"][1]["outcomes"][0]["converged"] = "yes"'
+expect_refusal "'runs\[1\].outcomes\[0\].converged' must be true or false" "$tool" merge "$work/s1" "$work/typed" "$work/s3" --out "$work/m8"
+mutated unnamed 'del j["experiment"]'
+expect_refusal "unnamed: shard.json: 'experiment' is missing" "$tool" merge "$work/s1" "$work/unnamed" "$work/s3" --out "$work/m8"
+mutated rescanned 'j["runs"][0]["outcomes"][1]["scan"] = 3'
+expect_refusal "'runs\[0\].outcomes\[1\].scan' is not the range's scan" "$tool" merge "$work/s1" "$work/rescanned" "$work/s3" --out "$work/m8"
+mkdir -p "$work/deep" && /usr/bin/python3 -c "print('[' * 100000)" >"$work/deep/shard.json"
+expect_refusal "shard.json: nested deeper than a shard file" "$tool" merge "$work/deep" --out "$work/m8"
+mkdir -p "$work/broken" && head -c 100 "$work/s1/shard.json" >"$work/broken/shard.json"
+expect_refusal "broken/shard.json: not JSON" "$tool" merge "$work/broken" --out "$work/m8"
+if grep -q "json.exception" "$work/err"; then fail "a raw JSON library message"; fi
+[[ ! -e "$work/m8" ]] || fail "a refused merge wrote its folder"
+
+[ "$failed" -eq 0 ] && echo "shards: merged equal the unsharded run; 17 refusals"
 [ "$failed" -eq 0 ]

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,8 +21,11 @@
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/rosbag.hpp"
+#include "radargauss/io/yaml_file.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/simulator.hpp"
+#include "radargauss/solvers/matching_map.hpp"
+#include "radargauss/trajectory.hpp"
 #include "temp_dir.hpp"
 
 namespace radargauss {
@@ -168,14 +172,107 @@ pid_t EndedPid() {
 }
 
 TEST_F(HostileInput, WritesRemoveTemporariesOfEndedProcesses) {
-  const std::string stale = WriteFile("map.rgm.tmp." + std::to_string(EndedPid()), "half a map");
-  const std::string live = WriteFile("map.rgm.tmp." + std::to_string(getppid()), "a writer at work");
-  const std::string other = WriteFile("notes.tmp.x", "not ours");
+  const std::string stale = WriteFile("map.rgm.radargauss-tmp." + std::to_string(EndedPid()), "half a map");
+  const std::string live = WriteFile("map.rgm.radargauss-tmp." + std::to_string(getppid()), "a writer at work");
+  const std::string other = WriteFile("notes.tmp." + std::to_string(EndedPid()), "another program's");
   WriteFileAtomically(Path("map.rgm"), [](std::ostream& out) { out << "whole"; });
   EXPECT_FALSE(std::filesystem::exists(stale));
   EXPECT_TRUE(std::filesystem::exists(live));
   EXPECT_TRUE(std::filesystem::exists(other));
   EXPECT_TRUE(std::filesystem::exists(Path("map.rgm")));
+}
+
+// Special files are refused by their type before a read: /dev/zero never
+// ends, a FIFO blocks until a writer comes.
+TEST_F(HostileInput, SpecialFilesAreRefusedByType) {
+  EXPECT_EQ(ErrorOf([] { ReadMap("/dev/zero"); }), "/dev/zero: is a character device, not a map");
+  EXPECT_EQ(ErrorOf([] { ReadTum("/dev/zero"); }), "/dev/zero: is a character device, not a TUM trajectory");
+  EXPECT_EQ(ErrorOf([] { LoadSimulationConfig("/dev/zero"); }),
+            "/dev/zero: is a character device, not a simulation config");
+  const std::string fifo = Path("fifo.pcd");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(ErrorOf([&] { ReadPcdScan(fifo); }), fifo + ": is a FIFO, not a PCD file");
+  EXPECT_EQ(ErrorOf([&] { ReadYamlDocument(fifo, "configuration file"); }),
+            fifo + ": is a FIFO, not a configuration file");
+  EXPECT_EQ(ErrorOf([&] { ReadMap(Path("absent.rgm")); }), Path("absent.rgm") + ": cannot open map (no such file)");
+}
+
+TEST_F(HostileInput, ConfigFilesAreOneBoundedDocumentWithoutRepeatedKeys) {
+  const auto error = [&](const std::string& text) {
+    return ErrorOf([&] { ReadYamlDocument(WriteFile("c.yaml", text), "configuration file"); });
+  };
+  const std::string path = Path("c.yaml");
+  EXPECT_EQ(error("seed: 1\nscans: 4\nseed: 2\n"), path + ":3: key 'seed' given twice (first on line 1)");
+  EXPECT_EQ(error("materials:\n  wall: {diffuse: 1, diffuse: 2}\n"),
+            path + ":2: key 'diffuse' given twice (first on line 2)");
+  EXPECT_EQ(error("seed: 1\n---\nseed: 2\n"),
+            path + ": a second YAML document after '---' (a configuration file is one document)");
+  EXPECT_EQ(error(std::string(40, '[') + std::string(40, ']')), path + ":1: nested more than 32 levels");
+  EXPECT_EQ(error("seed: 1\n" + std::string(kMaxConfigFileBytes, '#')),
+            path + ": configuration file of 1048584 bytes, more than 1048576");
+  EXPECT_EQ(error("seed: [1\n"), path + ":2: YAML: end of sequence flow not found");
+  EXPECT_EQ(error("seed: 1\n---\n"), "") << "a document end marker alone is one document";
+  EXPECT_EQ(ErrorOf([&] { LoadSimulationConfig(WriteFile("w.yaml", "seed: 1\nseed: 2\n")); }),
+            Path("w.yaml") + ":2: key 'seed' given twice (first on line 1)");
+}
+
+TEST_F(HostileInput, OutputsAreRegularFilesInExistingFolders) {
+  const auto write = [](const std::string& path) {
+    WriteFileAtomically(path, [](std::ostream& out) { out << "x"; });
+  };
+  const std::string fifo = Path("fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(ErrorOf([&] { write(fifo); }), fifo + ": is not a regular file (a device or FIFO?); refused as an output");
+  EXPECT_EQ(ErrorOf([&] { write("/dev/null"); }),
+            "/dev/null: is not a regular file (a device or FIFO?); refused as an output");
+  EXPECT_EQ(ErrorOf([&] { write(dir_.string()); }), dir_.string() + ": is a folder, not a file to write");
+  EXPECT_EQ(ErrorOf([&] { write(Path("absent/map.rgm")); }), Path("absent/map.rgm") + ": its folder does not exist");
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo));
+  EXPECT_EQ(ErrorOf([&] { StagedFolder folder(fifo); }),
+            fifo + ": exists and is not a folder; refused as an output folder");
+}
+
+// A results folder holds its old content or the complete new one; what the
+// run did not write stays, a folder it wrote is replaced whole.
+TEST_F(HostileInput, StagedFoldersReplaceTheOldResultsWhole) {
+  namespace fs = std::filesystem;
+  const std::string out = Path("results");
+  const auto run = [&](const std::vector<std::string>& files, bool fail) {
+    StagedFolder folder(out + "/");
+    for (const std::string& name : files) {
+      fs::create_directories((fs::path(folder.path()) / name).parent_path());
+      WriteFileAtomically(folder.path() + "/" + name, [&](std::ostream& o) { o << (fail ? "new " : "") << name; });
+    }
+    if (fail) throw DataError("the run failed");
+    folder.Commit();
+  };
+  run({"a.csv", "runs/one.tum"}, false);
+  WriteFile("results/plot.png", "a plot");
+  EXPECT_EQ(ErrorOf([&] { run({"a.csv", "b.csv"}, true); }), "the run failed");
+  EXPECT_FALSE(fs::exists(Path("results/b.csv")));
+  run({"a.csv", "runs/two.tum"}, false);
+  EXPECT_TRUE(fs::exists(Path("results/plot.png")));      // kept
+  EXPECT_TRUE(fs::exists(Path("results/runs/two.tum")));
+  EXPECT_FALSE(fs::exists(Path("results/runs/one.tum")));  // its folder was rewritten
+  std::size_t entries = 0;
+  for (const auto& entry : fs::directory_iterator(dir_)) entries += entry.path().filename() != "results";
+  EXPECT_EQ(entries, 0u) << "a staging folder was left";
+}
+
+TEST(HostileIndex, BlursAndCellsBeyondTheirBoundsAreRefusedAtOnce) {
+  GaussianMap map;
+  map.gaussians = {RoundGaussian(Eigen::Vector3d::Zero(), 0.3)};
+  for (const double sigma : {1e300, 1e160, std::numeric_limits<double>::infinity(), 101.0}) {
+    MatchingMapOptions options;
+    options.inflation = {sigma};
+    EXPECT_THROW(MatchingMap(map, options), std::invalid_argument) << sigma;
+  }
+  MatchingMapOptions options;
+  options.index_cell = 1e300;
+  EXPECT_THROW(MatchingMap(map, options), std::invalid_argument);
+  Gaussian infinite = RoundGaussian(Eigen::Vector3d::Zero(), 0.3);
+  infinite.covariance(0, 0) = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(ErrorOf([&] { GaussianIndex({infinite}); }), "Gaussian 0 has a non-finite mean or covariance");
 }
 
 }  // namespace

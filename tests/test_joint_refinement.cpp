@@ -14,6 +14,7 @@
 #include <limits>
 #include <random>
 
+#include "radargauss/error.hpp"
 #include "radargauss/experiment.hpp"
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/map/builder.hpp"
@@ -105,6 +106,32 @@ TEST(JointRefinement, LowersPoseErrorAndRcsResidual) {
   EXPECT_GT(largest_coefficient_change, 1e-3);  // the coefficients did move
   EXPECT_LT(largest_difference, 1e-6);
   EXPECT_THROW(RefineJointly(scans, {}, world.map, JointRefinementOptions{}), std::invalid_argument);
+}
+
+// A map of another place (the same map 1 km away) is refused before any
+// work, with the share it found; the real map passes the same check.
+TEST(JointRefinement, RefusesAMapTheScansDoNotLieOn) {
+  const World& world = SimulatedWorld();
+  const std::vector<RadarScan> scans(world.simulated.scans.begin() + 20, world.simulated.scans.begin() + 24);
+  std::vector<SE3d> poses;
+  for (int k = 20; k < 24; ++k) poses.push_back(world.simulated.ground_truth[k].pose);
+  GaussianMap elsewhere = world.map;
+  for (Gaussian& g : elsewhere.gaussians) g.mean.x() += 1000.0;
+  JointRefinementOptions options;
+  options.rounds = 1;
+  options.max_iterations_per_round = 1;
+  try {
+    RefineJointly(scans, poses, elsewhere, options);
+    ADD_FAILURE() << "a map 1 km away was refined";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("0.0 % of the scans' points lie near the map"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW(RefineJointly(scans, poses, world.map, options));
+  options.min_associated_share = 0.0;  // the check off
+  EXPECT_NO_THROW(RefineJointly(scans, poses, elsewhere, options));
+  options.min_associated_share = 1.5;
+  EXPECT_THROW(RefineJointly(scans, poses, world.map, options), std::invalid_argument);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "radargauss/atomic_file.hpp"
 #include "radargauss/evaluation.hpp"
 
 namespace radargauss::cli {
@@ -23,7 +24,11 @@ int RunEvaluate(const EvaluateSettings& s) {
   options.alignment = AlignmentFromString(s.alignment);
   options.time_tolerance = s.time_tolerance;
   const Evaluation evaluation = EvaluateTrajectory(ReadTum(s.estimate), ReadTum(s.reference), options);
-  const std::string table = s.out.empty() ? std::string() : WriteEvaluation(s.out, evaluation);
+  if (!s.out.empty()) {
+    StagedFolder folder(s.out);
+    WriteEvaluation(folder.path(), evaluation);
+    folder.Commit();
+  }
   std::printf("%zu poses paired, reference path %.1f m, %s alignment (scale %.4f)\n", evaluation.matched,
               evaluation.path_length, s.alignment.c_str(), evaluation.scale);
   std::printf("ATE translation: RMSE %.3f m, mean %.3f, median %.3f, max %.3f\n", evaluation.ate_translation.rmse,

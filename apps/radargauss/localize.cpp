@@ -2,6 +2,8 @@
 // radargauss localize: the paper's localisation experiment (docs/design.md,
 // "The localisation experiment"): every scan matched from its reference
 // pose plus a seeded error, for every combination of the swept settings.
+#include <zlib.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -12,6 +14,7 @@
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/experiment.hpp"
+#include "radargauss/io/read_file.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/progress.hpp"
 #include "radargauss/solvers/factory.hpp"
@@ -143,16 +146,71 @@ void WritePlotInputs(const std::string& out, const Experiment& e, const Gaussian
   });
 }
 
-int RunLocalize(LocalizeSettings s) {
+// CRC-32 of doubles, as their bytes.
+std::uint32_t Checksum(std::uint32_t crc, const double* values, std::size_t n) {
+  return std::uint32_t(crc32(crc, reinterpret_cast<const Bytef*>(values), uInt(n * sizeof(double))));
+}
+
+std::string Hex(std::uint32_t value) {
+  char text[9];
+  std::snprintf(text, sizeof(text), "%08x", value);
+  return text;
+}
+
+// What makes shards parts of one experiment (docs/design.md, "Shards"): the
+// value of every flag that changes results, and the contents behind the
+// paths (scans, reference poses, map file) rather than their spelling, so
+// workers may mount the data elsewhere.
+ExperimentIdentity IdentityOf(const CLI::App& app, const Sequence& sequence, const std::string& map_path) {
+  ExperimentIdentity identity;
+  const std::vector<std::string> skipped = {"--help", "--out",  "--shard",    "--sequence",
+                                            "--gt",   "--map", "--bag", "--extrinsic"};
+  for (const CLI::Option* option : app.get_options()) {
+    const std::string name = option->get_name();
+    if (std::find(skipped.begin(), skipped.end(), name) != skipped.end()) continue;
+    identity.emplace_back(name, option->count() > 0 ? CLI::detail::join(option->results(), ",")
+                                                    : option->get_default_str());
+  }
+  std::uint32_t scans = 0, poses = 0;
+  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
+    scans = Checksum(scans, &sequence.scans[k].timestamp, 1);
+    for (const RadarPoint& p : sequence.scans[k].points) {
+      const double values[5] = {p.position.x(), p.position.y(), p.position.z(), p.doppler, p.rcs};
+      scans = Checksum(scans, values, 5);
+    }
+    const Eigen::Quaterniond& q = sequence.poses[k].rotation().quaternion();
+    const Eigen::Vector3d& t = sequence.poses[k].translation();
+    const double pose[7] = {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
+    poses = Checksum(poses, pose, 7);
+  }
+  identity.emplace_back("scans", std::to_string(sequence.scans.size()) + " scans, crc32 " + Hex(scans));
+  identity.emplace_back("reference poses", "crc32 " + Hex(poses));
+  if (!map_path.empty()) {
+    // Adler-32, not CRC-32: a map file ends with its own CRC, and the CRC of
+    // any message followed by its CRC is one constant.
+    const std::string bytes = ReadFileBytes(map_path, "map");
+    identity.emplace_back("map", std::to_string(bytes.size()) + " bytes, adler32 " +
+                                     Hex(std::uint32_t(adler32(1, reinterpret_cast<const Bytef*>(bytes.data()),
+                                                               uInt(bytes.size())))));
+  }
+  return identity;
+}
+
+int RunLocalize(LocalizeSettings s, const CLI::App& app) {
   const Sequence sequence = LoadSequence(s.CheckedSequenceOptions());
   s.CheckAgainst(sequence);
   std::vector<int> degrees;
   const std::vector<GaussianMap> maps = MapsToMatch(sequence, s, degrees);
   const Experiment e = MakeExperiment(sequence, s);
+  StagedFolder folder(s.out);  // a bad --out fails before the run
   const std::vector<ConfigurationRun> runs = RunConfigurations(sequence, s, maps, degrees, e);
-  const std::string table = WriteExperimentResults(s.out, runs);
-  WritePlotInputs(s.out, e, maps.front());
-  if (!s.shard.empty()) WriteShard(s.out, ParseShard(s.shard), e.total_scans, runs, e.references);
+  const std::string table = WriteExperimentResults(folder.path(), runs);
+  WritePlotInputs(folder.path(), e, maps.front());
+  if (!s.shard.empty()) {
+    WriteShard(folder.path(), ParseShard(s.shard), e.total_scans, IdentityOf(app, sequence, s.map_path), runs,
+               e.references);
+  }
+  folder.Commit();
   double initial_t = 0.0;
   for (const ScanOutcome& o : runs.front().outcomes) initial_t += o.initial_translation_error;
   std::printf("%zu scans, %zu configurations; initial errors: mean %.3f m (uniform in [0, %g] m, [0, %g] deg)\n\n%s\n",
@@ -179,7 +237,7 @@ Subcommand AddLocalize(CLI::App& parent) {
   auto s = std::make_shared<LocalizeSettings>();
   CLI::App* app = parent.add_subcommand("localize", "The paper's localisation experiment (w_rcs sweep)");
   AddLocalizeOptions(app, *s);
-  return {app, [s] { return RunLocalize(*s); }};
+  return {app, [s, app] { return RunLocalize(*s, *app); }};
 }
 
 }  // namespace radargauss::cli

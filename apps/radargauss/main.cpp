@@ -3,6 +3,7 @@
 // one-line error and exits non-zero on bad input (flags, files).
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <new>
@@ -10,28 +11,33 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/io/read_file.hpp"
 #include "yaml_config.hpp"
 
 namespace {
 
 // The subcommand whose flags a --config file sets (CLI11 reads config files
 // on the main app only): the first subcommand word on the command line.
-std::string ConfigSection(int argc, char** argv) {
+// simulate's --config is the world's parameters, not its flags.
+std::string ConfigSection(int argc, char** argv, const std::vector<std::string>& subcommands) {
   for (int i = 1; i < argc; ++i) {
     const std::string word = argv[i];
-    if (word == "info" || word == "build-map" || word == "localize" || word == "map-info" || word == "odometry") return word;
+    if (std::find(subcommands.begin(), subcommands.end(), word) != subcommands.end()) {
+      return word == "simulate" ? std::string() : word;
+    }
   }
   return {};
 }
 
-// The file given to the main app's --config, for the messages.
+// The file given to --config (empty without one).
 std::string ConfigPath(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string word = argv[i];
     if (word == "--config" && i + 1 < argc) return argv[i + 1];
     if (word.rfind("--config=", 0) == 0) return word.substr(9);
   }
-  return "config file";
+  return {};
 }
 
 }  // namespace
@@ -43,30 +49,43 @@ int main(int argc, char** argv) {
   const std::vector<Subcommand> subcommands = {AddInfo(app), AddSimulate(app), AddBuildMap(app), AddMapInfo(app),
                                                AddLocalize(app), AddEvaluate(app), AddRefine(app),
                                                AddOdometry(app), AddMerge(app)};
+  std::vector<std::string> names;
+  for (const Subcommand& command : subcommands) names.push_back(command.app->get_name());
   int threads = 0;
   app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(NonNegative());
-  // info, build-map and localize read a YAML file of their flags with
-  // --config (simulate's --config is the world's parameters); flags given on
-  // the command line override the file.
-  app.set_config("--config", "", "YAML file of the subcommand's flags (info, build-map, localize, odometry)");
-  app.config_formatter(std::make_shared<radargauss::YamlConfig>(ConfigSection(argc, argv), ConfigPath(argc, argv)));
+  // Every subcommand but simulate (whose --config is the world's parameters)
+  // reads a YAML file of its flags with --config; flags given on the command
+  // line override the file.
+  const std::string config_path = ConfigPath(argc, argv);
+  app.set_config("--config", "", "YAML file of the subcommand's flags (all but simulate)");
+  app.config_formatter(std::make_shared<radargauss::YamlConfig>(ConfigSection(argc, argv, names), config_path));
   app.allow_config_extras(CLI::config_extras_mode::error);
   for (const Subcommand& command : subcommands) {
-    const std::string name = command.app->get_name();
-    if (name == "info" || name == "build-map" || name == "localize" || name == "odometry") command.app->fallthrough();
+    if (command.app->get_name() != "simulate") command.app->fallthrough();
   }
   CheckEveryNumberIsFinite(app);
   try {
+    // By type before CLI11 opens it: a FIFO would block, /dev/zero never end.
+    if (!config_path.empty()) radargauss::CheckRegularInputFile(config_path, "configuration file");
     app.parse(argc, argv);
+  } catch (const radargauss::DataError& e) {
+    std::fprintf(stderr, "radargauss: error: %s\n", radargauss::Printable(e.what()).c_str());
+    return 2;
   } catch (const CLI::ConfigError& e) {
     // CLI11 names the file "INI" and the key section.key.
     const std::string extra = "INI was not able to parse ";
     std::string what = e.what();
     if (what.rfind(extra, 0) == 0) what = "unknown flag '" + what.substr(what.find('.') + 1) + "'";
-    std::fprintf(stderr, "radargauss: error: %s: %s\n", ConfigPath(argc, argv).c_str(), what.c_str());
+    std::fprintf(stderr, "radargauss: error: %s: %s\n", radargauss::Printable(config_path).c_str(),
+                 radargauss::Printable(what).c_str());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "radargauss: error: %s: out of memory\n", radargauss::Printable(config_path).c_str());
     return 2;
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    std::fprintf(stderr, "radargauss: error: %s\n", radargauss::Printable(e.what()).c_str());
+    return e.get_exit_code();
   }
   std::unique_ptr<tbb::global_control> thread_limit;
   if (threads > 0) {
@@ -81,7 +100,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "radargauss: error: out of memory (an input larger than this machine can hold?)\n");
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "radargauss: error: %s\n", e.what());
+    std::fprintf(stderr, "radargauss: error: %s\n", radargauss::Printable(e.what()).c_str());
     return 1;
   }
   return 0;

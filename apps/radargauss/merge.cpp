@@ -23,17 +23,20 @@ struct MergeSettings {
 int RunMerge(const MergeSettings& s) {
   std::vector<SE3d> references;
   const std::vector<ConfigurationRun> runs = MergeShards(s.shards, references);
-  const std::string table = WriteExperimentResults(s.out, runs);
+  StagedFolder folder(s.out);
+  const std::string table = WriteExperimentResults(folder.path(), runs);
   std::vector<double> times;
   for (const ScanOutcome& o : runs.front().outcomes) times.push_back(o.time);
-  WriteReferenceTrajectory(s.out, times, references);
+  WriteReferenceTrajectory(folder.path(), times, references);
   // The map's means are the same in every shard (copied through a temporary, as every output).
   namespace fs = std::filesystem;
   const fs::path means = fs::path(s.shards.front()) / "map_means.csv";
   if (fs::exists(means)) {
     const std::string bytes = ReadFileBytes(means.string(), "map means file");
-    WriteFileAtomically((fs::path(s.out) / "map_means.csv").string(), [&](std::ostream& out) { out << bytes; });
+    WriteFileAtomically((fs::path(folder.path()) / "map_means.csv").string(),
+                        [&](std::ostream& out) { out << bytes; });
   }
+  folder.Commit();
   std::printf("%zu shards, %zu scans, %zu configurations\n\n%s\nresults: %s\n", s.shards.size(), references.size(),
               runs.size(), table.c_str(), s.out.c_str());
   return 0;

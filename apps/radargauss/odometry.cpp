@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "commands.hpp"
+#include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/evaluation.hpp"
 #include "radargauss/io/rosbag.hpp"
@@ -78,12 +79,19 @@ OdometryOptions Resolved(const OdometrySettings& s) {
   return o;
 }
 
+// R_radar_imu from --imu-rotation, checked whether or not an IMU is read.
+Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw) {
+  const Eigen::Quaterniond q(xyzw[3], xyzw[0], xyzw[1], xyzw[2]);
+  if (!(std::abs(q.norm() - 1.0) < kTumQuaternionNormTolerance)) {
+    throw DataError("--imu-rotation: not a unit quaternion (x y z w), its norm is " + std::to_string(q.norm()));
+  }
+  return q.normalized().toRotationMatrix();
+}
+
 // The bag's gyro rates turned into the radar frame by q_radar_imu.
 std::vector<GyroSample> GyroOf(const OdometrySettings& s) {
   if (s.sequence.bag.empty()) throw DataError("--imu-topic needs --bag");
-  const Eigen::Quaterniond q(s.imu_rotation[3], s.imu_rotation[0], s.imu_rotation[1], s.imu_rotation[2]);
-  if (!(std::abs(q.norm() - 1.0) < 1e-3)) throw DataError("--imu-rotation must be a unit quaternion (x y z w)");
-  const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
+  const Eigen::Matrix3d R = ImuRotation(s.imu_rotation);
   std::vector<GyroSample> samples;
   for (const ImuSample& imu : ReadBagImu(s.sequence.bag, s.imu_topic, s.imu_stamps == "record")) {
     samples.push_back({imu.stamp, R * imu.angular_velocity});
@@ -101,6 +109,23 @@ void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence)
   }
 }
 
+// The evaluation pairs scans with reference poses by time: a reference of
+// another run or clock pairs with none, which is said before the run.
+void CheckReferenceCovers(const Trajectory& reference, const Sequence& sequence, const std::string& path) {
+  const double tolerance = EvaluationOptions().time_tolerance;
+  std::size_t covered = 0;
+  for (const RadarScan& scan : sequence.scans) {
+    covered += scan.timestamp >= reference.StartTime() - tolerance && scan.timestamp <= reference.EndTime() + tolerance;
+  }
+  if (covered < 3) {
+    char spans[120];
+    std::snprintf(spans, sizeof(spans), "%.3f to %.3f s; the scans': %.3f to %.3f s", reference.StartTime(),
+                  reference.EndTime(), sequence.scans.front().timestamp, sequence.scans.back().timestamp);
+    throw FileError(path, "--gt: " + std::to_string(covered) + " of the " + std::to_string(sequence.scans.size()) +
+                              " scans lie in the reference's time span (" + spans + ")");
+  }
+}
+
 void PrintSummary(const OdometrySummary& summary) {
   std::printf("odometry: %zu scans (%zu matched, %zu keyframes, %zu with predicted velocity, %zu standing, %zu "
               "with predicted pose), path %.1f m; %.2f ms per scan (median, p90 %.2f); %zu Gaussians active, %zu "
@@ -113,6 +138,7 @@ void PrintSummary(const OdometrySummary& summary) {
 int RunOdometry(const OdometrySettings& s) {
   const OdometryOptions options = Resolved(s);
   ValidateOptions(options);
+  ImuRotation(s.imu_rotation);
   SequenceOptions sequence_options = s.sequence;
   sequence_options.ground_truth.clear();  // every scan, not only those the reference covers
   Sequence sequence = LoadSequence(sequence_options);
@@ -125,7 +151,9 @@ int RunOdometry(const OdometrySettings& s) {
   if (!s.sequence.ground_truth.empty()) {
     reference = ReadRadarTrajectory(s.sequence.ground_truth,
                                     ResolveExtrinsic(s.sequence.extrinsic, s.sequence.ground_truth));
+    CheckReferenceCovers(*reference, sequence, s.sequence.ground_truth);
   }
+  StagedFolder folder(s.out);  // a bad --out fails before the run
   RadarOdometry odometry(options, MatcherOf(s.matcher));
   if (!s.imu_topic.empty()) {
     const std::vector<GyroSample> gyro = GyroOf(s);
@@ -145,9 +173,11 @@ int RunOdometry(const OdometrySettings& s) {
   bar.Finish();
   std::optional<Evaluation> evaluation;
   if (reference) evaluation = EvaluateTrajectory(odometry.trajectory(), *reference);
-  WriteOdometry(s.out, odometry);
+  WriteOdometry(folder.path(), odometry);
+  const std::string table = evaluation ? WriteEvaluation(folder.path(), *evaluation) : std::string();
+  folder.Commit();
   PrintSummary(Summarise(odometry));
-  if (evaluation) std::printf("%s", WriteEvaluation(s.out, *evaluation).c_str());
+  std::printf("%s", table.c_str());
   std::printf("wrote %s (odometry.tum, per_scan.csv, summary.json, map.rgm, map.ply%s)\n", s.out.c_str(),
               evaluation ? ", evaluation.json, evaluation.md" : "");
   return 0;
@@ -180,10 +210,10 @@ void AddLocalMapOptions(CLI::App* app, OdometrySettings& s) {
   app->add_option("--coarse-sigmas", o.map.matching.inflation,
                   "Blur sigma_k of the coarse levels (m), coarse first; 0: the exact map alone")
       ->expected(1, 8)
-      ->check(NonNegative())
+      ->check(InRange(0.0, kMaxCoarseSigma))
       ->capture_default_str();
   app->add_option("--index-cell", o.map.matching.index_cell, "Cell of the active map's spatial index (m)")
-      ->check(Positive())
+      ->check(InRange(0.0, kMaxIndexCell, true))
       ->capture_default_str();
 }
 

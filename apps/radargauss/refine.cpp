@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/evaluation.hpp"
 #include "radargauss/map/map_file.hpp"
@@ -44,20 +45,19 @@ int RunRefine(const RefineSettings& s) {
   const GaussianMap map = ReadMap(s.map_path);
   const JointRefinementResult result = RefineJointly(sequence.scans, sequence.poses, map, s.refinement);
   namespace fs = std::filesystem;
-  std::error_code error;
-  fs::create_directories(s.out, error);
-  if (error) throw FileError(s.out, "cannot create the output folder: " + error.message());
+  StagedFolder folder(s.out);
   const Trajectory before = TrajectoryOf(sequence, sequence.poses), after = TrajectoryOf(sequence, result.poses);
-  WriteTum((fs::path(s.out) / "refined.tum").string(), after);
-  WriteMap((fs::path(s.out) / "refined.rgm").string(), result.map);
+  WriteTum((fs::path(folder.path()) / "refined.tum").string(), after);
+  WriteMap((fs::path(folder.path()) / "refined.rgm").string(), result.map);
   std::printf("refined %zu poses and %zu Gaussians' SH coefficients: cost %.6g -> %.6g in %d Ceres iterations "
               "(%s), %.1f s\n",
               result.poses.size(), result.map.gaussians.size(), result.initial_cost, result.final_cost,
               result.iterations, result.converged ? "converged" : result.reason.c_str(), result.time_ms / 1000.0);
   if (!s.reference.empty()) {
-    PrintEvaluation("before", before, s.reference, (fs::path(s.out) / "before").string());
-    PrintEvaluation("after", after, s.reference, (fs::path(s.out) / "after").string());
+    PrintEvaluation("before", before, s.reference, (fs::path(folder.path()) / "before").string());
+    PrintEvaluation("after", after, s.reference, (fs::path(folder.path()) / "after").string());
   }
+  folder.Commit();
   std::printf("wrote %s/refined.tum and refined.rgm\n", s.out.c_str());
   return 0;
 }
@@ -89,6 +89,10 @@ Subcommand AddRefine(CLI::App& parent) {
   app->add_option("--coefficient-prior", s->refinement.coefficient_prior,
                   "Weight of the map's SH coefficients (0: off)")
       ->check(NonNegative())
+      ->capture_default_str();
+  app->add_option("--min-associated-share", s->refinement.min_associated_share,
+                  "Refuse a map on which fewer of the scans' points lie at their poses (0..1; 0: never)")
+      ->check(InRange(0.0, 1.0))
       ->capture_default_str();
   return {app, [s] { return RunRefine(*s); }};
 }

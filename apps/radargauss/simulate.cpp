@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/simulator.hpp"
 
@@ -31,9 +32,10 @@ int RunSimulate(const SimulateSettings& s) {
   if (!s.force && fs::exists(points, error) && !fs::is_empty(points, error)) {
     throw FileError(s.out, "already holds a sequence (use --force to overwrite)");
   }
-  if (s.force) fs::remove_all(points, error);
+  StagedFolder folder(s.out);  // with --force, the new scans replace the old ones whole
   const SimulatedSequence sequence = Simulate(config);
-  WriteSimulatedSequence(s.out, sequence);
+  WriteSimulatedSequence(folder.path(), sequence);
+  folder.Commit();
   std::size_t detections = 0;
   for (const RadarScan& scan : sequence.scans) detections += scan.points.size();
   std::printf("simulated %zu scans, %zu detections (seed %u) into %s\n", sequence.scans.size(), detections,

@@ -12,9 +12,11 @@
 #include <CLI/CLI.hpp>
 #include <yaml-cpp/yaml.h>
 
-#include <sstream>
 #include <string>
 #include <vector>
+
+#include "radargauss/error.hpp"
+#include "radargauss/io/yaml_file.hpp"
 
 namespace radargauss {
 
@@ -27,18 +29,14 @@ class YamlConfig final : public CLI::Config {
 
   std::string to_config(const CLI::App*, bool, bool, std::string) const override { return {}; }
 
-  std::vector<CLI::ConfigItem> from_config(std::istream& input) const override {
-    std::stringstream text;
-    try {
-      text << input.rdbuf();
-    } catch (const std::exception&) {
-      throw Error("cannot be read (a directory?)");
-    }
+  // Reads the file by its path (bounded, one document, no key twice), not
+  // the stream CLI11 opened: docs/design.md, "Bounds on input".
+  std::vector<CLI::ConfigItem> from_config(std::istream&) const override {
     YAML::Node root;
     try {
-      root = YAML::Load(text.str());
-    } catch (const YAML::Exception& e) {
-      throw Error("YAML: " + e.msg + " at line " + std::to_string(e.mark.line + 1));
+      root = ReadYamlDocument(path_, "configuration file");
+    } catch (const DataError& e) {
+      throw CLI::ConversionError(e.what());
     }
     std::vector<CLI::ConfigItem> items;
     if (root.IsNull()) return items;

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Writing output files so that a reader never sees a half-written file: the
-// content goes to "<path>.tmp.<pid>" and is renamed over <path> when complete.
-// The first write into a folder removes the temporaries there of processes
-// that have ended (killed during a write).
+// Writing outputs so that a reader never sees a half-written file or folder:
+// the content goes to "<path>.radargauss-tmp.<pid>" and is renamed over <path> when
+// complete. The first write into a folder removes the temporaries there of
+// processes that have ended (killed during a write).
 #pragma once
 
 #include <functional>
@@ -15,8 +15,40 @@ namespace radargauss {
 // then renames the file to `path`. On any failure (including an exception
 // from `write`) the temporary file is removed and DataError (or the
 // exception) propagates; `path` is untouched.
+// `path` must name a regular file or nothing: a device node, a FIFO or a
+// folder there is refused (DataError), never replaced.
 void WriteFileAtomically(const std::string& path,
                          const std::function<void(std::ostream&)>& write,
                          bool binary = false);
+
+// Throws DataError naming `path` unless a file could be written there: its
+// folder exists and `path` names a regular file or nothing. Lets a command
+// that writes two files check both before writing either.
+void CheckOutputFile(const std::string& path);
+
+// A results folder written whole: a command writes into path(), a staging
+// folder beside the target, and Commit() puts it in place with one rename
+// (an exchange when the target exists), so the target holds either its old
+// content or the complete new one. The files and folders of an existing
+// target that this run did not write are kept (hard links); a folder it
+// wrote replaces the old one whole. Without Commit() the staging folder is
+// removed and the target is left as it was.
+class StagedFolder {
+ public:
+  // Throws DataError naming `target` when it exists and is not a folder, or
+  // the staging folder cannot be made.
+  explicit StagedFolder(const std::string& target);
+  ~StagedFolder();
+  StagedFolder(const StagedFolder&) = delete;
+  StagedFolder& operator=(const StagedFolder&) = delete;
+
+  const std::string& path() const { return staging_; }
+  void Commit();
+
+ private:
+  std::string target_;
+  std::string staging_;
+  bool committed_ = false;
+};
 
 }  // namespace radargauss

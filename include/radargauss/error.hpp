@@ -24,4 +24,20 @@ inline DataError FileError(const std::string& path, std::size_t line, const std:
   return DataError(path + ":" + std::to_string(line) + ": " + what);
 }
 
+// `text` with every byte outside printable ASCII written as \xNN: names and
+// keys echoed in messages cannot retitle or clear the terminal.
+inline std::string Printable(const std::string& text) {
+  static const char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7f) {
+      out += c;
+    } else {
+      out += {'\\', 'x', kHex[byte >> 4], kHex[byte & 15]};
+    }
+  }
+  return out;
+}
+
 }  // namespace radargauss

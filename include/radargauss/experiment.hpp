@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "radargauss/lie/se3.hpp"
@@ -62,14 +63,23 @@ struct Shard {
 // "I/N" with 1 <= I <= N; throws std::invalid_argument.
 Shard ParseShard(const std::string& text);
 
-// shard.json in `dir`: which shard, and every outcome's numbers and poses
-// exactly (doubles that read back bit for bit), with the reference pose of
-// each scan, so that merged shards give the files one run writes.
+// What makes two shards parts of one experiment: named values (every flag
+// that changes results, the sequence's and the map's checksums), compared
+// as text by the merge.
+using ExperimentIdentity = std::vector<std::pair<std::string, std::string>>;
+
+// shard.json in `dir`: the experiment's identity, which shard and its scan
+// range, and every outcome's numbers and poses exactly (doubles that read
+// back bit for bit), with the reference pose of each scan, so that merged
+// shards give the files one run writes.
 void WriteShard(const std::string& dir, const Shard& shard, std::size_t total_scans,
-                const std::vector<ConfigurationRun>& runs, const std::vector<SE3d>& references);
+                const ExperimentIdentity& identity, const std::vector<ConfigurationRun>& runs,
+                const std::vector<SE3d>& references);
 // The runs of the whole experiment from the folders of all its shards (any
 // order), and the reference pose of every scan. Throws DataError naming the
-// folder for a missing, repeated or inconsistent shard.
+// folder (and the field) for a malformed shard.json, a missing, repeated or
+// foreign shard (another identity or count), or a shard whose range or
+// outcomes are not the ones its index gives.
 std::vector<ConfigurationRun> MergeShards(const std::vector<std::string>& dirs, std::vector<SE3d>& references);
 
 // Writes per_scan.csv, summary.json, table.md and trajectories/<name>.tum into

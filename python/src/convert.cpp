@@ -38,10 +38,11 @@ Array CheckedArray(const py::handle& value, const std::vector<py::ssize_t>& shap
     }
   } else if (py::isinstance<py::sequence>(value) && !py::isinstance<py::str>(value)) {
     try {  // a list of numbers
-      array = Array::ensure(value);
-    } catch (const py::error_already_set&) {
+      array = Array(py::reinterpret_borrow<py::object>(value));
+    } catch (const py::error_already_set& e) {
+      if (e.matches(PyExc_MemoryError)) throw;
+      throw py::value_error(name + " must be numbers of shape " + ShapeText(shape));
     }
-    if (!array) throw py::value_error(name + " must be numbers of shape " + ShapeText(shape));
   } else {
     throw py::value_error(name + " must be an array of shape " + ShapeText(shape));
   }
@@ -52,7 +53,9 @@ Array CheckedArray(const py::handle& value, const std::vector<py::ssize_t>& shap
   if (!shape_ok) {
     throw py::value_error(name + " must have shape " + ShapeText(shape) + ", not " + ShapeText(array));
   }
-  Array converted = Array::ensure(array);
+  // The converting constructor raises numpy's error (MemoryError for a copy
+  // too large); ensure() would clear it and return no array.
+  const Array converted(array);
   const double* data = converted.data();
   for (py::ssize_t i = 0; i < converted.size(); ++i) {
     if (!std::isfinite(data[i])) throw py::value_error(name + " holds a value that is not finite");

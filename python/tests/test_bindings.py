@@ -5,6 +5,7 @@ arguments raise ValueError with the library's message."""
 import os
 import struct
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -107,6 +108,39 @@ def test_errors_carry_the_library_message(tmp_path):
     bad.write_text("1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n")
     with pytest.raises(rg.DataError, match="bad.txt:2: time does not increase"):
         rg.read_tum(str(bad))
+
+
+def test_readers_refuse_special_files_by_type(tmp_path):
+    with pytest.raises(rg.DataError, match="^/dev/zero: is a character device, not a map$"):
+        rg.read_map("/dev/zero")
+    with pytest.raises(rg.DataError, match="^/dev/zero: is a character device, not a TUM trajectory$"):
+        rg.read_tum("/dev/zero")
+    fifo = tmp_path / "scan.pcd"
+    os.mkfifo(fifo)
+    with pytest.raises(rg.DataError, match="scan.pcd: is a FIFO, not a PCD file"):
+        rg.read_pcd(str(fifo))
+
+
+# A conversion that numpy cannot allocate: MemoryError, not a crash. In a
+# child whose address space is capped just above what it holds, the float32
+# array fits and its float64 copy (twice the bytes) does not.
+CAPPED_CONVERSION = """
+import resource, numpy as np, radargauss as rg
+held = int(open('/proc/self/statm').read().split()[0]) * resource.getpagesize()
+points = np.ones((50_000_000, 3), np.float32)
+resource.setrlimit(resource.RLIMIT_AS, (held + 1_000_000_000, resource.RLIM_INFINITY))
+try:
+    rg.Scan(points)
+    print("converted")
+except MemoryError:
+    print("MemoryError")
+"""
+
+
+def test_a_conversion_too_large_raises_memory_error():
+    done = subprocess.run([sys.executable, "-c", CAPPED_CONVERSION], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["MemoryError"], done.stdout + done.stderr[-2000:]
 
 
 @pytest.mark.parametrize("call, message", [

@@ -185,17 +185,21 @@ PcdCloud ReadPcdCloud(const std::string& path) {
 }
 
 bool TimestampFromFileName(const std::string& path, double& timestamp) {
-  const std::string stem = std::filesystem::path(path).stem().string();
+  std::string stem = std::filesystem::path(path).stem().string();
+  const bool negative = !stem.empty() && stem.front() == '-';  // a clock before its epoch
+  if (negative) stem.erase(0, 1);
   const std::size_t dot = stem.find('.');
   if (dot == std::string::npos || dot == 0 || dot + 1 == stem.size()) return false;
   const std::string seconds = stem.substr(0, dot);
   const std::string fraction = stem.substr(dot + 1);
+  if (seconds.size() > 12 || fraction.size() > 18) return false;  // not a clock's stamp
   for (const char c : seconds + fraction) {
     if (c < '0' || c > '9') return false;
   }
   // Seconds and fraction separately, so a 10-digit epoch keeps its nanoseconds
   // as well as a double can.
   timestamp = std::stod(seconds) + std::stod(fraction) * std::pow(10.0, -double(fraction.size()));
+  if (negative) timestamp = -timestamp;
   return true;
 }
 

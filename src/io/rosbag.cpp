@@ -10,6 +10,7 @@
 #include <map>
 
 #include "radargauss/error.hpp"
+#include "radargauss/io/read_file.hpp"
 
 namespace radargauss {
 
@@ -18,6 +19,7 @@ bool RosbagSupported() { return true; }
 namespace {
 
 void OpenBag(rosbag::Bag& bag, const std::string& path) {
+  CheckRegularInputFile(path, "ROS1 bag");
   try {
     bag.open(path, rosbag::bagmode::Read);
   } catch (const std::exception& e) {

@@ -3,12 +3,12 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "radargauss/error.hpp"
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/pcd.hpp"
+#include "radargauss/io/read_file.hpp"
 #include "radargauss/io/rosbag.hpp"
 
 namespace radargauss {
@@ -46,10 +46,11 @@ SE3d ResolveExtrinsic(const std::string& spec, const std::string& ground_truth_p
     const std::string name = fs::path(ground_truth_path).filename().string();
     return name.find("xt32") != std::string::npos ? SnailRadar20231213Extrinsic() : SE3d();
   }
-  std::ifstream in(spec);
-  if (!in) {
+  std::error_code error;
+  if (!std::filesystem::exists(spec, error)) {
     throw FileError(spec, "not an extrinsic preset (identity, snail-20231213, auto) nor a readable file");
   }
+  std::istringstream in(ReadFileBytes(spec, "pose file (extrinsic)", 1 << 16));
   std::string line;
   while (std::getline(in, line)) {
     const auto first = line.find_first_not_of(" \t\r");

@@ -135,10 +135,15 @@ std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vecto
   const Eigen::Matrix3d information = g.covariance.inverse();
   entry.sqrt_information_t = Eigen::LLT<Eigen::Matrix3d>(information).matrixL().transpose();
   const Eigen::Vector3d half = extent_sigmas_ * g.covariance.diagonal().cwiseSqrt();
-  // The cells as Key finds them (VoxelOf of the box's corners).
+  if (!g.mean.allFinite() || !half.allFinite()) {
+    throw DataError("Gaussian " + std::to_string(id) + " has a non-finite mean or covariance");
+  }
+  // The cells as Key finds them (VoxelOf of the box's corners); the box's
+  // size in doubles, which saturated corners cannot overflow.
   const VoxelKey lo = VoxelOf(g.mean - half, cell_size_);
   const VoxelKey hi = VoxelOf(g.mean + half, cell_size_);
-  const double box = double(hi.x - lo.x + 1) * double(hi.y - lo.y + 1) * double(hi.z - lo.z + 1);
+  const double box = (double(hi.x) - double(lo.x) + 1.0) * (double(hi.y) - double(lo.y) + 1.0) *
+                     (double(hi.z) - double(lo.z) + 1.0);
   if (!(box <= double(kMaxIndexCellsPerGaussian))) {
     throw DataError("Gaussian " + std::to_string(id) + " spans " + Brief(box) + " index cells of " +
                     Brief(cell_size_) + " m (at most " + std::to_string(kMaxIndexCellsPerGaussian) +

@@ -13,7 +13,7 @@
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/pcd.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/io/yaml_file.hpp"
 
 namespace radargauss {
 
@@ -108,14 +108,7 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
 
 SimulationConfig LoadSimulationConfig(const std::string& path) {
   SimulationConfig config;
-  // Read here, not by YAML::LoadFile, which leaks its buffer when the read fails.
-  const std::string text = ReadFileBytes(path, "simulation config");
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw FileError(path, e.mark.line + 1, "YAML: " + e.msg);
-  }
+  const YAML::Node root = ReadYamlDocument(path, "simulation config");
   if (root.IsNull()) return config;
   if (!root.IsMap()) throw FileError(path, "expected a map of parameters");
   auto fields = ConfigFields(config);

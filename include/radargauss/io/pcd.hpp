@@ -54,7 +54,8 @@ enum class PcdFormat { kAscii, kBinary, kBinaryCompressed };
 void WritePcdScan(const std::string& path, const RadarScan& scan,
                   PcdFormat format = PcdFormat::kBinary);
 
-// The scan time encoded in a file name "<secs>.<fraction>.pcd", or false.
+// The scan time encoded in a file name "<secs>.<fraction>.pcd" (a leading
+// '-' for stamps before the clock's epoch; at most 12 + 18 digits), or false.
 bool TimestampFromFileName(const std::string& path, double& timestamp);
 
 }  // namespace radargauss
