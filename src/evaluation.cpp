@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <sstream>
 
@@ -58,8 +59,10 @@ SE3d AlignmentOf(const std::vector<SE3d>& est, const std::vector<SE3d>& ref, Ali
   double spread = 0.0;
   for (const Eigen::Vector3d& point : p) spread = std::max(spread, (point - mean).norm());
   if (alignment == Alignment::kSim3 && !(spread > 1e-9)) {
-    throw DataError("a sim3 alignment needs an estimate that moves (its positions spread " + std::to_string(spread) +
-                    " m); use se3 or first");
+    char text[160];
+    std::snprintf(text, sizeof(text), "a sim3 alignment needs an estimate that moves (its positions spread %g m); use "
+                  "se3 or first", spread);
+    throw DataError(text);
   }
   return AlignPoints(p, q, alignment == Alignment::kSim3, scale);
 }

@@ -121,7 +121,7 @@ expect_fail "an extrinsic from /dev/zero" "/dev/zero: is a character device, not
 # A map of another place: refine refuses it before refining.
 "$tool" build-map "${seq[@]}" --out "$work/map.rgm" >/dev/null
 awk '{ $2 = sprintf("%.9f", $2 + 1000); print }' "$work/seq/gt_radar_tum.txt" >"$work/far.tum"
-expect_fail "refine on a map the scans miss" "0.0 % of the scans' points lie near the map" -- \
+expect_fail "refine on a map the scans miss" "map.rgm: 0.0 % of the scans' points lie near the map" -- \
   "$tool" refine --sequence "$work/seq" --poses "$work/far.tum" --extrinsic identity --map "$work/map.rgm" --out "$work/r"
 [[ ! -e "$work/r" ]] || { echo "FAIL: a refused refine left its output"; failed=$((failed + 1)); }
 

@@ -83,7 +83,9 @@ OdometryOptions Resolved(const OdometrySettings& s) {
 Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw) {
   const Eigen::Quaterniond q(xyzw[3], xyzw[0], xyzw[1], xyzw[2]);
   if (!(std::abs(q.norm() - 1.0) < kTumQuaternionNormTolerance)) {
-    throw DataError("--imu-rotation: not a unit quaternion (x y z w), its norm is " + std::to_string(q.norm()));
+    char norm[32];
+    std::snprintf(norm, sizeof(norm), "%g", q.norm());
+    throw DataError(std::string("--imu-rotation: not a unit quaternion (x y z w), its norm is ") + norm);
   }
   return q.normalized().toRotationMatrix();
 }

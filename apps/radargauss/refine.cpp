@@ -43,7 +43,12 @@ int RunRefine(const RefineSettings& s) {
   if (s.sequence.ground_truth.empty()) throw DataError("refine needs --poses");
   const Sequence sequence = LoadSequence(s.sequence);
   const GaussianMap map = ReadMap(s.map_path);
-  const JointRefinementResult result = RefineJointly(sequence.scans, sequence.poses, map, s.refinement);
+  JointRefinementResult result;
+  try {
+    result = RefineJointly(sequence.scans, sequence.poses, map, s.refinement);
+  } catch (const DataError& e) {  // the map the scans miss: name it
+    throw FileError(s.map_path, e.what());
+  }
   namespace fs = std::filesystem;
   StagedFolder folder(s.out);
   const Trajectory before = TrajectoryOf(sequence, sequence.poses), after = TrajectoryOf(sequence, result.poses);
