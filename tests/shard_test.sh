@@ -67,18 +67,17 @@ mutated() {
   /usr/bin/python3 -c "import json, sys; j = json.load(open(sys.argv[1])); $2; json.dump(j, open(sys.argv[1], 'w'))" \
     "$work/$1/shard.json"
 }
-mutated fewer 'j["runs"][0]["outcomes"].pop()'
-expect_refusal "fewer: shard.json: 'runs\[0\].outcomes' must be a list of 7" "$tool" merge "$work/s1" "$work/fewer" "$work/s3" --out "$work/m8"
-mutated shifted 'j["first_scan"] += 1'
-expect_refusal "are not shard 2 of 3's range of 20 scans" "$tool" merge "$work/s1" "$work/shifted" "$work/s3" --out "$work/m8"
-mutated huge 'j["of"] = 1e308'
-expect_refusal "huge: shard.json: 'of' must be a whole number in \[0, 1000000\]" "$tool" merge "$work/s1" "$work/huge" "$work/s3" --out "$work/m8"
-mutated typed 'j["runs"][1]["outcomes"][0]["converged"] = "yes"'
-expect_refusal "'runs\[1\].outcomes\[0\].converged' must be true or false" "$tool" merge "$work/s1" "$work/typed" "$work/s3" --out "$work/m8"
-mutated unnamed 'del j["experiment"]'
-expect_refusal "unnamed: shard.json: 'experiment' is missing" "$tool" merge "$work/s1" "$work/unnamed" "$work/s3" --out "$work/m8"
-mutated rescanned 'j["runs"][0]["outcomes"][1]["scan"] = 3'
-expect_refusal "'runs\[0\].outcomes\[1\].scan' is not the range's scan" "$tool" merge "$work/s1" "$work/rescanned" "$work/s3" --out "$work/m8"
+while IFS='|' read -r name change needle; do
+  mutated "$name" "$change"
+  expect_refusal "$needle" "$tool" merge "$work/s1" "$work/$name" "$work/s3" --out "$work/m8"
+done <<'CASES'
+fewer|j["runs"][0]["outcomes"].pop()|fewer: shard.json: 'runs\[0\].outcomes' must be a list of 7
+shifted|j["first_scan"] += 1|are not shard 2 of 3's range of 20 scans
+huge|j["of"] = 1e308|huge: shard.json: 'of' must be a whole number in \[0, 1000000\]
+typed|j["runs"][1]["outcomes"][0]["converged"] = "yes"|'runs\[1\].outcomes\[0\].converged' must be true or false
+unnamed|del j["experiment"]|unnamed: shard.json: 'experiment' is missing
+rescanned|j["runs"][0]["outcomes"][1]["scan"] = 3|'runs\[0\].outcomes\[1\].scan' is not the range's scan
+CASES
 mkdir -p "$work/deep" && /usr/bin/python3 -c "print('[' * 100000)" >"$work/deep/shard.json"
 expect_refusal "shard.json: nested deeper than a shard file" "$tool" merge "$work/deep" --out "$work/m8"
 mkdir -p "$work/broken" && head -c 100 "$work/s1/shard.json" >"$work/broken/shard.json"
