@@ -2,6 +2,9 @@
 // Scan matching, odometry and trajectory evaluation in Python.
 #include <pybind11/stl.h>
 
+#include <string>
+#include <vector>
+
 #include "bindings.hpp"
 #include "radargauss/evaluation.hpp"
 #include "radargauss/experiment.hpp"
@@ -25,6 +28,21 @@ MatchOptions MatchOptionsFrom(double w_rcs, const std::string& solver, const std
   options.matching.geometric_loss = {LossTypeFromString(loss), loss_scale};
   options.matching.rcs_loss = {LossTypeFromString(rcs_loss), rcs_loss_scale};
   return options;
+}
+
+std::string CommaSeparated(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text;
+}
+
+// match's docstring, its name lists from the library's name tables.
+const char* MatchDoc() {
+  static const std::string doc =
+      "Matches a Scan against a GaussianMap from `initial` (T_world_radar, 4x4 or [x y z qx qy qz qw]), "
+      "minimising eq. 2 coarse to fine as `radargauss localize` does. solver: " +
+      CommaSeparated(ScanMatcherNames()) + "; loss and rcs_loss: " + CommaSeparated(LossNames()) + ".";
+  return doc.c_str();
 }
 
 void BindMatchResult(py::module_& m) {
@@ -142,9 +160,7 @@ void BindMatch(py::module_& m) {
       py::arg("scan"), py::arg("map"), py::arg("initial"), py::arg("w_rcs") = 0.0, py::arg("solver") = "gn",
       py::arg("loss") = "trivial", py::arg("loss_scale") = 1.0, py::arg("rcs_loss") = "cauchy",
       py::arg("rcs_loss_scale") = 1.0,
-      "Matches a Scan against a GaussianMap from `initial` (T_world_radar, 4x4 or [x y z qx qy qz qw]), "
-      "minimising eq. 2 coarse to fine as `radargauss localize` does. solver: gn, gn-autodiff, ceres, "
-      "ceres-dogleg, multi-hypothesis; loss and rcs_loss: trivial, huber, cauchy, ...")
+      MatchDoc())
   ;
   m.def(
       "initial_errors",

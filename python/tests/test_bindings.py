@@ -162,5 +162,18 @@ def test_bad_arguments_raise_value_error(call, message):
         call(sequence.scans[0], world)
 
 
+def test_docstring_names_exactly_the_solvers_and_losses_match_takes():
+    sequence = rg.simulate(seed=2, scans=3)
+    world = rg.build_map(sequence)
+    doc = rg.match.__doc__
+    solvers = doc.rsplit("solver: ", 1)[1].split(";")[0].split(", ")
+    losses = doc.split("loss and rcs_loss: ")[1].rstrip(".\n ").split(", ")
+    assert "mh-gn" in solvers and "trivial" in losses
+    for solver in solvers:
+        rg.match(sequence.scans[0], world, sequence.poses[0], solver=solver)
+    for loss in losses:
+        rg.match(sequence.scans[0], world, sequence.poses[0], loss=loss)
+
+
 def test_help_explains_the_arguments():
     assert "initial" in rg.match.__doc__ and "w_rcs" in rg.match.__doc__ and "solver" in rg.match.__doc__
