@@ -58,7 +58,7 @@ printf 'w-rcs: 0.25\nseed: 3\nw-rcs: 0.5\n' >"$work/twice.yaml"
 expect_fail "a key given twice" "twice.yaml:3: key 'w-rcs' given twice (first on line 1)" -- \
   "$tool" localize --config "$work/twice.yaml" "${seq[@]}" --out "$work/l"
 printf 'seed: 3\n---\nseed: 4\n' >"$work/two.yaml"
-expect_fail "a second YAML document" "two.yaml: a second YAML document after '---'" -- \
+expect_fail "a second YAML document" "two.yaml: more than one YAML document" -- \
   "$tool" localize --config "$work/two.yaml" "${seq[@]}" --out "$work/l"
 printf 'b\033]0;retitled\007ogus: 1\n' >"$work/escape.yaml"
 expect_fail "escape sequences in a key are escaped" "unknown flag 'b.x1b]0;retitled.x07ogus'" -- \

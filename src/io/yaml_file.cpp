@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/io/yaml_file.hpp"
 
-#include <algorithm>
+#include <yaml-cpp/eventhandler.h>
+
 #include <map>
-#include <vector>
+#include <sstream>
 
 #include "radargauss/error.hpp"
 #include "radargauss/io/read_file.hpp"
@@ -36,24 +37,56 @@ void CheckKeysAndDepth(const YAML::Node& node, const std::string& path, int dept
   }
 }
 
+// Whether a parsed document holds anything (an empty one is a lone null).
+class DocumentContent final : public YAML::EventHandler {
+ public:
+  bool found = false;
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override { found = true; }
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override { found = true; }
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    found = true;
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    found = true;
+  }
+  void OnMapEnd() override {}
+};
+
+// Whether a document with content follows the first. The parser is driven
+// document by document with a bound: YAML::LoadAll never ends on some
+// malformed inputs (", ").
+bool HasSecondDocument(const std::string& text) {
+  std::istringstream input(text);
+  YAML::Parser parser(input);
+  DocumentContent first;
+  if (!parser.HandleNextDocument(first)) return false;
+  for (int document = 1; document < 8; ++document) {
+    DocumentContent next;
+    if (!parser.HandleNextDocument(next)) return false;
+    if (next.found) return true;
+  }
+  return true;  // a parser that keeps finding documents: not one document
+}
+
 }  // namespace
 
 YAML::Node ReadYamlDocument(const std::string& path, const std::string& what) {
   const std::string text = ReadFileBytes(path, what, kMaxConfigFileBytes);
-  std::vector<YAML::Node> documents;
+  YAML::Node document;
   try {
-    documents = YAML::LoadAll(text);
+    document = YAML::Load(text);
+    if (HasSecondDocument(text)) {
+      throw FileError(path, "more than one YAML document (a " + what + " is one)");
+    }
   } catch (const YAML::Exception& e) {
     throw FileError(path, std::size_t(e.mark.line + 1), "YAML: " + e.msg);
   }
-  // An empty document after '---' adds nothing; one with content would be ignored silently.
-  const auto with_content = [](const YAML::Node& document) { return !document.IsNull(); };
-  if (documents.size() > 1 && std::any_of(documents.begin() + 1, documents.end(), with_content)) {
-    throw FileError(path, "a second YAML document after '---' (a " + what + " is one document)");
-  }
-  if (documents.empty()) return YAML::Node();
-  CheckKeysAndDepth(documents.front(), path, 0);
-  return documents.front();
+  CheckKeysAndDepth(document, path, 0);
+  return document;
 }
 
 }  // namespace radargauss
