@@ -58,7 +58,8 @@ for target in "${targets[@]}"; do
   if [ "$code" -eq 0 ]; then
     printf '%-15s %10s %8s %8s %s\n' "$target" "${runs:-?}" "${coverage:-?}" "${features:-?}" none
   else
-    reproducer=$(ls -t "$findings"/crash-* "$findings"/leak-* "$findings"/timeout-* "$findings"/oom-* 2>/dev/null | head -1)
+    reproducer=$( (ls -t "$findings"/crash-* "$findings"/leak-* "$findings"/timeout-* "$findings"/oom-* 2>/dev/null || true) |
+      head -1)
     printf '%-15s %10s %8s %8s %s\n' "$target" "${runs:-?}" "${coverage:-?}" "${features:-?}" \
       "FINDING: ${reproducer:-see $log}"
     status=1

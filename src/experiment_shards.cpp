@@ -127,6 +127,8 @@ json ReadShardFile(const std::string& dir) {
     return json::parse(bytes, bounded);
   } catch (const json::parse_error& e) {
     throw FileError(path, "not JSON (byte " + std::to_string(e.byte) + ")");
+  } catch (const json::out_of_range&) {  // the parser's only other error: a number beyond a double
+    throw FileError(path, "not a shard file: a number beyond the range of a double");
   }
 }
 
