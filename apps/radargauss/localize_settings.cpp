@@ -6,6 +6,7 @@
 
 #include "radargauss/error.hpp"
 #include "radargauss/experiment.hpp"
+#include "radargauss/names.hpp"
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/solvers/factory.hpp"
 
@@ -32,12 +33,6 @@ std::string FormatWeight(double w) {
 }
 
 namespace {
-
-std::string Joined(const std::vector<std::string>& names, const char* separator = ", ") {
-  std::string joined;
-  for (const std::string& name : names) joined += (joined.empty() ? "" : separator) + name;
-  return joined;
-}
 
 void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--w-rcs", s.w_rcs, "Weights w_rcs of eq. 2 to sweep (0..1)")

@@ -15,6 +15,13 @@ namespace radargauss {
 template <typename Enum>
 using NamedValue = std::pair<Enum, const char*>;
 
+// `names` as one list, "a, b, c": help texts, messages and docstrings.
+inline std::string Joined(const std::vector<std::string>& names, const char* separator = ", ") {
+  std::string joined;
+  for (const std::string& name : names) joined += (joined.empty() ? "" : separator) + name;
+  return joined;
+}
+
 // Every name of `table`, in its order.
 template <typename Enum, std::size_t N>
 std::vector<std::string> NamesOf(const NamedValue<Enum> (&table)[N]) {
@@ -29,9 +36,7 @@ Enum ValueNamed(const NamedValue<Enum> (&table)[N], const std::string& name, con
   for (const auto& [value, entry_name] : table) {
     if (name == entry_name) return value;
   }
-  std::string choices;
-  for (const auto& entry : table) choices += (choices.empty() ? "" : ", ") + std::string(entry.second);
-  throw std::invalid_argument("unknown " + std::string(what) + " '" + name + "' (" + choices + ")");
+  throw std::invalid_argument("unknown " + std::string(what) + " '" + name + "' (" + Joined(NamesOf(table)) + ")");
 }
 
 // The name of `value` ("unknown" for a value outside the table).

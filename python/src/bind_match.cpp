@@ -8,6 +8,7 @@
 #include "bindings.hpp"
 #include "radargauss/evaluation.hpp"
 #include "radargauss/experiment.hpp"
+#include "radargauss/names.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/radargauss.hpp"
 
@@ -30,18 +31,12 @@ MatchOptions MatchOptionsFrom(double w_rcs, const std::string& solver, const std
   return options;
 }
 
-std::string CommaSeparated(const std::vector<std::string>& names) {
-  std::string text;
-  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
-  return text;
-}
-
 // match's docstring, its name lists from the library's name tables.
 const char* MatchDoc() {
   static const std::string doc =
       "Matches a Scan against a GaussianMap from `initial` (T_world_radar, 4x4 or [x y z qx qy qz qw]), "
       "minimising eq. 2 coarse to fine as `radargauss localize` does. solver: " +
-      CommaSeparated(ScanMatcherNames()) + "; loss and rcs_loss: " + CommaSeparated(LossNames()) + ".";
+      Joined(ScanMatcherNames()) + "; loss and rcs_loss: " + Joined(LossNames()) + ".";
   return doc.c_str();
 }
 
