@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <sstream>
 
@@ -49,20 +48,9 @@ SE3d AlignmentOf(const std::vector<SE3d>& est, const std::vector<SE3d>& ref, Ali
   if (alignment == Alignment::kNone) return SE3d();
   if (alignment == Alignment::kFirst) return ref.front() * est.front().Inverse();
   std::vector<Eigen::Vector3d> p, q;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < est.size(); ++k) {
     p.push_back(est[k].translation());
     q.push_back(ref[k].translation());
-    mean += p.back() / double(est.size());
-  }
-  // A scale is the ratio of the two spreads: none exists for an estimate that stays put.
-  double spread = 0.0;
-  for (const Eigen::Vector3d& point : p) spread = std::max(spread, (point - mean).norm());
-  if (alignment == Alignment::kSim3 && !(spread > 1e-9)) {
-    char text[160];
-    std::snprintf(text, sizeof(text), "a sim3 alignment needs an estimate that moves (its positions spread %g m); use "
-                  "se3 or first", spread);
-    throw DataError(text);
   }
   return AlignPoints(p, q, alignment == Alignment::kSim3, scale);
 }
@@ -124,6 +112,10 @@ SE3d AlignPoints(const std::vector<Eigen::Vector3d>& p, const std::vector<Eigen:
   }
   const Eigen::Matrix4d T = Eigen::umeyama(source, target, with_scale);
   scale = with_scale ? std::cbrt(T.topLeftCorner<3, 3>().determinant()) : 1.0;
+  // The scale is the ratio of the two spreads: points that all coincide have none (0 / 0).
+  if (!(scale > 0.0 && std::isfinite(scale))) {
+    throw DataError("a sim3 alignment needs an estimate that moves (its positions all coincide); use se3 or first");
+  }
   return SE3d(SO3d::FromMatrix(T.topLeftCorner<3, 3>() / scale), T.topRightCorner<3, 1>());
 }
 

@@ -62,6 +62,7 @@ Evaluation EvaluateTrajectory(const Trajectory& estimate, const Trajectory& refe
 
 // The rigid (or similarity, with `with_scale`) transform minimising
 // sum |s R p_i + t - q_i|^2 (Umeyama 1991); returns it and writes the scale.
+// Throws DataError when no scale fits (the points p all coincide).
 SE3d AlignPoints(const std::vector<Eigen::Vector3d>& p, const std::vector<Eigen::Vector3d>& q, bool with_scale,
                  double& scale);
 
