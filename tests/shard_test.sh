@@ -57,7 +57,7 @@ expect_refusal "another experiment than $work/s1 ('--seed' is '9'" "$tool" merge
   --out "$work/other.rgm" >/dev/null
 "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/other.rgm" \
   --w-rcs 0,0.25 --solver gn,ceres --stride 2 --shard 2/3 --out "$work/other_map" >/dev/null
-expect_refusal "('map' is '[0-9]* bytes, adler32" "$tool" merge "$work/s1" "$work/other_map" "$work/s3" --out "$work/m7"
+expect_refusal "('maps' is '[0-9]* Gaussians, crc32" "$tool" merge "$work/s1" "$work/other_map" "$work/s3" --out "$work/m7"
 [[ ! -e "$work/m6" && ! -e "$work/m7" ]] || fail "a refused merge wrote its folder"
 
 # shard.json read field by field: every fault names the folder and the field.

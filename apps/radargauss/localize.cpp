@@ -14,7 +14,6 @@
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/experiment.hpp"
-#include "radargauss/io/read_file.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/progress.hpp"
 #include "radargauss/solvers/factory.hpp"
@@ -159,9 +158,9 @@ std::string Hex(std::uint32_t value) {
 
 // What makes shards parts of one experiment (docs/design.md, "Shards"): the
 // value of every flag that changes results, and the contents behind the
-// paths (scans, reference poses, map file) rather than their spelling, so
-// workers may mount the data elsewhere.
-ExperimentIdentity IdentityOf(const CLI::App& app, const Sequence& sequence, const std::string& map_path) {
+// paths (scans, reference poses, the maps matched) rather than their
+// spelling, so workers may mount the data elsewhere.
+ExperimentIdentity IdentityOf(const CLI::App& app, const Sequence& sequence, const std::vector<GaussianMap>& maps) {
   ExperimentIdentity identity;
   const std::vector<std::string> skipped = {"--help", "--out",  "--shard",    "--sequence",
                                             "--gt",   "--map", "--bag", "--extrinsic"};
@@ -185,14 +184,19 @@ ExperimentIdentity IdentityOf(const CLI::App& app, const Sequence& sequence, con
   }
   identity.emplace_back("scans", std::to_string(sequence.scans.size()) + " scans, crc32 " + Hex(scans));
   identity.emplace_back("reference poses", "crc32 " + Hex(poses));
-  if (!map_path.empty()) {
-    // Adler-32, not CRC-32: a map file ends with its own CRC, and the CRC of
-    // any message followed by its CRC is one constant.
-    const std::string bytes = ReadFileBytes(map_path, "map");
-    identity.emplace_back("map", std::to_string(bytes.size()) + " bytes, adler32 " +
-                                     Hex(std::uint32_t(adler32(1, reinterpret_cast<const Bytef*>(bytes.data()),
-                                                               uInt(bytes.size())))));
+  std::uint32_t gaussians = 0;
+  std::size_t count = 0;
+  for (const GaussianMap& map : maps) {
+    for (const Gaussian& g : map.gaussians) {
+      gaussians = Checksum(gaussians, g.mean.data(), 3);
+      gaussians = Checksum(gaussians, g.covariance.data(), 9);
+      const double rcs[2] = {g.rcs.median, g.rcs.scale};
+      gaussians = Checksum(gaussians, rcs, 2);
+      gaussians = Checksum(gaussians, g.rcs.coefficients.data(), g.rcs.coefficients.size());
+    }
+    count += map.gaussians.size();
   }
+  identity.emplace_back("maps", std::to_string(count) + " Gaussians, crc32 " + Hex(gaussians));
   return identity;
 }
 
@@ -207,7 +211,7 @@ int RunLocalize(LocalizeSettings s, const CLI::App& app) {
   const std::string table = WriteExperimentResults(folder.path(), runs);
   WritePlotInputs(folder.path(), e, maps.front());
   if (!s.shard.empty()) {
-    WriteShard(folder.path(), ParseShard(s.shard), e.total_scans, IdentityOf(app, sequence, s.map_path), runs,
+    WriteShard(folder.path(), ParseShard(s.shard), e.total_scans, IdentityOf(app, sequence, maps), runs,
                e.references);
   }
   folder.Commit();
