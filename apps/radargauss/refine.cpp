@@ -43,6 +43,7 @@ int RunRefine(const RefineSettings& s) {
   if (s.sequence.ground_truth.empty()) throw DataError("refine needs --poses");
   const Sequence sequence = LoadSequence(s.sequence);
   const GaussianMap map = ReadMap(s.map_path);
+  StagedFolder folder(s.out);  // a bad --out fails before the refinement
   JointRefinementResult result;
   try {
     result = RefineJointly(sequence.scans, sequence.poses, map, s.refinement);
@@ -50,7 +51,6 @@ int RunRefine(const RefineSettings& s) {
     throw FileError(s.map_path, e.what());
   }
   namespace fs = std::filesystem;
-  StagedFolder folder(s.out);
   const Trajectory before = TrajectoryOf(sequence, sequence.poses), after = TrajectoryOf(sequence, result.poses);
   WriteTum((fs::path(folder.path()) / "refined.tum").string(), after);
   WriteMap((fs::path(folder.path()) / "refined.rgm").string(), result.map);
