@@ -24,8 +24,12 @@ namespace radargauss::fuzz {
 namespace {
 
 // The readers take paths: the input goes to a file of this process first.
+std::string InputPath(const std::string& name) {
+  return "/tmp/radargauss_fuzz_" + std::to_string(::getpid()) + "_" + name;
+}
+
 std::string WriteInput(const std::uint8_t* data, std::size_t size, const std::string& name) {
-  const std::string path = "/tmp/radargauss_fuzz_" + std::to_string(::getpid()) + "_" + name;
+  const std::string path = InputPath(name);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
   return path;
@@ -132,11 +136,9 @@ void CliYaml(const std::uint8_t* data, std::size_t size) {
 
 // One shard folder merged alone: every field of shard.json is read.
 void ShardJson(const std::uint8_t* data, std::size_t size) {
-  const std::string dir = "/tmp/radargauss_fuzz_" + std::to_string(::getpid()) + "_shard";
+  const std::string dir = InputPath("shard");
   ::mkdir(dir.c_str(), 0700);
-  std::ofstream out(dir + "/shard.json", std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
-  out.close();
+  WriteInput(data, size, "shard/shard.json");
   Expecting([&] {
     std::vector<SE3d> references;
     MergeShards({dir}, references);

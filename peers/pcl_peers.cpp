@@ -84,7 +84,8 @@ PclPeerMatcher::~PclPeerMatcher() = default;
 
 std::string PclPeerMatcher::Name() const { return impl_->method == PclMethod::kNdt ? "pcl-ndt" : "pcl-gicp"; }
 
-ScanMatchingResult PclPeerMatcher::Match(const RadarScan& scan, const MatchingMap&, const SE3d& initial) const {
+ScanMatchingResult PclPeerMatcher::Match(const RadarScan& scan, const MatchingMap&, const SE3d& initial,
+                                         const ScanPriors&) const {
   const auto start = std::chrono::steady_clock::now();
   ScanMatchingResult result;
   result.pose = initial;

@@ -3,7 +3,7 @@
 // NDT and GICP match each scan against the merged map cloud (the static
 // points the Gaussian map was built from), from the same initial poses, and
 // report through the same ScanMatcher interface, so that they appear as rows
-// of the same table. The MatchingMap argument of Match is not used.
+// of the same table. Match uses neither the MatchingMap nor the priors.
 #pragma once
 
 #include <memory>
@@ -42,7 +42,9 @@ class PclPeerMatcher final : public ScanMatcher {
                  const PclPeerOptions& options = {});
   ~PclPeerMatcher() override;
   std::string Name() const override;
-  ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial) const override;
+  using ScanMatcher::Match;
+  ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                           const ScanPriors& priors) const override;
 
  private:
   struct Impl;

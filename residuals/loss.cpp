@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "radargauss/residuals/loss.hpp"
+#include "radargauss/residuals/robust_loss.hpp"
 
 #include "radargauss/names.hpp"
 

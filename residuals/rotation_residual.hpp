@@ -15,22 +15,9 @@
 
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/lie/so3.hpp"
+#include "radargauss/residuals/priors.hpp"
 
 namespace radargauss {
-
-// The term as scan matching adds it to eq. 2: weight * |r_w|^2.
-struct RotationPrior {
-  SO3d predicted;                                                  // R_pred
-  Eigen::Matrix3d sqrt_information = Eigen::Matrix3d::Identity();  // W
-  double weight = 1.0;                                             // 0: off
-  Eigen::Vector3d Residual(const SO3d& rotation) const {
-    return sqrt_information * (predicted.Inverse() * rotation).Log();
-  }
-  // d r_w / d dphi for R Exp(dphi) (right perturbation): W Jr^-1(Log(R_pred^T R)).
-  Eigen::Matrix3d Jacobian(const SO3d& rotation) const {
-    return sqrt_information * SO3d::RightJacobianInverse((predicted.Inverse() * rotation).Log());
-  }
-};
 
 class RotationResidual {
  public:

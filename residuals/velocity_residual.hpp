@@ -12,34 +12,12 @@
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/sized_cost_function.h>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include "radargauss/lie/se3.hpp"
+#include "radargauss/residuals/priors.hpp"
 
 namespace radargauss {
-
-// W = L^-1 with L L^T = S dt^2 + Q (Cholesky), so W^T W = (S dt^2 + Q)^-1;
-// the floor Q must make the sum positive definite.
-inline Eigen::Matrix3d VelocitySqrtInformation(const Eigen::Matrix3d& velocity_covariance, double dt,
-                                               const Eigen::Matrix3d& floor) {
-  const Eigen::Matrix3d covariance = velocity_covariance * dt * dt + floor;
-  const Eigen::Matrix3d L = covariance.llt().matrixL();
-  return L.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity());
-}
-
-// The term as scan matching adds it to eq. 2: weight * |r_v|^2.
-struct VelocityPrior {
-  SE3d previous;                                              // (R_prev, t_prev)
-  Eigen::Vector3d displacement = Eigen::Vector3d::Zero();     // v dt, previous radar frame
-  Eigen::Matrix3d sqrt_information = Eigen::Matrix3d::Identity();  // W
-  double weight = 1.0;                                        // 0: off
-  Eigen::Matrix3d Jacobian() const { return sqrt_information * previous.rotation().Matrix().transpose(); }
-  Eigen::Vector3d Residual(const Eigen::Vector3d& translation) const {
-    return sqrt_information *
-           (previous.rotation().Matrix().transpose() * (translation - previous.translation()) - displacement);
-  }
-};
 
 class VelocityResidual {
  public:

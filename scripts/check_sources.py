@@ -3,11 +3,14 @@
 """Checks the product's files against the project's rules: source files of at
 most 400 lines and functions of at most 80, README.md of at most 200 lines and
 bench/RESULTS.md of at most 400, no narrative of how the project was made, and
-every docs/design.md section that a file cites present there.
+every docs/design.md section that a file cites present there, and no include
+that points up the layers of docs/design.md, "Layers" (check_layers.py).
   scripts/check_sources.py [ROOT]"""
 import pathlib
 import re
 import sys
+
+import check_layers
 
 ROOT = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else pathlib.Path(__file__).parent.parent)
 SOURCE_DIRS = ["include", "src", "residuals", "solvers", "apps", "peers", "examples", "tests", "bench"]
@@ -115,6 +118,7 @@ def main():
         count = len((ROOT / name).read_text().split("\n")) - 1
         if count > limit:
             problems.append(f"{name}: {count} lines (at most {limit})")
+    problems += check_layers.problems(ROOT.resolve())
     for problem in problems:
         print(problem)
     print(f"check_sources: {len(problems)} problems")

@@ -8,6 +8,8 @@
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/residuals/geometric_residual.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
+#include "radargauss/residuals/rotation_residual.hpp"
+#include "radargauss/residuals/velocity_residual.hpp"
 #include "radargauss/solvers/ceres_term_blocks.hpp"
 
 namespace radargauss {
@@ -15,7 +17,8 @@ namespace radargauss {
 using internal::TermBlocks;
 
 struct CeresScanProblem::Impl {
-  Impl(const ScanMatchingOptions& options, double* rotation, double* translation, CeresBlocks blocks, int threads)
+  Impl(const ScanMatchingOptions& options, const ScanPriors& priors, double* rotation, double* translation,
+       CeresBlocks blocks, int threads)
       : options_(options),
         geometric_(problem_, options.geometric_loss, options.jacobians == JacobianMode::kAnalytic, blocks, threads,
                    {rotation, translation}),
@@ -26,14 +29,14 @@ struct CeresScanProblem::Impl {
         problem_(ProblemOptions()) {
     problem_.AddParameterBlock(rotation, 4, &so3_);
     problem_.AddParameterBlock(translation, 3);
-    if (options.velocity && options.velocity->weight > 0.0) {  // the same for every association
-      velocity_cost_ = std::make_unique<VelocityCostFunction>(*options.velocity);
-      velocity_loss_ = std::make_unique<ceres::ScaledLoss>(nullptr, options.velocity->weight, ceres::TAKE_OWNERSHIP);
+    if (priors.velocity && priors.velocity->weight > 0.0) {  // the same for every association
+      velocity_cost_ = std::make_unique<VelocityCostFunction>(*priors.velocity);
+      velocity_loss_ = std::make_unique<ceres::ScaledLoss>(nullptr, priors.velocity->weight, ceres::TAKE_OWNERSHIP);
       problem_.AddResidualBlock(velocity_cost_.get(), velocity_loss_.get(), translation);
     }
-    if (options.rotation && options.rotation->weight > 0.0) {
-      rotation_cost_ = std::make_unique<RotationCostFunction>(*options.rotation);
-      rotation_loss_ = std::make_unique<ceres::ScaledLoss>(nullptr, options.rotation->weight, ceres::TAKE_OWNERSHIP);
+    if (priors.rotation && priors.rotation->weight > 0.0) {
+      rotation_cost_ = std::make_unique<RotationCostFunction>(*priors.rotation);
+      rotation_loss_ = std::make_unique<ceres::ScaledLoss>(nullptr, priors.rotation->weight, ceres::TAKE_OWNERSHIP);
       problem_.AddResidualBlock(rotation_cost_.get(), rotation_loss_.get(), rotation);
     }
   }
@@ -87,9 +90,9 @@ struct CeresScanProblem::Impl {
   ceres::Problem problem_;  // last: destroyed before what it refers to
 };
 
-CeresScanProblem::CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation,
-                                   CeresBlocks blocks, int threads)
-    : impl_(std::make_unique<Impl>(options, rotation, translation, blocks, threads)) {}
+CeresScanProblem::CeresScanProblem(const ScanMatchingOptions& options, const ScanPriors& priors, double* rotation,
+                                   double* translation, CeresBlocks blocks, int threads)
+    : impl_(std::make_unique<Impl>(options, priors, rotation, translation, blocks, threads)) {}
 CeresScanProblem::~CeresScanProblem() = default;
 void CeresScanProblem::Update(const Correspondences& correspondences, double w_rcs) {
   impl_->Update(correspondences, w_rcs);

@@ -7,17 +7,10 @@
 
 #include <memory>
 
-#include "radargauss/solvers/scan_matcher.hpp"
+#include "radargauss/solvers/correspondences.hpp"
+#include "radargauss/solvers/solver_options.hpp"
 
 namespace radargauss {
-
-// How analytic terms enter the ceres::Problem (CeresScanProblem); autodiff
-// terms always take a residual block each.
-enum class CeresBlocks {
-  kPerTerm,     // a residual block per term under ScaledLoss(its loss): Ceres's own loss handling
-  kShared,      // blocks of CeresScanProblem::kTermsPerBlock terms, each term's loss in its residual
-  kSquareRoot,  // shared blocks, each handed to Ceres in its square-root form (default)
-};
 
 // The ceres::Problem of one match, kept across associations: the pose blocks
 // and the current association's terms, shared, square-root or one block per
@@ -27,10 +20,10 @@ class CeresScanProblem {
   static constexpr std::size_t kTermsPerBlock = 64;  // kShared
 
   // `rotation` (quaternion x y z w) and `translation` are the parameter
-  // blocks; they must outlive the problem. `threads`: square-root blocks
-  // per kind of term.
-  CeresScanProblem(const ScanMatchingOptions& options, double* rotation, double* translation,
-                   CeresBlocks blocks = CeresBlocks::kSquareRoot, int threads = 1);
+  // blocks; they must outlive the problem. `priors`: the scan's terms, in
+  // every association. `threads`: square-root blocks per kind of term.
+  CeresScanProblem(const ScanMatchingOptions& options, const ScanPriors& priors, double* rotation,
+                   double* translation, CeresBlocks blocks = CeresBlocks::kSquareRoot, int threads = 1);
   ~CeresScanProblem();
   CeresScanProblem(const CeresScanProblem&) = delete;
   CeresScanProblem& operator=(const CeresScanProblem&) = delete;

@@ -5,6 +5,9 @@
 
 #include <stdexcept>
 
+#include "radargauss/solvers/ceres_scan_problem.hpp"
+#include "radargauss/solvers/coarse_to_fine.hpp"
+
 namespace radargauss {
 
 namespace {
@@ -69,8 +72,8 @@ std::string CeresSolver::Name() const {
   return name;
 }
 
-ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& map,
-                                      const SE3d& initial) const {
+ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                                      const ScanPriors& priors) const {
   Eigen::Vector4d rotation = initial.rotation().quaternion().coeffs();
   Eigen::Vector3d translation = initial.translation();
   ceres::Solver::Options solver_options;
@@ -82,7 +85,7 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
   solver_options.function_tolerance = ceres_options_.function_tolerance;
   solver_options.gradient_tolerance = ceres_options_.gradient_tolerance;
   solver_options.parameter_tolerance = ceres_options_.parameter_tolerance;
-  CeresScanProblem problem(options_, rotation.data(), translation.data(), ceres_options_.blocks,
+  CeresScanProblem problem(options_, priors, rotation.data(), translation.data(), ceres_options_.blocks,
                            ceres_options_.threads);
 
   ceres::Solver::Options exact_options = solver_options;
@@ -90,32 +93,35 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
   exact_options.update_state_every_iteration = true;  // the callback reads the pose
   ExactMapStop stop(options_, rotation.data(), translation.data());
   exact_options.callbacks.push_back(&stop);
-  return RunCoarseToFine(scan, map, initial, options_, [&](const LevelStep& level, ScanMatchingResult& result) {
-    const Correspondences& c = level.correspondences;
-    problem.Update(c, level.options.w_rcs);
-    ceres::Solver::Summary summary;
-    const SE3d before = result.pose;
-    stop.Start(c.pose);
-    ceres::Solve(level.full_cost ? exact_options : solver_options, &problem.problem(), &summary);
-    if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
-      result.reason = "Ceres: " + summary.message;
-      rotation = before.rotation().quaternion().coeffs();
-      translation = before.translation();
-      return StepOutcome::kFailed;
+  // Per stage: associate, solve the association's problem, stop once the pose settles.
+  CoarseToFine match(scan, map, initial, options_, priors);
+  bool converged = false;
+  for (const Stage& stage : match.stages()) {
+    converged = false;
+    for (int iteration = 1; iteration <= stage.max_iterations && !converged; ++iteration) {
+      if (!match.Associate(stage, iteration)) return match.Failed();
+      const Correspondences& c = match.correspondences();
+      problem.Update(c, stage.options.w_rcs);
+      const SE3d before = match.pose();
+      stop.Start(c.pose);
+      ceres::Solver::Summary summary;
+      ceres::Solve(stage.full_cost ? exact_options : solver_options, &problem.problem(), &summary);
+      if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
+        match.SetReason("Ceres: " + summary.message);
+        return match.Failed();
+      }
+      match.pose() = PoseOfBlocks(rotation.data(), translation.data());
+      const SE3d step = before.Inverse() * match.pose();
+      // Converged when the pose settled, or when Ceres converged (or took a
+      // step below the tolerances) on an association the outer loop keeps:
+      // the next solve would be the same problem from its own solution.
+      // (stop.small_step: only the last stage's solves carry the callback)
+      const bool settled = summary.termination_type == ceres::CONVERGENCE || stop.small_step;
+      converged = stage.SmallStep(step.translation().norm(), step.rotation().Log().norm()) ||
+                  (KeepsAssociation(stage.finest, c.pose, match.pose(), options_) && settled);
     }
-    result.pose = PoseOfBlocks(rotation.data(), translation.data());
-    const SE3d step = before.Inverse() * result.pose;
-    const bool small = level.SmallStep(step.translation().norm(), step.rotation().Log().norm());
-    // Converged when the pose settled, or when Ceres converged (or took a
-    // step below the tolerances) on an association the outer loop keeps: the
-    // next solve would be the same problem from its own solution.
-    // (stop.small_step: only the last stage's solves carry the callback)
-    const bool settled = summary.termination_type == ceres::CONVERGENCE || stop.small_step;
-    if (small || (KeepsAssociation(level.finest, c.pose, result.pose, options_) && settled)) {
-      return StepOutcome::kConverged;
-    }
-    return StepOutcome::kContinue;
-  });
+  }
+  return match.Finish(converged);
 }
 
 }  // namespace radargauss

@@ -7,35 +7,18 @@
 // translation a constant of the current association.
 #pragma once
 
-#include "radargauss/solvers/ceres_scan_problem.hpp"
 #include "radargauss/solvers/scan_matcher.hpp"
+#include "radargauss/solvers/solver_options.hpp"
 
 namespace radargauss {
-
-struct CeresSolverOptions {
-  bool dogleg = false;           // Levenberg-Marquardt (default) or dogleg
-  // Iterations per solve (per association) in the stages that steer: few, as
-  // the outer loop re-associates after each solve there.
-  int max_inner_iterations = 2;
-  // In the last stage a solve also ends when the pose leaves the association
-  // or a step is below the loop's tolerances (docs/design.md, "Ceres").
-  int max_exact_inner_iterations = 8;
-  // How analytic terms enter the problem (docs/design.md, "The residual blocks").
-  CeresBlocks blocks = CeresBlocks::kSquareRoot;
-  int threads = 1;
-  // Ceres's stopping rules per association (Ceres's defaults; the outer
-  // loop's step tolerances decide convergence of the match).
-  double function_tolerance = 1e-6;
-  double gradient_tolerance = 1e-10;
-  double parameter_tolerance = 1e-8;
-};
 
 class CeresSolver final : public ScanMatcher {
  public:
   CeresSolver(const ScanMatchingOptions& options, const CeresSolverOptions& ceres_options = {});
   std::string Name() const override;
-  ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map,
-                           const SE3d& initial) const override;
+  using ScanMatcher::Match;
+  ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                           const ScanPriors& priors) const override;
 
  private:
   ScanMatchingOptions options_;

@@ -19,7 +19,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "radargauss/residuals/loss.hpp"
+#include "radargauss/residuals/robust_loss.hpp"
 
 namespace radargauss::internal {
 

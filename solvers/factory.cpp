@@ -5,7 +5,9 @@
 #include <utility>
 
 #include "radargauss/names.hpp"
+#include "radargauss/solvers/ceres_solver.hpp"
 #include "radargauss/solvers/gauss_newton.hpp"
+#include "radargauss/solvers/multi_hypothesis.hpp"
 
 namespace radargauss {
 
@@ -19,7 +21,14 @@ const NamedValue<SolverKind> kSolverNames[] = {
     {SolverKind::kMultiHypothesis, "mh-gn"},
 };
 
+const NamedValue<CeresBlocks> kBlocksNames[] = {
+    {CeresBlocks::kPerTerm, "per-term"}, {CeresBlocks::kShared, "shared"}, {CeresBlocks::kSquareRoot, "square-root"}};
+
 }  // namespace
+
+std::string ToString(CeresBlocks blocks) { return NameOf(kBlocksNames, blocks); }
+CeresBlocks CeresBlocksFromString(const std::string& name) { return ValueNamed(kBlocksNames, name, "Ceres blocks"); }
+std::vector<std::string> CeresBlocksNames() { return NamesOf(kBlocksNames); }
 
 std::string ToString(SolverKind kind) { return NameOf(kSolverNames, kind); }
 SolverKind SolverKindFromString(const std::string& name) { return ValueNamed(kSolverNames, name, "solver"); }

@@ -8,10 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "radargauss/solvers/ceres_solver.hpp"
-#include "radargauss/solvers/gauss_newton.hpp"
-#include "radargauss/solvers/multi_hypothesis.hpp"
 #include "radargauss/solvers/scan_matcher.hpp"
+#include "radargauss/solvers/solver_options.hpp"
 
 namespace radargauss {
 

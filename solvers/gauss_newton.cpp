@@ -6,10 +6,12 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <Eigen/Cholesky>
 
 #include "radargauss/conventions.hpp"
+#include "radargauss/solvers/coarse_to_fine.hpp"
 #include "radargauss/solvers/normal_equations.hpp"
 
 namespace radargauss {
@@ -47,81 +49,63 @@ bool SolveStep(const CombinedSystem& system, bool loss_curvature, Vector6& dx, s
   return true;
 }
 
-// The step check on the exact map: a step must not raise eq. 2 for its
-// association; one that does is halved (at most max_halvings times). When
-// the next iteration keeps the association, its system carries the cost at
-// the new pose, so the check waits for it (no extra pass over the
-// residuals); otherwise eq. 2 is evaluated at once.
-class StepCheck {
- public:
-  explicit StepCheck(int max_halvings) : max_halvings_(max_halvings) {}
-
-  // First in every iteration, with eq. 2 at the current pose: a waiting step
-  // on this association that raised it is taken back and halved; returns
-  // the step taken instead then.
-  std::optional<Vector6> TakeBackRaisingStep(const LevelStep& level, double cost, SE3d& pose) {
-    const Correspondences& c = level.correspondences;
-    same_association_ = c.index == index_ && SamePose(c.pose, associated_at_);
-    if (!pending_) return std::nullopt;
-    pending_ = false;
-    if (!same_association_ || !(cost > cost_)) return std::nullopt;
-    taken_back_ = true;
-    return Backtrack(level, from_, dx_, cost_, 0.5, 1, pose);
-  }
-
-  // Takes dx from `pose` (eq. 2 there: cost). Checked now when it converges,
-  // is the level's last, follows a taken-back step on this association, or
-  // leaves the association; otherwise it waits. Returns the step taken.
-  Vector6 Take(const LevelStep& level, const Vector6& dx, double cost, const ScanMatchingOptions& options,
-               SE3d& pose) {
-    const Correspondences& c = level.correspondences;
-    const bool small = level.SmallStep(dx.segment<3>(kTranslationOffset).norm(), dx.segment<3>(kRotationOffset).norm());
-    const SE3d next = Step(pose, dx);
-    if (small || level.last_iteration || (same_association_ && taken_back_) ||
-        !KeepsAssociation(true, c.pose, next, options)) {
-      return Backtrack(level, pose, dx, cost, 1.0, 0, pose);
-    }
-    pending_ = true;
-    from_ = pose;
-    dx_ = dx;
-    cost_ = cost;
-    index_ = c.index;
-    associated_at_ = c.pose;
-    taken_back_ = false;
-    pose = next;
-    return dx;
-  }
-
- private:
-  // Halves dx from `from` (first by `scale`) while eq. 2 exceeds `cost`; sets
-  // `pose`, records eq. 2 there when it evaluated it, returns the step taken.
-  Vector6 Backtrack(const LevelStep& level, SE3d from, const Vector6& dx, double cost, double scale, int halvings,
-                    SE3d& pose) const {
-    SE3d next = Step(from, scale * dx);
-    level.evaluated->known = false;
-    for (; halvings < max_halvings_; ++halvings) {
-      const double next_cost = EvaluateCost(level.correspondences, next, level.options);
-      if (next_cost <= cost) {
-        *level.evaluated = {true, next, next_cost};
-        break;
-      }
-      scale *= 0.5;
-      next = Step(from, scale * dx);
-    }
-    pose = next;
-    return scale * dx;
-  }
-
-  int max_halvings_;
-  bool pending_ = false;                // a step waits for its check
-  SE3d from_;                           // the pose it was taken from
-  Vector6 dx_ = Vector6::Zero();        // the full step
-  double cost_ = 0.0;                   // eq. 2 at from_
-  const GaussianIndex* index_ = nullptr;  // the association it was taken on
-  SE3d associated_at_;
-  bool taken_back_ = false;             // a step on that association was taken back
-  bool same_association_ = false;       // this iteration's association is that one
+// The step check on the exact map (docs/design.md, "The own Gauss-Newton"):
+// a step must not raise eq. 2 for its association; one that does is halved
+// (at most max_step_halvings times). When the next iteration keeps the
+// association, its system carries the cost at the new pose, so the check
+// waits for it; otherwise eq. 2 is evaluated at once. A plain value, kept
+// across the stages of a match.
+struct StepCheck {
+  struct Waiting {
+    SE3d from;        // the pose the step was taken from
+    Vector6 dx;       // the full step
+    double cost = 0;  // eq. 2 at `from`
+  };
+  std::optional<Waiting> waiting;        // a step whose check waits for the next system
+  const GaussianIndex* index = nullptr;  // the association the last waiting step was taken on
+  SE3d associated_at;
+  bool taken_back = false;               // a step on that association was taken back
+  bool On(const Correspondences& c) const { return c.index == index && SamePose(c.pose, associated_at); }
 };
+
+// Halves dx from `from` (first by `scale`, `halvings` done) while eq. 2
+// exceeds `cost`; sets the match's pose, records eq. 2 there when it
+// evaluated it, returns the step taken.
+Vector6 Backtrack(CoarseToFine& match, const Stage& stage, const SE3d& from, const Vector6& dx, double cost,
+                  double scale, int halvings, int max_halvings) {
+  SE3d next = Step(from, scale * dx);
+  match.ForgetCost();
+  for (; halvings < max_halvings; ++halvings) {
+    const double next_cost = EvaluateCost(match.correspondences(), next, stage.options, match.priors());
+    if (next_cost <= cost) {
+      match.RecordCost(next, next_cost);
+      break;
+    }
+    scale *= 0.5;
+    next = Step(from, scale * dx);
+  }
+  match.pose() = next;
+  return scale * dx;
+}
+
+// Takes dx on the exact map (eq. 2 at the match's pose: cost). Checked now
+// when it ends the stage, follows a taken-back step on this association, or
+// leaves the association; otherwise it waits for the next system.
+Vector6 TakeChecked(CoarseToFine& match, const Stage& stage, StepCheck& check, bool same_association,
+                    const Vector6& dx, double cost, bool last_iteration, int max_halvings) {
+  const Correspondences& c = match.correspondences();
+  const SE3d next = Step(match.pose(), dx);
+  if (stage.SmallStep(dx.segment<3>(kTranslationOffset).norm(), dx.segment<3>(kRotationOffset).norm()) ||
+      last_iteration || (same_association && check.taken_back) || !KeepsAssociation(true, c.pose, next, stage.options)) {
+    return Backtrack(match, stage, match.pose(), dx, cost, 1.0, 0, max_halvings);
+  }
+  check.waiting = StepCheck::Waiting{match.pose(), dx, cost};
+  check.index = c.index;
+  check.associated_at = c.pose;
+  check.taken_back = false;
+  match.pose() = next;
+  return dx;
+}
 
 }  // namespace
 
@@ -135,31 +119,46 @@ std::string GaussNewtonSolver::Name() const {
   return options_.jacobians == JacobianMode::kAnalytic ? "gn" : "gn-autodiff";
 }
 
-// The paper's loop, per iteration of RunCoarseToFine (which associates):
-// linearise eq. 2, solve the 6x6 system, step (checked on the exact map).
-ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const MatchingMap& map,
-                                            const SE3d& initial) const {
-  StepCheck check(gauss_newton_.max_step_halvings);
-  return RunCoarseToFine(scan, map, initial, options_, [&, this](const LevelStep& level, ScanMatchingResult& result) {
-    const auto outcome = [&](const Vector6& step) {
-      return level.SmallStep(step.segment<3>(kTranslationOffset).norm(), step.segment<3>(kRotationOffset).norm())
-                 ? StepOutcome::kConverged
-                 : StepOutcome::kContinue;
-    };
-    // Eq. 2: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs, likewise g.
-    const CombinedSystem system =
-        BuildCombinedSystem(level.correspondences, result.pose, level.options, gauss_newton_.loss_curvature);
-    if (const std::optional<Vector6> step = check.TakeBackRaisingStep(level, system.cost, result.pose)) {
-      return outcome(*step);
+// The paper's loop per stage (docs/design.md, "Coarse to fine"): associate,
+// linearise eq. 2, solve the 6x6 system, update the pose (checked on the
+// exact map), stop on a small step.
+ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                                            const ScanPriors& priors) const {
+  CoarseToFine match(scan, map, initial, options_, priors);
+  const int max_halvings = gauss_newton_.max_step_halvings;
+  StepCheck check;
+  bool converged = false;
+  for (const Stage& stage : match.stages()) {
+    converged = false;
+    for (int iteration = 1; iteration <= stage.max_iterations && !converged; ++iteration) {
+      if (!match.Associate(stage, iteration)) return match.Failed();
+      const Correspondences& c = match.correspondences();
+      // H = (1-w)/N_geo H_geo + w/N_rcs H_rcs plus the priors', likewise g (eq. 2).
+      const CombinedSystem system =
+          BuildCombinedSystem(c, match.pose(), stage.options, priors, gauss_newton_.loss_curvature);
+      const bool same_association = check.On(c);
+      const std::optional<StepCheck::Waiting> waiting = std::exchange(check.waiting, std::nullopt);
+      Vector6 dx;
+      if (waiting && same_association && system.cost > waiting->cost) {  // the last step raised eq. 2
+        check.taken_back = true;
+        dx = Backtrack(match, stage, waiting->from, waiting->dx, waiting->cost, 0.5, 1, max_halvings);
+      } else {
+        std::string reason;
+        if (!SolveStep(system, gauss_newton_.loss_curvature, dx, reason)) {
+          match.SetReason(reason);
+          return match.Failed();
+        }
+        if (!stage.finest || max_halvings == 0) {  // plain steps: coarse levels only steer
+          match.pose() = Step(match.pose(), dx);
+        } else {
+          dx = TakeChecked(match, stage, check, same_association, dx, system.cost,
+                           iteration == stage.max_iterations, max_halvings);
+        }
+      }
+      converged = stage.SmallStep(dx.segment<3>(kTranslationOffset).norm(), dx.segment<3>(kRotationOffset).norm());
     }
-    Vector6 dx;
-    if (!SolveStep(system, gauss_newton_.loss_curvature, dx, result.reason)) return StepOutcome::kFailed;
-    if (!level.finest || gauss_newton_.max_step_halvings == 0) {  // plain steps: coarse levels only steer
-      result.pose = Step(result.pose, dx);
-      return outcome(dx);
-    }
-    return outcome(check.Take(level, dx, system.cost, options_, result.pose));
-  });
+  }
+  return match.Finish(converged);
 }
 
 }  // namespace radargauss

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The own Gauss-Newton scan matcher (docs/design.md, "The own Gauss-Newton"): per outer
-// iteration, re-associate (lazily on the exact map: RunCoarseToFine),
+// iteration, re-associate (lazily on the exact map: CoarseToFine),
 // accumulate H and g per residual with IRLS weights
 // rho'(s) from the losses, combine with eq. 2's weights, solve the 6x6 system
 // H dx = -g by LDLT, update t += dt, R = R Exp(dphi); stop on a small update
@@ -17,30 +17,19 @@
 // gradient zero, before the weighted sum. With kFull they are kept.
 #pragma once
 
-#include "radargauss/solvers/normal_equations.hpp"
 #include "radargauss/solvers/scan_matcher.hpp"
+#include "radargauss/solvers/solver_options.hpp"
 
 namespace radargauss {
-
-// What only the own Gauss-Newton has.
-struct GaussNewtonOptions {
-  int max_step_halvings = 8;  // on the exact map, halvings of a step that raises eq. 2; 0: plain steps
-  // The robust losses' curvature in the Hessian: per term J^T (rho' I +
-  // 2 rho'' r r^T) J with the curvature along r clamped at 0, where IRLS
-  // takes J^T rho' J (the same gradient). For concave losses (Cauchy) IRLS
-  // overestimates the curvature and its steps come out short. When the
-  // system is not positive definite the step falls back to IRLS. Off: IRLS,
-  // as the paper and Ceres (whose Corrector ignores rho'' < 0).
-  bool loss_curvature = false;
-};
 
 class GaussNewtonSolver final : public ScanMatcher {
  public:
   // Throws std::invalid_argument for bad options.
   explicit GaussNewtonSolver(const ScanMatchingOptions& options, const GaussNewtonOptions& gauss_newton = {});
   std::string Name() const override;
-  ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map,
-                           const SE3d& initial) const override;
+  using ScanMatcher::Match;
+  ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                           const ScanPriors& priors) const override;
 
  private:
   ScanMatchingOptions options_;

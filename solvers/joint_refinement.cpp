@@ -15,6 +15,8 @@
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/residuals/geometric_residual.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
+#include "radargauss/residuals/robust_loss.hpp"
+#include "radargauss/solvers/correspondences.hpp"
 
 namespace radargauss {
 

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "radargauss/solvers/correspondences.hpp"
+
 namespace radargauss {
 
 std::vector<Eigen::Vector3d> HypothesisOffsets(const MultiHypothesisOptions& o) {
@@ -44,8 +46,8 @@ double Score(const RadarScan& scan, const MatchingMap& map, const SE3d& pose, do
 
 }  // namespace
 
-ScanMatchingResult MultiHypothesisSolver::Match(const RadarScan& scan, const MatchingMap& map,
-                                                const SE3d& initial) const {
+ScanMatchingResult MultiHypothesisSolver::Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                                                const ScanPriors& priors) const {
   const auto start = std::chrono::steady_clock::now();
   ScanMatchingResult best;
   double best_score = INFINITY;
@@ -55,7 +57,7 @@ ScanMatchingResult MultiHypothesisSolver::Match(const RadarScan& scan, const Mat
   for (const Eigen::Vector3d& offset : HypothesisOffsets(hypotheses_)) {
     const SE3d perturbation(SO3d::Exp(Eigen::Vector3d(0, 0, offset.z())),
                             Eigen::Vector3d(offset.x(), offset.y(), 0.0));
-    ScanMatchingResult candidate = inner_->Match(scan, map, initial * perturbation);
+    ScanMatchingResult candidate = inner_->Match(scan, map, initial * perturbation, priors);
     total_iterations += candidate.iterations;
     const double score = Score(scan, map, candidate.pose, options_.gate);
     const bool better = !have_best || (candidate.converged && !best_converged) ||

@@ -11,14 +11,9 @@
 #include <vector>
 
 #include "radargauss/solvers/scan_matcher.hpp"
+#include "radargauss/solvers/solver_options.hpp"
 
 namespace radargauss {
-
-struct MultiHypothesisOptions {
-  int starts = 8;            // the first `starts` of the pattern below (1..13)
-  double xy_offset = 1.0;    // m
-  double yaw_offset = 0.05;  // rad
-};
 
 // Start offsets (dx, dy, dyaw) in the radar frame: the initial pose, +/-x,
 // +/-y, +/-yaw, the four xy diagonals, and +/-yaw at +x.
@@ -29,8 +24,9 @@ class MultiHypothesisSolver final : public ScanMatcher {
   MultiHypothesisSolver(std::shared_ptr<const ScanMatcher> inner, const ScanMatchingOptions& options,
                         const MultiHypothesisOptions& hypotheses = {});
   std::string Name() const override;
-  ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map,
-                           const SE3d& initial) const override;
+  using ScanMatcher::Match;
+  ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
+                           const ScanPriors& priors) const override;
 
  private:
   std::shared_ptr<const ScanMatcher> inner_;

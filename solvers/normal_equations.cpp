@@ -8,6 +8,7 @@
 #include "radargauss/conventions.hpp"
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/residuals/geometric_residual.hpp"
+#include "radargauss/residuals/robust_loss.hpp"
 
 namespace radargauss {
 
@@ -325,7 +326,8 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
 }
 
 CombinedSystem BuildCombinedSystem(const Correspondences& c, const SE3d& pose,
-                                   const ScanMatchingOptions& options, bool loss_curvature) {
+                                   const ScanMatchingOptions& options, const ScanPriors& priors,
+                                   bool loss_curvature) {
   CombinedSystem combined;
   const double w = options.w_rcs;
   const auto add = [&](const LinearSystem& system, double weight) {
@@ -342,16 +344,16 @@ CombinedSystem BuildCombinedSystem(const Correspondences& c, const SE3d& pose,
     const LinearSystem rcs = BuildRcsSystem(c, pose, options, loss_curvature);
     add(rcs, w / double(rcs.residuals));
   }
-  if (options.velocity && options.velocity->weight > 0.0) {  // linear in t: J = W R_prev^T
-    const VelocityPrior& prior = *options.velocity;
+  if (priors.velocity && priors.velocity->weight > 0.0) {  // linear in t: J = W R_prev^T
+    const VelocityPrior& prior = *priors.velocity;
     const Eigen::Matrix3d J = prior.Jacobian();
     const Eigen::Vector3d r = prior.Residual(pose.translation());
     combined.H.block<3, 3>(kTranslationOffset, kTranslationOffset) += prior.weight * J.transpose() * J;
     combined.g.segment<3>(kTranslationOffset) += prior.weight * J.transpose() * r;
     combined.cost += prior.weight * r.squaredNorm();
   }
-  if (options.rotation && options.rotation->weight > 0.0) {  // J = W Jr^-1(Log(R_pred^T R))
-    const RotationPrior& prior = *options.rotation;
+  if (priors.rotation && priors.rotation->weight > 0.0) {  // J = W Jr^-1(Log(R_pred^T R))
+    const RotationPrior& prior = *priors.rotation;
     const Eigen::Matrix3d J = prior.Jacobian(pose.rotation());
     const Eigen::Vector3d r = prior.Residual(pose.rotation());
     combined.H.block<3, 3>(kRotationOffset, kRotationOffset) += prior.weight * J.transpose() * J;

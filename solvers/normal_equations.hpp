@@ -9,7 +9,7 @@
 
 #include <Eigen/Core>
 
-#include "radargauss/solvers/scan_matcher.hpp"
+#include "radargauss/solvers/correspondences.hpp"
 
 namespace radargauss {
 
@@ -33,8 +33,8 @@ LinearSystem BuildRcsSystem(const Correspondences& correspondences, const SE3d& 
                             const ScanMatchingOptions& options, bool loss_curvature = false);
 
 // Eq. 2's weighted sum: H = (1-w)/N_geo H_geo + w/N_rcs H_rcs, likewise g,
-// the loss curvature and the cost f (with the velocity term when set); a
-// term with weight 0 is not built.
+// the loss curvature and the cost f, plus the terms of `priors`; a term with
+// weight 0 is not built.
 struct CombinedSystem {
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 6> loss_curvature = Eigen::Matrix<double, 6, 6>::Zero();
@@ -42,7 +42,8 @@ struct CombinedSystem {
   double cost = 0.0;  // f of eq. 2 at the pose, as EvaluateCost
 };
 CombinedSystem BuildCombinedSystem(const Correspondences& correspondences, const SE3d& pose,
-                                   const ScanMatchingOptions& options, bool loss_curvature = false);
+                                   const ScanMatchingOptions& options, const ScanPriors& priors,
+                                   bool loss_curvature = false);
 
 // ScanMatchingResult::information: the combined H with IRLS weights, the
 // rotation-only RCS term's identity translation block left out.

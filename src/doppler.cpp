@@ -8,7 +8,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
-#include "radargauss/map/builder.hpp"
+#include "radargauss/voxel_grid.hpp"
 
 namespace radargauss {
 

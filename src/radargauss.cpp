@@ -21,4 +21,10 @@ ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE
   return MakeScanMatcher(options)->Match(scan, map, initial);
 }
 
+RadarOdometry Odometry(const Sequence& sequence, const OdometryOptions& options) {
+  RadarOdometry odometry(options);
+  for (const RadarScan& scan : sequence.scans) odometry.Register(scan);
+  return odometry;
+}
+
 }  // namespace radargauss

@@ -270,7 +270,7 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
         const SE3d pose = Perturbed(truth, 0.1, 0.5, 3);
         Eigen::Vector4d rotation = pose.rotation().quaternion().coeffs();
         Eigen::Vector3d translation = pose.translation();
-        CeresScanProblem problem(options, rotation.data(), translation.data(), layout.blocks, layout.threads);
+        CeresScanProblem problem(options, {}, rotation.data(), translation.data(), layout.blocks, layout.threads);
         int u = 0;
         for (const Update& update : updates) {
           const Correspondences c = FindCorrespondences(*update.scan, map, update.level, pose, 3.0, update.w > 0.0);
@@ -287,7 +287,7 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
           ceres::CRSMatrix jacobian;
           ASSERT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient,
                                                  analytic ? &jacobian : nullptr));
-          const double f = EvaluateCost(c, pose, weighted);
+          const double f = EvaluateCost(c, pose, weighted, {});
           EXPECT_NEAR(2.0 * cost, f, 1e-12 * f) << "w " << update.w << " level " << update.level << ", " << layout.name;
           // With residuals only (a candidate step's cost), the same cost.
           double cost_only = 0.0;
@@ -339,7 +339,7 @@ TEST(CeresScanProblem, SquareRootOfARankDeficientBlock) {
   const auto evaluate = [&](CeresBlocks blocks) {
     Eigen::Vector4d rotation = pose.rotation().quaternion().coeffs();
     Eigen::Vector3d translation = pose.translation();
-    CeresScanProblem problem(ScanMatchingOptions(), rotation.data(), translation.data(), blocks);
+    CeresScanProblem problem(ScanMatchingOptions(), {}, rotation.data(), translation.data(), blocks);
     problem.Update(c, 0.5);
     Evaluation e;
     ceres::CRSMatrix jacobian;

@@ -185,11 +185,12 @@ TEST(CoarseGate, CoarseLevelsAssociateWithinIt) {
     const MatchingMap matching(map, map_options);
     EXPECT_EQ(matching.coarse_gate(), coarse_gate);
     std::vector<std::size_t> associated;  // per level visited
-    const auto record = [&](const LevelStep& step, ScanMatchingResult&) {
-      associated.push_back(step.correspondences.geometric.size());
-      return StepOutcome::kConverged;
-    };
-    const ScanMatchingResult result = RunCoarseToFine(scan, matching, SE3d(), options, record);
+    CoarseToFine match(scan, matching, SE3d(), options, {});
+    for (const Stage& stage : match.stages()) {
+      if (!match.Associate(stage, 1)) break;
+      associated.push_back(match.correspondences().geometric.size());
+    }
+    const ScanMatchingResult result = match.Failed();
     // The coarse level: the 1.5 m points (1.49 std) always, the 2.6 m ones
     // (2.59 std) only within a gate of 3. The exact map (0.1 m std): none.
     ASSERT_EQ(associated.size(), 1u);
@@ -223,14 +224,12 @@ TEST(CoarseVoxels, CoarseLevelsMatchTheScansVoxelCentroids) {
   EXPECT_EQ(matching.sigma(2), 0.0);  // the exact map
   const auto coarse_points = [&](const ScanMatchingOptions& options) {
     std::vector<std::vector<Eigen::Vector3d>> levels;  // the associated points, per coarse level
-    const auto record = [&](const LevelStep& step, ScanMatchingResult&) {
-      if (!step.finest) {
-        levels.emplace_back();
-        for (const GeometricTerm& term : step.correspondences.geometric) levels.back().push_back(term.point_radar);
-      }
-      return StepOutcome::kConverged;
-    };
-    RunCoarseToFine(scan, matching, SE3d(), options, record);
+    CoarseToFine match(scan, matching, SE3d(), options, {});
+    for (const Stage& stage : match.stages()) {
+      if (stage.finest || !match.Associate(stage, 1)) break;
+      levels.emplace_back();
+      for (const GeometricTerm& term : match.correspondences().geometric) levels.back().push_back(term.point_radar);
+    }
     return levels;
   };
   const auto expect_points = [](const std::vector<Eigen::Vector3d>& got, const std::vector<Eigen::Vector3d>& want,

@@ -95,7 +95,7 @@ TEST(Correspondences, AddRcsTermsAsAssociatingWithRcs) {
   }
   ScanMatchingOptions options;
   options.w_rcs = 0.25;
-  EXPECT_EQ(EvaluateCost(added, pose, options), EvaluateCost(with_rcs, pose, options));
+  EXPECT_EQ(EvaluateCost(added, pose, options, {}), EvaluateCost(with_rcs, pose, options, {}));
   AddRcsTerms(scan, exact, added);  // replaces, does not append
   EXPECT_EQ(added.rcs.size(), with_rcs.rcs.size());
   RadarScan no_rcs = scan;
@@ -115,30 +115,31 @@ TEST(GeometricFirst, ExactMapGeometricStageThenEq2) {
   const MatchingMap& matching = *world.matching;
   const std::size_t coarse = matching.levels() - 1;
   const SE3d initial = Perturbed(world.simulated.ground_truth[kTestScan].pose, 0.1, 0.5, 5);
-  struct Stage {
+  struct Seen {
     bool finest;
     double w, translation_tolerance;
     Correspondences c;
   };
-  // One step per stage; `move` shifts the pose by that much (x) in the
+  // One iteration per stage; `move` shifts the pose by that much (x) in the
   // exact map's geometric stage.
   const auto stages = [&](const ScanMatchingOptions& options, double move) {
-    std::vector<Stage> seen;
-    RunCoarseToFine(scan, matching, initial, options, [&](const LevelStep& step, ScanMatchingResult& result) {
-      seen.push_back({step.finest, step.options.w_rcs, step.translation_tolerance, step.correspondences});
-      if (step.finest && step.options.w_rcs == 0.0 && move > 0.0) {
-        result.pose = SE3d(result.pose.rotation(), result.pose.translation() + Eigen::Vector3d(move, 0, 0));
+    std::vector<Seen> seen;
+    CoarseToFine match(scan, matching, initial, options, {});
+    for (const Stage& stage : match.stages()) {
+      if (!match.Associate(stage, 1)) break;
+      seen.push_back({stage.finest, stage.options.w_rcs, stage.translation_tolerance, match.correspondences()});
+      if (stage.finest && stage.options.w_rcs == 0.0 && move > 0.0) {
+        match.pose() = SE3d(match.pose().rotation(), match.pose().translation() + Eigen::Vector3d(move, 0, 0));
       }
-      return StepOutcome::kConverged;
-    });
+    }
     return seen;
   };
   ScanMatchingOptions options;
   options.w_rcs = 0.25;
-  std::vector<Stage> seen = stages(options, 0.0);
+  std::vector<Seen> seen = stages(options, 0.0);
   ASSERT_EQ(seen.size(), coarse + 2);
   for (std::size_t k = 0; k < coarse; ++k) EXPECT_FALSE(seen[k].finest);
-  const Stage &geometric = seen[coarse], &full = seen[coarse + 1];
+  const Seen &geometric = seen[coarse], &full = seen[coarse + 1];
   EXPECT_TRUE(geometric.finest && full.finest);
   EXPECT_EQ(geometric.w, 0.0);
   EXPECT_TRUE(geometric.c.rcs.empty());

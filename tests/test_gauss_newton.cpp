@@ -55,7 +55,7 @@ TEST(GaussNewton, FinalCostIsEq2AtTheFinalPose) {
     ASSERT_TRUE(result.converged) << result.reason;
     ASSERT_GT(result.iterations, 1);
     const Correspondences c = FindCorrespondences(scan, exact, 0, initial, options.gate, w > 0.0);
-    const double expected = EvaluateCost(c, result.pose, options);
+    const double expected = EvaluateCost(c, result.pose, options, {});
     EXPECT_NEAR(result.final_cost, expected, 1e-12 * expected) << "w = " << w;
     EXPECT_EQ(result.n_geo, c.geometric.size());
     EXPECT_EQ(result.n_rcs, c.rcs.size());
@@ -99,7 +99,7 @@ TEST(GaussNewton, AnalyticAndAutodiffSystemsAgree) {
     EXPECT_NEAR(ga.rho_sum, gd.rho_sum, 1e-9 * ga.rho_sum);
     EXPECT_NEAR(ra.rho_sum, rd.rho_sum, 1e-9 * ra.rho_sum);
     const double f = 0.75 / double(ga.residuals) * ga.rho_sum + 0.25 / double(ra.residuals) * ra.rho_sum;
-    EXPECT_NEAR(f, EvaluateCost(c, pose, analytic), 1e-12 * f);
+    EXPECT_NEAR(f, EvaluateCost(c, pose, analytic, {}), 1e-12 * f);
     if (mode == RcsTranslation::kRotationOnly) {
       // The paper's rotation-only system: the translation rows/columns are
       // the identity, the translation gradient zero, and the rotation block
@@ -194,7 +194,7 @@ TEST(GaussNewton, StepCheckKeepsTheCostFalling) {
   options.w_rcs = 1.0;
   options.reassociate = false;
   const double initial_cost =
-      EvaluateCost(FindCorrespondences(world.scan, single, 0, initial, options.gate, true), initial, options);
+      EvaluateCost(FindCorrespondences(world.scan, single, 0, initial, options.gate, true), initial, options, {});
   double checked = initial_cost, plain_highest = 0.0;
   for (int k = 1; k <= 12; ++k) {
     options.max_iterations = k;

@@ -24,7 +24,7 @@
 #include "radargauss/io/yaml_file.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/simulator.hpp"
-#include "radargauss/solvers/matching_map.hpp"
+#include "radargauss/map/matching_map.hpp"
 #include "radargauss/trajectory.hpp"
 #include "temp_dir.hpp"
 

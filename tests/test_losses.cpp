@@ -22,7 +22,7 @@
 #include "radargauss/sh.hpp"
 #include "radargauss/simulator.hpp"
 #include "radargauss/residuals/geometric_residual.hpp"
-#include "radargauss/residuals/loss.hpp"
+#include "radargauss/residuals/robust_loss.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
 #include "radargauss/solvers/ceres_solver.hpp"
 #include "radargauss/solvers/factory.hpp"

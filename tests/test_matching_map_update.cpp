@@ -9,7 +9,7 @@
 #include <random>
 
 #include "radargauss/lie/so3.hpp"
-#include "radargauss/solvers/matching_map.hpp"
+#include "radargauss/map/matching_map.hpp"
 #include "test_util.hpp"
 
 namespace radargauss {

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "radargauss/error.hpp"
 #include "radargauss/evaluation.hpp"
@@ -166,24 +167,32 @@ TEST(RadarOdometry, ScansWithoutVelocityGiveAReasonAndAPredictedPose) {
 }
 
 // Another matcher in the same loop: the factory's matcher makes every match,
-// and one that wraps the default gives the default's trajectory.
-TEST(RadarOdometry, MatchesWithTheFactorysMatcher) {
+// one that wraps the default gives the default's trajectory, and the factory
+// is called once per map version (keyframes 2 m apart: several scans match
+// one version), not once per scan.
+TEST(RadarOdometry, MakesOneMatcherPerMapVersion) {
   const SimulatedSequence& drive = Drive();
-  std::size_t calls = 0;
-  RadarOdometry wrapped(StartingAtTruth(drive), [&calls](const LocalMap&, const MatchOptions& match) {
-    ++calls;
+  OdometryOptions options = StartingAtTruth(drive);
+  options.keyframe_distance = 2.0;
+  std::vector<std::size_t> versions;
+  RadarOdometry wrapped(options, [&versions](const LocalMap& map, const MatchOptions& match) {
+    versions.push_back(map.version());
     return std::shared_ptr<const ScanMatcher>(MakeScanMatcher(match));
   });
-  RadarOdometry plain(StartingAtTruth(drive));
-  std::size_t matches = 0;
-  for (std::size_t k = 0; k < 30; ++k) {
+  RadarOdometry plain(options);
+  std::size_t matches = 0, keyframes = 0;
+  for (std::size_t k = 0; k < 40; ++k) {
     wrapped.Register(drive.scans[k]);
     plain.Register(drive.scans[k]);
     matches += wrapped.steps().back().iterations > 0;
+    keyframes += wrapped.steps().back().keyframe;
     ASSERT_EQ(wrapped.steps().back().pose.translation(), plain.steps().back().pose.translation()) << k;
   }
-  EXPECT_EQ(calls, matches);
-  EXPECT_GT(calls, 25u);
+  for (std::size_t k = 1; k < versions.size(); ++k) EXPECT_LT(versions[k - 1], versions[k]) << k;
+  EXPECT_EQ(wrapped.matchers_made(), versions.size());
+  EXPECT_LE(versions.size(), keyframes);
+  EXPECT_GT(matches, 35u);
+  EXPECT_LT(versions.size(), matches / 2);
   EXPECT_THROW(RadarOdometry(OdometryOptions(), MatcherFactory()), std::invalid_argument);
 }
 

@@ -30,17 +30,17 @@ TEST(RotationTerm, EntersTheCostAndTheNormalEquations) {
   const Correspondences c = FindCorrespondences(world.simulated.scans[kTestScan], *world.exact, 0, pose, 3.0, true);
   ScanMatchingOptions plain;
   plain.w_rcs = 0.25;
-  ScanMatchingOptions with = plain;
+  ScanPriors with;
   with.rotation = PriorAt(Perturbed(truth, 0.0, 3.0, 5).rotation(), 0.01);
   const Eigen::Vector3d r = with.rotation->Residual(pose.rotation());
-  EXPECT_NEAR(EvaluateCost(c, pose, with), EvaluateCost(c, pose, plain) + 0.01 * r.squaredNorm(), 1e-12);
+  EXPECT_NEAR(EvaluateCost(c, pose, plain, with), EvaluateCost(c, pose, plain, {}) + 0.01 * r.squaredNorm(), 1e-12);
   // g = sum w J^T r is half the cost's gradient along R Exp(dphi).
   const auto term_cost = [&](const Eigen::VectorXd& dphi) {
     const SE3d moved(pose.rotation() * SO3d::Exp(Eigen::Vector3d(dphi)), pose.translation());
-    return Eigen::VectorXd::Constant(1, EvaluateCost(c, moved, with) - EvaluateCost(c, moved, plain));
+    return Eigen::VectorXd::Constant(1, EvaluateCost(c, moved, plain, with) - EvaluateCost(c, moved, plain, {}));
   };
   const Eigen::VectorXd gradient = NumericJacobian(term_cost, Eigen::VectorXd::Zero(3)).transpose();
-  const CombinedSystem a = BuildCombinedSystem(c, pose, plain), b = BuildCombinedSystem(c, pose, with);
+  const CombinedSystem a = BuildCombinedSystem(c, pose, plain, {}), b = BuildCombinedSystem(c, pose, plain, with);
   EXPECT_LT(((b.g - a.g).segment<3>(kRotationOffset) - 0.5 * gradient).norm(), 1e-6 * gradient.norm());
   const Eigen::Matrix3d J = with.rotation->Jacobian(pose.rotation());
   const Eigen::Matrix<double, 6, 6> added = b.H - a.H;
@@ -60,24 +60,25 @@ TEST(RotationTerm, SolversAgreeAndFollowAStrongTerm) {
   const SE3d initial = Perturbed(truth, 0.1, 0.3, 6);
   ScanMatchingOptions options = OneAssociationToConvergence();
   const SO3d target = truth.rotation() * SO3d::Exp(Eigen::Vector3d(0.01, -0.02, 0.015));
-  options.rotation = PriorAt(target, 1e-4);
-  const ScanMatchingResult gn = MakeSolver("gn", options)->Match(scan, *world.exact, initial);
-  const ScanMatchingResult lm = CeresSolver(options, CeresToItsOptimum()).Match(scan, *world.exact, initial);
+  ScanPriors priors;
+  priors.rotation = PriorAt(target, 1e-4);
+  const ScanMatchingResult gn = MakeSolver("gn", options)->Match(scan, *world.exact, initial, priors);
+  const ScanMatchingResult lm = CeresSolver(options, CeresToItsOptimum()).Match(scan, *world.exact, initial, priors);
   ASSERT_TRUE(gn.converged) << gn.reason;
   ASSERT_TRUE(lm.converged) << lm.reason;
   ExpectPoseNear(gn.pose, lm.pose, 1e-4, 1e-4, "gn against ceres with the rotation term");
-  const Eigen::Matrix3d J = options.rotation->Jacobian(gn.pose.rotation());
+  const Eigen::Matrix3d J = priors.rotation->Jacobian(gn.pose.rotation());
   const Eigen::Matrix3d kept = gn.rotation_information.block<3, 3>(kRotationOffset, kRotationOffset);
   EXPECT_LT((kept - 1e-4 * J.transpose() * J).norm(), 1e-9);
-  options.rotation->weight = 1e4;
+  priors.rotation->weight = 1e4;
   for (const std::string name : {"gn", "ceres"}) {
-    const ScanMatchingResult strong = MakeSolver(name, options)->Match(scan, *world.exact, initial);
+    const ScanMatchingResult strong = MakeSolver(name, options)->Match(scan, *world.exact, initial, priors);
     EXPECT_LT((target.Inverse() * strong.pose.rotation()).Log().norm(), 1e-3) << name;
   }
-  options.rotation->weight = 0.0;
-  const ScanMatchingResult off = MakeSolver("gn", options)->Match(scan, *world.exact, initial);
-  options.rotation.reset();
-  EXPECT_TRUE(SamePose(off.pose, MakeSolver("gn", options)->Match(scan, *world.exact, initial).pose));
+  priors.rotation->weight = 0.0;
+  const ScanMatchingResult off = MakeSolver("gn", options)->Match(scan, *world.exact, initial, priors);
+  priors.rotation.reset();
+  EXPECT_TRUE(SamePose(off.pose, MakeSolver("gn", options)->Match(scan, *world.exact, initial, priors).pose));
 }
 
 // Roll and pitch of the estimate against the truth's, the worst over a run (deg).

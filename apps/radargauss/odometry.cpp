@@ -41,8 +41,8 @@ struct OdometrySettings {
   std::string matcher = "gaussians";  // or a PCL peer
 };
 
-// The step's matcher: the Gaussian solvers, or a PCL peer over the active
-// map's points, made again only when the map changed.
+// The matcher of a map version: the Gaussian solvers, or a PCL peer over the
+// active map's points (RadarOdometry makes one per map version).
 MatcherFactory MatcherOf(const std::string& matcher) {
   if (matcher == "gaussians") {
     return [](const LocalMap&, const MatchOptions& match) {
@@ -51,17 +51,8 @@ MatcherFactory MatcherOf(const std::string& matcher) {
   }
 #ifdef RADARGAUSS_HAVE_PCL
   const PclMethod method = matcher == "pcl-ndt" ? PclMethod::kNdt : PclMethod::kGicp;
-  struct Cache {
-    std::size_t version = 0;
-    std::shared_ptr<const ScanMatcher> matcher;
-  };
-  auto cache = std::make_shared<Cache>();
-  return [method, cache](const LocalMap& map, const MatchOptions&) {
-    if (!cache->matcher || cache->version != map.version()) {
-      cache->matcher = std::make_shared<PclPeerMatcher>(method, map.ActivePoints());
-      cache->version = map.version();
-    }
-    return cache->matcher;
+  return [method](const LocalMap& map, const MatchOptions&) {
+    return std::shared_ptr<const ScanMatcher>(std::make_shared<PclPeerMatcher>(method, map.ActivePoints()));
   };
 #else
   throw DataError("--matcher " + matcher + " needs radargauss built with RADARGAUSS_WITH_PCL");

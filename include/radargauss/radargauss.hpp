@@ -1,22 +1,27 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The front door: the main jobs in a few calls. Build a Gaussian-RCS map
-// from scans and reference poses, match a scan against it, read and write
-// the files in between. docs/design.md explains each step.
+// The front door: the main jobs in a few calls, without a Ceres header (the
+// solvers keep Ceres behind the library). Simulate or load a sequence, build
+// a Gaussian-RCS map from scans and reference poses, match a scan against it,
+// run odometry on a map built on the way, evaluate a trajectory.
+// docs/design.md explains each step.
 //
 //   const Sequence sequence = LoadSequence(sequence_options);
 //   const MatchingMap map(BuildMap(sequence));
 //   const ScanMatchingResult match = Match(scan, map, initial_guess);
+//   const RadarOdometry odometry = Odometry(sequence);
 #pragma once
 
 #include <vector>
 
 #include "radargauss/error.hpp"
+#include "radargauss/evaluation.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/pipeline.hpp"
+#include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/simulator.hpp"
 #include "radargauss/solvers/factory.hpp"
-#include "radargauss/solvers/scan_matcher.hpp"
 #include "radargauss/trajectory.hpp"
 #include "radargauss/types.hpp"
 
@@ -35,5 +40,10 @@ GaussianMap BuildMap(const std::vector<RadarScan>& scans, const std::vector<SE3d
 // result.reason.
 ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
                          const MatchOptions& options = {});
+
+// `radargauss odometry`: every scan of `sequence` registered in order on a
+// map built on the way (docs/design.md, "Odometry"); its steps, trajectory()
+// and map() hold the run. Throws DataError for stamps that do not increase.
+RadarOdometry Odometry(const Sequence& sequence, const OdometryOptions& options = {});
 
 }  // namespace radargauss

@@ -50,36 +50,11 @@ Eigen::Matrix3d ClampCovariance(const Eigen::Matrix3d& covariance, double min_st
 
 namespace {
 
-constexpr std::int64_t kKeyBits = 21;
-constexpr std::int64_t kKeyOffset = std::int64_t(1) << (kKeyBits - 1);
-constexpr std::int64_t kKeyMask = (std::int64_t(1) << kKeyBits) - 1;
-
-std::int64_t PackKey(std::int64_t x, std::int64_t y, std::int64_t z) {
-  return ((x + kKeyOffset) & kKeyMask) | (((y + kKeyOffset) & kKeyMask) << kKeyBits) |
-         (((z + kKeyOffset) & kKeyMask) << (2 * kKeyBits));
-}
-
-}  // namespace
-
-std::int64_t PackVoxelKey(const VoxelKey& key) { return PackKey(key.x, key.y, key.z); }
-
-namespace {
-
 // A number in a message, %.3g.
 std::string Brief(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.3g", value);
   return text;
-}
-
-// floor(x) as an integer, inline (std::floor is a library call without
-// SSE4.1); saturated at +-2^62, where the conversion would be undefined
-// (cells alias there, which costs candidates, not answers).
-std::int64_t FloorToInt(double x) {
-  constexpr double kLimit = 4.611686018427387904e18;  // 2^62
-  x = std::min(std::max(x, -kLimit), kLimit);
-  const auto truncated = static_cast<std::int64_t>(x);
-  return truncated - (static_cast<double>(truncated) > x);
 }
 
 // Whether the cell [lo, hi] may hold a point within `extent` standard
@@ -115,18 +90,12 @@ bool CellMeetsEllipsoid(Eigen::Vector3d lo, Eigen::Vector3d hi, const Eigen::Vec
 
 }  // namespace
 
-VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel) {
-  // One division, then products: monotone in p, so a point inside a box is
-  // in one of the voxels of the box's corners.
-  const double inverse = 1.0 / voxel;
-  return {FloorToInt(p.x() * inverse), FloorToInt(p.y() * inverse), FloorToInt(p.z() * inverse)};
-}
 
 std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
   // A non-finite point has no voxel: the empty key finds an empty slot (no candidates).
   if (!p.allFinite()) return kEmptyCell;
   const VoxelKey v = VoxelOf(p, cell_size_);
-  return PackKey(v.x, v.y, v.z);
+  return PackVoxelKey(v.x, v.y, v.z);
 }
 
 std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys) {
@@ -158,7 +127,7 @@ std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vecto
         const Eigen::Vector3d corner = Eigen::Vector3d(double(x), double(y), double(z)) * cell_size_;
         if (CellMeetsEllipsoid(corner, corner.array() + cell_size_, g.mean, g.covariance, information,
                                extent_sigmas_)) {
-          cell_keys.push_back(PackKey(x, y, z));
+          cell_keys.push_back(PackVoxelKey(x, y, z));
         }
       }
     }

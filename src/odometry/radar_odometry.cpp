@@ -39,10 +39,20 @@ RadarOdometry::RadarOdometry(const OdometryOptions& options)
         return std::shared_ptr<const ScanMatcher>(MakeScanMatcher(match));
       }) {}
 
-RadarOdometry::RadarOdometry(const OdometryOptions& options, MatcherFactory matcher)
-    : options_(options), matcher_(std::move(matcher)), map_(options.map) {
+RadarOdometry::RadarOdometry(const OdometryOptions& options, MatcherFactory factory)
+    : options_(options), factory_(std::move(factory)), map_(options.map) {
   ValidateOptions(options_);
-  if (!matcher_) throw std::invalid_argument("RadarOdometry needs a matcher factory");
+  if (!factory_) throw std::invalid_argument("RadarOdometry needs a matcher factory");
+}
+
+const ScanMatcher& RadarOdometry::MatcherForMap() {
+  if (!matcher_ || matcher_version_ != map_.version()) {
+    matcher_ = factory_(map_, options_.match);
+    if (!matcher_) throw std::invalid_argument("the matcher factory returned no matcher");
+    matcher_version_ = map_.version();
+    ++matchers_made_;
+  }
+  return *matcher_;
 }
 
 void RadarOdometry::AddGyro(const std::vector<GyroSample>& samples) {
@@ -75,17 +85,17 @@ std::optional<SO3d> RadarOdometry::GyroIncrement(double from, double to) const {
 }
 
 RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
-  const OdometryStep& last = steps_.back();
+  const MotionState& last = *state_;
   Prediction p;
   p.dt = stamp - last.stamp;
   SO3d increment;
   if (const std::optional<SO3d> gyro = GyroIncrement(last.stamp, stamp)) {
     increment = *gyro;
     p.gyro = true;
-  } else if (steps_.size() >= 2) {  // the last increment's yaw rate; roll and pitch held
-    const OdometryStep& before = steps_[steps_.size() - 2];
+  } else if (last.before) {  // the last increment's yaw rate; roll and pitch held
+    const auto& [before_stamp, before_pose] = *last.before;
     const double yaw_rate =
-        (before.pose.rotation().Inverse() * last.pose.rotation()).Log().z() / (last.stamp - before.stamp);
+        (before_pose.rotation().Inverse() * last.pose.rotation()).Log().z() / (last.stamp - before_stamp);
     increment = SO3d::Exp(Eigen::Vector3d(0.0, 0.0, yaw_rate * p.dt));
   }
   p.increment = increment;
@@ -97,7 +107,7 @@ RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
 }
 
 SE3d RadarOdometry::PredictedPose(const Prediction& p, const Eigen::Vector3d& velocity) const {
-  const SE3d& last = steps_.back().pose;
+  const SE3d& last = state_->pose;
   return SE3d(last.rotation() * p.increment, last.translation() + last.rotation() * Displacement(p, velocity));
 }
 
@@ -107,20 +117,23 @@ Eigen::Vector3d RadarOdometry::Displacement(const Prediction& p, const Eigen::Ve
   return SO3d::Exp(0.5 * p.increment.Log()) * velocity * p.dt;
 }
 
-std::vector<std::size_t> RadarOdometry::MeasureVelocity(const RadarScan& scan, const Prediction* prediction,
-                                                        OdometryStep& step) {
-  std::vector<std::size_t> static_points;
+RadarOdometry::Velocity RadarOdometry::MeasureVelocity(const RadarScan& scan,
+                                                       const std::optional<Prediction>& prediction) const {
+  Velocity v;
+  if (prediction) {
+    v.value = prediction->velocity;
+    v.covariance = prediction->velocity_covariance;
+  }
   if (!scan.has_doppler) {
-    step.reason = "no Doppler field: velocity predicted, every point matched";
-    for (std::size_t i = 0; i < scan.points.size(); ++i) static_points.push_back(i);
-    return static_points;
+    v.reason = "no Doppler field: velocity predicted, every point matched";
+    for (std::size_t i = 0; i < scan.points.size(); ++i) v.static_points.push_back(i);
+    return v;
   }
   std::optional<VelocityGate> gate;
-  if (prediction && last_measured_) {
-    const OdometryStep& measured = steps_[*last_measured_];
-    const double dt = scan.timestamp - measured.stamp;
-    const double spread =
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(measured.velocity_covariance).eigenvalues().maxCoeff();
+  if (prediction && state_->measured) {
+    const auto& [measured_stamp, measured_covariance] = *state_->measured;
+    const double dt = scan.timestamp - measured_stamp;
+    const double spread = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(measured_covariance).eigenvalues().maxCoeff();
     gate = VelocityGate{prediction->velocity,
                         std::max(options_.min_gate, options_.gate_sigmas *
                                                         std::sqrt(std::max(spread, 0.0) +
@@ -128,126 +141,165 @@ std::vector<std::size_t> RadarOdometry::MeasureVelocity(const RadarScan& scan, c
   }
   const EgoVelocityResult ego = EstimateEgoVelocity(scan, options_.ego_velocity, gate);
   for (std::size_t i = 0; i < ego.inlier.size(); ++i) {
-    if (ego.inlier[i]) static_points.push_back(i);
+    if (ego.inlier[i]) v.static_points.push_back(i);
   }
-  if (!ego.success || (!ego.zero_velocity && static_points.size() < options_.min_static_points)) {
-    step.reason = ego.success ? "too few static points (" + std::to_string(static_points.size()) +
-                                    "): velocity and pose predicted"
-                              : "ego velocity: " + ego.reason + ": velocity and pose predicted";
-    static_points.clear();
-    return static_points;
+  if (!ego.success || (!ego.zero_velocity && v.static_points.size() < options_.min_static_points)) {
+    v.reason = ego.success ? "too few static points (" + std::to_string(v.static_points.size()) +
+                                 "): velocity and pose predicted"
+                           : "ego velocity: " + ego.reason + ": velocity and pose predicted";
+    v.static_points.clear();
+    return v;
   }
-  step.velocity_measured = true;
-  step.standstill = ego.zero_velocity;
-  step.velocity = ego.velocity;
-  step.velocity_covariance = ego.covariance;
-  return static_points;
+  v.measured = true;
+  v.standstill = ego.zero_velocity;
+  v.value = ego.velocity;
+  v.covariance = ego.covariance;
+  return v;
 }
 
+// Kiss-icp's shape: each stage returns a value, the step is assembled at the end.
 const OdometryStep& RadarOdometry::Register(const RadarScan& scan) {
   const auto start = std::chrono::steady_clock::now();
-  if (!std::isfinite(scan.timestamp)) throw DataError("scan stamp is not finite");
-  if (!steps_.empty() && !(scan.timestamp > steps_.back().stamp)) {
-    throw DataError("scan stamps must increase: " + std::to_string(scan.timestamp) + " s after " +
-                    std::to_string(steps_.back().stamp) + " s");
-  }
-  ValidateScan(scan, "scan at " + std::to_string(scan.timestamp) + " s");
-  OdometryStep step;
-  step.stamp = scan.timestamp;
-  step.points = scan.points.size();
+  CheckStamp(scan);
   std::optional<Prediction> prediction;
-  if (!steps_.empty()) prediction = Predict(scan.timestamp);
-  if (prediction) {
-    step.velocity = prediction->velocity;
-    step.velocity_covariance = prediction->velocity_covariance;
-    step.gyro = prediction->gyro;
-  }
-  const std::vector<std::size_t> static_points = MeasureVelocity(scan, prediction ? &*prediction : nullptr, step);
-  step.static_points = static_points.size();
-  if (!prediction) {
-    step.pose = options_.initial_pose;
-  } else if (step.standstill) {
-    step.pose = steps_.back().pose;  // standing: the pose holds
-  } else {
-    step.pose = PredictedPose(*prediction, step.velocity);
-    if (static_points.size() >= options_.min_static_points) Match(scan, static_points, *prediction, step);
-  }
-  if (step.velocity_measured) last_measured_ = steps_.size();
-  if (!step.standstill) UpdateMap(scan, static_points, step);
-  step.active_gaussians = map_.gaussians();
+  if (state_) prediction = Predict(scan.timestamp);
+  const Velocity velocity = MeasureVelocity(scan, prediction);
+  const PoseEstimate estimate = EstimatePose(scan, prediction, velocity);
+  const bool keyframe = IsKeyframe(estimate.pose, velocity);
+  if (keyframe) InsertKeyframe(scan, velocity.static_points, estimate.pose);
+  OdometryStep step = StepOf(scan, prediction, velocity, estimate, keyframe);
   step.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   // Counted outside the step's time: the map changes on keyframes only.
-  step.active_map_bytes = step.keyframe || steps_.empty() ? map_.MemoryBytes() : steps_.back().active_map_bytes;
+  if (keyframe || !state_) map_bytes_ = map_.MemoryBytes();
+  step.active_map_bytes = map_bytes_;
+  MotionState next;
+  next.stamp = step.stamp;
+  next.pose = step.pose;
+  if (state_) next.before = std::make_pair(state_->stamp, state_->pose);
+  next.velocity = step.velocity;
+  next.velocity_covariance = step.velocity_covariance;
+  next.measured = velocity.measured ? std::make_optional(std::make_pair(step.stamp, step.velocity_covariance))
+                                    : (state_ ? state_->measured : std::nullopt);
+  state_ = next;
   steps_.push_back(step);
   return steps_.back();
 }
 
-void RadarOdometry::Match(const RadarScan& scan, const std::vector<std::size_t>& static_points,
-                          const Prediction& prediction, OdometryStep& step) {
+void RadarOdometry::CheckStamp(const RadarScan& scan) const {
+  if (!std::isfinite(scan.timestamp)) throw DataError("scan stamp is not finite");
+  if (state_ && !(scan.timestamp > state_->stamp)) {
+    throw DataError("scan stamps must increase: " + std::to_string(scan.timestamp) + " s after " +
+                    std::to_string(state_->stamp) + " s");
+  }
+  ValidateScan(scan, "scan at " + std::to_string(scan.timestamp) + " s");
+}
+
+RadarOdometry::PoseEstimate RadarOdometry::EstimatePose(const RadarScan& scan,
+                                                        const std::optional<Prediction>& prediction,
+                                                        const Velocity& velocity) {
+  if (!prediction) return {options_.initial_pose, std::nullopt, false, ""};
+  if (velocity.standstill) return {state_->pose, std::nullopt, false, ""};  // standing: the pose holds
+  const SE3d predicted = PredictedPose(*prediction, velocity.value);
+  if (velocity.static_points.size() < options_.min_static_points) return {predicted, std::nullopt, false, ""};
+  return Match(scan, *prediction, velocity, predicted);
+}
+
+RadarOdometry::PoseEstimate RadarOdometry::Match(const RadarScan& scan, const Prediction& prediction,
+                                                 const Velocity& velocity, const SE3d& predicted) {
   RadarScan matched;
   matched.timestamp = scan.timestamp;
   matched.has_doppler = scan.has_doppler;
   matched.has_rcs = scan.has_rcs;
-  matched.points.reserve(static_points.size());
-  for (const std::size_t i : static_points) matched.points.push_back(scan.points[i]);
-  MatchOptions match = options_.match;
+  matched.points.reserve(velocity.static_points.size());
+  for (const std::size_t i : velocity.static_points) matched.points.push_back(scan.points[i]);
+  PoseEstimate estimate{predicted, std::nullopt, false, ""};
+  estimate.match = MatcherForMap().Match(matched, map_.matching(), predicted, PriorsOf(prediction, velocity));
+  const ScanMatchingResult& result = *estimate.match;
+  const bool usable = result.pose.translation().allFinite() && result.n_geo >= options_.min_matched_points;
+  if (!usable) {
+    estimate.reason = "matching: " + (result.reason.empty() ? std::string("too few points associated") : result.reason) +
+                      ": pose predicted";
+    return estimate;
+  }
+  estimate.pose = result.pose;
+  estimate.matched = true;
+  if (!result.converged) estimate.reason = "matching: " + result.reason;
+  return estimate;
+}
+
+ScanPriors RadarOdometry::PriorsOf(const Prediction& prediction, const Velocity& velocity) const {
+  ScanPriors priors;
   if (options_.velocity_weight > 0.0) {
     VelocityPrior prior;
-    prior.previous = steps_.back().pose;
-    prior.displacement = Displacement(prediction, step.velocity);
+    prior.previous = state_->pose;
+    prior.displacement = Displacement(prediction, velocity.value);
     prior.sqrt_information = VelocitySqrtInformation(
-        step.velocity_covariance, prediction.dt,
+        velocity.covariance, prediction.dt,
         options_.velocity_floor * options_.velocity_floor * Eigen::Matrix3d::Identity());
     prior.weight = options_.velocity_weight;
-    match.matching.velocity = prior;
+    priors.velocity = prior;
   }
   if (options_.rotation_weight > 0.0) {
     RotationPrior prior;
-    prior.predicted = steps_.back().pose.rotation() * prediction.increment;
+    prior.predicted = state_->pose.rotation() * prediction.increment;
     const Eigen::Vector3d sigma = options_.rotation_rate_std_deg * (M_PI / 180.0 * prediction.dt);
     prior.sqrt_information = sigma.cwiseInverse().asDiagonal();
     prior.weight = options_.rotation_weight;
-    match.matching.rotation = prior;
+    priors.rotation = prior;
   }
-  const ScanMatchingResult result = matcher_(map_, match)->Match(matched, map_.matching(), step.pose);
-  step.iterations = result.iterations;
-  step.final_cost = result.final_cost;
-  step.converged = result.converged;
-  const bool usable = result.pose.translation().allFinite() && result.n_geo >= options_.min_matched_points;
-  if (!usable) {
-    const std::string why = result.reason.empty() ? "too few points associated" : result.reason;
-    step.reason = (step.reason.empty() ? "" : step.reason + "; ") + "matching: " + why + ": pose predicted";
-    step.converged = false;
-    return;
-  }
-  step.pose = result.pose;
-  step.matched = true;
-  step.information = result.information;
-  step.velocity_information = result.velocity_information;
-  step.rotation_information = result.rotation_information;
-  if (!result.converged) step.reason = (step.reason.empty() ? "" : step.reason + "; ") + "matching: " + result.reason;
+  return priors;
 }
 
-void RadarOdometry::UpdateMap(const RadarScan& scan, const std::vector<std::size_t>& static_points,
-                              OdometryStep& step) {
-  if (static_points.empty()) return;
-  if (!steps_.empty()) {
-    const SE3d moved = last_keyframe_.Inverse() * step.pose;
-    const bool far = moved.translation().norm() >= options_.keyframe_distance;
-    const bool turned = moved.rotation().Log().norm() >= options_.keyframe_angle_deg * M_PI / 180.0;
-    if (!far && !turned) return;
-  }
+bool RadarOdometry::IsKeyframe(const SE3d& pose, const Velocity& velocity) const {
+  if (velocity.standstill || velocity.static_points.empty()) return false;
+  if (!state_) return true;
+  const SE3d moved = last_keyframe_.Inverse() * pose;
+  return moved.translation().norm() >= options_.keyframe_distance ||
+         moved.rotation().Log().norm() >= options_.keyframe_angle_deg * M_PI / 180.0;
+}
+
+void RadarOdometry::InsertKeyframe(const RadarScan& scan, const std::vector<std::size_t>& static_points,
+                                   const SE3d& pose) {
   std::vector<Eigen::Vector3d> points;
   std::vector<double> rcs;
   points.reserve(static_points.size());
   for (const std::size_t i : static_points) {
-    points.push_back(step.pose * scan.points[i].position);
+    points.push_back(pose * scan.points[i].position);
     if (scan.has_rcs) rcs.push_back(scan.points[i].rcs);
   }
-  map_.Insert(points, rcs, step.pose);
-  map_.Evict(step.pose.translation());
-  last_keyframe_ = step.pose;
-  step.keyframe = true;
+  map_.Insert(points, rcs, pose);
+  map_.Evict(pose.translation());
+  last_keyframe_ = pose;
+}
+
+OdometryStep RadarOdometry::StepOf(const RadarScan& scan, const std::optional<Prediction>& prediction,
+                                   const Velocity& velocity, const PoseEstimate& estimate, bool keyframe) const {
+  OdometryStep step;
+  step.stamp = scan.timestamp;
+  step.pose = estimate.pose;
+  step.points = scan.points.size();
+  step.static_points = velocity.static_points.size();
+  step.velocity_measured = velocity.measured;
+  step.standstill = velocity.standstill;
+  step.gyro = prediction && prediction->gyro;
+  step.velocity = velocity.value;
+  step.velocity_covariance = velocity.covariance;
+  step.matched = estimate.matched;
+  if (estimate.match) {
+    step.iterations = estimate.match->iterations;
+    step.final_cost = estimate.match->final_cost;
+    step.converged = estimate.matched && estimate.match->converged;
+  }
+  if (estimate.matched) {
+    step.information = estimate.match->information;
+    step.velocity_information = estimate.match->velocity_information;
+    step.rotation_information = estimate.match->rotation_information;
+  }
+  step.reason = velocity.reason;
+  if (!estimate.reason.empty()) step.reason += (step.reason.empty() ? "" : "; ") + estimate.reason;
+  step.keyframe = keyframe;
+  step.active_gaussians = map_.gaussians();
+  return step;
 }
 
 Trajectory RadarOdometry::trajectory() const {

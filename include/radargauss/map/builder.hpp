@@ -18,10 +18,12 @@
 #include <Eigen/Core>
 
 #include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/voxel_grid.hpp"
 
 namespace radargauss {
 
 enum class MapBuilder { kKMeans, kVoxel };
+std::string ToString(MapBuilder builder);
 MapBuilder MapBuilderFromString(const std::string& name);  // "kmeans", "voxel"; throws std::invalid_argument
 std::vector<std::string> MapBuilderNames();
 
@@ -51,16 +53,6 @@ std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
                                      const GaussianMapOptions& options,
                                      const ProgressCallback& progress = {},
                                      std::vector<int>* association = nullptr);
-
-// The indices of `points` grouped by voxel of edge `voxel`: groups in voxel
-// key order, indices ascending within each.
-std::vector<std::vector<std::uint32_t>> GroupByVoxel(const std::vector<Eigen::Vector3d>& points, double voxel);
-
-// Centroids of the occupied voxels of edge `voxel` (non-finite points
-// skipped), ordered by voxel key or, cheaper, by each voxel's first point.
-enum class VoxelOrder { kByKey, kFirstPoint };
-std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points, double voxel,
-                                             VoxelOrder order = VoxelOrder::kByKey);
 
 // For each point, the Gaussian it belongs to (-1: none within the gate).
 std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points,

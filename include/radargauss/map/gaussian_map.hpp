@@ -11,8 +11,9 @@
 
 #include <Eigen/Core>
 
-#include "radargauss/map/linear_probing_table.hpp"
+#include "radargauss/linear_probing_table.hpp"
 #include "radargauss/sh.hpp"
+#include "radargauss/voxel_grid.hpp"
 
 namespace radargauss {
 
@@ -61,18 +62,6 @@ void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs,
 
 // Clamps every principal std to at least `min_std` (docs/design.md, "Building the map").
 Eigen::Matrix3d ClampCovariance(const Eigen::Matrix3d& covariance, double min_std);
-
-// The integer voxel of a point in a grid of side `voxel` (floor(p / voxel)),
-// ordered so that it can key sorted containers.
-struct VoxelKey {
-  std::int64_t x, y, z;
-  bool operator<(const VoxelKey& o) const { return x != o.x ? x < o.x : (y != o.y ? y < o.y : z < o.z); }
-  bool operator==(const VoxelKey& o) const { return x == o.x && y == o.y && z == o.z; }
-};
-VoxelKey VoxelOf(const Eigen::Vector3d& p, double voxel);
-// The voxel packed into one non-negative integer, 21 bits per axis (wrapping:
-// a hash, and the spatial index's cell key).
-std::int64_t PackVoxelKey(const VoxelKey& key);
 
 // The upper triangle (00 01 02 11 12 22) of Sigma^-1 = L L^T from that of the
 // upper-triangular L^T, for one Gaussian (T = double) or one per SIMD lane

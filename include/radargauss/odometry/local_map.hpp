@@ -22,7 +22,7 @@
 #include "radargauss/map/builder.hpp"
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/map/rcs_model.hpp"
-#include "radargauss/solvers/matching_map.hpp"
+#include "radargauss/map/matching_map.hpp"
 
 namespace radargauss {
 

@@ -17,6 +17,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -97,10 +98,11 @@ struct GyroSample {
   Eigen::Vector3d rate = Eigen::Vector3d::Zero();
 };
 
-// The scan matcher of one step, for the active map and the step's options
-// (the velocity term included): by default MakeScanMatcher(options). Another
-// factory puts other matchers (the PCL peers) in the same loop, map policy
-// and Doppler filter; it may keep one matcher per LocalMap::version().
+// The scan matcher of a version of the active map: by default
+// MakeScanMatcher(options.match). RadarOdometry calls it once per
+// LocalMap::version() (the map changes on keyframes) and hands each scan its
+// velocity and rotation priors as arguments of Match. Another factory puts
+// other matchers (the PCL peers) in the same loop, map policy and Doppler filter.
 using MatcherFactory =
     std::function<std::shared_ptr<const ScanMatcher>(const LocalMap& map, const MatchOptions& options)>;
 
@@ -119,8 +121,21 @@ class RadarOdometry {
   Trajectory trajectory() const;
   const LocalMap& map() const { return map_; }
   const OdometryOptions& options() const { return options_; }
+  // How many matchers the factory has made: one per map version matched against.
+  std::size_t matchers_made() const { return matchers_made_; }
 
  private:
+  // What the motion model keeps of the past: the last two poses (the yaw
+  // rate), the last velocity with its covariance, the last measured one's
+  // stamp and covariance (the gate's centre of trust).
+  struct MotionState {
+    double stamp = 0.0;
+    SE3d pose;
+    std::optional<std::pair<double, SE3d>> before;  // the scan before: stamp, pose
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();
+    std::optional<std::pair<double, Eigen::Matrix3d>> measured;  // stamp, velocity covariance
+  };
   // The motion model's guess for the next scan.
   struct Prediction {
     SO3d increment;            // rotation since the last scan (gyro, or the last yaw rate)
@@ -129,25 +144,55 @@ class RadarOdometry {
     double dt = 0.0;
     bool gyro = false;         // the increment comes from gyro rates
   };
+  // The scan's ego velocity: measured (gated by the prediction), or the prediction's.
+  struct Velocity {
+    bool measured = false;
+    bool standstill = false;             // the zero-velocity branch decided
+    Eigen::Vector3d value = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    std::vector<std::size_t> static_points;  // to match and to insert
+    std::string reason;                  // why the prediction stands in
+  };
+  // The scan's pose: matched, or the prediction's (with why).
+  struct PoseEstimate {
+    SE3d pose;
+    std::optional<ScanMatchingResult> match;  // when a match was made
+    bool matched = false;                     // the pose is the match's
+    std::string reason;
+  };
+
+  void CheckStamp(const RadarScan& scan) const;
   Prediction Predict(double stamp) const;
   SE3d PredictedPose(const Prediction& prediction, const Eigen::Vector3d& velocity) const;
   // The translation since the last scan in its frame for a velocity of the new frame.
   static Eigen::Vector3d Displacement(const Prediction& prediction, const Eigen::Vector3d& velocity);
   // The rotation between two stamps from the gyro samples, if they cover it.
   std::optional<SO3d> GyroIncrement(double from, double to) const;
-  // The gated ego velocity and its covariance into `step`; the static points to match and insert.
-  std::vector<std::size_t> MeasureVelocity(const RadarScan& scan, const Prediction* prediction, OdometryStep& step);
-  void Match(const RadarScan& scan, const std::vector<std::size_t>& static_points, const Prediction& prediction,
-             OdometryStep& step);
-  void UpdateMap(const RadarScan& scan, const std::vector<std::size_t>& static_points, OdometryStep& step);
+  Velocity MeasureVelocity(const RadarScan& scan, const std::optional<Prediction>& prediction) const;
+  PoseEstimate EstimatePose(const RadarScan& scan, const std::optional<Prediction>& prediction,
+                            const Velocity& velocity);
+  PoseEstimate Match(const RadarScan& scan, const Prediction& prediction, const Velocity& velocity,
+                     const SE3d& predicted);
+  // The velocity and rotation terms of a scan matched from the prediction.
+  ScanPriors PriorsOf(const Prediction& prediction, const Velocity& velocity) const;
+  const ScanMatcher& MatcherForMap();
+  // Whether the scan at `pose` enters the map (the first, or far or turned enough since the last keyframe).
+  bool IsKeyframe(const SE3d& pose, const Velocity& velocity) const;
+  void InsertKeyframe(const RadarScan& scan, const std::vector<std::size_t>& static_points, const SE3d& pose);
+  OdometryStep StepOf(const RadarScan& scan, const std::optional<Prediction>& prediction, const Velocity& velocity,
+                      const PoseEstimate& estimate, bool keyframe) const;
 
   OdometryOptions options_;
-  MatcherFactory matcher_;
+  MatcherFactory factory_;
+  std::shared_ptr<const ScanMatcher> matcher_;  // for map_ at matcher_version_
+  std::size_t matcher_version_ = 0;
+  std::size_t matchers_made_ = 0;
   LocalMap map_;
-  std::vector<OdometryStep> steps_;
+  std::vector<OdometryStep> steps_;  // the record of the run (the motion model reads state_)
+  std::optional<MotionState> state_;
   std::vector<GyroSample> gyro_;
-  std::optional<std::size_t> last_measured_;  // the last step whose velocity was measured: the gate's centre of trust
   SE3d last_keyframe_;
+  std::size_t map_bytes_ = 0;  // LocalMap::MemoryBytes after the last keyframe
 };
 
 // Per-scan time (median, p90 in ms), scan and keyframe counts, fallbacks.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "radargauss/solvers/matching_map.hpp"
+#include "radargauss/map/matching_map.hpp"
 
 #include <algorithm>
 #include <stdexcept>
