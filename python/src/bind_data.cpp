@@ -2,6 +2,8 @@
 // Scans, sequences, trajectories and the simulator in Python.
 #include <pybind11/stl.h>
 
+#include <algorithm>
+
 #include "bindings.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/sequence.hpp"
@@ -40,6 +42,16 @@ Array Poses(const std::vector<SE3d>& poses) {
   return out;
 }
 
+// (N, 4, 4): the matrices numpy users compose with @.
+Array PoseMatrices(const std::vector<SE3d>& poses) {
+  Array out = NewArray({py::ssize_t(poses.size()), 4, 4});
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const Array matrix = PoseToMatrix(poses[i]);
+    std::copy(matrix.data(), matrix.data() + 16, out.mutable_data() + 16 * i);
+  }
+  return out;
+}
+
 void BindScan(py::module_& m) {
   py::class_<RadarScan>(m, "Scan", "One radar scan: points (N, 3) in the radar frame, Doppler (m/s, positive "
                                    "receding) and RCS (dBsm), each a copy as a numpy array.")
@@ -66,12 +78,25 @@ void BindSequence(py::module_& m) {
       .def_readonly("sources", &Sequence::scan_sources)
       .def_property_readonly("poses", [](const Sequence& s) { return Poses(s.poses); },
                              "T_world_radar of each scan as (N, 7) [x y z qx qy qz qw]; empty without ground truth")
+      .def_property_readonly("poses_matrix", [](const Sequence& s) { return PoseMatrices(s.poses); },
+                             "The same as (N, 4, 4) matrices, to compose with @")
       .def_property_readonly("stamps", [](const Sequence& s) {
         Array out = NewArray({py::ssize_t(s.scans.size())});
         for (std::size_t i = 0; i < s.scans.size(); ++i) out.mutable_at(py::ssize_t(i)) = s.scans[i].timestamp;
         return out;
       })
       .def("__len__", [](const Sequence& s) { return s.scans.size(); });
+  m.def(
+      "pose_matrix", [](const py::handle& pose) { return PoseToMatrix(PoseFromPython(pose, "pose")); },
+      py::arg("pose"), "A pose [x y z qx qy qz qw] (or 4x4) as its 4x4 matrix.");
+  m.def(
+      "pose_matrices",
+      [](const py::handle& poses) {
+        std::vector<SE3d> out;
+        for (const py::handle row : py::iter(poses)) out.push_back(PoseFromPython(row, "poses[" + std::to_string(out.size()) + "]"));
+        return PoseMatrices(out);
+      },
+      py::arg("poses"), "Poses (N, 7) [x y z qx qy qz qw] (or (N, 4, 4)) as (N, 4, 4) matrices.");
   m.def(
       "read_sequence",
       [](const std::string& path, const std::string& gt, const std::string& extrinsic, const std::string& bag,

@@ -1,42 +1,30 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Scan matching, odometry and trajectory evaluation in Python.
+// Scan matching and trajectory evaluation in Python.
 #include <pybind11/stl.h>
 
 #include <string>
 #include <vector>
 
 #include "bindings.hpp"
+#include "option_fields.hpp"
 #include "radargauss/evaluation.hpp"
 #include "radargauss/experiment.hpp"
-#include "radargauss/names.hpp"
-#include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/radargauss.hpp"
 
 namespace radargauss::python {
 
 namespace {
 
-// The options of one match, by the names `radargauss localize` takes.
-MatchOptions MatchOptionsFrom(double w_rcs, const std::string& solver, const std::string& loss, double loss_scale,
-                              const std::string& rcs_loss, double rcs_loss_scale) {
-  if (!(w_rcs >= 0.0 && w_rcs <= 1.0)) throw py::value_error("w_rcs must be in [0, 1]");
-  if (!(loss_scale > 0.0) || !(rcs_loss_scale > 0.0) || !std::isfinite(loss_scale) || !std::isfinite(rcs_loss_scale)) {
-    throw py::value_error("loss scales must be finite and > 0");
-  }
-  MatchOptions options;
-  options.solver = SolverKindFromString(solver);
-  options.matching.w_rcs = w_rcs;
-  options.matching.geometric_loss = {LossTypeFromString(loss), loss_scale};
-  options.matching.rcs_loss = {LossTypeFromString(rcs_loss), rcs_loss_scale};
-  return options;
-}
-
-// match's docstring, its name lists from the library's name tables.
+// match's docstring (numpydoc), its keywords from the option table.
 const char* MatchDoc() {
   static const std::string doc =
-      "Matches a Scan against a GaussianMap from `initial` (T_world_radar, 4x4 or [x y z qx qy qz qw]), "
-      "minimising eq. 2 coarse to fine as `radargauss localize` does. solver: " +
-      Joined(ScanMatcherNames()) + "; loss and rcs_loss: " + Joined(LossNames()) + ".";
+      "Matches a Scan against a GaussianMap, minimising eq. 2 coarse to fine as `radargauss localize` does.\n\n"
+      "Parameters\n----------\n"
+      "scan : Scan\n    the scan, in the radar frame\n"
+      "map : GaussianMap\n    the map (its coarse-to-fine levels are built on first use)\n"
+      "initial : array (4, 4) or (7,)\n    T_world_radar to start from\n"
+      "**options\n    any of the keywords below (match_options() gives them all with their values)\n" +
+      ParametersDoc(MatchFields()) + "\nReturns\n-------\nMatchResult\n";
   return doc.c_str();
 }
 
@@ -55,68 +43,6 @@ void BindMatchResult(py::module_& m) {
       .def_readonly("time_ms", &ScanMatchingResult::time_ms)
       .def_property_readonly("information", [](const ScanMatchingResult& r) { return MatrixToArray<6, 6>(r.information); },
                              "6x6 Gauss-Newton matrix of eq. 2 over [dt (world); dphi (radar)]");
-}
-
-py::dict StepToDict(const OdometryStep& s) {
-  py::dict d;
-  d["stamp"] = s.stamp;
-  d["pose"] = PoseToMatrix(s.pose);
-  d["points"] = s.points;
-  d["static_points"] = s.static_points;
-  d["velocity_measured"] = s.velocity_measured;
-  d["velocity"] = MatrixToArray<3, 1>(s.velocity);
-  d["standstill"] = s.standstill;
-  d["matched"] = s.matched;
-  d["iterations"] = s.iterations;
-  d["cost"] = s.final_cost;
-  d["converged"] = s.converged;
-  d["reason"] = s.reason;
-  d["keyframe"] = s.keyframe;
-  d["active_gaussians"] = s.active_gaussians;
-  d["time_ms"] = s.time_ms;
-  d["information"] = MatrixToArray<6, 6>(s.information);
-  return d;
-}
-
-void BindOdometry(py::module_& m) {
-  py::class_<RadarOdometry>(m, "RadarOdometry",
-                            "Radar odometry on a map it builds as it goes (docs/design.md, \"Odometry\"): "
-                            "register scans in time order.")
-      .def(py::init([](double w_rcs, const std::string& solver, double velocity_weight, double rotation_weight,
-                       double keyframe_distance, double active_radius, const py::object& initial_pose) {
-             OdometryOptions options;
-             if (!initial_pose.is_none()) options.initial_pose = PoseFromPython(initial_pose, "initial_pose");
-             options.match = MatchOptionsFrom(w_rcs, solver, "trivial", 1.0, "cauchy", 1.0);
-             options.velocity_weight = velocity_weight;
-             options.rotation_weight = rotation_weight;
-             options.keyframe_distance = keyframe_distance;
-             options.map.active_radius = active_radius;
-             ValidateOptions(options);
-             return std::make_unique<RadarOdometry>(options);
-           }),
-           py::arg("w_rcs") = 0.0, py::arg("solver") = "gn", py::arg("velocity_weight") = OdometryOptions().velocity_weight,
-           py::arg("rotation_weight") = OdometryOptions().rotation_weight,
-           py::arg("keyframe_distance") = OdometryOptions().keyframe_distance,
-           py::arg("active_radius") = LocalMapOptions().active_radius, py::arg("initial_pose") = py::none(),
-           "w_rcs and solver as in match; velocity_weight of the Doppler term and rotation_weight of the "
-           "rotation term (0: off); keyframe_distance (m); "
-           "active_radius (m) of the map kept for matching; initial_pose: T_world_radar of the first scan.")
-      .def(
-          "register",
-          [](RadarOdometry& odometry, const RadarScan& scan) {
-            const OdometryStep* step = nullptr;
-            {
-              py::gil_scoped_release release;
-              step = &odometry.Register(scan);
-            }
-            return StepToDict(*step);
-          },
-          py::arg("scan"), "Adds the next scan; returns what happened to it (pose 4x4, reason, ...).")
-      .def("trajectory", [](const RadarOdometry& o) { return TrajectoryToArrays(o.trajectory()); },
-           "(stamps, poses (N, 7)) so far")
-      .def("map", [](const RadarOdometry& o) { return std::make_shared<PyMap>(o.map().GlobalMap()); },
-           "The map built so far, the Gaussians that left the active radius included")
-      .def("__len__", [](const RadarOdometry& o) { return o.steps().size(); });
 }
 
 py::dict DriftToDict(const SegmentDrift& d) {
@@ -144,19 +70,22 @@ void BindMatch(py::module_& m) {
   BindMatchResult(m);
   m.def(
       "match",
-      [](const RadarScan& scan, const PyMap& map, const py::handle& initial, double w_rcs, const std::string& solver,
-         const std::string& loss, double loss_scale, const std::string& rcs_loss, double rcs_loss_scale) {
+      [](const RadarScan& scan, const PyMap& map, const py::handle& initial, const py::kwargs& kwargs) {
         const SE3d start = PoseFromPython(initial, "initial");
-        const MatchOptions options = MatchOptionsFrom(w_rcs, solver, loss, loss_scale, rcs_loss, rcs_loss_scale);
+        const MatchOptions options = OptionsFrom(MatchFields(), kwargs);
         const MatchingMap& matching = map.matching();
         py::gil_scoped_release release;
         return Match(scan, matching, start, options);
       },
-      py::arg("scan"), py::arg("map"), py::arg("initial"), py::arg("w_rcs") = 0.0, py::arg("solver") = "gn",
-      py::arg("loss") = "trivial", py::arg("loss_scale") = 1.0, py::arg("rcs_loss") = "cauchy",
-      py::arg("rcs_loss_scale") = 1.0,
-      MatchDoc())
-  ;
+      py::arg("scan"), py::arg("map"), py::arg("initial"), MatchDoc());
+  m.def(
+      "match_options",
+      [](const py::kwargs& kwargs) {
+        const MatchOptions options = OptionsFrom(MatchFields(), kwargs);
+        MakeScanMatcher(options);  // validates: std::invalid_argument is a ValueError
+        return OptionsToDict(MatchFields(), options);
+      },
+      "Every option of match, the given keywords set (checked as match checks them), as a dict.");
   m.def(
       "initial_errors",
       [](std::size_t scans, double max_translation, double max_rotation_deg, std::uint32_t seed) {
@@ -175,7 +104,6 @@ void BindMatch(py::module_& m) {
       "compose",
       [](const py::handle& a, const py::handle& b) { return PoseToTum(PoseFromPython(a, "a") * PoseFromPython(b, "b")); },
       py::arg("a"), py::arg("b"), "The rigid transform a * b as [x y z qx qy qz qw].");
-  BindOdometry(m);
   m.def(
       "evaluate",
       [](const py::tuple& estimate, const py::tuple& reference, const std::string& align) {

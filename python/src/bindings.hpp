@@ -6,7 +6,7 @@
 
 #include "convert.hpp"
 #include "radargauss/map/gaussian_map.hpp"
-#include "radargauss/solvers/matching_map.hpp"
+#include "radargauss/map/matching_map.hpp"
 #include "radargauss/trajectory.hpp"
 
 namespace radargauss::python {
@@ -31,5 +31,6 @@ Trajectory TrajectoryFromArrays(const py::handle& stamps, const py::handle& pose
 void BindData(py::module_& m);
 void BindMap(py::module_& m);
 void BindMatch(py::module_& m);
+void BindOdometry(py::module_& m);
 
 }  // namespace radargauss::python

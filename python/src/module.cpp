@@ -23,6 +23,7 @@ PYBIND11_MODULE(_radargauss, m) {
   radargauss::python::BindData(m);
   radargauss::python::BindMap(m);
   radargauss::python::BindMatch(m);
+  radargauss::python::BindOdometry(m);
   m.def(
       "set_threads",
       [](int threads) {

@@ -1,0 +1,275 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Type stubs of radargauss._radargauss, written by scripts/generate_stubs.py.
+from typing import Any, Sequence
+
+import numpy
+from numpy.typing import ArrayLike
+
+class DataError(ValueError): ...
+
+class GaussianMap:
+    """A Gaussian-RCS map; every array is a copy (the Gaussians are stored one by one, not as columns)."""
+    def __len__(self: GaussianMap) -> int:
+        ...
+    @property
+    def covariances(self) -> Any: ...
+    @property
+    def incidence(self) -> Any: ...
+    @property
+    def means(self) -> Any: ...
+    @property
+    def point_counts(self) -> Any: ...
+    @property
+    def rcs_coefficients(self) -> Any: ...
+    @property
+    def rcs_degrees(self) -> Any: ...
+    @property
+    def rcs_medians(self) -> Any: ...
+    @property
+    def rcs_scales(self) -> Any: ...
+
+class MatchResult:
+    """The outcome of one scan match."""
+    @property
+    def converged(self) -> Any: ...
+    @property
+    def cost(self) -> Any: ...
+    @property
+    def geometric_residuals(self) -> Any: ...
+    @property
+    def information(self) -> Any: ...
+    @property
+    def iterations(self) -> Any: ...
+    @property
+    def pose(self) -> Any: ...
+    @property
+    def pose_tum(self) -> Any: ...
+    @property
+    def rcs_residuals(self) -> Any: ...
+    @property
+    def reason(self) -> Any: ...
+    @property
+    def time_ms(self) -> Any: ...
+
+class RadarOdometry:
+    """Radar odometry on a map it builds as it goes (docs/design.md, "Odometry"): register scans in time order."""
+    def __init__(self: RadarOdometry, *,
+        ego_min_range: float = 0.25,
+        ego_max_range: float = 100.0,
+        ego_outlier_probability: float = 0.4,
+        ego_success_probability: float = 0.9999,
+        ego_inlier_threshold: float = 0.15,
+        ego_zero_velocity_threshold: float = 0.05,
+        ego_zero_velocity_sigma: float = 0.025,
+        ego_seed: int = 1,
+        ego_consensus_voxel: float = 1.0,
+        gate_sigmas: float = 3.0,
+        acceleration_std: float = 3.0,
+        min_gate: float = 0.5,
+        min_static_points: int = 10,
+        velocity_weight: float = 1.0,
+        velocity_floor: float = 0.05,
+        rotation_weight: float = 1.0,
+        rotation_rate_std_deg: Sequence[float] = [1.0, 1.0, 90.0],
+        region: float = 4.0,
+        region_capacity: int = 256,
+        region_min_points: int = 8,
+        refit_growth: float = 0.5,
+        active_radius: float = 100.0,
+        gaussians_builder: str = 'kmeans',
+        gaussians_downsample_voxel: float = 0.25,
+        gaussians_points_per_gaussian: float = 4.0,
+        gaussians_kmeans_iterations: int = 8,
+        gaussians_em_iterations: int = 10,
+        gaussians_min_std: float = 0.05,
+        gaussians_seed: int = 1,
+        gaussians_ndt_voxel: float = 1.0,
+        gaussians_ndt_min_points: int = 5,
+        gaussians_index_cell: float = 1.0,
+        gaussians_association_gate: float = 3.0,
+        rcs_max_degree: int = 3,
+        rcs_adaptive: bool = True,
+        rcs_incidence: str = 'offset',
+        rcs_rank_threshold: float = 0.01,
+        map_inflation: list[float] = [0.25],
+        map_index_cell: float = 1.0,
+        map_coarse: str = 'merged',
+        map_coarse_gate: float = 3.0,
+        map_updatable: bool = False,
+        keyframe_distance: float = 0.5,
+        keyframe_angle_deg: float = 2.0,
+        min_matched_points: int = 10,
+        initial_pose: ArrayLike = ...,
+        solver: str = 'gn',
+        w_rcs: float = 0.0,
+        loss: str = 'trivial',
+        loss_scale: float = 1.0,
+        rcs_loss: str = 'cauchy',
+        rcs_loss_scale: float = 1.0,
+        rcs_translation: str = 'rotation-only',
+        jacobians: str = 'analytic',
+        gate: float = 3.0,
+        max_iterations: int = 30,
+        coarse_iterations: int = 15,
+        coarse_voxel_per_sigma: float = 2.0,
+        coarse_points: int = 0,
+        geometric_first: bool = True,
+        reassociate: bool = True,
+        reassociation_translation: float = 0.01,
+        reassociation_rotation: float = 0.002,
+        translation_tolerance: float = 0.001,
+        rotation_tolerance: float = 0.0001,
+        coarse_translation_tolerance: float = 0.01,
+        coarse_rotation_tolerance: float = 0.001,
+        gn_max_step_halvings: int = 8,
+        gn_loss_curvature: bool = False,
+        ceres_dogleg: bool = False,
+        ceres_max_inner_iterations: int = 2,
+        ceres_max_exact_inner_iterations: int = 8,
+        ceres_blocks: str = 'square-root',
+        ceres_threads: int = 1,
+        ceres_function_tolerance: float = 1e-06,
+        ceres_gradient_tolerance: float = 1e-10,
+        ceres_parameter_tolerance: float = 1e-08,
+        mh_starts: int = 8,
+        mh_xy_offset: float = 1.0,
+        mh_yaw_offset: float = 0.05) -> None:
+        ...
+    def __len__(self: RadarOdometry) -> int:
+        ...
+    def map(self: RadarOdometry) -> GaussianMap:
+        """The map built so far, the Gaussians that left the active radius included"""
+    @property
+    def matchers_made(self) -> Any: ...
+    def options(self: RadarOdometry) -> dict:
+        """Every option by keyword, as odometry_options gives them"""
+    def register(self: RadarOdometry, scan: Scan) -> dict:
+        """Adds the next scan (stamps must increase); returns what happened to it as a dict: pose (4x4), velocity, matched, keyframe, reason, the information matrices, ..."""
+    def trajectory(self: RadarOdometry) -> tuple:
+        """(stamps (N,), poses (N, 7)) so far"""
+
+class Scan:
+    """One radar scan: points (N, 3) in the radar frame, Doppler (m/s, positive receding) and RCS (dBsm), each a copy as a numpy array."""
+    def __init__(self: Scan, points: Any, doppler: Any = None, rcs: Any = None, stamp: float = 0.0) -> None:
+        ...
+    def __len__(self: Scan) -> int:
+        ...
+    def __repr__(self: Scan) -> str:
+        ...
+    @property
+    def doppler(self) -> Any: ...
+    @property
+    def has_doppler(self) -> Any: ...
+    @property
+    def has_rcs(self) -> Any: ...
+    @property
+    def points(self) -> Any: ...
+    @property
+    def rcs(self) -> Any: ...
+    @property
+    def stamp(self) -> Any: ...
+
+class Sequence:
+    """Scans in time order and, with ground truth, the pose of each."""
+    def __len__(self: Sequence) -> int:
+        ...
+    @property
+    def layout(self) -> Any: ...
+    @property
+    def poses(self) -> Any: ...
+    @property
+    def poses_matrix(self) -> Any: ...
+    @property
+    def scans(self) -> Any: ...
+    @property
+    def sources(self) -> Any: ...
+    @property
+    def stamps(self) -> Any: ...
+
+def build_map(scans: Any, poses: Any = None, builder: str = 'kmeans', points_per_gaussian: float = 4.0, min_std: float = 0.05, incidence: str = 'offset', max_degree: int = 3, doppler_filter: bool = True) -> GaussianMap:
+    """The map of `radargauss build-map`: from a Sequence with poses, or from a list of Scans and their poses T_world_radar (4x4 or [x y z qx qy qz qw]). builder: kmeans or voxel; incidence: offset, view or none."""
+
+def compose(a: Any, b: Any) -> numpy.ndarray:
+    """The rigid transform a * b as [x y z qx qy qz qw]."""
+
+def evaluate(estimate: tuple, reference: tuple, align: str = 'se3') -> dict:
+    """ATE and RPE of `radargauss evaluate`: align se3, sim3, first or none."""
+
+def initial_errors(scans: int, max_translation: float = 2.0, max_rotation_deg: float = 5.0, seed: int = 42) -> numpy.ndarray:
+    """The seeded errors E of `radargauss localize` (its --max-translation, --max-rotation, --seed): the initial pose of scan i is compose(reference_i, E_i). (N, 7)."""
+
+def match(scan: Scan, map: GaussianMap, initial: Any, *,
+    solver: str = 'gn',
+    w_rcs: float = 0.0,
+    loss: str = 'trivial',
+    loss_scale: float = 1.0,
+    rcs_loss: str = 'cauchy',
+    rcs_loss_scale: float = 1.0,
+    rcs_translation: str = 'rotation-only',
+    jacobians: str = 'analytic',
+    gate: float = 3.0,
+    max_iterations: int = 30,
+    coarse_iterations: int = 15,
+    coarse_voxel_per_sigma: float = 2.0,
+    coarse_points: int = 0,
+    geometric_first: bool = True,
+    reassociate: bool = True,
+    reassociation_translation: float = 0.01,
+    reassociation_rotation: float = 0.002,
+    translation_tolerance: float = 0.001,
+    rotation_tolerance: float = 0.0001,
+    coarse_translation_tolerance: float = 0.01,
+    coarse_rotation_tolerance: float = 0.001,
+    gn_max_step_halvings: int = 8,
+    gn_loss_curvature: bool = False,
+    ceres_dogleg: bool = False,
+    ceres_max_inner_iterations: int = 2,
+    ceres_max_exact_inner_iterations: int = 8,
+    ceres_blocks: str = 'square-root',
+    ceres_threads: int = 1,
+    ceres_function_tolerance: float = 1e-06,
+    ceres_gradient_tolerance: float = 1e-10,
+    ceres_parameter_tolerance: float = 1e-08,
+    mh_starts: int = 8,
+    mh_xy_offset: float = 1.0,
+    mh_yaw_offset: float = 0.05) -> MatchResult:
+    """Matches a Scan against a GaussianMap, minimising eq. 2 coarse to fine as `radargauss localize` does."""
+
+def match_options(**kwargs) -> dict:
+    """Every option of match, the given keywords set (checked as match checks them), as a dict."""
+
+def odometry_options(**kwargs) -> dict:
+    """Every option of RadarOdometry, the given keywords set (checked), as a dict."""
+
+def option_fields(kind: str) -> list:
+    """The keywords of match ('match') or RadarOdometry ('odometry'): one dict per option with its keyword, the C++ member it sets (path), type, doc and default."""
+
+def pose_matrices(poses: Any) -> numpy.ndarray:
+    """Poses (N, 7) [x y z qx qy qz qw] (or (N, 4, 4)) as (N, 4, 4) matrices."""
+
+def pose_matrix(pose: Any) -> numpy.ndarray:
+    """A pose [x y z qx qy qz qw] (or 4x4) as its 4x4 matrix."""
+
+def read_map(path: str) -> GaussianMap:
+    """Reads a .rgm map file (validated: docs/design.md, "Bounds on input")."""
+
+def read_pcd(path: str) -> Scan:
+    """One PCD scan (ascii, binary or binary_compressed); the stamp from a <secs>.<nsecs>.pcd name."""
+
+def read_sequence(path: str = '', gt: str = '', extrinsic: str = 'auto', bag: str = '', topic: str = '', rcs_field: str = '', doppler_field: str = '') -> Sequence:
+    """Reads a sequence as `radargauss info` does: a Snail-Radar folder, a folder of .pcd or .bin scans (path), or a ROS1 bag (bag, topic); gt: a TUM file of reference poses, extrinsic T_gt_radar."""
+
+def read_tum(path: str) -> tuple:
+    """A TUM file as (stamps (N,), poses (N, 7) [x y z qx qy qz qw])."""
+
+def set_threads(threads: int) -> None:
+    """Worker threads of the parallel stages (0: all cores), as the tool's --threads."""
+
+def simulate(seed: int = 1, scans: int = 0, config: str = '') -> Sequence:
+    """The synthetic 4D radar drive of `radargauss simulate` (configs/synthetic_world.yaml) as a Sequence with its ground-truth poses; scans > 0 overrides the config's count."""
+
+def write_map(path: str, map: GaussianMap) -> None:
+    """Writes a .rgm map file atomically."""
+
+def write_tum(path: str, stamps: Any, poses: Any) -> None:
+    """Writes stamps (N,) and poses (N, 7) or (N, 4, 4) as a TUM file (9 decimals), atomically."""

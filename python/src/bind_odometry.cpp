@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Radar odometry and the option tables in Python.
+#include <pybind11/stl.h>
+
+#include <string>
+
+#include "bindings.hpp"
+#include "option_fields.hpp"
+#include "radargauss/odometry/radar_odometry.hpp"
+
+namespace radargauss::python {
+
+namespace {
+
+py::dict StepToDict(const OdometryStep& s) {
+  py::dict d;
+  d["stamp"] = s.stamp;
+  d["pose"] = PoseToMatrix(s.pose);
+  d["points"] = s.points;
+  d["static_points"] = s.static_points;
+  d["velocity_measured"] = s.velocity_measured;
+  d["standstill"] = s.standstill;
+  d["gyro"] = s.gyro;
+  d["velocity"] = MatrixToArray<3, 1>(s.velocity);
+  d["velocity_covariance"] = MatrixToArray<3, 3>(s.velocity_covariance);
+  d["matched"] = s.matched;
+  d["iterations"] = s.iterations;
+  d["cost"] = s.final_cost;
+  d["converged"] = s.converged;
+  d["reason"] = s.reason;
+  d["keyframe"] = s.keyframe;
+  d["active_gaussians"] = s.active_gaussians;
+  d["active_map_bytes"] = s.active_map_bytes;
+  d["time_ms"] = s.time_ms;
+  d["information"] = MatrixToArray<6, 6>(s.information);
+  d["velocity_information"] = MatrixToArray<6, 6>(s.velocity_information);
+  d["rotation_information"] = MatrixToArray<6, 6>(s.rotation_information);
+  return d;
+}
+
+const char* OdometryDoc() {
+  static const std::string doc =
+      "Radar odometry on a map it builds as it goes (docs/design.md, \"Odometry\"): register scans in time "
+      "order.\n\nParameters\n----------\n"
+      "**options\n    any of the keywords below (odometry_options() gives them all with their values)\n" +
+      ParametersDoc(OdometryFields());
+  return doc.c_str();
+}
+
+OdometryOptions OdometryOptionsFrom(const py::kwargs& kwargs) {
+  const OdometryOptions options = OptionsFrom(OdometryFields(), kwargs);
+  ValidateOptions(options);  // std::invalid_argument: ValueError
+  return options;
+}
+
+}  // namespace
+
+void BindOdometry(py::module_& m) {
+  py::class_<RadarOdometry>(m, "RadarOdometry", OdometryDoc())
+      .def(py::init([](const py::kwargs& kwargs) { return std::make_unique<RadarOdometry>(OdometryOptionsFrom(kwargs)); }))
+      .def(
+          "register",
+          [](RadarOdometry& odometry, const RadarScan& scan) {
+            const OdometryStep* step = nullptr;
+            {
+              py::gil_scoped_release release;
+              step = &odometry.Register(scan);
+            }
+            return StepToDict(*step);
+          },
+          py::arg("scan"),
+          "Adds the next scan (stamps must increase); returns what happened to it as a dict: pose (4x4), "
+          "velocity, matched, keyframe, reason, the information matrices, ...")
+      .def("trajectory", [](const RadarOdometry& o) { return TrajectoryToArrays(o.trajectory()); },
+           "(stamps (N,), poses (N, 7)) so far")
+      .def("map", [](const RadarOdometry& o) { return std::make_shared<PyMap>(o.map().GlobalMap()); },
+           "The map built so far, the Gaussians that left the active radius included")
+      .def("options", [](const RadarOdometry& o) { return OptionsToDict(OdometryFields(), o.options()); },
+           "Every option by keyword, as odometry_options gives them")
+      .def_property_readonly("matchers_made", &RadarOdometry::matchers_made,
+                             "Matchers made so far: one per version of the local map matched against")
+      .def("__len__", [](const RadarOdometry& o) { return o.steps().size(); });
+  m.def(
+      "odometry_options", [](const py::kwargs& kwargs) { return OptionsToDict(OdometryFields(), OdometryOptionsFrom(kwargs)); },
+      "Every option of RadarOdometry, the given keywords set (checked), as a dict.");
+  m.def(
+      "option_fields",
+      [](const std::string& kind) {
+        if (kind == "match") return FieldsToList(MatchFields());
+        if (kind == "odometry") return FieldsToList(OdometryFields());
+        throw py::value_error("option_fields takes 'match' or 'odometry', not '" + kind + "'");
+      },
+      py::arg("kind"),
+      "The keywords of match ('match') or RadarOdometry ('odometry'): one dict per option with its keyword, the "
+      "C++ member it sets (path), type, doc and default.");
+}
+
+}  // namespace radargauss::python
