@@ -1,9 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
 # Builds the libFuzzer targets (fuzz/) with clang, ASan and UBSan in their own
-# tree (build/fuzz; RADARGAUSS_FUZZ_TREE names a tree configured with
-# RADARGAUSS_BUILD_FUZZERS instead, as scripts/test.sh's sanitizer tree is)
-# and runs each for SECONDS on one worker, seeded by
+# tree (build/fuzz) and runs each for SECONDS on one worker, seeded by
 # scripts/fuzz_seeds.py and the regression inputs of tests/data/fuzz.
 # Prints executions and coverage per target; exits non-zero on a finding
 # (a crash, leak, UB, a 10 s timeout or more than 2 GB) and names the
@@ -28,18 +26,12 @@ if ! [[ "$seconds" =~ ^[1-9][0-9]*$ ]]; then
 fi
 
 RADARGAUSS_DEPS_EXTRA="clang libclang-rt-14-dev libcli11-dev ${RADARGAUSS_DEPS_EXTRA:-}" "$root/scripts/deps.sh"
-build=${RADARGAUSS_FUZZ_TREE:-}
-if [ -z "$build" ]; then
-  build="$root/build/fuzz"
-  CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug \
-    -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link" \
-    -DRADARGAUSS_SANITIZE=ON -DRADARGAUSS_BUILD_FUZZERS=ON -DRADARGAUSS_BUILD_TESTS=OFF \
-    -DRADARGAUSS_BUILD_BENCHMARKS=OFF -DRADARGAUSS_BUILD_APPS=OFF -DRADARGAUSS_BUILD_EXAMPLES=OFF \
-    -DRADARGAUSS_WITH_ROSBAG=OFF >/dev/null
-elif ! grep -q '^RADARGAUSS_BUILD_FUZZERS:BOOL=ON' "$build/CMakeCache.txt" 2>/dev/null; then
-  echo "fuzz.sh: $build is not a tree configured with RADARGAUSS_BUILD_FUZZERS=ON" >&2
-  exit 2
-fi
+build="$root/build/fuzz"
+CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug \
+  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link" \
+  -DRADARGAUSS_SANITIZE=ON -DRADARGAUSS_BUILD_FUZZERS=ON -DRADARGAUSS_BUILD_TESTS=OFF \
+  -DRADARGAUSS_BUILD_BENCHMARKS=OFF -DRADARGAUSS_BUILD_APPS=OFF -DRADARGAUSS_BUILD_EXAMPLES=OFF \
+  -DRADARGAUSS_WITH_ROSBAG=OFF >/dev/null
 cmake --build "$build" -j "$(nproc)" --target "${targets[@]/#/fuzz_}"
 /usr/bin/python3 "$root/scripts/fuzz_seeds.py" "$build/corpus"
 

@@ -206,7 +206,9 @@ TEST(RotationOnlyRcs, TranslationFixedAtWeightOne) {
 }
 
 TEST(RotationOnlyRcs, RcsAloneReducesAPureRotationErrorOnPlantedModels) {
-  // Exact patterns: both incidence models recover the truth. With RCS noise
+  // Exact patterns: both incidence models recover the truth (to 1e-5 deg:
+  // the last steps differ between GCC and clang builds by ~1e-6 deg, far
+  // below the stopping rule's 1e-4 rad). With RCS noise
   // of 0.1 (normalised units, a twentieth of the range) the paper's offset
   // incidence still does, to < 0.1 deg: mu_r moves by range x angle against
   // the fixed p_r, so d turns much faster than the pose. The view incidence
@@ -235,7 +237,7 @@ TEST(RotationOnlyRcs, RcsAloneReducesAPureRotationErrorOnPlantedModels) {
                     name.c_str(), ToString(incidence).c_str(), rcs_noise, dr, result.n_rcs);
         EXPECT_EQ(dt, 0.0) << name;
         EXPECT_GT(result.n_rcs, world.scan.points.size() / 2) << name;
-        EXPECT_LT(dr, rcs_noise == 0.0 ? 1e-6 : 0.1) << name << ", " << ToString(incidence) << " incidence";
+        EXPECT_LT(dr, rcs_noise == 0.0 ? 1e-5 : 0.1) << name << ", " << ToString(incidence) << " incidence";
       }
     }
   }
