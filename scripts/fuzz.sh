@@ -28,7 +28,7 @@ fi
 RADARGAUSS_DEPS_EXTRA="clang libclang-rt-14-dev libcli11-dev ${RADARGAUSS_DEPS_EXTRA:-}" "$root/scripts/deps.sh"
 build="$root/build/fuzz"
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug \
-  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link" \
+  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link" \
   -DRADARGAUSS_SANITIZE=ON -DRADARGAUSS_BUILD_FUZZERS=ON -DRADARGAUSS_BUILD_TESTS=OFF \
   -DRADARGAUSS_BUILD_BENCHMARKS=OFF -DRADARGAUSS_BUILD_APPS=OFF -DRADARGAUSS_BUILD_EXAMPLES=OFF \
   -DRADARGAUSS_WITH_ROSBAG=OFF >/dev/null
