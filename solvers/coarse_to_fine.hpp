@@ -44,6 +44,13 @@ class CoarseToFine {
   // with w = 1 the last alone.
   CoarseToFine(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
                const ScanMatchingOptions& options, const ScanPriors& priors);
+  // It keeps references: temporaries would not outlive it.
+  CoarseToFine(const RadarScan&&, const MatchingMap&, const SE3d&, const ScanMatchingOptions&,
+               const ScanPriors&) = delete;
+  CoarseToFine(const RadarScan&, const MatchingMap&, const SE3d&, const ScanMatchingOptions&&,
+               const ScanPriors&) = delete;
+  CoarseToFine(const RadarScan&, const MatchingMap&, const SE3d&, const ScanMatchingOptions&,
+               const ScanPriors&&) = delete;
 
   const std::vector<Stage>& stages() const { return stages_; }
   // Iteration `iteration` of `stage` at pose(): its correspondences are made
@@ -84,11 +91,12 @@ class CoarseToFine {
   // any) and the information matrices.
   void FinishCounts(ScanMatchingResult& result) const;
 
+  // The caller's, which outlive the match: nothing is copied per match.
   const RadarScan& scan_;
   const MatchingMap& map_;
   const SE3d initial_;
-  const ScanMatchingOptions options_;
-  const ScanPriors priors_;
+  const ScanMatchingOptions& options_;
+  const ScanPriors& priors_;
   const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   std::vector<Stage> stages_;
   bool geometric_first_ = false;         // the exact map's geometric stage before eq. 2's

@@ -185,7 +185,8 @@ TEST(CoarseGate, CoarseLevelsAssociateWithinIt) {
     const MatchingMap matching(map, map_options);
     EXPECT_EQ(matching.coarse_gate(), coarse_gate);
     std::vector<std::size_t> associated;  // per level visited
-    CoarseToFine match(scan, matching, SE3d(), options, {});
+    const ScanPriors none;
+    CoarseToFine match(scan, matching, SE3d(), options, none);
     for (const Stage& stage : match.stages()) {
       if (!match.Associate(stage, 1)) break;
       associated.push_back(match.correspondences().geometric.size());
@@ -224,7 +225,8 @@ TEST(CoarseVoxels, CoarseLevelsMatchTheScansVoxelCentroids) {
   EXPECT_EQ(matching.sigma(2), 0.0);  // the exact map
   const auto coarse_points = [&](const ScanMatchingOptions& options) {
     std::vector<std::vector<Eigen::Vector3d>> levels;  // the associated points, per coarse level
-    CoarseToFine match(scan, matching, SE3d(), options, {});
+    const ScanPriors none;
+    CoarseToFine match(scan, matching, SE3d(), options, none);
     for (const Stage& stage : match.stages()) {
       if (stage.finest || !match.Associate(stage, 1)) break;
       levels.emplace_back();

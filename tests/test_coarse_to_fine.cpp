@@ -124,7 +124,8 @@ TEST(GeometricFirst, ExactMapGeometricStageThenEq2) {
   // exact map's geometric stage.
   const auto stages = [&](const ScanMatchingOptions& options, double move) {
     std::vector<Seen> seen;
-    CoarseToFine match(scan, matching, initial, options, {});
+    const ScanPriors none;
+    CoarseToFine match(scan, matching, initial, options, none);
     for (const Stage& stage : match.stages()) {
       if (!match.Associate(stage, 1)) break;
       seen.push_back({stage.finest, stage.options.w_rcs, stage.translation_tolerance, match.correspondences()});
