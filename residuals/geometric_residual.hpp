@@ -40,10 +40,9 @@ class GeometricResidual {
   }
 
   using AutoDiff = ceres::AutoDiffCostFunction<GeometricResidual, 3, 4, 3>;
+  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const Eigen::Vector3d& point_radar, const Eigen::Vector3d& mean,
-                                     const Eigen::Matrix3d& sqrt_information_t) {
-    return new AutoDiff(new GeometricResidual(point_radar, mean, sqrt_information_t));
-  }
+                                     const Eigen::Matrix3d& sqrt_information_t);
 
  private:
   Eigen::Vector3d point_radar_;

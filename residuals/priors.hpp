@@ -9,7 +9,6 @@
 
 #include <optional>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include "radargauss/lie/se3.hpp"
@@ -19,12 +18,8 @@ namespace radargauss {
 
 // W = L^-1 with L L^T = S dt^2 + Q (Cholesky), so W^T W = (S dt^2 + Q)^-1;
 // the floor Q must make the sum positive definite.
-inline Eigen::Matrix3d VelocitySqrtInformation(const Eigen::Matrix3d& velocity_covariance, double dt,
-                                               const Eigen::Matrix3d& floor) {
-  const Eigen::Matrix3d covariance = velocity_covariance * dt * dt + floor;
-  const Eigen::Matrix3d L = covariance.llt().matrixL();
-  return L.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity());
-}
+Eigen::Matrix3d VelocitySqrtInformation(const Eigen::Matrix3d& velocity_covariance, double dt,
+                                        const Eigen::Matrix3d& floor);
 
 // The velocity term as scan matching adds it to eq. 2: weight * |r_v|^2.
 struct VelocityPrior {

@@ -94,7 +94,7 @@ class RcsResidual {
   void Reset(const RcsTerm& term) { term_ = term; }
 
   using AutoDiff = ceres::AutoDiffCostFunction<RcsResidual, 1, 4, 3>;
-  static ceres::CostFunction* Create(const RcsTerm& term) { return new AutoDiff(new RcsResidual(term)); }
+  static ceres::CostFunction* Create(const RcsTerm& term);  // residuals/autodiff_costs.cpp
 
  private:
   RcsTerm term_;
@@ -117,9 +117,7 @@ class RcsRotationResidual {
   }
 
   using AutoDiff = ceres::AutoDiffCostFunction<RcsRotationResidual, 1, 4>;
-  static ceres::CostFunction* Create(const RcsTerm& term, const Eigen::Vector3d& translation) {
-    return new AutoDiff(new RcsRotationResidual(term, translation));
-  }
+  static ceres::CostFunction* Create(const RcsTerm& term, const Eigen::Vector3d& translation);
 
  private:
   RcsTerm term_;
@@ -241,14 +239,7 @@ class RcsCoefficientResidual {
   }
 
   using AutoDiff = ceres::DynamicAutoDiffCostFunction<RcsCoefficientResidual, 4>;
-  static ceres::CostFunction* Create(const RcsTerm& term, const Eigen::Vector3d& translation, bool full) {
-    auto* cost = new AutoDiff(new RcsCoefficientResidual(term, translation, full));
-    cost->AddParameterBlock(4);
-    cost->AddParameterBlock(ShCoefficientCount(term.degree));
-    if (full) cost->AddParameterBlock(3);
-    cost->SetNumResiduals(1);
-    return cost;
-  }
+  static ceres::CostFunction* Create(const RcsTerm& term, const Eigen::Vector3d& translation, bool full);
 
  private:
   const RcsTerm term_;

@@ -32,9 +32,9 @@ class RotationResidual {
     return true;
   }
 
-  static ceres::CostFunction* Create(const SO3d& predicted, const Eigen::Matrix3d& sqrt_information) {
-    return new ceres::AutoDiffCostFunction<RotationResidual, 3, 4>(new RotationResidual(predicted, sqrt_information));
-  }
+  using AutoDiff = ceres::AutoDiffCostFunction<RotationResidual, 3, 4>;
+  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
+  static ceres::CostFunction* Create(const SO3d& predicted, const Eigen::Matrix3d& sqrt_information);
 
  private:
   const SO3d predicted_inverse_;

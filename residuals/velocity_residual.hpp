@@ -37,11 +37,10 @@ class VelocityResidual {
     return true;
   }
 
+  using AutoDiff = ceres::AutoDiffCostFunction<VelocityResidual, 3, 3>;
+  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const SE3d& previous, const Eigen::Vector3d& velocity, double dt,
-                                     const Eigen::Matrix3d& sqrt_information) {
-    return new ceres::AutoDiffCostFunction<VelocityResidual, 3, 3>(
-        new VelocityResidual(previous, velocity, dt, sqrt_information));
-  }
+                                     const Eigen::Matrix3d& sqrt_information);
 
  private:
   const Eigen::Matrix3d rotation_previous_t_;

@@ -47,7 +47,7 @@ for tree in $trees; do
       # its -O1 code ran the tests twice as slowly under ASan.)
       cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug \
         -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DRADARGAUSS_SANITIZE=ON \
-        -DRADARGAUSS_BUILD_BENCHMARKS=OFF -DRADARGAUSS_WITH_ROSBAG=ON ;;
+        -DRADARGAUSS_BUILD_BENCHMARKS=OFF -DRADARGAUSS_BUILD_EXAMPLES=OFF -DRADARGAUSS_WITH_ROSBAG=ON ;;
     *)
       echo "test.sh: unknown tree '$tree' (release, sanitize)" >&2
       exit 2 ;;

@@ -14,7 +14,7 @@ failed=0
 checked=0
 
 mkdir -p "$work/out"
-"$tool" simulate --out "$work/seq" --scans 300 --seed 5 >/dev/null
+"$tool" simulate --out "$work/seq" --scans 120 --seed 5 >/dev/null
 seq=(--sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt")
 build=("$tool" build-map "${seq[@]}")
 localize=("$tool" localize "${seq[@]}" --map "$work/ref.rgm" --w-rcs 0,0.25)

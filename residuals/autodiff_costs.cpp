@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The automatic-differentiation twins of the residuals, made here once: an
+// AutoDiffCostFunction instantiated in a header would be instantiated again
+// in every file that includes it (docs/design.md, "Build").
+#include <ceres/dynamic_autodiff_cost_function.h>
+
+#include "radargauss/residuals/geometric_residual.hpp"
+#include "radargauss/residuals/rcs_residual.hpp"
+#include "radargauss/residuals/rotation_residual.hpp"
+#include "radargauss/residuals/velocity_residual.hpp"
+
+namespace radargauss {
+
+ceres::CostFunction* GeometricResidual::Create(const Eigen::Vector3d& point_radar, const Eigen::Vector3d& mean,
+                                               const Eigen::Matrix3d& sqrt_information_t) {
+  return new AutoDiff(new GeometricResidual(point_radar, mean, sqrt_information_t));
+}
+
+ceres::CostFunction* RcsResidual::Create(const RcsTerm& term) { return new AutoDiff(new RcsResidual(term)); }
+
+ceres::CostFunction* RcsRotationResidual::Create(const RcsTerm& term, const Eigen::Vector3d& translation) {
+  return new AutoDiff(new RcsRotationResidual(term, translation));
+}
+
+ceres::CostFunction* RcsCoefficientResidual::Create(const RcsTerm& term, const Eigen::Vector3d& translation,
+                                                    bool full) {
+  auto* cost = new AutoDiff(new RcsCoefficientResidual(term, translation, full));
+  cost->AddParameterBlock(4);
+  cost->AddParameterBlock(ShCoefficientCount(term.degree));
+  if (full) cost->AddParameterBlock(3);
+  cost->SetNumResiduals(1);
+  return cost;
+}
+
+ceres::CostFunction* RotationResidual::Create(const SO3d& predicted, const Eigen::Matrix3d& sqrt_information) {
+  return new AutoDiff(new RotationResidual(predicted, sqrt_information));
+}
+
+ceres::CostFunction* VelocityResidual::Create(const SE3d& previous, const Eigen::Vector3d& velocity, double dt,
+                                              const Eigen::Matrix3d& sqrt_information) {
+  return new AutoDiff(new VelocityResidual(previous, velocity, dt, sqrt_information));
+}
+
+}  // namespace radargauss
