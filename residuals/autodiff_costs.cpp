@@ -16,10 +16,22 @@ ceres::CostFunction* GeometricResidual::Create(const Eigen::Vector3d& point_rada
   return new AutoDiff(new GeometricResidual(point_radar, mean, sqrt_information_t));
 }
 
+ceres::CostFunction* GeometricResidual::Create(std::unique_ptr<GeometricResidual> functor) {
+  return new AutoDiff(functor.release());
+}
+
 ceres::CostFunction* RcsResidual::Create(const RcsTerm& term) { return new AutoDiff(new RcsResidual(term)); }
+
+ceres::CostFunction* RcsResidual::Create(std::unique_ptr<RcsResidual> functor) {
+  return new AutoDiff(functor.release());
+}
 
 ceres::CostFunction* RcsRotationResidual::Create(const RcsTerm& term, const Eigen::Vector3d& translation) {
   return new AutoDiff(new RcsRotationResidual(term, translation));
+}
+
+ceres::CostFunction* RcsRotationResidual::Create(std::unique_ptr<RcsRotationResidual> functor) {
+  return new AutoDiff(functor.release());
 }
 
 ceres::CostFunction* RcsCoefficientResidual::Create(const RcsTerm& term, const Eigen::Vector3d& translation,

@@ -11,6 +11,8 @@
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/sized_cost_function.h>
 
+#include <memory>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -43,6 +45,8 @@ class GeometricResidual {
   // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const Eigen::Vector3d& point_radar, const Eigen::Vector3d& mean,
                                      const Eigen::Matrix3d& sqrt_information_t);
+  // The same around a functor the caller keeps a pointer to (for Reset).
+  static ceres::CostFunction* Create(std::unique_ptr<GeometricResidual> functor);
 
  private:
   Eigen::Vector3d point_radar_;

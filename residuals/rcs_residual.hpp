@@ -21,6 +21,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/cost_function.h>
@@ -95,6 +96,7 @@ class RcsResidual {
 
   using AutoDiff = ceres::AutoDiffCostFunction<RcsResidual, 1, 4, 3>;
   static ceres::CostFunction* Create(const RcsTerm& term);  // residuals/autodiff_costs.cpp
+  static ceres::CostFunction* Create(std::unique_ptr<RcsResidual> functor);  // kept by the caller for Reset
 
  private:
   RcsTerm term_;
@@ -118,6 +120,7 @@ class RcsRotationResidual {
 
   using AutoDiff = ceres::AutoDiffCostFunction<RcsRotationResidual, 1, 4>;
   static ceres::CostFunction* Create(const RcsTerm& term, const Eigen::Vector3d& translation);
+  static ceres::CostFunction* Create(std::unique_ptr<RcsRotationResidual> functor);
 
  private:
   RcsTerm term_;

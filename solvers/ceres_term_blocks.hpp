@@ -223,8 +223,9 @@ class TermBlocks {
         block.analytic = new AnalyticCost(args...);
         block.cost.reset(block.analytic);
       } else {
-        block.functor = new Functor(args...);
-        block.cost = std::make_unique<typename Functor::AutoDiff>(block.functor);
+        auto functor = std::make_unique<Functor>(args...);
+        block.functor = functor.get();
+        block.cost.reset(Functor::Create(std::move(functor)));  // owns the functor
       }
       blocks_.push_back(std::move(block));
     } else if (analytic_) {
