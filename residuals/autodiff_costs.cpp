@@ -6,6 +6,7 @@
 
 #include "radargauss/residuals/geometric_residual.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
+#include "radargauss/residuals/relative_pose_residual.hpp"
 #include "radargauss/residuals/rotation_residual.hpp"
 #include "radargauss/residuals/velocity_residual.hpp"
 
@@ -42,6 +43,11 @@ ceres::CostFunction* RcsCoefficientResidual::Create(const RcsTerm& term, const E
   if (full) cost->AddParameterBlock(3);
   cost->SetNumResiduals(1);
   return cost;
+}
+
+ceres::CostFunction* RelativePoseResidual::Create(const SE3d& measured,
+                                                  const Eigen::Matrix<double, 6, 6>& sqrt_information) {
+  return new AutoDiff(new RelativePoseResidual(measured, sqrt_information));
 }
 
 ceres::CostFunction* RotationResidual::Create(const SO3d& predicted, const Eigen::Matrix3d& sqrt_information) {

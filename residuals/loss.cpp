@@ -16,6 +16,7 @@ const NamedValue<LossType> kLossNames[] = {
     {LossType::kCauchy, "cauchy"},
     {LossType::kGemanMcClure, "geman-mcclure"},
     {LossType::kTukey, "tukey"},
+    {LossType::kDcs, "dcs"},
 };
 
 }  // namespace
@@ -47,6 +48,7 @@ ceres::LossFunction* MakeLoss(const LossConfig& config) {
     case LossType::kCauchy: return new ceres::CauchyLoss(config.scale);
     case LossType::kGemanMcClure: return new GemanMcClureLoss(config.scale);
     case LossType::kTukey: return new ceres::TukeyLoss(config.scale);
+    case LossType::kDcs: return new DcsLoss(config.scale);
   }
   return nullptr;
 }

@@ -7,6 +7,9 @@
 //   cauchy         a^2 log(1 + s / a^2)
 //   geman-mcclure  a^2 s / (a^2 + s)
 //   tukey          a^2/3 (1 - (1 - s/a^2)^3) for s <= a^2, else a^2/3
+//   dcs            s for s <= a^2, else a^2 (3 s - a^2) / (s + a^2): dynamic
+//                  covariance scaling (Agarwal et al. 2013, Phi = a^2), whose
+//                  rho' is the square of its scale min(1, 2 Phi / (Phi + s))
 #pragma once
 
 #include <string>
@@ -14,7 +17,7 @@
 
 namespace radargauss {
 
-enum class LossType { kTrivial, kHuber, kCauchy, kGemanMcClure, kTukey };
+enum class LossType { kTrivial, kHuber, kCauchy, kGemanMcClure, kTukey, kDcs };
 
 struct LossConfig {
   LossType type = LossType::kTrivial;

@@ -29,6 +29,28 @@ class GemanMcClureLoss final : public ceres::LossFunction {
   const double a2_;
 };
 
+// Dynamic covariance scaling as an M-estimator (residuals/loss.hpp): quadratic
+// up to Phi = a^2, then rho' = 4 Phi^2 / (s + Phi)^2.
+class DcsLoss final : public ceres::LossFunction {
+ public:
+  explicit DcsLoss(double a) : phi_(a * a) {}
+  void Evaluate(double s, double rho[3]) const override {
+    if (s <= phi_) {
+      rho[0] = s;
+      rho[1] = 1.0;
+      rho[2] = 0.0;
+      return;
+    }
+    const double scale = 2.0 * phi_ / (s + phi_);  // DCS's, in (0, 1)
+    rho[0] = phi_ * (3.0 - 2.0 * scale);           // Phi (3 s - Phi) / (s + Phi), without overflow
+    rho[1] = scale * scale;
+    rho[2] = -rho[1] * scale / phi_;               // -2 rho' / (s + Phi)
+  }
+
+ private:
+  const double phi_;
+};
+
 // A new loss (nullptr for trivial: Ceres's convention); the caller owns it.
 ceres::LossFunction* MakeLoss(const LossConfig& config);
 

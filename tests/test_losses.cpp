@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iterator>
 #include <memory>
 #include <cctype>
@@ -56,6 +57,30 @@ TEST(Losses, GemanMcClureDerivativesAndFactory) {
   EXPECT_THROW(LossTypeFromString("l7"), std::invalid_argument);
 }
 
+// Dynamic covariance scaling: rho' and rho'' against central differences on
+// both sides of Phi, continuous at Phi, and rho' the square of DCS's scale
+// min(1, 2 Phi / (Phi + s)) (Agarwal et al. 2013).
+TEST(Losses, DcsDerivativesAndScale) {
+  const double a = 1.5, phi = a * a;
+  const DcsLoss loss(a);
+  for (const double s : {0.5, 2.0, phi + 0.1, 10.0, 1e4}) {
+    double rho[3], plus[3], minus[3];
+    loss.Evaluate(s, rho);
+    loss.Evaluate(s + 1e-6, plus);
+    loss.Evaluate(s - 1e-6, minus);
+    EXPECT_NEAR(rho[1], (plus[0] - minus[0]) / 2e-6, 1e-6) << s;
+    EXPECT_NEAR(rho[2], (plus[1] - minus[1]) / 2e-6, 1e-5) << s;
+    const double scale = std::min(1.0, 2.0 * phi / (phi + s));
+    EXPECT_NEAR(rho[1], scale * scale, 1e-12) << s;
+  }
+  double below[3], above[3];
+  loss.Evaluate(phi * (1.0 - 1e-12), below);
+  loss.Evaluate(phi * (1.0 + 1e-12), above);
+  EXPECT_NEAR(below[0], above[0], 1e-9);
+  EXPECT_NEAR(below[1], above[1], 1e-9);
+  EXPECT_EQ(LossTypeFromString("dcs"), LossType::kDcs);
+}
+
 // LossSum against the loss classes term by term (Cauchy's product of logs
 // included): squared residuals from 0 to 1e307, so that the product is
 // renormalised many times, and then single factors pass 2^500 (1e307 would
@@ -67,7 +92,7 @@ TEST(Losses, LossSumMatchesTheLossClasses) {
   for (int k = 0; k < 20000; ++k) squared_norms.push_back(std::pow(10.0, exponent(rng)));
   for (const double s : {1e160, 1e307, 1.0, 1e307}) squared_norms.push_back(s);
   for (const LossType type : {LossType::kTrivial, LossType::kHuber, LossType::kCauchy, LossType::kGemanMcClure,
-                              LossType::kTukey}) {
+                              LossType::kTukey, LossType::kDcs}) {
     for (const double scale : {0.3, 1.0, 2.5}) {
       const std::unique_ptr<ceres::LossFunction> reference(MakeLoss({type, scale}));
       LossSum sum({type, scale});

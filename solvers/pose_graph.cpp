@@ -1,0 +1,253 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/solvers/pose_graph.hpp"
+
+#include <ceres/loss_function.h>
+#include <ceres/problem.h>
+#include <ceres/sized_cost_function.h>
+#include <ceres/solver.h>
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "radargauss/lie/manifold.hpp"
+#include "radargauss/residuals/relative_pose_residual.hpp"
+#include "radargauss/residuals/robust_loss.hpp"
+
+namespace radargauss {
+
+namespace {
+
+// A loop edge's relative-pose residual times its switch s (switchable
+// constraints): blocks R_i, t_i, R_j, t_j, s; d(s r)/ds = r.
+class SwitchedCost final : public ceres::SizedCostFunction<6, 4, 3, 4, 3, 1> {
+ public:
+  explicit SwitchedCost(ceres::CostFunction* edge) : edge_(edge) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    if (!edge_->Evaluate(parameters, residuals, jacobians)) return false;
+    const double s = parameters[4][0];
+    if (jacobians != nullptr) {
+      const int sizes[4] = {6 * 4, 6 * 3, 6 * 4, 6 * 3};
+      for (int b = 0; b < 4; ++b) {
+        if (jacobians[b] == nullptr) continue;
+        for (int k = 0; k < sizes[b]; ++k) jacobians[b][k] *= s;
+      }
+      if (jacobians[4] != nullptr) {
+        for (int k = 0; k < 6; ++k) jacobians[4][k] = residuals[k];
+      }
+    }
+    for (int k = 0; k < 6; ++k) residuals[k] *= s;
+    return true;
+  }
+
+ private:
+  std::unique_ptr<ceres::CostFunction> edge_;
+};
+
+// The switch's prior: (1 - s) / sigma.
+class SwitchPrior final : public ceres::SizedCostFunction<1, 1> {
+ public:
+  explicit SwitchPrior(double sigma) : inverse_sigma_(1.0 / sigma) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    residuals[0] = (1.0 - parameters[0][0]) * inverse_sigma_;
+    if (jacobians != nullptr && jacobians[0] != nullptr) jacobians[0][0] = -inverse_sigma_;
+    return true;
+  }
+
+ private:
+  const double inverse_sigma_;
+};
+
+ceres::CostFunction* EdgeCost(const PoseGraphEdge& edge, JacobianMode jacobians) {
+  if (jacobians == JacobianMode::kAutoDiff) return RelativePoseResidual::Create(edge.measured, edge.sqrt_information);
+  return new RelativePoseCostFunction(edge.measured, edge.sqrt_information);
+}
+
+// Levenberg-Marquardt on the sparse normal equations, by SuiteSparse's Cholesky.
+ceres::Solver::Options SolverOptions(const PoseGraphOptions& options) {
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.num_threads = options.threads;
+  solver_options.logging_type = ceres::SILENT;
+  return solver_options;
+}
+
+void Validate(const PoseGraphOptions& options) {
+  if (options.max_iterations < 1) throw std::invalid_argument("pose graph: max_iterations must be >= 1");
+  if (options.threads < 1) throw std::invalid_argument("pose graph: threads must be >= 1");
+  if (!(options.switch_prior_std > 0.0)) throw std::invalid_argument("pose graph: switch_prior_std must be > 0");
+  if (!(options.loop_loss.scale > 0.0)) throw std::invalid_argument("pose graph: loop loss scale must be > 0");
+  if (!(options.graduation_factor > 1.0)) throw std::invalid_argument("pose graph: graduation_factor must be > 1");
+}
+
+}  // namespace
+
+int PoseGraph::AddKeyframe(const SE3d& pose) {
+  if (!pose.translation().allFinite() || !pose.rotation().quaternion().coeffs().allFinite()) {
+    throw std::invalid_argument("pose graph: keyframe pose is not finite");
+  }
+  poses_.push_back(pose);
+  return int(poses_.size()) - 1;
+}
+
+void PoseGraph::Check(int from, int to, const SE3d& measured, const Eigen::Matrix<double, 6, 6>& W) const {
+  const int n = int(poses_.size());
+  if (from < 0 || to < 0 || from >= n || to >= n || from == to) {
+    throw std::invalid_argument("pose graph: edge " + std::to_string(from) + " -> " + std::to_string(to) +
+                                " needs two different keyframes of 0.." + std::to_string(n - 1));
+  }
+  if (!measured.translation().allFinite() || !measured.rotation().quaternion().coeffs().allFinite() ||
+      !W.allFinite()) {
+    throw std::invalid_argument("pose graph: edge measurement or information is not finite");
+  }
+}
+
+void PoseGraph::AddOdometry(int from, int to, const SE3d& measured, const Eigen::Matrix<double, 6, 6>& W) {
+  Check(from, to, measured, W);
+  edges_.push_back({from, to, measured, W, false});
+}
+
+int PoseGraph::AddLoop(int from, int to, const SE3d& measured, const Eigen::Matrix<double, 6, 6>& W) {
+  Check(from, to, measured, W);
+  edges_.push_back({from, to, measured, W, true});
+  switches_.push_back(1.0);
+  loop_weights_.push_back(1.0);
+  return int(switches_.size()) - 1;
+}
+
+// The graph as a Ceres problem: the parameter blocks, and per loop edge its
+// residual block and the loss wrapper that kLoss and kGraduated set.
+struct PoseGraph::Problem {
+  std::vector<Eigen::Vector4d> rotations;
+  std::vector<Eigen::Vector3d> translations;
+  SO3Manifold so3;
+  std::unique_ptr<ceres::Problem> problem;
+  std::vector<ceres::ResidualBlockId> loop_blocks;
+  std::vector<ceres::LossFunctionWrapper*> loop_losses;  // owned by the problem
+
+  // |r|^2 of each loop edge at the current parameters, without its loss.
+  std::vector<double> LoopSquaredNorms() const {
+    std::vector<double> norms;
+    for (const ceres::ResidualBlockId id : loop_blocks) {
+      double cost = 0.0;
+      Eigen::Matrix<double, 6, 1> r;
+      problem->EvaluateResidualBlock(id, false, &cost, r.data(), nullptr);
+      norms.push_back(r.squaredNorm());
+    }
+    return norms;
+  }
+};
+
+std::unique_ptr<PoseGraph::Problem> PoseGraph::Build(const PoseGraphOptions& options) {
+  auto graph = std::make_unique<Problem>();
+  const std::size_t n = poses_.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    graph->rotations.push_back(poses_[k].rotation().quaternion().coeffs());
+    graph->translations.push_back(poses_[k].translation());
+  }
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  graph->problem = std::make_unique<ceres::Problem>(problem_options);
+  ceres::Problem& problem = *graph->problem;
+  for (std::size_t k = 0; k < n; ++k) {
+    problem.AddParameterBlock(graph->rotations[k].data(), 4, &graph->so3);
+    problem.AddParameterBlock(graph->translations[k].data(), 3);
+  }
+  std::size_t loop = 0;
+  for (const PoseGraphEdge& edge : edges_) {
+    std::vector<double*> blocks = {graph->rotations[edge.from].data(), graph->translations[edge.from].data(),
+                                   graph->rotations[edge.to].data(), graph->translations[edge.to].data()};
+    ceres::CostFunction* cost = EdgeCost(edge, options.jacobians);
+    if (!edge.loop) {
+      problem.AddResidualBlock(cost, nullptr, blocks);
+      continue;
+    }
+    if (options.loop_rejection == LoopRejection::kSwitchable) {
+      double* s = &switches_[loop];
+      blocks.push_back(s);
+      graph->loop_blocks.push_back(problem.AddResidualBlock(new SwitchedCost(cost), nullptr, blocks));
+      problem.AddResidualBlock(new SwitchPrior(options.switch_prior_std), nullptr, s);
+      problem.SetParameterLowerBound(s, 0, 0.0);
+      problem.SetParameterUpperBound(s, 0, 1.0);
+    } else {
+      auto* loss = new ceres::LossFunctionWrapper(
+          options.loop_rejection == LoopRejection::kLoss ? MakeLoss(options.loop_loss) : nullptr,
+          ceres::TAKE_OWNERSHIP);
+      graph->loop_losses.push_back(loss);
+      graph->loop_blocks.push_back(problem.AddResidualBlock(cost, loss, blocks));
+    }
+    ++loop;
+  }
+  problem.SetParameterBlockConstant(graph->rotations[0].data());  // the gauge
+  problem.SetParameterBlockConstant(graph->translations[0].data());
+  return graph;
+}
+
+// Graduated non-convexity with Geman-McClure (Yang et al. 2020): from the
+// quadratic solution, rounds of weighted least squares with the weights
+// (mu a^2 / (s + mu a^2))^2, mu from 2 max(s) / a^2 down to 1 by the factor.
+void PoseGraph::Graduate(Problem& graph, const PoseGraphOptions& options, PoseGraphSummary& summary) {
+  const double a2 = options.loop_loss.scale * options.loop_loss.scale;
+  std::vector<double> norms = graph.LoopSquaredNorms();
+  double mu = 1.0;
+  for (const double s : norms) mu = std::max(mu, 2.0 * s / a2);
+  while (true) {
+    for (std::size_t l = 0; l < norms.size(); ++l) {
+      const double weight = mu * a2 / (norms[l] + mu * a2);
+      loop_weights_[l] = weight * weight;
+      graph.loop_losses[l]->Reset(new ceres::ScaledLoss(nullptr, loop_weights_[l], ceres::TAKE_OWNERSHIP),
+                                  ceres::TAKE_OWNERSHIP);
+    }
+    ceres::Solver::Summary round;
+    ceres::Solve(SolverOptions(options), graph.problem.get(), &round);
+    summary.iterations += int(round.iterations.size()) - 1;
+    summary.final_cost = round.final_cost;
+    summary.converged = round.termination_type == ceres::CONVERGENCE;
+    ++summary.solves;
+    if (mu <= 1.0) return;
+    mu = std::max(1.0, mu / options.graduation_factor);
+    norms = graph.LoopSquaredNorms();
+  }
+}
+
+PoseGraphSummary PoseGraph::Optimize(const PoseGraphOptions& options) {
+  Validate(options);
+  const auto start = std::chrono::steady_clock::now();
+  PoseGraphSummary summary;
+  if (poses_.empty()) {
+    summary.converged = true;
+    summary.message = "no keyframes";
+    return summary;
+  }
+  const std::unique_ptr<Problem> graph = Build(options);
+  ceres::Solver::Summary first;  // kGraduated: the quadratic solution it starts from
+  ceres::Solve(SolverOptions(options), graph->problem.get(), &first);
+  summary.converged = first.termination_type == ceres::CONVERGENCE;
+  summary.iterations = int(first.iterations.size()) - 1;
+  summary.initial_cost = first.initial_cost;
+  summary.final_cost = first.final_cost;
+  summary.message = first.message;
+  if (options.loop_rejection == LoopRejection::kGraduated) Graduate(*graph, options, summary);
+
+  for (std::size_t k = 0; k < poses_.size(); ++k) {
+    poses_[k] = SE3d(SO3d::FromXyzw(graph->rotations[k].data()), graph->translations[k]);
+  }
+  if (options.loop_rejection != LoopRejection::kGraduated) {
+    const std::vector<double> norms = graph->LoopSquaredNorms();
+    const std::unique_ptr<ceres::LossFunction> loss(MakeLoss(options.loop_loss));
+    for (std::size_t l = 0; l < norms.size(); ++l) {
+      double rho[3] = {0.0, 1.0, 0.0};
+      if (loss) loss->Evaluate(norms[l], rho);
+      loop_weights_[l] = options.loop_rejection == LoopRejection::kSwitchable ? switches_[l] : rho[1];
+    }
+  }
+  summary.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace radargauss

@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Scan Context: a yaw-rotated, shifted and noisy copy of a place retrieves
+// that place among others, with the yaw within one sector, in each channel.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "radargauss/slam/scan_context.hpp"
+
+namespace radargauss {
+namespace {
+
+// A place: walls, poles and parked cars as point clusters with their own RCS.
+std::vector<RadarPoint> RandomPlace(std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::normal_distribution<double> noise;
+  std::vector<RadarPoint> points;
+  for (int object = 0; object < 40; ++object) {
+    const Eigen::Vector3d centre(60.0 * uniform(rng), 60.0 * uniform(rng), 0.0);
+    const Eigen::Vector3d extent(4.0 * std::abs(uniform(rng)) + 0.2, 4.0 * std::abs(uniform(rng)) + 0.2,
+                                 2.0 * std::abs(uniform(rng)) + 0.3);
+    const double rcs = 15.0 * uniform(rng);
+    for (int k = 0; k < 15; ++k) {
+      RadarPoint point;
+      point.position = centre + extent.cwiseProduct(Eigen::Vector3d(uniform(rng), uniform(rng), std::abs(uniform(rng))));
+      point.rcs = rcs + noise(rng);
+      points.push_back(point);
+    }
+  }
+  return points;
+}
+
+// The place seen from a frame turned by yaw and moved by `shift`: p_q = R^T (p - shift).
+std::vector<RadarPoint> SeenFrom(const std::vector<RadarPoint>& place, double yaw, const Eigen::Vector3d& shift,
+                                 std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  std::vector<RadarPoint> seen = place;
+  for (RadarPoint& point : seen) {
+    point.position = R.transpose() * (point.position - shift) + 0.05 * Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    point.rcs += noise(rng);
+  }
+  return seen;
+}
+
+double AngleBetween(double a, double b) { return std::abs(std::remainder(a - b, 2.0 * M_PI)); }
+
+TEST(ScanContext, RotatedCopyRetrievesThePlaceWithItsYaw) {
+  for (const ScanContextChannel channel :
+       {ScanContextChannel::kGeometric, ScanContextChannel::kRcs, ScanContextChannel::kBoth}) {
+    ScanContextOptions options;
+    options.channel = channel;
+    std::vector<ScanContext> places;
+    for (std::uint32_t seed = 1; seed <= 10; ++seed) places.push_back(MakeScanContext(RandomPlace(seed), options));
+    const double sector = 2.0 * M_PI / options.sectors;
+    for (const double yaw : {0.0, 0.3, 1.7, -2.5, 3.1}) {
+      const ScanContext query =
+          MakeScanContext(SeenFrom(RandomPlace(4), yaw, Eigen::Vector3d(0.4, -0.3, 0.0), 99), options);
+      int best = -1;
+      ScanContextMatch best_match;
+      for (int p = 0; p < int(places.size()); ++p) {
+        const ScanContextMatch match = CompareScanContexts(query, places[p], options);
+        if (best < 0 || match.distance < best_match.distance) {
+          best = p;
+          best_match = match;
+        }
+      }
+      EXPECT_EQ(best, 3) << "yaw " << yaw << ", channel " << int(channel);
+      EXPECT_LE(AngleBetween(best_match.yaw, yaw), sector) << "yaw " << yaw << ", channel " << int(channel);
+      EXPECT_LT((query.ring_key - places[3].ring_key).norm(), 0.35);
+    }
+  }
+}
+
+// A query turned by k sectors, without a shift: the yaw is k sectors and the
+// aligned distance small.
+TEST(ScanContext, ExactSectorTurnGivesItsShift) {
+  ScanContextOptions options;
+  const std::vector<RadarPoint> place = RandomPlace(5);
+  const ScanContext candidate = MakeScanContext(place, options);
+  const double sector = 2.0 * M_PI / options.sectors;
+  for (const int k : {1, 7, 30, 59}) {
+    const ScanContext query = MakeScanContext(SeenFrom(place, k * sector, Eigen::Vector3d::Zero(), 3), options);
+    const ScanContextMatch match = CompareScanContexts(query, candidate, options);
+    EXPECT_LE(AngleBetween(match.yaw, k * sector), sector) << k;
+    EXPECT_LT(match.distance, 0.1) << k;
+  }
+}
+
+TEST(ScanContext, EmptyAndInvalid) {
+  ScanContextOptions options;
+  const ScanContext empty = MakeScanContext({}, options);
+  EXPECT_EQ(empty.ring_key.sum(), 0.0);
+  EXPECT_EQ(CompareScanContexts(empty, MakeScanContext(RandomPlace(1), options), options).distance, 1.0);
+  options.sectors = 0;
+  EXPECT_THROW(MakeScanContext({}, options), std::invalid_argument);
+  ScanContextOptions other;
+  other.rings = 10;
+  EXPECT_THROW(CompareScanContexts(empty, MakeScanContext({}, other), ScanContextOptions{}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace radargauss

@@ -1,0 +1,207 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The pose graph: the relative-pose term's analytic twin against autodiff and
+// central differences; planted keyframe poses recovered from noisy odometry
+// and exact loops; a false loop against each loop loss.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include "cost_function_checks.hpp"
+#include "radargauss/residuals/relative_pose_residual.hpp"
+#include "radargauss/solvers/pose_graph.hpp"
+#include "test_util.hpp"
+
+namespace radargauss {
+namespace {
+
+using testing::RandomUnitVector;
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+
+SE3d RandomPose(std::mt19937& rng, double rotation, double translation) {
+  return SE3d(SO3d::Exp(rotation * RandomUnitVector(rng)), translation * RandomUnitVector(rng));
+}
+
+Matrix6 RandomSqrtInformation(std::mt19937& rng) {
+  std::uniform_real_distribution<double> diagonal(1.0, 20.0), off(-1.0, 1.0);
+  Matrix6 W = Matrix6::Zero();
+  for (int r = 0; r < 6; ++r) {
+    W(r, r) = diagonal(rng);
+    for (int c = r + 1; c < 6; ++c) W(r, c) = off(rng);
+  }
+  return W;
+}
+
+TEST(RelativePoseJacobians, AnalyticAutodiffNumeric) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 20; ++trial) {
+    const SE3d Ti = RandomPose(rng, 2.0, 20.0), Tj = RandomPose(rng, 2.0, 20.0);
+    const SE3d measured = Ti.Inverse() * Tj * RandomPose(rng, 0.3, 1.0);
+    const Matrix6 W = RandomSqrtInformation(rng);
+    const RelativePoseCostFunction analytic(measured, W);
+    const std::unique_ptr<ceres::CostFunction> autodiff(RelativePoseResidual::Create(measured, W));
+    Eigen::Vector4d qi = Ti.rotation().quaternion().coeffs(), qj = Tj.rotation().quaternion().coeffs();
+    Eigen::Vector3d ti = Ti.translation(), tj = Tj.translation();
+    const std::vector<double*> blocks = {qi.data(), ti.data(), qj.data(), tj.data()};
+    std::vector<Eigen::MatrixXd> ja, jd;
+    const Eigen::VectorXd ra = EvaluateWithJacobians(analytic, blocks, ja);
+    const Eigen::VectorXd rd = EvaluateWithJacobians(*autodiff, blocks, jd);
+    EXPECT_LT(Relative(ra, rd), 1e-12);
+    for (int b = 0; b < 4; ++b) {
+      EXPECT_LT(Relative(ja[b], jd[b]), 1e-8) << "block " << b;
+      EXPECT_LT(Relative(ja[b], NumericBlockJacobian(analytic, blocks, b)), 1e-5) << "block " << b;
+    }
+    // Zero at the measurement itself.
+    const RelativePoseCostFunction exact(Ti.Inverse() * Tj, W);
+    EXPECT_LT(EvaluateWithJacobians(exact, blocks, ja).norm(), 1e-9);
+  }
+}
+
+// A closed drive of keyframes 2 m apart on a 30 m circle that climbs and
+// pitches a little; revisit k + kLap of k closes the loop.
+constexpr int kLap = 48;
+std::vector<SE3d> PlantedKeyframes(int laps) {
+  std::vector<SE3d> poses;
+  for (int k = 0; k < laps * kLap; ++k) {
+    const double a = 2.0 * M_PI * k / kLap;
+    const Eigen::Vector3d t(30.0 * std::sin(a), 30.0 * (1.0 - std::cos(a)), 0.5 * std::sin(2.0 * a));
+    poses.emplace_back(SO3d::Exp(Eigen::Vector3d(0.0, 0.02 * std::cos(2.0 * a), a)), t);
+  }
+  return poses;
+}
+
+constexpr double kSigmaT = 0.05, kSigmaR = 0.01;  // odometry noise per edge (m, rad)
+
+Matrix6 OdometrySqrtInformation() {
+  Matrix6 W = Matrix6::Zero();
+  W.diagonal() << Eigen::Vector3d::Constant(1.0 / kSigmaT), Eigen::Vector3d::Constant(1.0 / kSigmaR);
+  return W;
+}
+
+// Odometry between consecutive keyframes with noise of std `noise_scale`
+// times (kSigmaT, kSigmaR) and a yaw bias per edge, the initial estimate its
+// composition, and exact loops between the laps every fourth keyframe.
+PoseGraph DriftedGraph(const std::vector<SE3d>& truth, std::uint32_t seed, double noise_scale = 1.0,
+                       double yaw_bias = 0.0) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise;
+  PoseGraph graph;
+  graph.AddKeyframe(truth[0]);
+  SE3d estimate = truth[0];
+  for (std::size_t k = 1; k < truth.size(); ++k) {
+    Eigen::Matrix<double, 6, 1> xi;
+    for (int i = 0; i < 6; ++i) xi[i] = noise_scale * (i < 3 ? kSigmaT : kSigmaR) * noise(rng);
+    const SE3d measured = truth[k - 1].Inverse() * truth[k] * SE3d::Exp(xi);
+    estimate = estimate * measured * SE3d(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, yaw_bias)), Eigen::Vector3d::Zero());
+    graph.AddKeyframe(estimate);
+    graph.AddOdometry(int(k) - 1, int(k), measured, OdometrySqrtInformation());
+  }
+  for (std::size_t k = kLap; k < truth.size(); k += 4) {
+    graph.AddLoop(int(k - kLap), int(k), truth[k - kLap].Inverse() * truth[k], OdometrySqrtInformation());
+  }
+  return graph;
+}
+
+double MaxTranslationError(const std::vector<SE3d>& estimate, const std::vector<SE3d>& truth) {
+  double worst = 0.0;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    worst = std::max(worst, (estimate[k].translation() - truth[k].translation()).norm());
+  }
+  return worst;
+}
+
+PoseGraphOptions Quadratic() {
+  PoseGraphOptions options;
+  options.loop_rejection = LoopRejection::kLoss;
+  options.loop_loss = {LossType::kTrivial, 1.0};
+  return options;
+}
+
+// Exact edges from an estimate 1 deg of yaw off per keyframe (tens of metres
+// off): the planted poses come back to 1e-6 m, with either Jacobian; noisy
+// odometry and exact loops: the loops take out most of the drift.
+TEST(PoseGraph, RecoversPlantedKeyframes) {
+  const std::vector<SE3d> truth = PlantedKeyframes(2);
+  for (const JacobianMode jacobians : {JacobianMode::kAnalytic, JacobianMode::kAutoDiff}) {
+    PoseGraph graph = DriftedGraph(truth, 7, 0.0, 1.0 * M_PI / 180.0);
+    EXPECT_GT(MaxTranslationError(graph.poses(), truth), 10.0);
+    PoseGraphOptions options = Quadratic();
+    options.jacobians = jacobians;
+    const PoseGraphSummary summary = graph.Optimize(options);
+    EXPECT_TRUE(summary.converged) << summary.message;
+    EXPECT_LT(MaxTranslationError(graph.poses(), truth), 1e-6);
+  }
+  PoseGraph noisy = DriftedGraph(truth, 7);
+  const double before = MaxTranslationError(noisy.poses(), truth);
+  noisy.Optimize(Quadratic());
+  EXPECT_LT(MaxTranslationError(noisy.poses(), truth), 0.3 * before) << "before " << before;
+}
+
+// A false loop (keyframes half a lap apart, 60 m, measured as 2 m apart)
+// wrecks the graph without a robust loss (58 m); each outlier-aware choice is
+// held to the quadratic solution without it (the best the true edges allow,
+// 1.2 m): within 2x (and 5 cm), with the false loop's weight below 0.05. DCS
+// at Phi = 100 and switches with sigma 0.1 (the defaults): at the literature's
+// Phi = 1 and sigma = 1 they drop the true loops too from the drifted start
+// (6.6 m, odometry alone); Huber only bounds the pull (3.1 m) and is held to
+// a tenth of the unrobust error.
+TEST(PoseGraph, FalseLoopAgainstEachLoopRejection) {
+  const std::vector<SE3d> truth = PlantedKeyframes(2);
+  PoseGraph reference = DriftedGraph(truth, 7);
+  reference.Optimize(Quadratic());
+  const double clean = MaxTranslationError(reference.poses(), truth);
+  struct Case {
+    const char* name;
+    LoopRejection rejection;
+    LossConfig loss;
+  };
+  const Case cases[] = {{"trivial", LoopRejection::kLoss, {LossType::kTrivial, 1.0}},
+                        {"huber", LoopRejection::kLoss, {LossType::kHuber, 1.0}},
+                        {"cauchy", LoopRejection::kLoss, {LossType::kCauchy, 1.0}},
+                        {"dcs", LoopRejection::kLoss, {LossType::kDcs, 10.0}},
+                        {"switchable", LoopRejection::kSwitchable, {LossType::kTrivial, 1.0}},
+                        {"graduated", LoopRejection::kGraduated, {LossType::kGemanMcClure, 3.0}}};
+  for (const Case& c : cases) {
+    PoseGraph graph = DriftedGraph(truth, 7);
+    const int false_loop = graph.AddLoop(10, 10 + kLap / 2, SE3d(SO3d(), Eigen::Vector3d(2.0, 0.0, 0.0)),
+                                         OdometrySqrtInformation());
+    PoseGraphOptions options;
+    options.loop_rejection = c.rejection;
+    options.loop_loss = c.loss;
+    const PoseGraphSummary summary = graph.Optimize(options);
+    const double error = MaxTranslationError(graph.poses(), truth);
+    std::printf("%-10s  max error %7.3f m (clean %.3f m), false loop weight %.3g, %d solves\n", c.name, error,
+                clean, graph.loop_weights()[false_loop], summary.solves);
+    if (c.loss.type == LossType::kTrivial && c.rejection == LoopRejection::kLoss) {
+      EXPECT_GT(error, 10.0) << c.name;  // wrecked: tens of metres
+    } else if (c.loss.type == LossType::kHuber) {
+      EXPECT_LT(error, 0.1 * 58.0) << c.name;
+    } else {
+      EXPECT_LT(graph.loop_weights()[false_loop], 0.05) << c.name;
+      EXPECT_LT(error, 2.0 * clean + 0.05) << c.name;
+    }
+  }
+}
+
+TEST(PoseGraph, RefusesBadEdgesAndOptions) {
+  PoseGraph graph;
+  graph.AddKeyframe(SE3d());
+  graph.AddKeyframe(SE3d());
+  EXPECT_THROW(graph.AddOdometry(0, 2, SE3d(), Matrix6::Identity()), std::invalid_argument);
+  EXPECT_THROW(graph.AddOdometry(1, 1, SE3d(), Matrix6::Identity()), std::invalid_argument);
+  EXPECT_THROW(graph.AddLoop(0, 1, SE3d(), Matrix6::Constant(NAN)), std::invalid_argument);
+  PoseGraphOptions options;
+  options.max_iterations = 0;
+  EXPECT_THROW(graph.Optimize(options), std::invalid_argument);
+  options = PoseGraphOptions{};
+  options.loop_loss.scale = -1.0;
+  EXPECT_THROW(graph.Optimize(options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace radargauss
