@@ -4,6 +4,8 @@
 // in every file that includes it (docs/design.md, "Build").
 #include <ceres/dynamic_autodiff_cost_function.h>
 
+#include <memory>
+
 #include "radargauss/residuals/geometric_residual.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
 #include "radargauss/residuals/relative_pose_residual.hpp"
@@ -14,21 +16,21 @@ namespace radargauss {
 
 ceres::CostFunction* GeometricResidual::Create(const Eigen::Vector3d& point_radar, const Eigen::Vector3d& mean,
                                                const Eigen::Matrix3d& sqrt_information_t) {
-  return new AutoDiff(new GeometricResidual(point_radar, mean, sqrt_information_t));
+  return Create(std::make_unique<GeometricResidual>(point_radar, mean, sqrt_information_t));
 }
 
 ceres::CostFunction* GeometricResidual::Create(std::unique_ptr<GeometricResidual> functor) {
   return new AutoDiff(functor.release());
 }
 
-ceres::CostFunction* RcsResidual::Create(const RcsTerm& term) { return new AutoDiff(new RcsResidual(term)); }
+ceres::CostFunction* RcsResidual::Create(const RcsTerm& term) { return Create(std::make_unique<RcsResidual>(term)); }
 
 ceres::CostFunction* RcsResidual::Create(std::unique_ptr<RcsResidual> functor) {
   return new AutoDiff(functor.release());
 }
 
 ceres::CostFunction* RcsRotationResidual::Create(const RcsTerm& term, const Eigen::Vector3d& translation) {
-  return new AutoDiff(new RcsRotationResidual(term, translation));
+  return Create(std::make_unique<RcsRotationResidual>(term, translation));
 }
 
 ceres::CostFunction* RcsRotationResidual::Create(std::unique_ptr<RcsRotationResidual> functor) {

@@ -85,10 +85,14 @@ void Validate(const PoseGraphOptions& options) {
   if (!(options.graduation_factor > 1.0)) throw std::invalid_argument("pose graph: graduation_factor must be > 1");
 }
 
+bool Finite(const SE3d& pose) {
+  return pose.translation().allFinite() && pose.rotation().quaternion().coeffs().allFinite();
+}
+
 }  // namespace
 
 int PoseGraph::AddKeyframe(const SE3d& pose) {
-  if (!pose.translation().allFinite() || !pose.rotation().quaternion().coeffs().allFinite()) {
+  if (!Finite(pose)) {
     throw std::invalid_argument("pose graph: keyframe pose is not finite");
   }
   poses_.push_back(pose);
@@ -101,8 +105,7 @@ void PoseGraph::Check(int from, int to, const SE3d& measured, const Eigen::Matri
     throw std::invalid_argument("pose graph: edge " + std::to_string(from) + " -> " + std::to_string(to) +
                                 " needs two different keyframes of 0.." + std::to_string(n - 1));
   }
-  if (!measured.translation().allFinite() || !measured.rotation().quaternion().coeffs().allFinite() ||
-      !W.allFinite()) {
+  if (!Finite(measured) || !W.allFinite()) {
     throw std::invalid_argument("pose graph: edge measurement or information is not finite");
   }
 }
