@@ -13,10 +13,22 @@
 #include <string>
 
 #include "radargauss/lie/manifold.hpp"
+#include "radargauss/names.hpp"
 #include "radargauss/residuals/relative_pose_residual.hpp"
 #include "radargauss/residuals/robust_loss.hpp"
 
 namespace radargauss {
+
+namespace {
+constexpr NamedValue<LoopRejection> kLoopRejectionNames[] = {
+    {LoopRejection::kLoss, "loss"}, {LoopRejection::kSwitchable, "switchable"}, {LoopRejection::kGraduated, "graduated"}};
+}  // namespace
+
+std::string ToString(LoopRejection rejection) { return NameOf(kLoopRejectionNames, rejection); }
+LoopRejection LoopRejectionFromString(const std::string& name) {
+  return ValueNamed(kLoopRejectionNames, name, "loop rejection");
+}
+std::vector<std::string> LoopRejectionNames() { return NamesOf(kLoopRejectionNames); }
 
 namespace {
 

@@ -26,6 +26,9 @@ enum class LoopRejection {
   kSwitchable,  // switchable constraints (Suenderhauf and Protzel 2012)
   kGraduated,   // graduated non-convexity to Geman-McClure of scale loop_loss.scale (Yang et al. 2020)
 };
+std::string ToString(LoopRejection rejection);                        // "loss", "switchable", "graduated"
+LoopRejection LoopRejectionFromString(const std::string& name);       // throws std::invalid_argument
+std::vector<std::string> LoopRejectionNames();
 
 struct PoseGraphOptions {
   LoopRejection loop_rejection = LoopRejection::kGraduated;

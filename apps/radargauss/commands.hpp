@@ -28,6 +28,7 @@ Subcommand AddLocalize(CLI::App& parent);
 Subcommand AddEvaluate(CLI::App& parent);
 Subcommand AddRefine(CLI::App& parent);
 Subcommand AddOdometry(CLI::App& parent);
+Subcommand AddSlam(CLI::App& parent);
 
 // The flags every subcommand that reads a sequence shares; the trajectory
 // that gives the scans their poses is `poses_flag` (refine: --poses).

@@ -167,6 +167,7 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& scan) {
   const PoseEstimate estimate = EstimatePose(scan, prediction, velocity);
   const bool keyframe = IsKeyframe(estimate.pose, velocity);
   if (keyframe) InsertKeyframe(scan, velocity.static_points, estimate.pose);
+  last_static_points_ = velocity.static_points;
   OdometryStep step = StepOf(scan, prediction, velocity, estimate, keyframe);
   step.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   // Counted outside the step's time: the map changes on keyframes only.

@@ -49,8 +49,9 @@ ScanContext MakeScanContext(const std::vector<RadarPoint>& points, const ScanCon
 
 namespace {
 
-// Mean cosine distance of the columns occupied in both, query column k
-// against candidate column k + shift; 1 when none are.
+// Mean cosine distance over the columns occupied in either, query column k
+// against candidate column k + shift; a column occupied in one only counts 1,
+// so that sparse descriptors do not match on the few columns they share.
 double ShiftedDistance(const Eigen::MatrixXd& query, const Eigen::MatrixXd& candidate, int shift) {
   const int sectors = int(query.cols());
   double sum = 0.0;
@@ -58,9 +59,9 @@ double ShiftedDistance(const Eigen::MatrixXd& query, const Eigen::MatrixXd& cand
   for (int k = 0; k < sectors; ++k) {
     const auto a = query.col(k);
     const auto b = candidate.col((k + shift) % sectors);
-    const double norms = a.norm() * b.norm();
-    if (norms <= 0.0) continue;
-    sum += 1.0 - a.dot(b) / norms;
+    const double na = a.norm(), nb = b.norm();
+    if (na <= 0.0 && nb <= 0.0) continue;
+    sum += na > 0.0 && nb > 0.0 ? 1.0 - a.dot(b) / (na * nb) : 1.0;
     ++count;
   }
   return count > 0 ? sum / count : 1.0;

@@ -120,6 +120,9 @@ class RadarOdometry {
   const std::vector<OdometryStep>& steps() const { return steps_; }
   Trajectory trajectory() const;
   const LocalMap& map() const { return map_; }
+  // The indices of the last registered scan's static points (Doppler inliers;
+  // every point of a scan without Doppler; none when the prediction stood in).
+  const std::vector<std::size_t>& last_static_points() const { return last_static_points_; }
   const OdometryOptions& options() const { return options_; }
   // How many matchers the factory has made: one per map version matched against.
   std::size_t matchers_made() const { return matchers_made_; }
@@ -192,6 +195,7 @@ class RadarOdometry {
   std::optional<MotionState> state_;
   std::vector<GyroSample> gyro_;
   SE3d last_keyframe_;
+  std::vector<std::size_t> last_static_points_;
   std::size_t map_bytes_ = 0;  // LocalMap::MemoryBytes after the last keyframe
 };
 

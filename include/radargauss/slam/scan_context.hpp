@@ -42,7 +42,7 @@ struct ScanContext {
 ScanContext MakeScanContext(const std::vector<RadarPoint>& points, const ScanContextOptions& options);
 
 struct ScanContextMatch {
-  double distance = 1.0;  // mean cosine distance of the aligned columns, 0 (same) .. 1
+  double distance = 1.0;  // mean cosine distance of the aligned columns (1 where one is empty), 0 (same) .. 1
   int shift = 0;          // query sector k matches candidate sector k + shift
   double yaw = 0.0;       // rad, (-pi, pi]: the query frame's yaw in the candidate's
 };

@@ -1,0 +1,195 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "odometry_settings.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "radargauss/error.hpp"
+#include "radargauss/evaluation.hpp"
+#include "radargauss/io/rosbag.hpp"
+#include "radargauss/names.hpp"
+#ifdef RADARGAUSS_HAVE_PCL
+#include "radargauss/peers/pcl_peers.hpp"
+#endif
+
+namespace radargauss::cli {
+
+namespace {
+
+// The local map's flags (docs/design.md, "Odometry").
+void AddLocalMapOptions(CLI::App* app, OdometrySettings& s) {
+  OdometryOptions& o = s.odometry;
+  app->add_option("--active-radius", o.map.active_radius, "Radius of the active map around the radar (m)")
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--region", o.map.region, "Edge of the map regions fitted together (m)")
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--region-capacity", o.map.region_capacity, "Points a region keeps (the newest)")
+      ->check(InRange(4, 1000000))
+      ->capture_default_str();
+  app->add_option("--refit-growth", o.map.refit_growth, "Refit a region once its new points reach this share")
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--points-per-gaussian", o.map.gaussians.points_per_gaussian, "K = round(N_downsampled / this)")
+      ->check(InRange(1.0, 1e6))
+      ->capture_default_str();
+  app->add_option("--min-std", o.map.gaussians.min_std, "Minimum principal std of a Gaussian (m)")
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--coarse-levels", s.coarse_levels, "Coarse levels: merged or inflated")
+      ->check(CLI::IsMember(CoarseLevelsNames()))
+      ->capture_default_str();
+  app->add_option("--coarse-sigmas", o.map.matching.inflation,
+                  "Blur sigma_k of the coarse levels (m), coarse first; 0: the exact map alone")
+      ->expected(1, 8)
+      ->check(InRange(0.0, kMaxCoarseSigma))
+      ->capture_default_str();
+  app->add_option("--index-cell", o.map.matching.index_cell, "Cell of the active map's spatial index (m)")
+      ->check(InRange(0.0, kMaxIndexCell, true))
+      ->capture_default_str();
+}
+
+}  // namespace
+
+// The matcher of a map version: the Gaussian solvers, or a PCL peer over the
+// active map's points (RadarOdometry makes one per map version).
+MatcherFactory MatcherOf(const std::string& matcher) {
+  if (matcher == "gaussians") {
+    return [](const LocalMap&, const MatchOptions& match) {
+      return std::shared_ptr<const ScanMatcher>(MakeScanMatcher(match));
+    };
+  }
+#ifdef RADARGAUSS_HAVE_PCL
+  const PclMethod method = matcher == "pcl-ndt" ? PclMethod::kNdt : PclMethod::kGicp;
+  return [method](const LocalMap& map, const MatchOptions&) {
+    return std::shared_ptr<const ScanMatcher>(std::make_shared<PclPeerMatcher>(method, map.ActivePoints()));
+  };
+#else
+  throw DataError("--matcher " + matcher + " needs radargauss built with RADARGAUSS_WITH_PCL");
+#endif
+}
+
+OdometryOptions Resolved(const OdometrySettings& s) {
+  OdometryOptions o = s.odometry;
+  o.match.solver = SolverKindFromString(s.solver);
+  o.match.matching.geometric_loss.type = LossTypeFromString(s.loss);
+  o.map.rcs.incidence = IncidenceModelFromString(s.incidence);
+  o.map.matching.coarse = CoarseLevelsFromString(s.coarse_levels);
+  o.rotation_rate_std_deg = Eigen::Vector3d(s.rotation_rate_std[0], s.rotation_rate_std[1], s.rotation_rate_std[2]);
+  if (o.map.matching.inflation == std::vector<double>{0.0}) o.map.matching.inflation.clear();  // the exact map alone
+  return o;
+}
+
+// R_radar_imu from --imu-rotation, checked whether or not an IMU is read.
+Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw) {
+  const Eigen::Quaterniond q(xyzw[3], xyzw[0], xyzw[1], xyzw[2]);
+  if (!(std::abs(q.norm() - 1.0) < kTumQuaternionNormTolerance)) {
+    char norm[32];
+    std::snprintf(norm, sizeof(norm), "%g", q.norm());
+    throw DataError(std::string("--imu-rotation: not a unit quaternion (x y z w), its norm is ") + norm);
+  }
+  return q.normalized().toRotationMatrix();
+}
+
+// The bag's gyro rates turned into the radar frame by q_radar_imu.
+std::vector<GyroSample> GyroOf(const OdometrySettings& s) {
+  if (s.sequence.bag.empty()) throw DataError("--imu-topic needs --bag");
+  const Eigen::Matrix3d R = ImuRotation(s.imu_rotation);
+  std::vector<GyroSample> samples;
+  for (const ImuSample& imu : ReadBagImu(s.sequence.bag, s.imu_topic, s.imu_stamps == "record")) {
+    samples.push_back({imu.stamp, R * imu.angular_velocity});
+  }
+  return samples;
+}
+
+// Gyro samples that cover none of the scans' time span are a clock mismatch, not data.
+void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence) {
+  const double first = sequence.scans.front().timestamp, last = sequence.scans.back().timestamp;
+  if (gyro.back().stamp < first || gyro.front().stamp > last) {
+    throw DataError("the IMU's stamps (" + std::to_string(gyro.front().stamp) + " to " +
+                    std::to_string(gyro.back().stamp) + " s) do not overlap the scans' (" + std::to_string(first) +
+                    " to " + std::to_string(last) + " s); try --imu-stamps record");
+  }
+}
+
+// The evaluation pairs scans with reference poses by time: a reference of
+// another run or clock pairs with none, which is said before the run.
+void CheckReferenceCovers(const Trajectory& reference, const Sequence& sequence, const std::string& path) {
+  const double tolerance = EvaluationOptions().time_tolerance;
+  std::size_t covered = 0;
+  for (const RadarScan& scan : sequence.scans) {
+    covered += scan.timestamp >= reference.StartTime() - tolerance && scan.timestamp <= reference.EndTime() + tolerance;
+  }
+  if (covered < 3) {
+    char spans[120];
+    std::snprintf(spans, sizeof(spans), "%.3f to %.3f s; the scans': %.3f to %.3f s", reference.StartTime(),
+                  reference.EndTime(), sequence.scans.front().timestamp, sequence.scans.back().timestamp);
+    throw FileError(path, "--gt: " + std::to_string(covered) + " of the " + std::to_string(sequence.scans.size()) +
+                              " scans lie in the reference's time span (" + spans + ")");
+  }
+}
+
+void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
+  OdometryOptions& o = s.odometry;
+  app->add_option("--solver", s.solver, "Scan matcher: gn (own Gauss-Newton), gn-autodiff, ceres, ceres-dogleg, mh-gn")
+      ->check(CLI::IsMember(ScanMatcherNames()))
+      ->capture_default_str();
+  app->add_option("--matcher", s.matcher,
+                  "gaussians (the Gaussian-RCS map and --solver), or pcl-ndt / pcl-gicp on the active map's points "
+                  "(no w_rcs, no velocity term; needs PCL)")
+      ->check(CLI::IsMember({"gaussians", "pcl-ndt", "pcl-gicp"}))
+      ->capture_default_str();
+  app->add_option("--w-rcs", o.match.matching.w_rcs, "Weight w_rcs of eq. 2 (0..1)")
+      ->check(InRange(0.0, 1.0))
+      ->capture_default_str();
+  app->add_option("--loss", s.loss, "Geometric robust loss")->check(CLI::IsMember(LossNames()))->capture_default_str();
+  app->add_option("--loss-scale", o.match.matching.geometric_loss.scale, "Scale of the geometric loss")
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--incidence", s.incidence, "Incidence vector of the RCS models: offset or view")
+      ->check(CLI::IsMember(IncidenceModelNames()))
+      ->capture_default_str();
+  app->add_option("--degree", o.map.rcs.max_degree, "SH degree of the RCS models (0..3)")
+      ->check(InRange(0, kMaxShDegree))
+      ->capture_default_str();
+  app->add_option("--velocity-weight", o.velocity_weight, "Weight of the Doppler velocity term (0: off)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  app->add_option("--velocity-floor", o.velocity_floor, "Std of the velocity term's floor Q (m)")
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--rotation-weight", o.rotation_weight, "Weight of the rotation term (0: off)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  app->add_option("--rotation-rate-std", s.rotation_rate_std,
+                  "Rotation term: change of the rate between scans about x y z (roll pitch yaw, deg/s)")
+      ->expected(3)
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--gate-sigmas", o.gate_sigmas, "Doppler gate around the predicted velocity (sigmas)")
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--acceleration-std", o.acceleration_std, "Process noise of the velocity (m/s^2)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  app->add_option("--min-gate", o.min_gate, "Smallest Doppler gate (m/s)")->check(Positive())->capture_default_str();
+  app->add_option("--keyframe-distance", o.keyframe_distance, "A scan enters the map after this distance (m) ...")
+      ->check(NonNegative())
+      ->capture_default_str();
+  app->add_option("--keyframe-angle", o.keyframe_angle_deg, "... or this rotation (deg) since the last keyframe")
+      ->check(NonNegative())
+      ->capture_default_str();
+  AddLocalMapOptions(app, s);
+  app->add_option("--seed", o.ego_velocity.seed, "Seed of the Doppler RANSAC")->capture_default_str();
+  app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
+  app->add_option("--imu-stamps", s.imu_stamps, "Stamp the IMU by its header or by the bag's record time")
+      ->check(CLI::IsMember({"header", "record"}))
+      ->capture_default_str();
+  app->add_option("--imu-rotation", s.imu_rotation, "q_radar_imu as x y z w (rotates gyro rates into the radar frame)")
+      ->expected(4)
+      ->capture_default_str();
+  app->add_option("--max-scans", s.max_scans, "Only the first N scans (0: all)")->capture_default_str();
+}
+
+}  // namespace radargauss::cli

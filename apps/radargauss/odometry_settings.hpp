@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The flags of odometry and slam: the odometry's options, the matcher, the
+// IMU, and the checks of the reference and the gyro against the sequence.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/trajectory.hpp"
+
+namespace radargauss::cli {
+
+inline std::vector<double> ToVector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+struct OdometrySettings {
+  SequenceOptions sequence;  // ground_truth: the reference, for evaluation only
+  OdometryOptions odometry;
+  std::string out;
+  std::string solver = "gn";
+  std::string loss = "trivial";
+  std::string incidence = "offset";
+  std::string coarse_levels = ToString(MatchingMapOptions().coarse);
+  std::string imu_topic;
+  std::string imu_stamps = "header";
+  std::vector<double> imu_rotation = {0, 0, 0, 1};  // q_radar_imu (x y z w)
+  std::vector<double> rotation_rate_std = ToVector(OdometryOptions().rotation_rate_std_deg);  // deg/s
+  std::size_t max_scans = 0;
+  std::string matcher = "gaussians";  // or a PCL peer
+};
+
+// The matcher of a map version: the Gaussian solvers, or a PCL peer.
+MatcherFactory MatcherOf(const std::string& matcher);
+OdometryOptions Resolved(const OdometrySettings& s);
+// R_radar_imu from --imu-rotation, checked whether or not an IMU is read.
+Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw);
+// The bag's gyro rates turned into the radar frame by q_radar_imu.
+std::vector<GyroSample> GyroOf(const OdometrySettings& s);
+// Gyro samples that cover none of the scans' time span are a clock mismatch.
+void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence);
+// Throws FileError when fewer than 3 scans lie in the reference's time span.
+void CheckReferenceCovers(const Trajectory& reference, const Sequence& sequence, const std::string& path);
+// Every flag of OdometrySettings.
+void AddOdometryOptions(CLI::App* app, OdometrySettings& s);
+
+}  // namespace radargauss::cli

@@ -1,0 +1,154 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// radargauss slam: radar odometry with loop closure on a pose graph and one
+// Gaussian-RCS map of the place from the optimised trajectory
+// (docs/design.md, "SLAM"), evaluated against a reference when one is given.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "commands.hpp"
+#include "odometry_settings.hpp"
+#include "radargauss/atomic_file.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/evaluation.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/progress.hpp"
+#include "radargauss/radargauss.hpp"
+#include "radargauss/slam/radar_slam.hpp"
+
+namespace radargauss::cli {
+
+namespace {
+
+struct SlamSettings {
+  OdometrySettings odometry;
+  SlamOptions slam;
+  std::string descriptor = ToString(SlamOptions().descriptor);
+  std::string channel = "both";
+  std::string loop_rejection = ToString(PoseGraphOptions().loop_rejection);
+  std::string loop_loss = ToString(PoseGraphOptions().loop_loss.type);
+};
+
+SlamOptions Resolved(const SlamSettings& s) {
+  if (s.odometry.matcher != "gaussians") throw DataError("slam: --matcher must be gaussians");
+  SlamOptions o = s.slam;
+  o.odometry = Resolved(s.odometry);
+  o.descriptor = PlaceDescriptorKindFromString(s.descriptor);
+  o.scan_context.channel = s.channel == "geometric" ? ScanContextChannel::kGeometric
+                           : s.channel == "rcs"     ? ScanContextChannel::kRcs
+                                                    : ScanContextChannel::kBoth;
+  o.graph.loop_rejection = LoopRejectionFromString(s.loop_rejection);
+  o.graph.loop_loss.type = LossTypeFromString(s.loop_loss);
+  return o;
+}
+
+// The map of the place: build-map's estimator with the odometry map's
+// Gaussian and RCS options over every scan at its optimised pose.
+GaussianMap PlaceMap(const Sequence& sequence, const RadarSlam& slam) {
+  MapOptions options;
+  options.cloud.ego_velocity = slam.options().odometry.ego_velocity;
+  options.gaussians = slam.options().odometry.map.gaussians;
+  options.rcs = slam.options().odometry.map.rcs;
+  return BuildMap(sequence.scans, slam.Poses(), options);
+}
+
+int RunSlam(const SlamSettings& s) {
+  const SlamOptions options = Resolved(s);
+  ValidateOptions(options);
+  SequenceOptions sequence_options = s.odometry.sequence;
+  sequence_options.ground_truth.clear();
+  Sequence sequence = LoadSequence(sequence_options);
+  if (s.odometry.max_scans > 0 && sequence.scans.size() > s.odometry.max_scans) {
+    sequence.scans.resize(s.odometry.max_scans);
+  }
+  if (sequence.scans.empty()) throw DataError("the sequence has no scans");
+  CheckRcsWeights(sequence, {options.odometry.match.matching.w_rcs});
+  std::optional<Trajectory> reference;
+  const SequenceOptions& given = s.odometry.sequence;
+  if (!given.ground_truth.empty()) {
+    reference = ReadRadarTrajectory(given.ground_truth, ResolveExtrinsic(given.extrinsic, given.ground_truth));
+    CheckReferenceCovers(*reference, sequence, given.ground_truth);
+  }
+  StagedFolder folder(s.odometry.out);
+  RadarSlam slam(options);
+  ProgressBar bar;
+  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
+    try {
+      slam.Register(sequence.scans[k]);
+    } catch (const DataError& e) {
+      throw DataError(sequence.scan_sources[k] + ": " + e.what());
+    }
+    if (k % 16 == 0) bar.Update("slam", k, sequence.scans.size());
+  }
+  slam.Finish();
+  bar.Update("slam", sequence.scans.size(), sequence.scans.size());
+  bar.Finish();
+  const GaussianMap map = PlaceMap(sequence, slam);
+  const std::string out = folder.path();
+  WriteOdometry((std::filesystem::path(out) / "odometry").string(), slam.odometry());
+  WriteSlam(out, slam);
+  WriteMap((std::filesystem::path(out) / "map.rgm").string(), map);
+  ExportPly((std::filesystem::path(out) / "map.ply").string(), map);
+  std::string tables;
+  if (reference) {
+    WriteEvaluation((std::filesystem::path(out) / "odometry").string(),
+                    EvaluateTrajectory(slam.odometry().trajectory(), *reference));
+    tables = WriteEvaluation(out, EvaluateTrajectory(slam.trajectory(), *reference));
+  }
+  folder.Commit();
+  const SlamSummary summary = Summarise(slam);
+  std::printf("slam: %zu scans, %zu keyframes, %zu candidates compared, %zu verified, %zu loops; place "
+              "recognition %.2f ms per keyframe (median); map of %zu Gaussians\n",
+              sequence.scans.size(), summary.keyframes, summary.compared, summary.verified, summary.loops,
+              summary.describe_ms + summary.search_ms, map.gaussians.size());
+  std::printf("%s", tables.c_str());
+  std::printf("wrote %s (slam.tum, keyframes.csv, loops.csv, slam.json, map.rgm, map.ply, odometry/%s)\n",
+              s.odometry.out.c_str(), reference ? ", evaluation.json, evaluation.md" : "");
+  return 0;
+}
+
+void AddSlamOptions(CLI::App* app, SlamSettings& s) {
+  SlamOptions& o = s.slam;
+  app->add_option("--submap-distance", o.submap_distance, "A keyframe every this many metres driven")
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--descriptor", s.descriptor, "Place descriptor: scan-context or radon")
+      ->check(CLI::IsMember(PlaceDescriptorKindNames()))
+      ->capture_default_str();
+  app->add_option("--channel", s.channel, "Scan Context channels: geometric, rcs or both")
+      ->check(CLI::IsMember({"geometric", "rcs", "both"}))
+      ->capture_default_str();
+  app->add_option("--min-loop-path", o.min_loop_path, "Metres driven between a loop's keyframes at least")
+      ->check(NonNegative())
+      ->capture_default_str();
+  app->add_option("--candidates", o.candidates, "Keyframes compared per query (nearest keys)")
+      ->check(InRange(1, 1000))
+      ->capture_default_str();
+  app->add_option("--max-descriptor-distance", o.max_descriptor_distance, "Compared keyframes farther are not verified")
+      ->check(InRange(0.0, 1.0))
+      ->capture_default_str();
+  app->add_option("--loop-rejection", s.loop_rejection, "Loop edges: loss, switchable or graduated")
+      ->check(CLI::IsMember(LoopRejectionNames()))
+      ->capture_default_str();
+  app->add_option("--loop-loss", s.loop_loss, "Loss of the loop edges (loop rejection 'loss'; graduated: its scale)")
+      ->check(CLI::IsMember(LossNames()))
+      ->capture_default_str();
+  app->add_option("--loop-loss-scale", o.graph.loop_loss.scale, "Scale of the loop loss")
+      ->check(Positive())
+      ->capture_default_str();
+}
+
+}  // namespace
+
+Subcommand AddSlam(CLI::App& parent) {
+  auto s = std::make_shared<SlamSettings>();
+  CLI::App* app = parent.add_subcommand("slam", "Radar SLAM: odometry, loop closure, one map of the place");
+  AddSequenceOptions(app, s->odometry.sequence, "--gt", "Reference trajectory (TUM), for the evaluation only");
+  app->add_option("--out", s->odometry.out, "Output folder")->required();
+  AddOdometryOptions(app, s->odometry);
+  AddSlamOptions(app, *s);
+  return {app, [s] { return RunSlam(*s); }};
+}
+
+}  // namespace radargauss::cli

@@ -1,0 +1,82 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Verification of a loop candidate (docs/design.md, "Loop verification"):
+// the query keyframe's submap rotated by the descriptor's yaw and shifted in
+// bird's eye view to the candidate's best overlap, then matched against the
+// candidate's Gaussians by the multi-hypothesis Gauss-Newton; accepted on
+// fitness, on the information matrix and on consistency with the graph.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "radargauss/lie/se3.hpp"
+#include "radargauss/map/builder.hpp"
+#include "radargauss/solvers/factory.hpp"
+#include "radargauss/types.hpp"
+
+namespace radargauss {
+
+// The match of a verification: multi-hypothesis Gauss-Newton, 2 m and 0.1 rad
+// apart (the descriptor's yaw is a sector wide), eq. 2's geometric term.
+inline MatchOptions LoopMatchOptions() {
+  MatchOptions options;
+  options.solver = SolverKind::kMultiHypothesis;
+  options.hypotheses = {13, 2.0, 0.1};
+  return options;
+}
+
+struct LoopVerificationOptions {
+  double bev_cell = 1.0;     // m: cells of the bird's-eye alignment
+  double bev_search = 12.0;  // m: translations tried around the keyframes' origins
+  MatchOptions match = LoopMatchOptions();  // geometric: w_rcs 0
+  GaussianMapOptions gaussians;             // the candidate submap's Gaussians (build-map's estimator)
+  double min_associated = 0.5;  // share of the query's points within the gate
+  double max_cost = 6.0;        // eq. 2's f (mean squared Mahalanobis distance within the gate) at the end
+  // The match's marginal stds (from N_geo times its information) may not exceed these.
+  double max_translation_std = 0.2;  // m
+  double max_rotation_std_deg = 1.0;
+  // Consistency with the graph: the loop may move the query from its current
+  // estimate by at most max(min_drift, drift * path) metres and
+  // max(min_drift_deg, drift_deg * path) degrees, path the distance driven in
+  // between along the graph (accepted loops crossed for free).
+  double drift = 0.05;
+  double min_drift = 5.0;          // m
+  double drift_deg = 0.05;         // deg per m
+  double min_drift_deg = 10.0;
+  // Added to the match's covariance: what the submaps' own errors leave.
+  double translation_floor_std = 0.1;  // m
+  double rotation_floor_std_deg = 0.5;
+};
+
+// Throws std::invalid_argument naming the bad option.
+void ValidateOptions(const LoopVerificationOptions& options);
+
+struct LoopCheck {
+  bool accepted = false;
+  std::string reason;  // why not; empty when accepted
+  SE3d relative;       // the match: candidate frame from query frame
+  double overlap = 0.0;     // share of the query's bird's-eye cells on the candidate's after the shift
+  double associated = 0.0;  // share of the query's points
+  double cost = 0.0;
+  double translation_std = 0.0, rotation_std_deg = 0.0;
+  double correction = 0.0, correction_deg = 0.0;  // against the graph's estimate
+  Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Zero();  // of the relative-pose term
+};
+
+// The translation (x, y) that best overlaps the bird's-eye cells of `query`
+// (already in the candidate's orientation) with those of `candidate`,
+// searched on the cell grid within +/- search; and the share of query cells
+// that overlap there.
+std::pair<Eigen::Vector2d, double> AlignBirdsEye(const std::vector<Eigen::Vector3d>& query,
+                                                 const std::vector<Eigen::Vector3d>& candidate, double cell,
+                                                 double search);
+
+// Checks the loop from `query` (points in its keyframe's frame) to
+// `candidate` at the descriptor's `yaw`; `expected` is the graph's current
+// candidate-from-query pose and `path` the metres driven between them.
+LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate, double yaw,
+                     const SE3d& expected, double path, const LoopVerificationOptions& options);
+
+}  // namespace radargauss

@@ -1,0 +1,127 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Radar SLAM (docs/design.md, "SLAM"): radar odometry as the front end;
+// every submap_distance metres a keyframe whose submap holds the static
+// points of the scans until the next, in its own frame. A closed submap is
+// described (Scan Context or the Radon descriptor), its nearest keyframes by
+// the yaw-invariant key farther back than min_loop_path are compared and
+// verified (slam/loop_verification.hpp), and an accepted loop enters the
+// pose graph, which is optimised again from its current estimate. Each scan
+// follows its keyframe.
+//
+//   RadarSlam slam(options);
+//   for (const RadarScan& scan : sequence.scans) slam.Register(scan);
+//   slam.Finish();
+//   WriteTum(path, slam.trajectory());
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/slam/loop_verification.hpp"
+#include "radargauss/slam/radon_descriptor.hpp"
+#include "radargauss/slam/scan_context.hpp"
+#include "radargauss/solvers/pose_graph.hpp"
+
+namespace radargauss {
+
+enum class PlaceDescriptorKind { kScanContext, kRadon };
+std::string ToString(PlaceDescriptorKind kind);                       // "scan-context", "radon"
+PlaceDescriptorKind PlaceDescriptorKindFromString(const std::string& name);  // throws std::invalid_argument
+std::vector<std::string> PlaceDescriptorKindNames();
+
+struct SlamOptions {
+  OdometryOptions odometry;
+  double submap_distance = 10.0;  // m driven per keyframe
+  double submap_voxel = 0.25;     // m: a submap keeps the first point of each voxel
+  PlaceDescriptorKind descriptor = PlaceDescriptorKind::kScanContext;
+  ScanContextOptions scan_context;
+  RadonOptions radon;
+  double min_loop_path = 150.0;          // m driven between a loop's keyframes (the active map closes shorter ones)
+  int candidates = 5;                    // keyframes compared per query, nearest by key
+  double max_descriptor_distance = 0.4;  // compared keyframes farther are not verified
+  LoopVerificationOptions verification;
+  PoseGraphOptions graph;
+  // The odometry edges' stds: floor plus drift per metre driven between keyframes.
+  double odometry_translation_std = 0.05;  // m
+  double odometry_drift = 0.02;            // m per m
+  double odometry_rotation_std_deg = 0.1;
+  double odometry_drift_deg = 0.02;        // deg per m
+};
+
+// Throws std::invalid_argument naming the bad option.
+void ValidateOptions(const SlamOptions& options);
+
+struct Keyframe {
+  std::size_t scan = 0;  // the scan that opened it
+  double stamp = 0.0;
+  SE3d odometry_pose;    // the odometry's T_world_radar at that scan
+  double path = 0.0;     // m driven to it
+  std::vector<RadarPoint> points;  // its submap, in its frame (closed keyframes)
+  ScanContext scan_context;        // the selected descriptor's
+  RadonDescriptor radon;
+  double describe_ms = 0.0, search_ms = 0.0;  // place recognition's time
+};
+
+// A compared pair: the descriptor's verdict, then the verification's.
+struct LoopCandidate {
+  int query = 0, candidate = 0;  // keyframes
+  double distance = 1.0;         // the descriptor's
+  double yaw = 0.0;              // rad: the descriptor's, of the query in the candidate
+  bool verified = false;         // passed to verification
+  LoopCheck check;               // check.accepted: in the graph
+};
+
+class RadarSlam {
+ public:
+  explicit RadarSlam(const SlamOptions& options = {});
+
+  // As RadarOdometry::Register; a keyframe that closes is described and searched.
+  const OdometryStep& Register(const RadarScan& scan);
+  // Closes the last keyframe (described and searched).
+  void Finish();
+
+  const RadarOdometry& odometry() const { return odometry_; }
+  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  const std::vector<LoopCandidate>& candidates() const { return candidates_; }
+  const PoseGraph& graph() const { return graph_; }
+  const SlamOptions& options() const { return options_; }
+  std::size_t loops() const;  // accepted
+  // T_world_radar of every scan: its keyframe's optimised pose times the odometry since.
+  std::vector<SE3d> Poses() const;
+  Trajectory trajectory() const;
+
+ private:
+  void OpenKeyframe(std::size_t scan, const SE3d& pose, double stamp);
+  void CloseKeyframe();
+  void SearchLoops(int query);
+  LoopCandidate Verify(int query, int candidate, double distance, double yaw) const;
+  // The metres driven between two keyframes along the graph's odometry edges,
+  // loop edges crossed for free: how far the graph's estimate may have drifted.
+  double PathThroughGraph(int from, int to) const;
+
+  SlamOptions options_;
+  RadarOdometry odometry_;
+  PoseGraph graph_;
+  std::vector<Keyframe> keyframes_;
+  std::vector<LoopCandidate> candidates_;
+  std::vector<std::size_t> scan_keyframe_;  // per scan
+  std::vector<RadarPoint> open_points_;     // the open keyframe's submap so far
+  double path_ = 0.0;
+  bool open_ = false;
+};
+
+// Keyframe and loop counts, place recognition's time per keyframe (median),
+// the last solve's.
+struct SlamSummary {
+  std::size_t keyframes = 0, compared = 0, verified = 0, loops = 0;
+  double describe_ms = 0.0, search_ms = 0.0;  // medians per keyframe
+};
+SlamSummary Summarise(const RadarSlam& slam);
+
+// Writes slam.tum (each scan's optimised T_world_radar), keyframes.csv,
+// loops.csv and slam.json into `dir` (created), each file whole or not at all.
+void WriteSlam(const std::string& dir, const RadarSlam& slam);
+
+}  // namespace radargauss

@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// A Radon-sinogram descriptor of a keyframe's submap after RING (Lu et al.,
+// RSS 2022; docs/design.md, "Place recognition"): the bird's-eye occupancy
+// projected on `angles` directions over [0, pi), each projection's DFT
+// magnitude. A translation shifts every projection and leaves the magnitudes
+// alone; a yaw shifts the rows circularly, so the best row shift gives the
+// yaw, up to pi (a projection and its opposite have the same magnitude).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "radargauss/types.hpp"
+
+namespace radargauss {
+
+struct RadonOptions {
+  int angles = 60;          // projection directions over [0, pi)
+  int offsets = 64;         // bins of the projection over [-max_range, max_range]
+  double cell = 1.0;        // m: the bird's-eye occupancy grid
+  double max_range = 80.0;  // m: cells farther are left out
+};
+
+// Throws std::invalid_argument on angles or offsets < 2, or a cell or range
+// that is not positive and finite.
+void ValidateRadonOptions(const RadonOptions& options);
+
+struct RadonDescriptor {
+  Eigen::MatrixXd spectra;  // angles x (offsets / 2 + 1): |DFT| of each projection
+  Eigen::VectorXd key;      // the rows' mean, unit norm (zero when empty): yaw-invariant
+};
+
+// Of points in the keyframe's frame (x forward, z up).
+RadonDescriptor MakeRadonDescriptor(const std::vector<RadarPoint>& points, const RadonOptions& options);
+
+struct RadonMatch {
+  double distance = 1.0;  // mean cosine distance of the aligned rows, 0 (same) .. 1
+  int shift = 0;          // query row k matches candidate row k + shift (mod angles)
+  double yaw = 0.0;       // rad, [0, pi): the query frame's yaw in the candidate's, or yaw - pi
+};
+
+// The best row shift of `query` against `candidate`; distance 1 when either is empty.
+RadonMatch CompareRadonDescriptors(const RadonDescriptor& query, const RadonDescriptor& candidate,
+                                   const RadonOptions& options);
+
+}  // namespace radargauss

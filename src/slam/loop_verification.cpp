@@ -1,0 +1,162 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/slam/loop_verification.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_set>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include "radargauss/map/matching_map.hpp"
+#include "radargauss/voxel_grid.hpp"
+
+namespace radargauss {
+
+void ValidateOptions(const LoopVerificationOptions& o) {
+  const auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("loop verification: ") + what);
+  };
+  require(o.bev_cell > 0.0 && std::isfinite(o.bev_cell), "bev_cell must be positive and finite");
+  require(o.bev_search >= 0.0 && o.bev_search <= 1000.0 * o.bev_cell, "bev_search must be in [0, 1000 cells]");
+  require(o.min_associated >= 0.0 && o.min_associated <= 1.0, "min_associated must be in [0, 1]");
+  require(o.max_cost > 0.0, "max_cost must be positive");
+  require(o.max_translation_std > 0.0 && o.max_rotation_std_deg > 0.0, "the maximum stds must be positive");
+  require(o.drift >= 0.0 && o.min_drift >= 0.0 && o.drift_deg >= 0.0 && o.min_drift_deg >= 0.0,
+          "the drift bounds must be >= 0");
+  require(o.translation_floor_std > 0.0 && o.rotation_floor_std_deg > 0.0, "the floor stds must be positive");
+  require(o.match.matching.w_rcs == 0.0, "the match is geometric (w_rcs 0)");
+}
+
+std::pair<Eigen::Vector2d, double> AlignBirdsEye(const std::vector<Eigen::Vector3d>& query,
+                                                 const std::vector<Eigen::Vector3d>& candidate, double cell,
+                                                 double search) {
+  // The candidate's occupancy as a dense grid over its extent, the query's as unique cells.
+  std::vector<Eigen::Vector2i> query_cells;
+  std::unordered_set<std::int64_t> seen;
+  for (const Eigen::Vector3d& p : query) {
+    const Eigen::Vector2i c(int(FloorToInt(p.x() / cell)), int(FloorToInt(p.y() / cell)));
+    if (seen.insert(PackVoxelKey(c.x(), c.y(), 0)).second) query_cells.push_back(c);
+  }
+  if (query_cells.empty() || candidate.empty()) return {Eigen::Vector2d::Zero(), 0.0};
+  Eigen::Vector2i low(INT32_MAX, INT32_MAX), high(INT32_MIN, INT32_MIN);
+  std::vector<Eigen::Vector2i> candidate_cells;
+  for (const Eigen::Vector3d& p : candidate) {
+    const Eigen::Vector2i c(int(FloorToInt(p.x() / cell)), int(FloorToInt(p.y() / cell)));
+    candidate_cells.push_back(c);
+    low = low.cwiseMin(c);
+    high = high.cwiseMax(c);
+  }
+  const Eigen::Vector2i size = high - low + Eigen::Vector2i::Ones();
+  std::vector<char> occupied(std::size_t(size.x()) * size.y(), 0);
+  for (const Eigen::Vector2i& c : candidate_cells) occupied[std::size_t(c.y() - low.y()) * size.x() + c.x() - low.x()] = 1;
+  const int reach = int(std::floor(search / cell));
+  int best_count = -1;
+  Eigen::Vector2i best(0, 0);
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      int count = 0;
+      for (const Eigen::Vector2i& c : query_cells) {
+        const int x = c.x() + dx - low.x(), y = c.y() + dy - low.y();
+        if (x >= 0 && y >= 0 && x < size.x() && y < size.y()) count += occupied[std::size_t(y) * size.x() + x];
+      }
+      // Ties go to the smaller shift: the keyframes' origins are the prior.
+      if (count > best_count || (count == best_count && dx * dx + dy * dy < best.squaredNorm())) {
+        best_count = count;
+        best = {dx, dy};
+      }
+    }
+  }
+  return {best.cast<double>() * cell, double(best_count) / query_cells.size()};
+}
+
+namespace {
+
+std::vector<Eigen::Vector3d> Positions(const std::vector<RadarPoint>& points) {
+  std::vector<Eigen::Vector3d> positions;
+  positions.reserve(points.size());
+  for (const RadarPoint& p : points) positions.push_back(p.position);
+  return positions;
+}
+
+// The match's covariance over [dt (candidate frame); dphi (query frame)], in
+// the relative-pose residual's [t_E; Log R_E] (t_E is in the query frame):
+// rotated by R^T, then the floors added; false when the information is singular.
+bool FillInformation(const ScanMatchingResult& match, const LoopVerificationOptions& options, LoopCheck& check) {
+  const Eigen::Matrix<double, 6, 6> information = match.information * double(match.n_geo);
+  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(information);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
+  const Eigen::Matrix<double, 6, 6> covariance = ldlt.solve(Eigen::Matrix<double, 6, 6>::Identity());
+  check.translation_std = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                                                      covariance.topLeftCorner<3, 3>()).eigenvalues().maxCoeff()));
+  check.rotation_std_deg = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                                                       covariance.bottomRightCorner<3, 3>()).eigenvalues().maxCoeff())) *
+                           180.0 / M_PI;
+  Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Identity();
+  J.topLeftCorner<3, 3>() = match.pose.rotation().Matrix().transpose();
+  Eigen::Matrix<double, 6, 6> residual_covariance = J * covariance * J.transpose();
+  const double rotation_floor = options.rotation_floor_std_deg * M_PI / 180.0;
+  residual_covariance.diagonal() += (Eigen::Matrix<double, 6, 1>() << Eigen::Vector3d::Constant(options.translation_floor_std),
+                                     Eigen::Vector3d::Constant(rotation_floor)).finished().cwiseAbs2();
+  const Eigen::Matrix<double, 6, 6> residual_information =
+      residual_covariance.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+  check.sqrt_information = Eigen::LLT<Eigen::Matrix<double, 6, 6>>(residual_information).matrixU();
+  return true;
+}
+
+}  // namespace
+
+LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate, double yaw,
+                     const SE3d& expected, double path, const LoopVerificationOptions& options) {
+  ValidateOptions(options);
+  LoopCheck check;
+  if (query.size() < 10 || candidate.size() < 10) {
+    check.reason = "submap too small";
+    return check;
+  }
+  const SO3d rotation(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
+  std::vector<Eigen::Vector3d> turned = Positions(query);
+  for (Eigen::Vector3d& p : turned) p = rotation * p;
+  const std::vector<Eigen::Vector3d> candidate_points = Positions(candidate);
+  const auto [shift, overlap] = AlignBirdsEye(turned, candidate_points, options.bev_cell, options.bev_search);
+  check.overlap = overlap;
+  const SE3d initial(rotation, Eigen::Vector3d(shift.x(), shift.y(), 0.0));
+
+  const MatchingMap map(GaussianMap{BuildGaussians(candidate_points, options.gaussians), {}});
+  RadarScan scan;
+  scan.points = query;
+  const ScanMatchingResult match = MakeScanMatcher(options.match)->Match(scan, map, initial);
+  check.relative = match.pose;
+  check.associated = double(match.n_geo) / query.size();
+  check.cost = match.final_cost;
+  const SE3d correction = expected.Inverse() * match.pose;
+  check.correction = correction.translation().norm();
+  check.correction_deg = correction.rotation().Log().norm() * 180.0 / M_PI;
+  char detail[96];
+  if (!match.converged) {
+    check.reason = "match did not converge: " + match.reason;
+  } else if (check.associated < options.min_associated) {
+    std::snprintf(detail, sizeof(detail), "%.2f of the points associated", check.associated);
+    check.reason = detail;
+  } else if (check.cost > options.max_cost) {
+    std::snprintf(detail, sizeof(detail), "cost %.2f", check.cost);
+    check.reason = detail;
+  } else if (!FillInformation(match, options, check) || check.translation_std > options.max_translation_std ||
+             check.rotation_std_deg > options.max_rotation_std_deg) {
+    std::snprintf(detail, sizeof(detail), "degenerate: std %.3f m, %.3f deg", check.translation_std,
+                  check.rotation_std_deg);
+    check.reason = detail;
+  } else if (check.correction > std::max(options.min_drift, options.drift * path) ||
+             check.correction_deg > std::max(options.min_drift_deg, options.drift_deg * path)) {
+    std::snprintf(detail, sizeof(detail), "inconsistent with the graph: %.1f m, %.1f deg", check.correction,
+                  check.correction_deg);
+    check.reason = detail;
+  } else {
+    check.accepted = true;
+  }
+  return check;
+}
+
+}  // namespace radargauss

@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/slam/radon_descriptor.hpp"
+
+#include <cmath>
+#include <complex>
+#include <stdexcept>
+#include <unordered_set>
+
+#include "radargauss/voxel_grid.hpp"
+
+namespace radargauss {
+
+void ValidateRadonOptions(const RadonOptions& options) {
+  if (options.angles < 2 || options.offsets < 2) {
+    throw std::invalid_argument("radon descriptor: angles and offsets must be >= 2");
+  }
+  for (const double value : {options.cell, options.max_range}) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      throw std::invalid_argument("radon descriptor: cell and max_range must be positive and finite");
+    }
+  }
+}
+
+namespace {
+
+// The centres of the occupied bird's-eye cells within max_range.
+std::vector<Eigen::Vector2d> OccupiedCells(const std::vector<RadarPoint>& points, const RadonOptions& options) {
+  std::unordered_set<std::int64_t> seen;
+  std::vector<Eigen::Vector2d> cells;
+  for (const RadarPoint& point : points) {
+    if (!(point.position.head<2>().norm() < options.max_range)) continue;
+    const std::int64_t x = FloorToInt(point.position.x() / options.cell);
+    const std::int64_t y = FloorToInt(point.position.y() / options.cell);
+    if (seen.insert(PackVoxelKey(x, y, 0)).second) {
+      cells.emplace_back((double(x) + 0.5) * options.cell, (double(y) + 0.5) * options.cell);
+    }
+  }
+  return cells;
+}
+
+double RowDistance(const Eigen::MatrixXd& query, const Eigen::MatrixXd& candidate, int shift) {
+  const int rows = int(query.rows());
+  double sum = 0.0;
+  int count = 0;
+  for (int k = 0; k < rows; ++k) {
+    const auto a = query.row(k);
+    const auto b = candidate.row((k + shift) % rows);
+    const double norms = a.norm() * b.norm();
+    if (norms <= 0.0) continue;
+    sum += 1.0 - a.dot(b) / norms;
+    ++count;
+  }
+  return count > 0 ? sum / count : 1.0;
+}
+
+}  // namespace
+
+RadonDescriptor MakeRadonDescriptor(const std::vector<RadarPoint>& points, const RadonOptions& options) {
+  ValidateRadonOptions(options);
+  const std::vector<Eigen::Vector2d> cells = OccupiedCells(points, options);
+  const int bins = options.offsets, frequencies = options.offsets / 2 + 1;
+  Eigen::MatrixXd sinogram = Eigen::MatrixXd::Zero(options.angles, bins);
+  for (int a = 0; a < options.angles; ++a) {
+    const double theta = M_PI * a / options.angles;
+    const Eigen::Vector2d direction(std::cos(theta), std::sin(theta));
+    for (const Eigen::Vector2d& cell : cells) {
+      const double s = (cell.dot(direction) + options.max_range) / (2.0 * options.max_range);
+      sinogram(a, std::min(bins - 1, std::max(0, int(s * bins)))) += 1.0;
+    }
+  }
+  // The DFT magnitudes of each projection (a few thousand terms: no FFT needed).
+  RadonDescriptor descriptor;
+  descriptor.spectra = Eigen::MatrixXd::Zero(options.angles, frequencies);
+  for (int k = 0; k < frequencies; ++k) {
+    Eigen::VectorXcd basis(bins);
+    for (int s = 0; s < bins; ++s) basis[s] = std::polar(1.0, -2.0 * M_PI * k * s / bins);
+    descriptor.spectra.col(k) = (sinogram.cast<std::complex<double>>() * basis).cwiseAbs();
+  }
+  descriptor.key = descriptor.spectra.colwise().mean().transpose();
+  if (descriptor.key.norm() > 0.0) descriptor.key.normalize();
+  return descriptor;
+}
+
+RadonMatch CompareRadonDescriptors(const RadonDescriptor& query, const RadonDescriptor& candidate,
+                                   const RadonOptions& options) {
+  ValidateRadonOptions(options);
+  const auto same_shape = [&](const Eigen::MatrixXd& m) {
+    return m.rows() == options.angles && m.cols() == options.offsets / 2 + 1;
+  };
+  if (!same_shape(query.spectra) || !same_shape(candidate.spectra)) {
+    throw std::invalid_argument("radon descriptor: descriptors of another size than the options'");
+  }
+  RadonMatch best;
+  for (int shift = 0; shift < options.angles; ++shift) {
+    const double distance = RowDistance(query.spectra, candidate.spectra, shift);
+    if (distance < best.distance) {
+      best.distance = distance;
+      best.shift = shift;
+    }
+  }
+  best.yaw = best.shift * M_PI / options.angles;
+  return best;
+}
+
+}  // namespace radargauss

@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// SLAM's outputs (docs/cli.md, "slam").
+#include <algorithm>
+#include <filesystem>
+#include <iomanip>
+#include <system_error>
+
+#include <nlohmann/json.hpp>
+
+#include "radargauss/atomic_file.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/slam/radar_slam.hpp"
+#include "radargauss/stats.hpp"
+
+namespace radargauss {
+
+namespace {
+
+void WriteKeyframes(std::ostream& out, const RadarSlam& slam) {
+  out << "keyframe,scan,stamp,path_m,points,x,y,z,qx,qy,qz,qw,describe_ms,search_ms\n" << std::setprecision(9);
+  for (std::size_t k = 0; k < slam.keyframes().size(); ++k) {
+    const Keyframe& keyframe = slam.keyframes()[k];
+    const SE3d& pose = slam.graph().poses()[k];
+    const Eigen::Quaterniond& q = pose.rotation().quaternion();
+    out << k << ',' << keyframe.scan << ',' << std::fixed << keyframe.stamp << std::defaultfloat << ','
+        << keyframe.path << ',' << keyframe.points.size() << ',' << pose.translation().x() << ','
+        << pose.translation().y() << ',' << pose.translation().z() << ',' << q.x() << ',' << q.y() << ',' << q.z()
+        << ',' << q.w() << ',' << keyframe.describe_ms << ',' << keyframe.search_ms << '\n';
+  }
+}
+
+void WriteLoops(std::ostream& out, const RadarSlam& slam) {
+  out << "query,candidate,score,yaw_deg,verified,overlap,associated,cost,translation_std,rotation_std_deg,"
+         "correction_m,correction_deg,accepted,reason\n"
+      << std::setprecision(6);
+  for (const LoopCandidate& c : slam.candidates()) {
+    const LoopCheck& check = c.check;
+    out << c.query << ',' << c.candidate << ',' << c.distance << ',' << c.yaw * 180.0 / M_PI << ',' << c.verified
+        << ',' << check.overlap << ',' << check.associated << ',' << check.cost << ',' << check.translation_std << ','
+        << check.rotation_std_deg << ',' << check.correction << ',' << check.correction_deg << ',' << check.accepted
+        << ",\"" << check.reason << "\"\n";
+  }
+}
+
+}  // namespace
+
+SlamSummary Summarise(const RadarSlam& slam) {
+  SlamSummary s;
+  s.keyframes = slam.keyframes().size();
+  s.compared = slam.candidates().size();
+  for (const LoopCandidate& c : slam.candidates()) {
+    s.verified += c.verified;
+    s.loops += c.check.accepted;
+  }
+  std::vector<double> describe, search;
+  for (const Keyframe& keyframe : slam.keyframes()) {
+    describe.push_back(keyframe.describe_ms);
+    search.push_back(keyframe.search_ms);
+  }
+  s.describe_ms = Median(describe);
+  s.search_ms = Median(search);
+  return s;
+}
+
+void WriteSlam(const std::string& dir, const RadarSlam& slam) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  fs::create_directories(dir, error);
+  if (error) throw FileError(dir, "cannot create the output folder: " + error.message());
+  const fs::path out(dir);
+  WriteTum((out / "slam.tum").string(), slam.trajectory());
+  WriteFileAtomically((out / "keyframes.csv").string(), [&](std::ostream& s) { WriteKeyframes(s, slam); });
+  WriteFileAtomically((out / "loops.csv").string(), [&](std::ostream& s) { WriteLoops(s, slam); });
+  const SlamSummary s = Summarise(slam);
+  const nlohmann::json summary = {{"keyframes", s.keyframes},
+                                  {"candidates_compared", s.compared},
+                                  {"candidates_verified", s.verified},
+                                  {"loops", s.loops},
+                                  {"describe_time_ms", s.describe_ms},
+                                  {"search_time_ms", s.search_ms}};
+  WriteFileAtomically((out / "slam.json").string(), [&](std::ostream& stream) { stream << summary.dump(2) << "\n"; });
+}
+
+}  // namespace radargauss
