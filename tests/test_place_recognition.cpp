@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Scan Context: a yaw-rotated, shifted and noisy copy of a place retrieves
-// that place among others, with the yaw within one sector, in each channel.
+// Place recognition: a yaw-rotated, shifted and noisy copy of a place
+// retrieves that place among others with the yaw within one sector (Scan
+// Context, each channel) or one angle step up to pi (the Radon descriptor);
+// verification recovers a planted relative pose and refuses another place.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +12,8 @@
 
 #include <Eigen/Geometry>
 
+#include "radargauss/slam/loop_verification.hpp"
+#include "radargauss/slam/radon_descriptor.hpp"
 #include "radargauss/slam/scan_context.hpp"
 
 namespace radargauss {
@@ -104,6 +108,65 @@ TEST(ScanContext, EmptyAndInvalid) {
   ScanContextOptions other;
   other.rings = 10;
   EXPECT_THROW(CompareScanContexts(empty, MakeScanContext({}, other), ScanContextOptions{}), std::invalid_argument);
+}
+
+// The Radon descriptor does not change with a translation: a copy shifted by
+// 6 m (where Scan Context's bins move) still finds its place.
+TEST(RadonDescriptor, ShiftedRotatedCopyRetrievesThePlaceWithItsYaw) {
+  RadonOptions options;
+  std::vector<RadonDescriptor> places;
+  for (std::uint32_t seed = 1; seed <= 10; ++seed) places.push_back(MakeRadonDescriptor(RandomPlace(seed), options));
+  const double step = M_PI / options.angles;
+  for (const double yaw : {0.0, 0.3, 1.7, -2.5, 3.1}) {
+    const RadonDescriptor query =
+        MakeRadonDescriptor(SeenFrom(RandomPlace(4), yaw, Eigen::Vector3d(4.0, -4.5, 0.0), 99), options);
+    int best = -1;
+    RadonMatch best_match;
+    std::vector<double> key_distances;
+    for (int p = 0; p < int(places.size()); ++p) {
+      const RadonMatch match = CompareRadonDescriptors(query, places[p], options);
+      key_distances.push_back((query.key - places[p].key).norm());
+      if (best < 0 || match.distance < best_match.distance) {
+        best = p;
+        best_match = match;
+      }
+    }
+    EXPECT_EQ(best, 3) << "yaw " << yaw;
+    // Known up to pi: the nearer of yaw and yaw - pi.
+    EXPECT_LE(std::min(AngleBetween(best_match.yaw, yaw), AngleBetween(best_match.yaw - M_PI, yaw)), 1.5 * step)
+        << "yaw " << yaw;
+    EXPECT_EQ(std::min_element(key_distances.begin(), key_distances.end()) - key_distances.begin(), 3) << yaw;
+  }
+  RadonOptions bad;
+  bad.angles = 1;
+  EXPECT_THROW(MakeRadonDescriptor({}, bad), std::invalid_argument);
+  EXPECT_EQ(CompareRadonDescriptors(MakeRadonDescriptor({}, options), places[0], options).distance, 1.0);
+}
+
+// A planted relative pose, 3 m and 25 deg from the descriptor's guess of 20
+// deg: verification recovers it; another place is refused and says why.
+TEST(LoopVerification, RecoversAPlantedLoopAndRefusesAnotherPlace) {
+  const std::vector<RadarPoint> place = RandomPlace(7);
+  const double yaw = 25.0 * M_PI / 180.0;
+  const Eigen::Vector3d shift(3.0, -2.0, 0.0);
+  const std::vector<RadarPoint> query = SeenFrom(place, yaw, shift, 5);
+  const SE3d planted(SO3d(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()))), shift);
+  LoopVerificationOptions options;
+  const LoopCheck check = VerifyLoop(query, place, 20.0 * M_PI / 180.0, planted, 300.0, options);
+  ASSERT_TRUE(check.accepted) << check.reason;
+  EXPECT_LT((check.relative.translation() - shift).norm(), 0.05);
+  EXPECT_LT((check.relative.rotation().Inverse() * planted.rotation()).Log().norm(), 0.2 * M_PI / 180.0);
+  EXPECT_GT(check.associated, 0.8);
+  EXPECT_GT(check.sqrt_information.diagonal().minCoeff(), 0.0);
+
+  const LoopCheck other = VerifyLoop(SeenFrom(RandomPlace(8), yaw, shift, 5), place, yaw, planted, 300.0, options);
+  EXPECT_FALSE(other.accepted);
+  EXPECT_FALSE(other.reason.empty());
+  // The right place, but far from where the graph has it after 20 m driven.
+  const SE3d elsewhere(planted.rotation(), shift + Eigen::Vector3d(30.0, 0.0, 0.0));
+  const LoopCheck inconsistent = VerifyLoop(query, place, yaw, elsewhere, 20.0, options);
+  EXPECT_FALSE(inconsistent.accepted);
+  EXPECT_NE(inconsistent.reason.find("inconsistent"), std::string::npos) << inconsistent.reason;
 }
 
 }  // namespace

@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Radar SLAM on a simulated drive of 1.8 laps around a small yard, with an
+// odometry that forgets its map beyond 30 m and so drifts: the revisits are
+// found, no false loop is accepted, the trajectory is closer to the truth
+// than the odometry's, and the run is the same for any thread count.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "radargauss/evaluation.hpp"
+#include "radargauss/simulator.hpp"
+#include "radargauss/slam/radar_slam.hpp"
+
+namespace radargauss {
+namespace {
+
+const SimulatedSequence& Yard() {
+  static const SimulatedSequence* drive = [] {
+    SimulationConfig config;
+    config.scans = 500;  // 300 m at 6 m/s: 1.8 laps of 166 m
+    config.loop_length = 60.0;
+    config.loop_width = 30.0;
+    config.corner_radius = 8.0;
+    config.poles = 12;
+    config.parked_cars = 8;
+    config.moving_cars = 1;
+    config.min_detections = 150;
+    config.max_detections = 300;
+    config.max_range = 60.0;
+    return new SimulatedSequence(Simulate(config));
+  }();
+  return *drive;
+}
+
+SlamOptions YardOptions() {
+  SlamOptions options;
+  options.odometry.map.active_radius = 30.0;
+  options.min_loop_path = 100.0;
+  options.candidates = 20;
+  options.max_descriptor_distance = 0.6;
+  return options;
+}
+
+std::unique_ptr<RadarSlam> RunYard(const SlamOptions& options) {
+  auto slam = std::make_unique<RadarSlam>(options);
+  for (const RadarScan& scan : Yard().scans) slam->Register(scan);
+  slam->Finish();
+  return slam;
+}
+
+Eigen::Vector3d TruePosition(const Keyframe& keyframe) {
+  return Yard().ground_truth.Interpolate(keyframe.stamp)->translation();
+}
+
+TEST(RadarSlam, ClosesTheYardsRevisitsWithoutAFalseLoop) {
+  const std::unique_ptr<RadarSlam> slam = RunYard(YardOptions());
+  const std::vector<Keyframe>& keyframes = slam->keyframes();
+  EXPECT_EQ(keyframes.size(), std::size_t(std::ceil(299.0 / 10.0)));
+  // True revisits: a keyframe within 5 m of one at least min_loop_path back.
+  int revisits = 0, closed = 0;
+  for (std::size_t q = 0; q < keyframes.size(); ++q) {
+    bool revisit = false;
+    for (std::size_t c = 0; c < q; ++c) {
+      revisit |= keyframes[q].path - keyframes[c].path >= 100.0 &&
+                 (TruePosition(keyframes[q]) - TruePosition(keyframes[c])).norm() < 5.0;
+    }
+    revisits += revisit;
+    for (const LoopCandidate& loop : slam->candidates()) closed += revisit && loop.query == int(q) && loop.check.accepted;
+  }
+  std::size_t accepted = 0;
+  for (const LoopCandidate& loop : slam->candidates()) {
+    if (!loop.check.accepted) continue;
+    ++accepted;
+    const double apart = (TruePosition(keyframes[loop.query]) - TruePosition(keyframes[loop.candidate])).norm();
+    EXPECT_LT(apart, 8.0) << "false loop " << loop.query << " -> " << loop.candidate;
+    // The loop's measurement agrees with the truth.
+    const SE3d truth = Yard().ground_truth.Interpolate(keyframes[loop.candidate].stamp)->Inverse() *
+                       *Yard().ground_truth.Interpolate(keyframes[loop.query].stamp);
+    EXPECT_LT((truth.Inverse() * loop.check.relative).translation().norm(), 0.5);
+  }
+  EXPECT_EQ(accepted, slam->loops());
+  EXPECT_GE(revisits, 12);
+  EXPECT_GE(closed, int(0.7 * revisits)) << closed << " of " << revisits;
+  const Evaluation odometry = EvaluateTrajectory(slam->odometry().trajectory(), Yard().ground_truth);
+  const Evaluation corrected = EvaluateTrajectory(slam->trajectory(), Yard().ground_truth);
+  EXPECT_LT(corrected.ate_translation.rmse, 0.5 * odometry.ate_translation.rmse)
+      << corrected.ate_translation.rmse << " against " << odometry.ate_translation.rmse;
+  // Each scan follows its keyframe: a keyframe's own scan is exactly its graph pose.
+  const std::vector<SE3d> poses = slam->Poses();
+  for (std::size_t k = 0; k < keyframes.size(); ++k) {
+    EXPECT_LT((poses[keyframes[k].scan].translation() - slam->graph().poses()[k].translation()).norm(), 1e-9);
+  }
+}
+
+TEST(RadarSlam, SameRunForAnyThreadCountAndEitherDescriptor) {
+  for (const PlaceDescriptorKind descriptor : {PlaceDescriptorKind::kScanContext, PlaceDescriptorKind::kRadon}) {
+    SlamOptions one = YardOptions();
+    one.descriptor = descriptor;
+    one.graph.threads = 1;
+    SlamOptions two = one;
+    two.graph.threads = 2;
+    const std::unique_ptr<RadarSlam> a = RunYard(one), b = RunYard(two);
+    ASSERT_EQ(a->candidates().size(), b->candidates().size());
+    EXPECT_GT(a->loops(), 0u) << ToString(descriptor);
+    const std::vector<SE3d> pa = a->Poses(), pb = b->Poses();
+    for (std::size_t s = 0; s < pa.size(); ++s) ASSERT_EQ(pa[s].translation(), pb[s].translation()) << s;
+  }
+}
+
+TEST(RadarSlam, RefusesBadOptions) {
+  SlamOptions options;
+  options.submap_distance = 0.0;
+  EXPECT_THROW(RadarSlam{options}, std::invalid_argument);
+  options = SlamOptions();
+  options.verification.min_associated = 2.0;
+  EXPECT_THROW(RadarSlam{options}, std::invalid_argument);
+  EXPECT_THROW(PlaceDescriptorKindFromString("sift"), std::invalid_argument);
+  EXPECT_EQ(PlaceDescriptorKindFromString(ToString(PlaceDescriptorKind::kRadon)), PlaceDescriptorKind::kRadon);
+}
+
+}  // namespace
+}  // namespace radargauss
