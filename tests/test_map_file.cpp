@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -93,9 +94,66 @@ TEST_F(MapFiles, CorruptFilesGiveClearErrors) {
   expect_error(good.substr(0, 10), "too short");
   std::string version = good;
   version[8] = 7;
-  expect_error(version, "map version 7, this build reads version 1");
+  expect_error(version, "map version 7, this build reads versions 1 to 2");
   expect_error("PLY?" + good, "bad magic");
   EXPECT_THROW(ReadMap(Path("absent.rgm")), DataError);
+}
+
+// A SLAM map's places: poses bit-exact, points in float32; a version-1 file
+// (no places section) still reads; a truncated places section is an error.
+TEST_F(MapFiles, PlacesRoundTripAndVersionOneStillReads) {
+  GaussianMap map = ExampleMap();
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  for (int k = 0; k < 3; ++k) {
+    MapPlace place;
+    place.pose = SE3d::Exp((Eigen::Matrix<double, 6, 1>() << 10 * normal(rng), normal(rng), 0.1 * normal(rng),
+                            0.1 * normal(rng), 0.1 * normal(rng), normal(rng)).finished());
+    for (int i = 0; i < 5 + k; ++i) {
+      RadarPoint point;
+      point.position = 20.0 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+      point.rcs = 5.0 * normal(rng);
+      place.points.push_back(point);
+    }
+    map.places.push_back(place);
+  }
+  WriteMap(Path("places.rgm"), map);
+  const GaussianMap read = ReadMap(Path("places.rgm"));
+  ASSERT_EQ(read.places.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(read.places[k].pose.translation(), map.places[k].pose.translation());
+    // Renormalised on reading: equal to the last bit or two.
+    EXPECT_LT((read.places[k].pose.rotation().quaternion().coeffs() -
+               map.places[k].pose.rotation().quaternion().coeffs()).norm(), 1e-15);
+    ASSERT_EQ(read.places[k].points.size(), map.places[k].points.size());
+    for (std::size_t i = 0; i < map.places[k].points.size(); ++i) {
+      EXPECT_EQ(read.places[k].points[i].position, map.places[k].points[i].position.cast<float>().cast<double>());
+      EXPECT_EQ(read.places[k].points[i].rcs, double(float(map.places[k].points[i].rcs)));
+    }
+  }
+  // Version 1: the same Gaussians without the place count, its own CRC.
+  WriteMap(Path("plain.rgm"), ExampleMap());
+  std::string v1 = ReadBytes(Path("plain.rgm"));
+  v1.erase(v1.size() - 12);  // the place count (0) and the CRC
+  v1[8] = 1;
+  const uLong crc = crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(v1.data()), uInt(v1.size()));
+  const std::uint32_t crc32_value = std::uint32_t(crc);
+  v1.append(reinterpret_cast<const char*>(&crc32_value), 4);
+  const GaussianMap old = ReadMap(WriteFile("v1.rgm", v1));
+  EXPECT_EQ(old.gaussians.size(), map.gaussians.size());
+  EXPECT_TRUE(old.places.empty());
+  // The places file cut inside its last point, with a CRC that matches the cut.
+  std::string cut = ReadBytes(Path("places.rgm"));
+  cut.erase(cut.size() - 4 - 8);
+  const std::uint32_t cut_crc =
+      std::uint32_t(crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(cut.data()), uInt(cut.size())));
+  cut.append(reinterpret_cast<const char*>(&cut_crc), 4);
+  try {
+    ReadMap(WriteFile("cut.rgm", cut));
+    ADD_FAILURE() << "accepted a truncated places section";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("places section"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(MapFiles, PlyHasThe3dgsLayout) {

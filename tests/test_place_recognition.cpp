@@ -152,19 +152,20 @@ TEST(LoopVerification, RecoversAPlantedLoopAndRefusesAnotherPlace) {
   const std::vector<RadarPoint> query = SeenFrom(place, yaw, shift, 5);
   const SE3d planted(SO3d(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()))), shift);
   LoopVerificationOptions options;
-  const LoopCheck check = VerifyLoop(query, place, 20.0 * M_PI / 180.0, planted, 300.0, options);
+  const LoopCheck check = VerifyLoop(query, place, 20.0 * M_PI / 180.0, GraphPrior{planted, 300.0}, options);
   ASSERT_TRUE(check.accepted) << check.reason;
   EXPECT_LT((check.relative.translation() - shift).norm(), 0.05);
   EXPECT_LT((check.relative.rotation().Inverse() * planted.rotation()).Log().norm(), 0.2 * M_PI / 180.0);
   EXPECT_GT(check.associated, 0.8);
   EXPECT_GT(check.sqrt_information.diagonal().minCoeff(), 0.0);
 
-  const LoopCheck other = VerifyLoop(SeenFrom(RandomPlace(8), yaw, shift, 5), place, yaw, planted, 300.0, options);
+  const LoopCheck other = VerifyLoop(SeenFrom(RandomPlace(8), yaw, shift, 5), place, yaw, std::nullopt, options);
   EXPECT_FALSE(other.accepted);
   EXPECT_FALSE(other.reason.empty());
   // The right place, but far from where the graph has it after 20 m driven.
   const SE3d elsewhere(planted.rotation(), shift + Eigen::Vector3d(30.0, 0.0, 0.0));
-  const LoopCheck inconsistent = VerifyLoop(query, place, yaw, elsewhere, 20.0, options);
+  const LoopCheck inconsistent = VerifyLoop(query, place, yaw, GraphPrior{elsewhere, 20.0}, options);
+  EXPECT_TRUE(VerifyLoop(query, place, yaw, std::nullopt, options).accepted);  // no prior, no consistency check
   EXPECT_FALSE(inconsistent.accepted);
   EXPECT_NE(inconsistent.reason.find("inconsistent"), std::string::npos) << inconsistent.reason;
 }

@@ -37,8 +37,8 @@ SlamOptions YardOptions() {
   SlamOptions options;
   options.odometry.map.active_radius = 30.0;
   options.min_loop_path = 100.0;
-  options.candidates = 20;
-  options.max_descriptor_distance = 0.6;
+  options.place_recognition.candidates = 20;
+  options.place_recognition.max_scan_context_distance = 0.6;
   return options;
 }
 
@@ -96,7 +96,7 @@ TEST(RadarSlam, ClosesTheYardsRevisitsWithoutAFalseLoop) {
 TEST(RadarSlam, SameRunForAnyThreadCountAndEitherDescriptor) {
   for (const PlaceDescriptorKind descriptor : {PlaceDescriptorKind::kScanContext, PlaceDescriptorKind::kRadon}) {
     SlamOptions one = YardOptions();
-    one.descriptor = descriptor;
+    one.place_recognition.descriptor = descriptor;
     one.graph.threads = 1;
     SlamOptions two = one;
     two.graph.threads = 2;

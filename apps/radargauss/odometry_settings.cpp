@@ -192,4 +192,33 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   app->add_option("--max-scans", s.max_scans, "Only the first N scans (0: all)")->capture_default_str();
 }
 
+PlaceRecognitionOptions PlaceRecognitionSettings::Resolved() const {
+  PlaceRecognitionOptions o = options;
+  o.descriptor = PlaceDescriptorKindFromString(descriptor);
+  o.scan_context.channel = channel == "geometric" ? ScanContextChannel::kGeometric
+                           : channel == "rcs"     ? ScanContextChannel::kRcs
+                                                  : ScanContextChannel::kBoth;
+  return o;
+}
+
+void AddPlaceRecognitionOptions(CLI::App* app, PlaceRecognitionSettings& s) {
+  PlaceRecognitionOptions& o = s.options;
+  app->add_option("--descriptor", s.descriptor, "Place descriptor: scan-context or radon")
+      ->check(CLI::IsMember(PlaceDescriptorKindNames()))
+      ->capture_default_str();
+  app->add_option("--channel", s.channel, "Scan Context channels: geometric, rcs or both")
+      ->check(CLI::IsMember({"geometric", "rcs", "both"}))
+      ->capture_default_str();
+  app->add_option("--candidates", o.candidates, "Places compared per submap (nearest keys)")
+      ->check(InRange(1, 100000))
+      ->capture_default_str();
+  app->add_option("--max-scan-context-distance", o.max_scan_context_distance,
+                  "Places farther by Scan Context are not verified")
+      ->check(InRange(0.0, 1.0))
+      ->capture_default_str();
+  app->add_option("--max-radon-distance", o.max_radon_distance, "Places farther by the Radon descriptor are not verified")
+      ->check(InRange(0.0, 1.0))
+      ->capture_default_str();
+}
+
 }  // namespace radargauss::cli

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The flags of odometry and slam: the odometry's options, the matcher, the
-// IMU, and the checks of the reference and the gyro against the sequence.
+// The flags of odometry, slam and relocalize: the odometry's options, the
+// matcher, the IMU, place recognition, and the checks of the reference and
+// the gyro against the sequence.
 #pragma once
 
 #include <memory>
@@ -9,6 +10,7 @@
 
 #include "commands.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/slam/place_recognition.hpp"
 #include "radargauss/trajectory.hpp"
 
 namespace radargauss::cli {
@@ -44,5 +46,14 @@ void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence)
 void CheckReferenceCovers(const Trajectory& reference, const Sequence& sequence, const std::string& path);
 // Every flag of OdometrySettings.
 void AddOdometryOptions(CLI::App* app, OdometrySettings& s);
+
+// The place-recognition flags of slam and relocalize.
+struct PlaceRecognitionSettings {
+  PlaceRecognitionOptions options;
+  std::string descriptor = ToString(PlaceRecognitionOptions().descriptor);
+  std::string channel = "both";
+  PlaceRecognitionOptions Resolved() const;
+};
+void AddPlaceRecognitionOptions(CLI::App* app, PlaceRecognitionSettings& s);
 
 }  // namespace radargauss::cli

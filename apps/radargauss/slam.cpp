@@ -24,8 +24,7 @@ namespace {
 struct SlamSettings {
   OdometrySettings odometry;
   SlamOptions slam;
-  std::string descriptor = ToString(SlamOptions().descriptor);
-  std::string channel = "both";
+  PlaceRecognitionSettings place_recognition;
   std::string loop_rejection = ToString(PoseGraphOptions().loop_rejection);
   std::string loop_loss = ToString(PoseGraphOptions().loop_loss.type);
 };
@@ -34,10 +33,7 @@ SlamOptions Resolved(const SlamSettings& s) {
   if (s.odometry.matcher != "gaussians") throw DataError("slam: --matcher must be gaussians");
   SlamOptions o = s.slam;
   o.odometry = Resolved(s.odometry);
-  o.descriptor = PlaceDescriptorKindFromString(s.descriptor);
-  o.scan_context.channel = s.channel == "geometric" ? ScanContextChannel::kGeometric
-                           : s.channel == "rcs"     ? ScanContextChannel::kRcs
-                                                    : ScanContextChannel::kBoth;
+  o.place_recognition = s.place_recognition.Resolved();
   o.graph.loop_rejection = LoopRejectionFromString(s.loop_rejection);
   o.graph.loop_loss.type = LossTypeFromString(s.loop_loss);
   return o;
@@ -113,21 +109,10 @@ void AddSlamOptions(CLI::App* app, SlamSettings& s) {
   app->add_option("--submap-distance", o.submap_distance, "A keyframe every this many metres driven")
       ->check(Positive())
       ->capture_default_str();
-  app->add_option("--descriptor", s.descriptor, "Place descriptor: scan-context or radon")
-      ->check(CLI::IsMember(PlaceDescriptorKindNames()))
-      ->capture_default_str();
-  app->add_option("--channel", s.channel, "Scan Context channels: geometric, rcs or both")
-      ->check(CLI::IsMember({"geometric", "rcs", "both"}))
-      ->capture_default_str();
   app->add_option("--min-loop-path", o.min_loop_path, "Metres driven between a loop's keyframes at least")
       ->check(NonNegative())
       ->capture_default_str();
-  app->add_option("--candidates", o.candidates, "Keyframes compared per query (nearest keys)")
-      ->check(InRange(1, 1000))
-      ->capture_default_str();
-  app->add_option("--max-descriptor-distance", o.max_descriptor_distance, "Compared keyframes farther are not verified")
-      ->check(InRange(0.0, 1.0))
-      ->capture_default_str();
+  AddPlaceRecognitionOptions(app, s.place_recognition);
   app->add_option("--loop-rejection", s.loop_rejection, "Loop edges: loss, switchable or graduated")
       ->check(CLI::IsMember(LoopRejectionNames()))
       ->capture_default_str();

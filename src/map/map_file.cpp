@@ -35,6 +35,7 @@ void Put(std::string& out, T value) {
 class Reader {
  public:
   explicit Reader(const std::string& bytes) : bytes_(bytes) {}
+  std::size_t position() const { return position_; }
   template <typename T>
   T Get() {
     T value;
@@ -83,6 +84,16 @@ void WriteMap(const std::string& path, const GaussianMap& map) {
     Put<std::uint32_t>(bytes, g.rcs.inliers);
     for (const double c : g.rcs.coefficients) Put<double>(bytes, c);
   }
+  Put<std::uint64_t>(bytes, map.places.size());
+  for (const MapPlace& place : map.places) {
+    for (const double q : place.pose.rotation().quaternion().coeffs()) Put<double>(bytes, q);
+    for (int i = 0; i < 3; ++i) Put<double>(bytes, place.pose.translation()[i]);
+    Put<std::uint64_t>(bytes, place.points.size());
+    for (const RadarPoint& point : place.points) {
+      for (int i = 0; i < 3; ++i) Put<float>(bytes, float(point.position[i]));
+      Put<float>(bytes, float(point.rcs));
+    }
+  }
   Put<std::uint32_t>(bytes, Crc32(bytes.data(), bytes.size()));
   WriteFileAtomically(path, [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); },
                       /*binary=*/true);
@@ -111,6 +122,40 @@ void ValidateGaussian(const Gaussian& g, const Fail& fail) {
   if (g.rcs.degree >= 0 && !(g.rcs.scale > 0.0)) throw fail("RCS model with scale <= 0");
 }
 
+// The places section, which must end at `end` (the CRC).
+std::vector<MapPlace> ReadPlaces(Reader& reader, std::size_t end, const std::string& path) {
+  constexpr std::size_t kPoseBytes = 7 * 8 + 8, kPointBytes = 4 * 4;
+  const std::uint64_t count = reader.Get<std::uint64_t>();
+  if (count > (end - reader.position()) / kPoseBytes) throw FileError(path, "truncated places section");
+  std::vector<MapPlace> places(count);
+  for (std::uint64_t k = 0; k < count; ++k) {
+    if (end - reader.position() < kPoseBytes) throw FileError(path, "truncated places section");
+    double q[4], t[3];
+    for (double& v : q) v = reader.Get<double>();
+    for (double& v : t) v = reader.Get<double>();
+    const std::uint64_t points = reader.Get<std::uint64_t>();
+    const Eigen::Quaterniond quaternion(q[3], q[0], q[1], q[2]);
+    if (!quaternion.coeffs().allFinite() || std::abs(quaternion.norm() - 1.0) > 1e-6 ||
+        !Eigen::Vector3d(t[0], t[1], t[2]).allFinite()) {
+      throw FileError(path, "place " + std::to_string(k) + ": non-finite or non-unit pose");
+    }
+    if (points > (end - reader.position()) / kPointBytes) throw FileError(path, "truncated places section");
+    places[k].pose = SE3d(SO3d(quaternion), Eigen::Vector3d(t[0], t[1], t[2]));
+    places[k].points.resize(points);
+    for (RadarPoint& point : places[k].points) {
+      float v[4];
+      for (float& x : v) x = reader.Get<float>();
+      if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]) || !std::isfinite(v[3])) {
+        throw FileError(path, "place " + std::to_string(k) + ": non-finite point");
+      }
+      point.position = Eigen::Vector3d(v[0], v[1], v[2]);
+      point.rcs = v[3];
+    }
+  }
+  if (reader.position() != end) throw FileError(path, "trailing bytes after the places section");
+  return places;
+}
+
 }  // namespace
 
 GaussianMap ReadMap(const std::string& path) {
@@ -121,16 +166,18 @@ GaussianMap ReadMap(const std::string& path) {
   Reader reader(bytes);
   reader.Get<std::uint64_t>();  // magic
   const std::uint32_t version = reader.Get<std::uint32_t>();
-  if (version != kMapFileVersion) {
-    throw FileError(path, "map version " + std::to_string(version) + ", this build reads version " +
+  if (version != 1 && version != kMapFileVersion) {
+    throw FileError(path, "map version " + std::to_string(version) + ", this build reads versions 1 to " +
                               std::to_string(kMapFileVersion) + " (rebuild the map)");
   }
   const std::uint8_t incidence = reader.Get<std::uint8_t>();
   reader.Get<std::uint8_t>();
   reader.Get<std::uint16_t>();
   const std::uint64_t count = reader.Get<std::uint64_t>();
+  const std::size_t places_bytes = version == 1 ? 0 : 8;  // at least the place count
   if (count > (bytes.size() - kHeaderBytes) / kGaussianBytes ||
-      bytes.size() != kHeaderBytes + count * kGaussianBytes + 4) {
+      (version == 1 && bytes.size() != kHeaderBytes + count * kGaussianBytes + 4) ||
+      bytes.size() < kHeaderBytes + count * kGaussianBytes + places_bytes + 4) {
     throw FileError(path, "truncated or oversized: " + std::to_string(bytes.size()) +
                               " bytes for " + std::to_string(count) + " Gaussians");
   }
@@ -161,6 +208,7 @@ GaussianMap ReadMap(const std::string& path) {
     };
     ValidateGaussian(g, fail);
   }
+  if (version > 1) map.places = ReadPlaces(reader, bytes.size() - 4, path);
   return map;
 }
 

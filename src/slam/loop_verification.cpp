@@ -109,7 +109,7 @@ bool FillInformation(const ScanMatchingResult& match, const LoopVerificationOpti
 }  // namespace
 
 LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate, double yaw,
-                     const SE3d& expected, double path, const LoopVerificationOptions& options) {
+                     const std::optional<GraphPrior>& prior, const LoopVerificationOptions& options) {
   ValidateOptions(options);
   LoopCheck check;
   if (query.size() < 10 || candidate.size() < 10) {
@@ -131,9 +131,11 @@ LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const std::vector<Rad
   check.relative = match.pose;
   check.associated = double(match.n_geo) / query.size();
   check.cost = match.final_cost;
-  const SE3d correction = expected.Inverse() * match.pose;
-  check.correction = correction.translation().norm();
-  check.correction_deg = correction.rotation().Log().norm() * 180.0 / M_PI;
+  if (prior) {
+    const SE3d correction = prior->expected.Inverse() * match.pose;
+    check.correction = correction.translation().norm();
+    check.correction_deg = correction.rotation().Log().norm() * 180.0 / M_PI;
+  }
   char detail[96];
   if (!match.converged) {
     check.reason = "match did not converge: " + match.reason;
@@ -148,8 +150,8 @@ LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const std::vector<Rad
     std::snprintf(detail, sizeof(detail), "degenerate: std %.3f m, %.3f deg", check.translation_std,
                   check.rotation_std_deg);
     check.reason = detail;
-  } else if (check.correction > std::max(options.min_drift, options.drift * path) ||
-             check.correction_deg > std::max(options.min_drift_deg, options.drift_deg * path)) {
+  } else if (prior && (check.correction > std::max(options.min_drift, options.drift * prior->path) ||
+                       check.correction_deg > std::max(options.min_drift_deg, options.drift_deg * prior->path))) {
     std::snprintf(detail, sizeof(detail), "inconsistent with the graph: %.1f m, %.1f deg", check.correction,
                   check.correction_deg);
     check.reason = detail;

@@ -8,39 +8,17 @@
 #include <limits>
 #include <queue>
 #include <stdexcept>
-#include <unordered_set>
 
-#include "radargauss/names.hpp"
-#include "radargauss/voxel_grid.hpp"
 
 namespace radargauss {
 
 namespace {
 
-constexpr NamedValue<PlaceDescriptorKind> kDescriptorNames[] = {{PlaceDescriptorKind::kScanContext, "scan-context"},
-                                                                 {PlaceDescriptorKind::kRadon, "radon"}};
-
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The first point of each voxel, in arrival order.
-std::vector<RadarPoint> Downsampled(const std::vector<RadarPoint>& points, double voxel) {
-  std::unordered_set<std::int64_t> seen;
-  std::vector<RadarPoint> kept;
-  for (const RadarPoint& point : points) {
-    if (seen.insert(PackVoxelKey(VoxelOf(point.position, voxel))).second) kept.push_back(point);
-  }
-  return kept;
-}
-
 }  // namespace
-
-std::string ToString(PlaceDescriptorKind kind) { return NameOf(kDescriptorNames, kind); }
-PlaceDescriptorKind PlaceDescriptorKindFromString(const std::string& name) {
-  return ValueNamed(kDescriptorNames, name, "place descriptor");
-}
-std::vector<std::string> PlaceDescriptorKindNames() { return NamesOf(kDescriptorNames); }
 
 void ValidateOptions(const SlamOptions& o) {
   const auto require = [](bool ok, const char* what) {
@@ -48,14 +26,9 @@ void ValidateOptions(const SlamOptions& o) {
   };
   ValidateOptions(o.odometry);
   ValidateOptions(o.verification);
-  ValidateScanContextOptions(o.scan_context);
-  ValidateRadonOptions(o.radon);
+  ValidateOptions(o.place_recognition);
   require(o.submap_distance > 0.0 && std::isfinite(o.submap_distance), "submap_distance must be positive");
-  require(o.submap_voxel > 0.0 && std::isfinite(o.submap_voxel), "submap_voxel must be positive");
   require(o.min_loop_path >= 0.0, "min_loop_path must be >= 0");
-  require(o.candidates >= 1, "candidates must be >= 1");
-  require(o.max_descriptor_distance >= 0.0 && o.max_descriptor_distance <= 1.0,
-          "max_descriptor_distance must be in [0, 1]");
   require(o.odometry_translation_std > 0.0 && o.odometry_rotation_std_deg > 0.0, "odometry stds must be positive");
   require(o.odometry_drift >= 0.0 && o.odometry_drift_deg >= 0.0, "odometry drifts must be >= 0");
 }
@@ -118,13 +91,9 @@ void RadarSlam::OpenKeyframe(std::size_t scan, const SE3d& pose, double stamp) {
 void RadarSlam::CloseKeyframe() {
   const auto start = std::chrono::steady_clock::now();
   Keyframe& keyframe = keyframes_.back();
-  keyframe.points = Downsampled(open_points_, options_.submap_voxel);
+  keyframe.points = DownsampleSubmap(open_points_, options_.place_recognition.submap_voxel);
   open_points_.clear();
-  if (options_.descriptor == PlaceDescriptorKind::kScanContext) {
-    keyframe.scan_context = MakeScanContext(keyframe.points, options_.scan_context);
-  } else {
-    keyframe.radon = MakeRadonDescriptor(keyframe.points, options_.radon);
-  }
+  descriptions_.push_back(Describe(keyframe.points, options_.place_recognition));
   keyframe.describe_ms = MillisecondsSince(start);
   open_ = false;
   SearchLoops(int(keyframes_.size()) - 1);
@@ -132,48 +101,25 @@ void RadarSlam::CloseKeyframe() {
 
 void RadarSlam::SearchLoops(int query) {
   const auto start = std::chrono::steady_clock::now();
-  const Keyframe& q = keyframes_[query];
-  const bool scan_context = options_.descriptor == PlaceDescriptorKind::kScanContext;
-  const Eigen::VectorXd& query_key = scan_context ? q.scan_context.ring_key : q.radon.key;
-  // The nearest keys among the keyframes far enough back.
-  std::vector<std::pair<double, int>> nearest;
-  for (int c = 0; c < query; ++c) {
-    if (q.path - keyframes_[c].path < options_.min_loop_path) break;  // in path order
-    const Eigen::VectorXd& key = scan_context ? keyframes_[c].scan_context.ring_key : keyframes_[c].radon.key;
-    nearest.emplace_back((query_key - key).norm(), c);
+  std::vector<int> eligible;  // far enough back along the path
+  for (int c = 0; c < query && keyframes_[query].path - keyframes_[c].path >= options_.min_loop_path; ++c) {
+    eligible.push_back(c);
   }
-  const std::size_t kept = std::min<std::size_t>(nearest.size(), std::size_t(options_.candidates));
-  std::partial_sort(nearest.begin(), nearest.begin() + kept, nearest.end());
-  nearest.resize(kept);
-  // The full descriptors, best first; verified until one is accepted.
-  std::vector<LoopCandidate> compared;
-  for (const auto& [key_distance, c] : nearest) {
+  bool accepted = false;
+  for (const PlaceMatch& match : RankPlaces(descriptions_[query], descriptions_, eligible, options_.place_recognition)) {
     LoopCandidate candidate;
     candidate.query = query;
-    candidate.candidate = c;
-    if (scan_context) {
-      const ScanContextMatch match = CompareScanContexts(q.scan_context, keyframes_[c].scan_context, options_.scan_context);
-      candidate.distance = match.distance;
-      candidate.yaw = match.yaw;
-    } else {
-      const RadonMatch match = CompareRadonDescriptors(q.radon, keyframes_[c].radon, options_.radon);
-      candidate.distance = match.distance;
-      candidate.yaw = match.yaw;
-    }
-    compared.push_back(candidate);
-  }
-  std::stable_sort(compared.begin(), compared.end(),
-                   [](const LoopCandidate& a, const LoopCandidate& b) { return a.distance < b.distance; });
-  bool accepted = false;
-  for (LoopCandidate& candidate : compared) {
+    candidate.candidate = match.candidate;
+    candidate.distance = match.distance;
+    candidate.yaw = match.yaws.front();
     char reason[64];
     if (accepted) {
       candidate.check.reason = "another candidate was accepted";
-    } else if (candidate.distance > options_.max_descriptor_distance) {
-      std::snprintf(reason, sizeof(reason), "descriptor distance %.3f", candidate.distance);
+    } else if (!match.close) {
+      std::snprintf(reason, sizeof(reason), "descriptor distance %.3f", match.distance);
       candidate.check.reason = reason;
     } else {
-      candidate = Verify(query, candidate.candidate, candidate.distance, candidate.yaw);
+      candidate = Verify(query, match);
       if (candidate.check.accepted) {
         graph_.AddLoop(candidate.candidate, query, candidate.check.relative, candidate.check.sqrt_information);
         graph_.Optimize(options_.graph);
@@ -185,24 +131,20 @@ void RadarSlam::SearchLoops(int query) {
   keyframes_[query].search_ms = MillisecondsSince(start);
 }
 
-LoopCandidate RadarSlam::Verify(int query, int candidate, double distance, double yaw) const {
+LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match) const {
   LoopCandidate result;
   result.query = query;
-  result.candidate = candidate;
-  result.distance = distance;
-  result.yaw = yaw;
+  result.candidate = match.candidate;
+  result.distance = match.distance;
   result.verified = true;
-  const SE3d expected = graph_.poses()[candidate].Inverse() * graph_.poses()[query];
-  const double path = PathThroughGraph(candidate, query);
-  // The Radon descriptor's yaw is known up to pi: both are tried.
-  std::vector<double> yaws = {yaw};
-  if (options_.descriptor == PlaceDescriptorKind::kRadon) yaws.push_back(yaw - M_PI);
-  for (const double tried : yaws) {
-    LoopCheck check = VerifyLoop(keyframes_[query].points, keyframes_[candidate].points, tried, expected, path,
-                                 options_.verification);
-    if (check.accepted || tried == yaws.front() || check.associated > result.check.associated) {
+  const SE3d expected = graph_.poses()[match.candidate].Inverse() * graph_.poses()[query];
+  const double path = PathThroughGraph(match.candidate, query);
+  for (const double yaw : match.yaws) {
+    LoopCheck check = VerifyLoop(keyframes_[query].points, keyframes_[match.candidate].points, yaw,
+                                 GraphPrior{expected, path}, options_.verification);
+    if (check.accepted || yaw == match.yaws.front() || check.associated > result.check.associated) {
       result.check = std::move(check);
-      result.yaw = tried;
+      result.yaw = yaw;
     }
     if (result.check.accepted) break;
   }

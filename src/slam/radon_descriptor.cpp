@@ -58,7 +58,7 @@ double RowDistance(const Eigen::MatrixXd& query, const Eigen::MatrixXd& candidat
 RadonDescriptor MakeRadonDescriptor(const std::vector<RadarPoint>& points, const RadonOptions& options) {
   ValidateRadonOptions(options);
   const std::vector<Eigen::Vector2d> cells = OccupiedCells(points, options);
-  const int bins = options.offsets, frequencies = options.offsets / 2 + 1;
+  const int bins = options.offsets, frequencies = options.offsets / 2;
   Eigen::MatrixXd sinogram = Eigen::MatrixXd::Zero(options.angles, bins);
   for (int a = 0; a < options.angles; ++a) {
     const double theta = M_PI * a / options.angles;
@@ -68,13 +68,14 @@ RadonDescriptor MakeRadonDescriptor(const std::vector<RadarPoint>& points, const
       sinogram(a, std::min(bins - 1, std::max(0, int(s * bins)))) += 1.0;
     }
   }
-  // The DFT magnitudes of each projection (a few thousand terms: no FFT needed).
+  // The DFT magnitudes of each projection but its mean (the cell count, the
+  // same for every direction); a few thousand terms, no FFT needed.
   RadonDescriptor descriptor;
   descriptor.spectra = Eigen::MatrixXd::Zero(options.angles, frequencies);
-  for (int k = 0; k < frequencies; ++k) {
+  for (int k = 1; k <= frequencies; ++k) {
     Eigen::VectorXcd basis(bins);
     for (int s = 0; s < bins; ++s) basis[s] = std::polar(1.0, -2.0 * M_PI * k * s / bins);
-    descriptor.spectra.col(k) = (sinogram.cast<std::complex<double>>() * basis).cwiseAbs();
+    descriptor.spectra.col(k - 1) = (sinogram.cast<std::complex<double>>() * basis).cwiseAbs();
   }
   descriptor.key = descriptor.spectra.colwise().mean().transpose();
   if (descriptor.key.norm() > 0.0) descriptor.key.normalize();
@@ -85,7 +86,7 @@ RadonMatch CompareRadonDescriptors(const RadonDescriptor& query, const RadonDesc
                                    const RadonOptions& options) {
   ValidateRadonOptions(options);
   const auto same_shape = [&](const Eigen::MatrixXd& m) {
-    return m.rows() == options.angles && m.cols() == options.offsets / 2 + 1;
+    return m.rows() == options.angles && m.cols() == options.offsets / 2;
   };
   if (!same_shape(query.spectra) || !same_shape(candidate.spectra)) {
     throw std::invalid_argument("radon descriptor: descriptors of another size than the options'");

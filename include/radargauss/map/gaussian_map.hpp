@@ -11,8 +11,10 @@
 
 #include <Eigen/Core>
 
+#include "radargauss/lie/se3.hpp"
 #include "radargauss/linear_probing_table.hpp"
 #include "radargauss/sh.hpp"
+#include "radargauss/types.hpp"
 #include "radargauss/voxel_grid.hpp"
 
 namespace radargauss {
@@ -50,9 +52,18 @@ struct Gaussian {
   RcsModel rcs;
 };
 
+// A keyframe of the run that built the map (SLAM): where it was and the
+// static points it saw, so that a later run can describe its own submaps and
+// relocalise against the map (docs/design.md, "Relocalisation").
+struct MapPlace {
+  SE3d pose;                       // T_world_keyframe
+  std::vector<RadarPoint> points;  // its submap in its frame (position and RCS)
+};
+
 struct GaussianMap {
   std::vector<Gaussian> gaussians;
   IncidenceModel incidence = IncidenceModel::kOffset;  // how the RCS models were fitted
+  std::vector<MapPlace> places;                        // empty unless SLAM built the map
 };
 
 // The ellipsoid of a covariance: std devs (ascending) and the rotation whose

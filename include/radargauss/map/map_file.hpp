@@ -1,12 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Gaussian-RCS map files.
 //
-// .rgm, version 1, little-endian:
+// .rgm, version 2, little-endian:
 //   "RGAUSMAP" | u32 version | u8 incidence model | 3 zero bytes | u64 count |
 //   count x { f64 mean[3] | f64 covariance[6] (xx xy xz yy yz zz) |
 //             u32 point_count | i32 sh_degree (-1: no model) | f64 rcs_median |
 //             f64 rcs_scale | f64 fit_rmse | u32 inliers | f64 coefficients[16] } |
+//   u64 places | places x { f64 q[4] (x y z w) | f64 t[3] | u64 n |
+//                           n x { f32 x y z rcs } } |
 //   u32 CRC32 (zlib) of everything before it.
+// Version 1 (no places section) is still read.
 // Written to a temporary file and renamed: never a half-written map.
 //
 // PLY export in the 3D Gaussian Splatting layout (binary little-endian
@@ -26,7 +29,7 @@
 
 namespace radargauss {
 
-inline constexpr std::uint32_t kMapFileVersion = 1;
+inline constexpr std::uint32_t kMapFileVersion = 2;
 
 // What ReadMap accepts of a Gaussian (docs/design.md, "Bounds on input"):
 // every mean coordinate within kMaxMapCoordinate of the origin (UTM
@@ -39,7 +42,8 @@ inline constexpr double kMaxMapStd = 100.0;       // m
 
 void WriteMap(const std::string& path, const GaussianMap& map);
 // Throws DataError naming the file for a missing or truncated file, a wrong
-// magic or version, a CRC mismatch, or a Gaussian outside the bounds above.
+// magic or version, a CRC mismatch, a Gaussian outside the bounds above, or
+// a place with a non-finite or non-unit pose or a non-finite point.
 GaussianMap ReadMap(const std::string& path);
 
 void ExportPly(const std::string& path, const GaussianMap& map);

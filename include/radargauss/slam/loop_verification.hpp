@@ -6,6 +6,7 @@
 // fitness, on the information matrix and on consistency with the graph.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -73,10 +74,17 @@ std::pair<Eigen::Vector2d, double> AlignBirdsEye(const std::vector<Eigen::Vector
                                                  const std::vector<Eigen::Vector3d>& candidate, double cell,
                                                  double search);
 
+// Where the graph has the query: its current candidate-from-query pose and
+// the metres driven between them along the graph.
+struct GraphPrior {
+  SE3d expected;
+  double path = 0.0;
+};
+
 // Checks the loop from `query` (points in its keyframe's frame) to
-// `candidate` at the descriptor's `yaw`; `expected` is the graph's current
-// candidate-from-query pose and `path` the metres driven between them.
+// `candidate` at the descriptor's `yaw`; without a prior (relocalisation)
+// there is no consistency check.
 LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate, double yaw,
-                     const SE3d& expected, double path, const LoopVerificationOptions& options);
+                     const std::optional<GraphPrior>& prior, const LoopVerificationOptions& options);
 
 }  // namespace radargauss

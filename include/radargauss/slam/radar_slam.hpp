@@ -20,27 +20,16 @@
 
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/slam/loop_verification.hpp"
-#include "radargauss/slam/radon_descriptor.hpp"
-#include "radargauss/slam/scan_context.hpp"
+#include "radargauss/slam/place_recognition.hpp"
 #include "radargauss/solvers/pose_graph.hpp"
 
 namespace radargauss {
 
-enum class PlaceDescriptorKind { kScanContext, kRadon };
-std::string ToString(PlaceDescriptorKind kind);                       // "scan-context", "radon"
-PlaceDescriptorKind PlaceDescriptorKindFromString(const std::string& name);  // throws std::invalid_argument
-std::vector<std::string> PlaceDescriptorKindNames();
-
 struct SlamOptions {
   OdometryOptions odometry;
   double submap_distance = 10.0;  // m driven per keyframe
-  double submap_voxel = 0.25;     // m: a submap keeps the first point of each voxel
-  PlaceDescriptorKind descriptor = PlaceDescriptorKind::kScanContext;
-  ScanContextOptions scan_context;
-  RadonOptions radon;
-  double min_loop_path = 150.0;          // m driven between a loop's keyframes (the active map closes shorter ones)
-  int candidates = 5;                    // keyframes compared per query, nearest by key
-  double max_descriptor_distance = 0.4;  // compared keyframes farther are not verified
+  PlaceRecognitionOptions place_recognition;
+  double min_loop_path = 150.0;  // m driven between a loop's keyframes (the active map closes shorter ones)
   LoopVerificationOptions verification;
   PoseGraphOptions graph;
   // The odometry edges' stds: floor plus drift per metre driven between keyframes.
@@ -59,8 +48,6 @@ struct Keyframe {
   SE3d odometry_pose;    // the odometry's T_world_radar at that scan
   double path = 0.0;     // m driven to it
   std::vector<RadarPoint> points;  // its submap, in its frame (closed keyframes)
-  ScanContext scan_context;        // the selected descriptor's
-  RadonDescriptor radon;
   double describe_ms = 0.0, search_ms = 0.0;  // place recognition's time
 };
 
@@ -96,7 +83,7 @@ class RadarSlam {
   void OpenKeyframe(std::size_t scan, const SE3d& pose, double stamp);
   void CloseKeyframe();
   void SearchLoops(int query);
-  LoopCandidate Verify(int query, int candidate, double distance, double yaw) const;
+  LoopCandidate Verify(int query, const PlaceMatch& match) const;
   // The metres driven between two keyframes along the graph's odometry edges,
   // loop edges crossed for free: how far the graph's estimate may have drifted.
   double PathThroughGraph(int from, int to) const;
@@ -105,6 +92,7 @@ class RadarSlam {
   RadarOdometry odometry_;
   PoseGraph graph_;
   std::vector<Keyframe> keyframes_;
+  std::vector<PlaceDescription> descriptions_;  // per closed keyframe
   std::vector<LoopCandidate> candidates_;
   std::vector<std::size_t> scan_keyframe_;  // per scan
   std::vector<RadarPoint> open_points_;     // the open keyframe's submap so far

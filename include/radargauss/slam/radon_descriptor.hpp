@@ -2,7 +2,7 @@
 // A Radon-sinogram descriptor of a keyframe's submap after RING (Lu et al.,
 // RSS 2022; docs/design.md, "Place recognition"): the bird's-eye occupancy
 // projected on `angles` directions over [0, pi), each projection's DFT
-// magnitude. A translation shifts every projection and leaves the magnitudes
+// magnitude without its mean. A translation shifts every projection and leaves the magnitudes
 // alone; a yaw shifts the rows circularly, so the best row shift gives the
 // yaw, up to pi (a projection and its opposite have the same magnitude).
 #pragma once
@@ -26,7 +26,7 @@ struct RadonOptions {
 void ValidateRadonOptions(const RadonOptions& options);
 
 struct RadonDescriptor {
-  Eigen::MatrixXd spectra;  // angles x (offsets / 2 + 1): |DFT| of each projection
+  Eigen::MatrixXd spectra;  // angles x offsets / 2: |DFT| of each projection, frequencies 1 .. offsets / 2
   Eigen::VectorXd key;      // the rows' mean, unit norm (zero when empty): yaw-invariant
 };
 

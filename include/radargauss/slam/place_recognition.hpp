@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Place recognition over submaps (docs/design.md, "Place recognition"): a
+// submap's description by the selected descriptor, the candidates nearest by
+// its yaw-invariant key, and the full comparison that gives a distance and
+// the yaws to verify. SLAM searches its own keyframes with it,
+// relocalisation a map's places.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "radargauss/slam/radon_descriptor.hpp"
+#include "radargauss/slam/scan_context.hpp"
+#include "radargauss/types.hpp"
+
+namespace radargauss {
+
+enum class PlaceDescriptorKind { kScanContext, kRadon };
+std::string ToString(PlaceDescriptorKind kind);                              // "scan-context", "radon"
+PlaceDescriptorKind PlaceDescriptorKindFromString(const std::string& name);  // throws std::invalid_argument
+std::vector<std::string> PlaceDescriptorKindNames();
+
+struct PlaceRecognitionOptions {
+  PlaceDescriptorKind descriptor = PlaceDescriptorKind::kScanContext;
+  ScanContextOptions scan_context;
+  RadonOptions radon;
+  double submap_voxel = 0.25;  // m: a submap keeps the first point of each voxel
+  int candidates = 5;          // compared per query, nearest by key
+  // Compared places farther than this (the descriptor's distance) are not verified.
+  double max_scan_context_distance = 0.4;
+  double max_radon_distance = 0.2;
+};
+
+// Throws std::invalid_argument naming the bad option.
+void ValidateOptions(const PlaceRecognitionOptions& options);
+
+// The first point of each voxel of edge `voxel`, in arrival order.
+std::vector<RadarPoint> DownsampleSubmap(const std::vector<RadarPoint>& points, double voxel);
+
+// The selected descriptor of a submap (the other is left empty).
+struct PlaceDescription {
+  ScanContext scan_context;
+  RadonDescriptor radon;
+};
+PlaceDescription Describe(const std::vector<RadarPoint>& submap, const PlaceRecognitionOptions& options);
+// The yaw-invariant key: Scan Context's ring key or the Radon key.
+const Eigen::VectorXd& KeyOf(const PlaceDescription& description, const PlaceRecognitionOptions& options);
+
+struct PlaceMatch {
+  int candidate = 0;
+  double distance = 1.0;    // the descriptor's, 0 (same) .. 1
+  std::vector<double> yaws; // rad, the query's in the candidate's, to verify in order (Radon: yaw and yaw - pi)
+  bool close = false;       // distance within the descriptor's maximum
+};
+
+// The `candidates` descriptions nearest `query` by key among the `eligible`
+// indices of `places`, compared in full, nearest first.
+std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vector<PlaceDescription>& places,
+                                   const std::vector<int>& eligible, const PlaceRecognitionOptions& options);
+
+}  // namespace radargauss
