@@ -2,7 +2,8 @@
 // Radar SLAM on a simulated drive of 1.8 laps around a small yard, with an
 // odometry that forgets its map beyond 30 m and so drifts: the revisits are
 // found, no false loop is accepted, the trajectory is closer to the truth
-// than the odometry's, and the run is the same for any thread count.
+// than the odometry's, and the run is the same for any thread count. Then
+// relocalisation of another run in the map it builds.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,7 +11,9 @@
 
 #include "radargauss/evaluation.hpp"
 #include "radargauss/simulator.hpp"
+#include "radargauss/error.hpp"
 #include "radargauss/slam/radar_slam.hpp"
+#include "radargauss/slam/relocalization.hpp"
 
 namespace radargauss {
 namespace {
@@ -106,6 +109,69 @@ TEST(RadarSlam, SameRunForAnyThreadCountAndEitherDescriptor) {
     const std::vector<SE3d> pa = a->Poses(), pb = b->Poses();
     for (std::size_t s = 0; s < pa.size(); ++s) ASSERT_EQ(pa[s].translation(), pb[s].translation()) << s;
   }
+}
+
+// Another run of the yard's world (another noise seed, starting 70 m along
+// the loop) located in the map of the yard's SLAM run with no initial pose:
+// the first fix within 0.5 m and 2.5 deg of the truth (in the map's frame,
+// SLAM's trajectory aligned to the truth), every reported pose within 1 m;
+// a run in another yard gets no fix and reports no pose.
+SimulatedSequence SecondRun(bool same_world) {
+  SimulationConfig config = Yard().config;
+  config.scans = 200;
+  config.seed = 7;
+  config.world_seed = 1;  // the yard's objects
+  config.start_offset = 70.0;
+  if (!same_world) {      // another yard: other walls, other objects
+    config.loop_length = 90.0;
+    config.loop_width = 45.0;
+    config.world_seed = 99;
+  }
+  return Simulate(config);
+}
+
+TEST(Relocalizer, FindsASecondRunInTheSlamMapAndRefusesAnotherYard) {
+  const std::unique_ptr<RadarSlam> slam = RunYard(YardOptions());
+  const GaussianMap map = BuildPlaceMap(Yard().scans, *slam);
+  ASSERT_EQ(map.places.size(), slam->keyframes().size());
+  const SE3d truth_from_map = EvaluateTrajectory(slam->trajectory(), Yard().ground_truth).alignment;
+  RelocalizationOptions options;
+  options.place_recognition = YardOptions().place_recognition;
+  {
+    const SimulatedSequence second = SecondRun(true);
+    Relocalizer relocalizer(map, options);
+    for (const RadarScan& scan : second.scans) relocalizer.Register(scan);
+    ASSERT_TRUE(relocalizer.first_fix().has_value());
+    EXPECT_LT(*relocalizer.first_fix(), 60u);
+    std::size_t reported = 0;
+    for (std::size_t k = 0; k < relocalizer.steps().size(); ++k) {
+      const RelocalizationStep& step = relocalizer.steps()[k];
+      if (k < *relocalizer.first_fix()) {
+        EXPECT_FALSE(step.fixed) << k;
+      }
+      if (!step.fixed) continue;
+      ++reported;
+      const SE3d error = (truth_from_map * step.pose).Inverse() * *second.ground_truth.Interpolate(step.stamp);
+      const double limit = k == *relocalizer.first_fix() ? 0.5 : 1.0;
+      EXPECT_LT(error.translation().norm(), limit) << "scan " << k;
+      if (k == *relocalizer.first_fix()) {
+        EXPECT_LT(error.rotation().Log().norm() * 180.0 / M_PI, 2.5);
+      }
+    }
+    EXPECT_GT(reported, second.scans.size() / 2);
+  }
+  {
+    const SimulatedSequence elsewhere = SecondRun(false);
+    Relocalizer relocalizer(map, options);
+    for (const RadarScan& scan : elsewhere.scans) {
+      EXPECT_FALSE(relocalizer.Register(scan).fixed);
+    }
+    EXPECT_FALSE(relocalizer.first_fix().has_value());
+    EXPECT_GT(relocalizer.candidates().size(), 0u);
+  }
+  GaussianMap without_places = map;
+  without_places.places.clear();
+  EXPECT_THROW(Relocalizer(without_places, options), DataError);
 }
 
 TEST(RadarSlam, RefusesBadOptions) {

@@ -29,6 +29,7 @@ Subcommand AddEvaluate(CLI::App& parent);
 Subcommand AddRefine(CLI::App& parent);
 Subcommand AddOdometry(CLI::App& parent);
 Subcommand AddSlam(CLI::App& parent);
+Subcommand AddRelocalize(CLI::App& parent);
 
 // The flags every subcommand that reads a sequence shares; the trajectory
 // that gives the scans their poses is `poses_flag` (refine: --poses).

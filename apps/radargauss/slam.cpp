@@ -14,7 +14,6 @@
 #include "radargauss/evaluation.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/progress.hpp"
-#include "radargauss/radargauss.hpp"
 #include "radargauss/slam/radar_slam.hpp"
 
 namespace radargauss::cli {
@@ -37,16 +36,6 @@ SlamOptions Resolved(const SlamSettings& s) {
   o.graph.loop_rejection = LoopRejectionFromString(s.loop_rejection);
   o.graph.loop_loss.type = LossTypeFromString(s.loop_loss);
   return o;
-}
-
-// The map of the place: build-map's estimator with the odometry map's
-// Gaussian and RCS options over every scan at its optimised pose.
-GaussianMap PlaceMap(const Sequence& sequence, const RadarSlam& slam) {
-  MapOptions options;
-  options.cloud.ego_velocity = slam.options().odometry.ego_velocity;
-  options.gaussians = slam.options().odometry.map.gaussians;
-  options.rcs = slam.options().odometry.map.rcs;
-  return BuildMap(sequence.scans, slam.Poses(), options);
 }
 
 int RunSlam(const SlamSettings& s) {
@@ -80,7 +69,7 @@ int RunSlam(const SlamSettings& s) {
   slam.Finish();
   bar.Update("slam", sequence.scans.size(), sequence.scans.size());
   bar.Finish();
-  const GaussianMap map = PlaceMap(sequence, slam);
+  const GaussianMap map = BuildPlaceMap(sequence.scans, slam);
   const std::string out = folder.path();
   WriteOdometry((std::filesystem::path(out) / "odometry").string(), slam.odometry());
   WriteSlam(out, slam);

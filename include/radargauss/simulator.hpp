@@ -45,6 +45,8 @@ double MaterialRcs(const Material& material, double incidence_angle);
 // (configs/synthetic_world.yaml lists them all with these values).
 struct SimulationConfig {
   std::uint32_t seed = 1;
+  std::uint32_t world_seed = 0;      // the scene's objects; 0: drawn from seed (another seed, the same world)
+  double start_offset = 0.0;         // m along the loop where the drive starts
   // Drive.
   int scans = 300;
   double rate_hz = 10.0;

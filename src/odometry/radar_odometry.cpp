@@ -55,6 +55,16 @@ const ScanMatcher& RadarOdometry::MatcherForMap() {
   return *matcher_;
 }
 
+void RadarOdometry::LocalizeIn(std::shared_ptr<const MatchingMap> map, const SE3d& map_from_odometry) {
+  if (!map) throw std::invalid_argument("LocalizeIn: no map");
+  fixed_map_ = std::move(map);
+  if (state_) {
+    state_->pose = map_from_odometry * state_->pose;
+    if (state_->before) state_->before->second = map_from_odometry * state_->before->second;
+  }
+  last_keyframe_ = map_from_odometry * last_keyframe_;
+}
+
 void RadarOdometry::AddGyro(const std::vector<GyroSample>& samples) {
   for (const GyroSample& sample : samples) {
     if (!std::isfinite(sample.stamp) || !sample.rate.allFinite()) {
@@ -165,7 +175,7 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& scan) {
   if (state_) prediction = Predict(scan.timestamp);
   const Velocity velocity = MeasureVelocity(scan, prediction);
   const PoseEstimate estimate = EstimatePose(scan, prediction, velocity);
-  const bool keyframe = IsKeyframe(estimate.pose, velocity);
+  const bool keyframe = !fixed_map_ && IsKeyframe(estimate.pose, velocity);
   if (keyframe) InsertKeyframe(scan, velocity.static_points, estimate.pose);
   last_static_points_ = velocity.static_points;
   OdometryStep step = StepOf(scan, prediction, velocity, estimate, keyframe);
@@ -214,7 +224,8 @@ RadarOdometry::PoseEstimate RadarOdometry::Match(const RadarScan& scan, const Pr
   matched.points.reserve(velocity.static_points.size());
   for (const std::size_t i : velocity.static_points) matched.points.push_back(scan.points[i]);
   PoseEstimate estimate{predicted, std::nullopt, false, ""};
-  estimate.match = MatcherForMap().Match(matched, map_.matching(), predicted, PriorsOf(prediction, velocity));
+  const MatchingMap& target = fixed_map_ ? *fixed_map_ : map_.matching();
+  estimate.match = MatcherForMap().Match(matched, target, predicted, PriorsOf(prediction, velocity));
   const ScanMatchingResult& result = *estimate.match;
   const bool usable = result.pose.translation().allFinite() && result.n_geo >= options_.min_matched_points;
   if (!usable) {

@@ -27,6 +27,8 @@ using ConfigValue = std::variant<double*, int*, std::uint32_t*>;
 
 std::vector<std::pair<std::string, ConfigValue>> ConfigFields(SimulationConfig& c) {
   return {{"seed", &c.seed},
+          {"world_seed", &c.world_seed},
+          {"start_offset", &c.start_offset},
           {"scans", &c.scans},
           {"rate_hz", &c.rate_hz},
           {"start_time", &c.start_time},
@@ -74,6 +76,7 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
   require(c.rate_hz > 0.0, "rate_hz must be > 0");
   require(std::isfinite(c.start_time) && c.start_time >= 0.0, "start_time must be >= 0");
   require(c.speed >= 0.0, "speed must be >= 0");
+  require(c.start_offset >= 0.0, "start_offset must be >= 0");
   require(c.corner_radius > 0.0 && c.loop_length > 2.0 * c.corner_radius &&
               c.loop_width > 2.0 * c.corner_radius,
           "loop_length and loop_width must exceed 2 x corner_radius > 0");

@@ -143,7 +143,7 @@ void SensorState(const SimulationConfig& config, const LoopPath& path, double ti
   Eigen::Vector2d p;
   double heading = 0.0;
   bool straight = false;
-  path.At(5.0 + config.speed * time, p, heading, straight);
+  path.At(5.0 + config.start_offset + config.speed * time, p, heading, straight);
   const double roll = config.attitude_wobble_deg * kDeg * std::sin(2.0 * M_PI * 0.5 * time);
   const double pitch = config.attitude_wobble_deg * kDeg * std::sin(2.0 * M_PI * 0.3 * time + 1.0);
   const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ()) *

@@ -146,7 +146,8 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
   sequence.config = config;
   const simulation::LoopPath path{config.loop_length, config.loop_width, config.corner_radius};
   Draws draws(config.seed);
-  const Scene scene = BuildScene(config, path, draws.rng);
+  std::mt19937 world_rng(config.world_seed);
+  const Scene scene = BuildScene(config, path, config.world_seed == 0 ? draws.rng : world_rng);
   ScanState state;
   state.stds = {float(config.range_noise), float(config.azimuth_noise_deg * kDeg),
                 float(config.elevation_noise_deg * kDeg), float(config.doppler_noise)};

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// SLAM's outputs (docs/cli.md, "slam").
+// SLAM's outputs (docs/cli.md, "slam") and the map of the place.
 #include <algorithm>
 #include <filesystem>
 #include <iomanip>
@@ -9,6 +9,7 @@
 
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/map/pipeline.hpp"
 #include "radargauss/slam/radar_slam.hpp"
 #include "radargauss/stats.hpp"
 
@@ -43,6 +44,20 @@ void WriteLoops(std::ostream& out, const RadarSlam& slam) {
 }
 
 }  // namespace
+
+GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& slam) {
+  MapOptions options;
+  options.cloud.ego_velocity = slam.options().odometry.ego_velocity;
+  options.gaussians = slam.options().odometry.map.gaussians;
+  options.rcs = slam.options().odometry.map.rcs;
+  MapGeometry geometry = BuildMapGeometry(scans, slam.Poses(), options);
+  FitRcsModels(geometry.map, geometry.cloud, geometry.association, options.rcs);  // as BuildMap
+  GaussianMap map = std::move(geometry.map);
+  for (std::size_t k = 0; k < slam.keyframes().size(); ++k) {
+    map.places.push_back({slam.graph().poses()[k], slam.keyframes()[k].points});
+  }
+  return map;
+}
 
 SlamSummary Summarise(const RadarSlam& slam) {
   SlamSummary s;

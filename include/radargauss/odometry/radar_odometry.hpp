@@ -116,6 +116,10 @@ class RadarOdometry {
   const OdometryStep& Register(const RadarScan& scan);
   // Adds gyro samples (radar frame, time order) used from the next scan on.
   void AddGyro(const std::vector<GyroSample>& samples);
+  // From the next scan on, matches against `map`, fixed (nothing is
+  // inserted), with the motion model carried into the map's frame by
+  // `map_from_odometry`: localisation in a given map (relocalisation's tracking).
+  void LocalizeIn(std::shared_ptr<const MatchingMap> map, const SE3d& map_from_odometry);
 
   const std::vector<OdometryStep>& steps() const { return steps_; }
   Trajectory trajectory() const;
@@ -196,6 +200,7 @@ class RadarOdometry {
   std::vector<GyroSample> gyro_;
   SE3d last_keyframe_;
   std::vector<std::size_t> last_static_points_;
+  std::shared_ptr<const MatchingMap> fixed_map_;  // LocalizeIn's; null: the run's own map
   std::size_t map_bytes_ = 0;  // LocalMap::MemoryBytes after the last keyframe
 };
 

@@ -108,6 +108,12 @@ struct SlamSummary {
 };
 SlamSummary Summarise(const RadarSlam& slam);
 
+// The map of the place: build-map's estimator (the odometry map's Gaussian
+// and RCS options, its Doppler filter) over every scan at its optimised pose,
+// with the keyframes as places at their optimised poses. `scans` are the ones
+// registered, in order.
+GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& slam);
+
 // Writes slam.tum (each scan's optimised T_world_radar), keyframes.csv,
 // loops.csv and slam.json into `dir` (created), each file whole or not at all.
 void WriteSlam(const std::string& dir, const RadarSlam& slam);

@@ -1,0 +1,151 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// radargauss relocalize: a sequence located in a SLAM map without an initial
+// pose (docs/design.md, "Relocalisation"), evaluated against a reference
+// when one is given.
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <memory>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "odometry_settings.hpp"
+#include "radargauss/atomic_file.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/evaluation.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/progress.hpp"
+#include "radargauss/slam/relocalization.hpp"
+
+namespace radargauss::cli {
+
+namespace {
+
+struct RelocalizeSettings {
+  OdometrySettings odometry;
+  std::string map;
+  RelocalizationOptions relocalization;
+  PlaceRecognitionSettings place_recognition;
+};
+
+void WritePerScan(std::ostream& out, const Relocalizer& relocalizer) {
+  out << "scan,stamp,fixed,matched,x,y,z,qx,qy,qz,qw,reason\n" << std::setprecision(9);
+  for (std::size_t k = 0; k < relocalizer.steps().size(); ++k) {
+    const RelocalizationStep& s = relocalizer.steps()[k];
+    const Eigen::Quaterniond& q = s.pose.rotation().quaternion();
+    const Eigen::Vector3d& t = s.pose.translation();
+    out << k << ',' << std::fixed << s.stamp << std::defaultfloat << ',' << s.fixed << ',' << s.matched;
+    if (s.fixed) {
+      out << ',' << t.x() << ',' << t.y() << ',' << t.z() << ',' << q.x() << ',' << q.y() << ',' << q.z() << ','
+          << q.w();
+    } else {
+      out << ",,,,,,,";
+    }
+    out << ",\"" << s.reason << "\"\n";
+  }
+}
+
+void WriteCandidates(std::ostream& out, const Relocalizer& relocalizer) {
+  out << "submap,place,score,yaw_deg,verified,overlap,associated,cost,translation_std,rotation_std_deg,accepted,"
+         "fixed,reason\n"
+      << std::setprecision(6);
+  for (const PlaceCandidate& c : relocalizer.candidates()) {
+    out << c.submap << ',' << c.place << ',' << c.distance << ',' << c.yaw * 180.0 / M_PI << ',' << c.verified << ','
+        << c.check.overlap << ',' << c.check.associated << ',' << c.check.cost << ',' << c.check.translation_std << ','
+        << c.check.rotation_std_deg << ',' << c.check.accepted << ',' << c.fixed << ",\"" << c.check.reason << "\"\n";
+  }
+}
+
+int RunRelocalize(const RelocalizeSettings& s) {
+  RelocalizationOptions options = s.relocalization;
+  if (s.odometry.matcher != "gaussians") throw DataError("relocalize: --matcher must be gaussians");
+  options.odometry = Resolved(s.odometry);
+  options.place_recognition = s.place_recognition.Resolved();
+  ValidateOptions(options);
+  GaussianMap map = ReadMap(s.map);
+  if (map.places.empty()) {
+    throw FileError(s.map, "the map has no places to relocalise against (build it with radargauss slam)");
+  }
+  SequenceOptions sequence_options = s.odometry.sequence;
+  sequence_options.ground_truth.clear();
+  Sequence sequence = LoadSequence(sequence_options);
+  if (s.odometry.max_scans > 0 && sequence.scans.size() > s.odometry.max_scans) {
+    sequence.scans.resize(s.odometry.max_scans);
+  }
+  if (sequence.scans.empty()) throw DataError("the sequence has no scans");
+  CheckRcsWeights(sequence, {options.odometry.match.matching.w_rcs});
+  std::optional<Trajectory> reference;
+  const SequenceOptions& given = s.odometry.sequence;
+  if (!given.ground_truth.empty()) {
+    reference = ReadRadarTrajectory(given.ground_truth, ResolveExtrinsic(given.extrinsic, given.ground_truth));
+    CheckReferenceCovers(*reference, sequence, given.ground_truth);
+  }
+  StagedFolder folder(s.odometry.out);
+  Relocalizer relocalizer(std::move(map), options);
+  ProgressBar bar;
+  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
+    try {
+      relocalizer.Register(sequence.scans[k]);
+    } catch (const DataError& e) {
+      throw DataError(sequence.scan_sources[k] + ": " + e.what());
+    }
+    if (k % 16 == 0) bar.Update("relocalize", k, sequence.scans.size());
+  }
+  bar.Update("relocalize", sequence.scans.size(), sequence.scans.size());
+  bar.Finish();
+  Trajectory located;
+  std::size_t matched = 0;
+  for (const RelocalizationStep& step : relocalizer.steps()) {
+    if (step.fixed) located.Append(step.stamp, step.pose);
+    matched += step.matched;
+  }
+  const std::filesystem::path out(folder.path());
+  WriteTum((out / "relocalization.tum").string(), located);
+  WriteFileAtomically((out / "per_scan.csv").string(), [&](std::ostream& o) { WritePerScan(o, relocalizer); });
+  WriteFileAtomically((out / "candidates.csv").string(), [&](std::ostream& o) { WriteCandidates(o, relocalizer); });
+  const std::optional<std::size_t> fix = relocalizer.first_fix();
+  nlohmann::json summary = {{"scans", sequence.scans.size()},
+                            {"fixed_scans", located.size()},
+                            {"matched_scans", matched},
+                            {"submaps_compared", relocalizer.candidates().empty() ? 0 : relocalizer.candidates().back().submap + 1}};
+  summary["first_fix_scan"] = fix ? nlohmann::json(*fix) : nlohmann::json(nullptr);
+  summary["time_to_first_fix_s"] =
+      fix ? nlohmann::json(sequence.scans[*fix].timestamp - sequence.scans.front().timestamp) : nlohmann::json(nullptr);
+  WriteFileAtomically((out / "summary.json").string(), [&](std::ostream& o) { o << summary.dump(2) << "\n"; });
+  std::string table;
+  if (reference && located.size() >= 3) table = WriteEvaluation(out.string(), EvaluateTrajectory(located, *reference));
+  folder.Commit();
+  if (fix) {
+    std::printf("relocalize: first fix at scan %zu (%.1f s in); %zu of %zu scans located, %zu matched to the map\n",
+                *fix, sequence.scans[*fix].timestamp - sequence.scans.front().timestamp, located.size(),
+                sequence.scans.size(), matched);
+  } else {
+    std::printf("relocalize: no fix: none of the %zu candidates of %d submaps verified; no pose reported\n",
+                relocalizer.candidates().size(),
+                relocalizer.candidates().empty() ? 0 : relocalizer.candidates().back().submap + 1);
+  }
+  std::printf("%s", table.c_str());
+  std::printf("wrote %s (relocalization.tum, per_scan.csv, candidates.csv, summary.json%s)\n", s.odometry.out.c_str(),
+              table.empty() ? "" : ", evaluation.json, evaluation.md");
+  return 0;
+}
+
+}  // namespace
+
+Subcommand AddRelocalize(CLI::App& parent) {
+  auto s = std::make_shared<RelocalizeSettings>();
+  CLI::App* app = parent.add_subcommand("relocalize", "Locate a sequence in a SLAM map without an initial pose");
+  app->add_option("--map", s->map, "Map of radargauss slam (.rgm with places)")->required();
+  AddSequenceOptions(app, s->odometry.sequence, "--gt", "Reference trajectory (TUM, map frame), for the evaluation only");
+  app->add_option("--out", s->odometry.out, "Output folder")->required();
+  AddOdometryOptions(app, s->odometry);
+  app->add_option("--submap-distance", s->relocalization.submap_distance, "A submap every this many metres driven")
+      ->check(Positive())
+      ->capture_default_str();
+  AddPlaceRecognitionOptions(app, s->place_recognition);
+  return {app, [s] { return RunRelocalize(*s); }};
+}
+
+}  // namespace radargauss::cli

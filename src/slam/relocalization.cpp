@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/slam/relocalization.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "radargauss/error.hpp"
+
+namespace radargauss {
+
+void ValidateOptions(const RelocalizationOptions& o) {
+  ValidateOptions(o.odometry);
+  ValidateOptions(o.place_recognition);
+  ValidateOptions(o.verification);
+  if (!(o.submap_distance > 0.0) || !std::isfinite(o.submap_distance)) {
+    throw std::invalid_argument("relocalization: submap_distance must be positive");
+  }
+  if (!(o.confirm_translation > 0.0) || !(o.confirm_rotation_deg > 0.0)) {
+    throw std::invalid_argument("relocalization: the confirmation tolerances must be positive");
+  }
+  if (o.max_unmatched_scans < 1) throw std::invalid_argument("relocalization: max_unmatched_scans must be >= 1");
+}
+
+Relocalizer::Relocalizer(GaussianMap map, const RelocalizationOptions& options) : options_(options) {
+  ValidateOptions(options_);
+  if (map.places.empty()) throw DataError("the map has no places to relocalise against (build it with radargauss slam)");
+  if (map.gaussians.empty()) throw DataError("the map has no Gaussians");
+  map_ = std::make_shared<const GaussianMap>(std::move(map));
+  matching_ = std::make_shared<const MatchingMap>(map_);
+  for (const MapPlace& place : map_->places) places_.push_back(Describe(place.points, options_.place_recognition));
+  Restart();
+}
+
+void Relocalizer::Restart() {
+  odometry_ = std::make_unique<RadarOdometry>(options_.odometry);
+  submap_.clear();
+  path_ = submap_start_ = 0.0;
+  fix_.reset();
+  pending_.reset();
+  unmatched_ = 0;
+}
+
+const RelocalizationStep& Relocalizer::Register(const RadarScan& scan) {
+  const std::size_t index = steps_.size();
+  const std::size_t local = odometry_->steps().size();  // since the last restart
+  const OdometryStep& odometry = odometry_->Register(scan);
+  RelocalizationStep step;
+  step.stamp = odometry.stamp;
+  if (fix_) {
+    // Only a scan matched to the map has a pose: a prediction is not verified.
+    step.fixed = step.matched = odometry.matched;
+    step.pose = odometry.pose;
+    step.reason = odometry.reason;
+    unmatched_ = odometry.matched ? 0 : unmatched_ + 1;
+    if (unmatched_ >= options_.max_unmatched_scans) {
+      step.reason = "lost the map after " + std::to_string(unmatched_) + " scans without a match: searching again";
+      Restart();
+    }
+    steps_.push_back(std::move(step));
+    return steps_.back();
+  }
+  if (local > 0) path_ += (odometry.pose.translation() - odometry_->steps()[local - 1].pose.translation()).norm();
+  if (local == 0) submap_origin_ = odometry.pose;
+  const SE3d submap_from_scan = submap_origin_.Inverse() * odometry.pose;
+  for (const std::size_t i : odometry_->last_static_points()) {
+    RadarPoint point = scan.points[i];
+    point.position = submap_from_scan * point.position;
+    submap_.push_back(point);
+  }
+  if (path_ - submap_start_ >= options_.submap_distance) {
+    Search();
+    submap_.clear();
+    submap_origin_ = odometry.pose;
+    submap_start_ = path_;
+    if (fix_) {
+      if (!first_fix_) first_fix_ = index;
+      ++fixes_;
+      odometry_->LocalizeIn(matching_, *fix_);
+      step.fixed = true;
+      step.pose = *fix_ * odometry.pose;  // registered before the fix: in the odometry's frame
+    }
+  }
+  if (!fix_) step.reason = "no verified fix yet (" + std::to_string(submaps_) + " submaps searched)";
+  steps_.push_back(std::move(step));
+  return steps_.back();
+}
+
+void Relocalizer::Search() {
+  const int submap = submaps_++;
+  const std::vector<RadarPoint> points = DownsampleSubmap(submap_, options_.place_recognition.submap_voxel);
+  const PlaceDescription description = Describe(points, options_.place_recognition);
+  std::vector<int> every(places_.size());
+  for (std::size_t p = 0; p < places_.size(); ++p) every[p] = int(p);
+  std::optional<SE3d> found;  // T_map_odometry from this submap
+  for (const PlaceMatch& match : RankPlaces(description, places_, every, options_.place_recognition)) {
+    PlaceCandidate candidate;
+    candidate.submap = submap;
+    candidate.place = match.candidate;
+    candidate.distance = match.distance;
+    candidate.yaw = match.yaws.front();
+    if (found) {
+      candidate.check.reason = "another candidate was accepted";
+    } else if (!match.close) {
+      char reason[64];
+      std::snprintf(reason, sizeof(reason), "descriptor distance %.3f", match.distance);
+      candidate.check.reason = reason;
+    } else {
+      candidate.verified = true;
+      for (const double yaw : match.yaws) {
+        LoopCheck check = VerifyLoop(points, map_->places[match.candidate].points, yaw, std::nullopt,
+                                     options_.verification);
+        if (check.accepted || yaw == match.yaws.front() || check.associated > candidate.check.associated) {
+          candidate.check = std::move(check);
+          candidate.yaw = yaw;
+        }
+        if (candidate.check.accepted) break;
+      }
+      // The place's pose times the match gives the submap's origin in the map.
+      if (candidate.check.accepted) {
+        found = map_->places[match.candidate].pose * candidate.check.relative * submap_origin_.Inverse();
+      }
+    }
+    candidates_.push_back(std::move(candidate));
+  }
+  // A fix needs the submap before to have found the same T_map_odometry.
+  if (found && pending_) {
+    const SE3d disagreement = pending_->Inverse() * *found;
+    if (disagreement.translation().norm() <= options_.confirm_translation &&
+        disagreement.rotation().Log().norm() * 180.0 / M_PI <= options_.confirm_rotation_deg) {
+      fix_ = found;
+      candidates_.back().fixed = true;
+    }
+  }
+  pending_ = found;
+}
+
+}  // namespace radargauss
