@@ -91,7 +91,7 @@ expect_fail "odometry's --gt of another time" "later.tum: --gt: 0 of the 4 scans
 # Every unbounded number flag at both extremes: a result or a one-line
 # refusal within the timeout, never a hang or a crash (squares, cell counts
 # and region counts derive from them).
-for command in odometry localize build-map; do
+for command in odometry slam localize build-map; do
   while read -r flag count; do
     for value in 1e300 1e-300; do
       values=()
@@ -124,6 +124,18 @@ awk '{ $2 = sprintf("%.9f", $2 + 1000); print }' "$work/seq/gt_radar_tum.txt" >"
 expect_fail "refine on a map the scans miss" "map.rgm: 0.0 % of the scans' points lie near the map" -- \
   "$tool" refine --sequence "$work/seq" --poses "$work/far.tum" --extrinsic identity --map "$work/map.rgm" --out "$work/r"
 [[ ! -e "$work/r" ]] || { echo "FAIL: a refused refine left its output"; failed=$((failed + 1)); }
+
+# SLAM and relocalisation: a map without places, an empty sequence, a missing map.
+expect_fail "relocalize on a map without places" "map.rgm: the map has no places to relocalise against" -- \
+  "$tool" relocalize --map "$work/map.rgm" --sequence "$work/seq" --out "$work/rl"
+[[ ! -e "$work/rl" ]] || { echo "FAIL: a refused relocalize left its output"; failed=$((failed + 1)); }
+expect_fail "relocalize on a missing map" "absent.rgm" -- \
+  "$tool" relocalize --map "$work/absent.rgm" --sequence "$work/seq" --out "$work/rl"
+mkdir -p "$work/empty"
+expect_fail "slam on an empty sequence" "empty: no scans found" -- "$tool" slam --sequence "$work/empty" --out "$work/sl"
+[[ ! -e "$work/sl" ]] || { echo "FAIL: a refused slam left its output"; failed=$((failed + 1)); }
+expect_fail "slam with a PCL matcher" "slam: --matcher must be gaussians" -- \
+  "$tool" slam --matcher pcl-ndt "${seq[@]}" --out "$work/sl"
 
 # Negative stamps order numerically (as text -1 would come before -2).
 mkdir -p "$work/negative"

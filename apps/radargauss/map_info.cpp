@@ -30,8 +30,9 @@ int RunMapInfo(const std::string& path) {
     }
   }
   const std::size_t n = map.gaussians.size();
-  std::printf("map: %s (version %u)\n", path.c_str(), kMapFileVersion);
+  std::printf("map: %s\n", path.c_str());
   std::printf("gaussians: %zu, member points: %zu\n", n, members);
+  std::printf("places (SLAM keyframes for relocalize): %zu\n", map.places.size());
   std::printf("incidence model: %s\n", ToString(map.incidence).c_str());
   std::printf("rcs coverage: %zu of %zu (%.1f%%) have a model\n", with_model, n,
               n ? 100.0 * double(with_model) / double(n) : 0.0);

@@ -32,7 +32,7 @@ int RunOdometry(const OdometrySettings& s) {
   SequenceOptions sequence_options = s.sequence;
   sequence_options.ground_truth.clear();  // every scan, not only those the reference covers
   Sequence sequence = LoadSequence(sequence_options);
-  if (s.max_scans > 0 && sequence.scans.size() > s.max_scans) sequence.scans.resize(s.max_scans);
+  SelectScans(s, sequence);
   if (sequence.scans.empty()) throw DataError("the sequence has no scans");
   CheckRcsWeights(sequence, {options.match.matching.w_rcs});
   // The reference is read before the run, and the evaluation made before any

@@ -189,7 +189,8 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   app->add_option("--imu-rotation", s.imu_rotation, "q_radar_imu as x y z w (rotates gyro rates into the radar frame)")
       ->expected(4)
       ->capture_default_str();
-  app->add_option("--max-scans", s.max_scans, "Only the first N scans (0: all)")->capture_default_str();
+  app->add_option("--first-scan", s.first_scan, "Skip the scans before this one (0: none)")->capture_default_str();
+  app->add_option("--max-scans", s.max_scans, "Only the first N scans from --first-scan (0: all)")->capture_default_str();
 }
 
 PlaceRecognitionOptions PlaceRecognitionSettings::Resolved() const {
@@ -219,6 +220,14 @@ void AddPlaceRecognitionOptions(CLI::App* app, PlaceRecognitionSettings& s) {
   app->add_option("--max-radon-distance", o.max_radon_distance, "Places farther by the Radon descriptor are not verified")
       ->check(InRange(0.0, 1.0))
       ->capture_default_str();
+}
+
+void SelectScans(const OdometrySettings& s, Sequence& sequence) {
+  const std::size_t first = std::min(s.first_scan, sequence.scans.size());
+  sequence.scans.erase(sequence.scans.begin(), sequence.scans.begin() + std::ptrdiff_t(first));
+  sequence.scan_sources.erase(sequence.scan_sources.begin(),
+                              sequence.scan_sources.begin() + std::ptrdiff_t(std::min(first, sequence.scan_sources.size())));
+  if (s.max_scans > 0 && sequence.scans.size() > s.max_scans) sequence.scans.resize(s.max_scans);
 }
 
 }  // namespace radargauss::cli

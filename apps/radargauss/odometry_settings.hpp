@@ -29,6 +29,7 @@ struct OdometrySettings {
   std::string imu_stamps = "header";
   std::vector<double> imu_rotation = {0, 0, 0, 1};  // q_radar_imu (x y z w)
   std::vector<double> rotation_rate_std = ToVector(OdometryOptions().rotation_rate_std_deg);  // deg/s
+  std::size_t first_scan = 0;
   std::size_t max_scans = 0;
   std::string matcher = "gaussians";  // or a PCL peer
 };
@@ -44,6 +45,8 @@ std::vector<GyroSample> GyroOf(const OdometrySettings& s);
 void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence);
 // Throws FileError when fewer than 3 scans lie in the reference's time span.
 void CheckReferenceCovers(const Trajectory& reference, const Sequence& sequence, const std::string& path);
+// --first-scan and --max-scans: the scans to run, in place.
+void SelectScans(const OdometrySettings& s, Sequence& sequence);
 // Every flag of OdometrySettings.
 void AddOdometryOptions(CLI::App* app, OdometrySettings& s);
 

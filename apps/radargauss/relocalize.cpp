@@ -71,9 +71,7 @@ int RunRelocalize(const RelocalizeSettings& s) {
   SequenceOptions sequence_options = s.odometry.sequence;
   sequence_options.ground_truth.clear();
   Sequence sequence = LoadSequence(sequence_options);
-  if (s.odometry.max_scans > 0 && sequence.scans.size() > s.odometry.max_scans) {
-    sequence.scans.resize(s.odometry.max_scans);
-  }
+  SelectScans(s.odometry, sequence);
   if (sequence.scans.empty()) throw DataError("the sequence has no scans");
   CheckRcsWeights(sequence, {options.odometry.match.matching.w_rcs});
   std::optional<Trajectory> reference;

@@ -24,6 +24,7 @@ struct SlamSettings {
   OdometrySettings odometry;
   SlamOptions slam;
   PlaceRecognitionSettings place_recognition;
+  bool no_map = false;
   std::string loop_rejection = ToString(PoseGraphOptions().loop_rejection);
   std::string loop_loss = ToString(PoseGraphOptions().loop_loss.type);
 };
@@ -44,9 +45,7 @@ int RunSlam(const SlamSettings& s) {
   SequenceOptions sequence_options = s.odometry.sequence;
   sequence_options.ground_truth.clear();
   Sequence sequence = LoadSequence(sequence_options);
-  if (s.odometry.max_scans > 0 && sequence.scans.size() > s.odometry.max_scans) {
-    sequence.scans.resize(s.odometry.max_scans);
-  }
+  SelectScans(s.odometry, sequence);
   if (sequence.scans.empty()) throw DataError("the sequence has no scans");
   CheckRcsWeights(sequence, {options.odometry.match.matching.w_rcs});
   std::optional<Trajectory> reference;
@@ -69,12 +68,14 @@ int RunSlam(const SlamSettings& s) {
   slam.Finish();
   bar.Update("slam", sequence.scans.size(), sequence.scans.size());
   bar.Finish();
-  const GaussianMap map = BuildPlaceMap(sequence.scans, slam);
+  const GaussianMap map = s.no_map ? GaussianMap{} : BuildPlaceMap(sequence.scans, slam);
   const std::string out = folder.path();
   WriteOdometry((std::filesystem::path(out) / "odometry").string(), slam.odometry());
   WriteSlam(out, slam);
-  WriteMap((std::filesystem::path(out) / "map.rgm").string(), map);
-  ExportPly((std::filesystem::path(out) / "map.ply").string(), map);
+  if (!s.no_map) {
+    WriteMap((std::filesystem::path(out) / "map.rgm").string(), map);
+    ExportPly((std::filesystem::path(out) / "map.ply").string(), map);
+  }
   std::string tables;
   if (reference) {
     WriteEvaluation((std::filesystem::path(out) / "odometry").string(),
@@ -83,13 +84,13 @@ int RunSlam(const SlamSettings& s) {
   }
   folder.Commit();
   const SlamSummary summary = Summarise(slam);
-  std::printf("slam: %zu scans, %zu keyframes, %zu candidates compared, %zu verified, %zu loops; place "
+  std::printf("slam: %zu scans, %zu keyframes, %zu candidates compared, %zu verified, %zu loops (%zu false injected); place "
               "recognition %.2f ms per keyframe (median); map of %zu Gaussians\n",
-              sequence.scans.size(), summary.keyframes, summary.compared, summary.verified, summary.loops,
+              sequence.scans.size(), summary.keyframes, summary.compared, summary.verified, summary.loops, summary.injected,
               summary.describe_ms + summary.search_ms, map.gaussians.size());
   std::printf("%s", tables.c_str());
-  std::printf("wrote %s (slam.tum, keyframes.csv, loops.csv, slam.json, map.rgm, map.ply, odometry/%s)\n",
-              s.odometry.out.c_str(), reference ? ", evaluation.json, evaluation.md" : "");
+  std::printf("wrote %s (slam.tum, keyframes.csv, loops.csv, slam.json%s, odometry/%s)\n", s.odometry.out.c_str(),
+              s.no_map ? "" : ", map.rgm, map.ply", reference ? ", evaluation.json, evaluation.md" : "");
   return 0;
 }
 
@@ -102,6 +103,12 @@ void AddSlamOptions(CLI::App* app, SlamSettings& s) {
       ->check(NonNegative())
       ->capture_default_str();
   AddPlaceRecognitionOptions(app, s.place_recognition);
+  app->add_flag("--no-map", s.no_map, "Write no map of the place (trajectories and loops only)");
+  app->add_option("--false-loop-rate", o.false_loop_rate,
+                  "Robustness studies: the share of keyframes given an injected false loop (0: none)")
+      ->check(InRange(0.0, 1.0))
+      ->capture_default_str();
+  app->add_option("--false-loop-seed", o.false_loop_seed, "Seed of the injected false loops")->capture_default_str();
   app->add_option("--loop-rejection", s.loop_rejection, "Loop edges: loss, switchable or graduated")
       ->check(CLI::IsMember(LoopRejectionNames()))
       ->capture_default_str();

@@ -29,11 +29,13 @@ void ValidateOptions(const SlamOptions& o) {
   ValidateOptions(o.place_recognition);
   require(o.submap_distance > 0.0 && std::isfinite(o.submap_distance), "submap_distance must be positive");
   require(o.min_loop_path >= 0.0, "min_loop_path must be >= 0");
+  require(o.false_loop_rate >= 0.0 && o.false_loop_rate <= 1.0, "false_loop_rate must be in [0, 1]");
   require(o.odometry_translation_std > 0.0 && o.odometry_rotation_std_deg > 0.0, "odometry stds must be positive");
   require(o.odometry_drift >= 0.0 && o.odometry_drift_deg >= 0.0, "odometry drifts must be >= 0");
 }
 
-RadarSlam::RadarSlam(const SlamOptions& options) : options_(options), odometry_(options.odometry) {
+RadarSlam::RadarSlam(const SlamOptions& options)
+    : options_(options), odometry_(options.odometry), false_loops_(options.false_loop_seed) {
   ValidateOptions(options_);
 }
 
@@ -129,6 +131,24 @@ void RadarSlam::SearchLoops(int query) {
     candidates_.push_back(candidate);
   }
   keyframes_[query].search_ms = MillisecondsSince(start);
+  if (options_.false_loop_rate > 0.0 && !eligible.empty()) InjectFalseLoop(query, eligible);
+}
+
+void RadarSlam::InjectFalseLoop(int query, const std::vector<int>& eligible) {
+  if (std::uniform_real_distribution<double>(0.0, 1.0)(false_loops_) >= options_.false_loop_rate) return;
+  LoopCandidate loop;
+  loop.query = query;
+  loop.candidate = eligible[std::uniform_int_distribution<std::size_t>(0, eligible.size() - 1)(false_loops_)];
+  loop.injected = true;
+  loop.check.accepted = true;
+  loop.check.reason = "injected false loop";
+  Eigen::Matrix<double, 6, 1> weights;
+  weights << Eigen::Vector3d::Constant(1.0 / options_.verification.translation_floor_std),
+      Eigen::Vector3d::Constant(180.0 / M_PI / options_.verification.rotation_floor_std_deg);
+  loop.check.sqrt_information = weights.asDiagonal();
+  graph_.AddLoop(loop.candidate, query, SE3d(), loop.check.sqrt_information);
+  graph_.Optimize(options_.graph);
+  candidates_.push_back(loop);
 }
 
 LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match) const {
@@ -181,7 +201,7 @@ double RadarSlam::PathThroughGraph(int from, int to) const {
 
 std::size_t RadarSlam::loops() const {
   return std::size_t(std::count_if(candidates_.begin(), candidates_.end(),
-                                   [](const LoopCandidate& c) { return c.check.accepted; }));
+                                   [](const LoopCandidate& c) { return c.check.accepted && !c.injected; }));
 }
 
 std::vector<SE3d> RadarSlam::Poses() const {

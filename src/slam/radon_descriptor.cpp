@@ -38,19 +38,15 @@ std::vector<Eigen::Vector2d> OccupiedCells(const std::vector<RadarPoint>& points
   return cells;
 }
 
+// (1 - cosine) / 2 of the two matrices with the query's rows shifted:
+// 0 the same, 1/2 unrelated, 1 opposite; 1 when either is all zero.
 double RowDistance(const Eigen::MatrixXd& query, const Eigen::MatrixXd& candidate, int shift) {
   const int rows = int(query.rows());
-  double sum = 0.0;
-  int count = 0;
-  for (int k = 0; k < rows; ++k) {
-    const auto a = query.row(k);
-    const auto b = candidate.row((k + shift) % rows);
-    const double norms = a.norm() * b.norm();
-    if (norms <= 0.0) continue;
-    sum += 1.0 - a.dot(b) / norms;
-    ++count;
-  }
-  return count > 0 ? sum / count : 1.0;
+  const double norms = query.norm() * candidate.norm();
+  if (norms <= 0.0) return 1.0;
+  double dot = 0.0;
+  for (int k = 0; k < rows; ++k) dot += query.row(k).dot(candidate.row((k + shift) % rows));
+  return 0.5 * (1.0 - dot / norms);
 }
 
 }  // namespace
@@ -77,7 +73,10 @@ RadonDescriptor MakeRadonDescriptor(const std::vector<RadarPoint>& points, const
     for (int s = 0; s < bins; ++s) basis[s] = std::polar(1.0, -2.0 * M_PI * k * s / bins);
     descriptor.spectra.col(k - 1) = (sinogram.cast<std::complex<double>>() * basis).cwiseAbs();
   }
+  // The key is the mean over directions; the rows keep what differs between
+  // directions (their deviation from that mean), which the yaw aligns.
   descriptor.key = descriptor.spectra.colwise().mean().transpose();
+  descriptor.spectra.rowwise() -= descriptor.key.transpose();
   if (descriptor.key.norm() > 0.0) descriptor.key.normalize();
   return descriptor;
 }

@@ -31,12 +31,12 @@ void WriteKeyframes(std::ostream& out, const RadarSlam& slam) {
 }
 
 void WriteLoops(std::ostream& out, const RadarSlam& slam) {
-  out << "query,candidate,score,yaw_deg,verified,overlap,associated,cost,translation_std,rotation_std_deg,"
+  out << "query,candidate,injected,score,yaw_deg,verified,overlap,associated,cost,translation_std,rotation_std_deg,"
          "correction_m,correction_deg,accepted,reason\n"
       << std::setprecision(6);
   for (const LoopCandidate& c : slam.candidates()) {
     const LoopCheck& check = c.check;
-    out << c.query << ',' << c.candidate << ',' << c.distance << ',' << c.yaw * 180.0 / M_PI << ',' << c.verified
+    out << c.query << ',' << c.candidate << ',' << c.injected << ',' << c.distance << ',' << c.yaw * 180.0 / M_PI << ',' << c.verified
         << ',' << check.overlap << ',' << check.associated << ',' << check.cost << ',' << check.translation_std << ','
         << check.rotation_std_deg << ',' << check.correction << ',' << check.correction_deg << ',' << check.accepted
         << ",\"" << check.reason << "\"\n";
@@ -65,7 +65,8 @@ SlamSummary Summarise(const RadarSlam& slam) {
   s.compared = slam.candidates().size();
   for (const LoopCandidate& c : slam.candidates()) {
     s.verified += c.verified;
-    s.loops += c.check.accepted;
+    s.loops += c.check.accepted && !c.injected;
+    s.injected += c.injected;
   }
   std::vector<double> describe, search;
   for (const Keyframe& keyframe : slam.keyframes()) {
@@ -91,6 +92,7 @@ void WriteSlam(const std::string& dir, const RadarSlam& slam) {
                                   {"candidates_compared", s.compared},
                                   {"candidates_verified", s.verified},
                                   {"loops", s.loops},
+                                  {"injected_false_loops", s.injected},
                                   {"describe_time_ms", s.describe_ms},
                                   {"search_time_ms", s.search_ms}};
   WriteFileAtomically((out / "slam.json").string(), [&](std::ostream& stream) { stream << summary.dump(2) << "\n"; });

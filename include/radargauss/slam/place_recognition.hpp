@@ -27,10 +27,10 @@ struct PlaceRecognitionOptions {
   ScanContextOptions scan_context;
   RadonOptions radon;
   double submap_voxel = 0.25;  // m: a submap keeps the first point of each voxel
-  int candidates = 5;          // compared per query, nearest by key
+  int candidates = 10;         // compared per query, nearest by key
   // Compared places farther than this (the descriptor's distance) are not verified.
   double max_scan_context_distance = 0.4;
-  double max_radon_distance = 0.2;
+  double max_radon_distance = 0.15;
 };
 
 // Throws std::invalid_argument naming the bad option.

@@ -15,6 +15,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -37,6 +39,12 @@ struct SlamOptions {
   double odometry_drift = 0.02;            // m per m
   double odometry_rotation_std_deg = 0.1;
   double odometry_drift_deg = 0.02;        // deg per m
+  // Robustness studies: after each keyframe's search, with this probability
+  // a false loop to a keyframe chosen at random (at least min_loop_path
+  // back) claiming the two coincide (identity, at the loop floors' weight)
+  // goes into the graph, recorded in candidates() as injected. 0: none.
+  double false_loop_rate = 0.0;
+  std::uint32_t false_loop_seed = 1;
 };
 
 // Throws std::invalid_argument naming the bad option.
@@ -57,6 +65,7 @@ struct LoopCandidate {
   double distance = 1.0;         // the descriptor's
   double yaw = 0.0;              // rad: the descriptor's, of the query in the candidate
   bool verified = false;         // passed to verification
+  bool injected = false;         // a false loop of false_loop_rate, not a candidate
   LoopCheck check;               // check.accepted: in the graph
 };
 
@@ -74,7 +83,7 @@ class RadarSlam {
   const std::vector<LoopCandidate>& candidates() const { return candidates_; }
   const PoseGraph& graph() const { return graph_; }
   const SlamOptions& options() const { return options_; }
-  std::size_t loops() const;  // accepted
+  std::size_t loops() const;  // accepted (injected false loops not counted)
   // T_world_radar of every scan: its keyframe's optimised pose times the odometry since.
   std::vector<SE3d> Poses() const;
   Trajectory trajectory() const;
@@ -83,6 +92,7 @@ class RadarSlam {
   void OpenKeyframe(std::size_t scan, const SE3d& pose, double stamp);
   void CloseKeyframe();
   void SearchLoops(int query);
+  void InjectFalseLoop(int query, const std::vector<int>& eligible);
   LoopCandidate Verify(int query, const PlaceMatch& match) const;
   // The metres driven between two keyframes along the graph's odometry edges,
   // loop edges crossed for free: how far the graph's estimate may have drifted.
@@ -98,12 +108,13 @@ class RadarSlam {
   std::vector<RadarPoint> open_points_;     // the open keyframe's submap so far
   double path_ = 0.0;
   bool open_ = false;
+  std::mt19937 false_loops_;
 };
 
 // Keyframe and loop counts, place recognition's time per keyframe (median),
 // the last solve's.
 struct SlamSummary {
-  std::size_t keyframes = 0, compared = 0, verified = 0, loops = 0;
+  std::size_t keyframes = 0, compared = 0, verified = 0, loops = 0, injected = 0;  // loops: accepted, not injected
   double describe_ms = 0.0, search_ms = 0.0;  // medians per keyframe
 };
 SlamSummary Summarise(const RadarSlam& slam);

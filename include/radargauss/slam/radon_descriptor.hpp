@@ -26,7 +26,7 @@ struct RadonOptions {
 void ValidateRadonOptions(const RadonOptions& options);
 
 struct RadonDescriptor {
-  Eigen::MatrixXd spectra;  // angles x offsets / 2: |DFT| of each projection, frequencies 1 .. offsets / 2
+  Eigen::MatrixXd spectra;  // angles x offsets / 2: |DFT| of each projection (frequencies 1 .. offsets / 2) minus their mean
   Eigen::VectorXd key;      // the rows' mean, unit norm (zero when empty): yaw-invariant
 };
 
@@ -34,7 +34,7 @@ struct RadonDescriptor {
 RadonDescriptor MakeRadonDescriptor(const std::vector<RadarPoint>& points, const RadonOptions& options);
 
 struct RadonMatch {
-  double distance = 1.0;  // mean cosine distance of the aligned rows, 0 (same) .. 1
+  double distance = 1.0;  // (1 - cosine) / 2 of the aligned spectra: 0 same, 1/2 unrelated, 1 opposite
   int shift = 0;          // query row k matches candidate row k + shift (mod angles)
   double yaw = 0.0;       // rad, [0, pi): the query frame's yaw in the candidate's, or yaw - pi
 };
