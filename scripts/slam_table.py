@@ -97,7 +97,7 @@ def evaluation(out):
 
 
 def map_size(tool, path):
-    text = run(tool + ["map-info", "--map", path])
+    text = run(tool + ["map-info", path])
     gaussians = int(text.split("gaussians: ")[1].split(",")[0])
     return gaussians, os.path.getsize(path) / 1e6
 
