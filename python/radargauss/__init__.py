@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""radargauss: 4D radar Gaussian-RCS maps, scan matching and odometry.
+"""radargauss: 4D radar Gaussian-RCS maps, scan matching, odometry and SLAM.
 
     import radargauss as rg
     sequence = rg.simulate(seed=1, scans=50)
@@ -11,13 +11,14 @@ Poses are T_world_radar, as 4x4 matrices or [x y z qx qy qz qw]
 RadarOdometry take every option as a keyword (option_fields lists them).
 Every function's help() lists its arguments; docs/python.md tells the rest.
 """
-from ._radargauss import (DataError, GaussianMap, MatchResult, RadarOdometry, Scan, Sequence, build_map, compose,
+from ._radargauss import (DataError, GaussianMap, MatchResult, RadarOdometry, RadarSlam, Relocalizer, Scan, Sequence,
+                          build_map, compose,
                           evaluate, initial_errors, match, match_options, odometry_options, option_fields,
                           pose_matrices, pose_matrix, read_map, read_pcd, read_sequence, read_tum, set_threads,
                           simulate, write_map, write_tum)
 from .sweep import Task, plan, run_task, sweep
 
-__all__ = ["DataError", "GaussianMap", "MatchResult", "RadarOdometry", "Scan", "Sequence", "build_map", "compose",
+__all__ = ["DataError", "GaussianMap", "MatchResult", "RadarOdometry", "RadarSlam", "Relocalizer", "Scan", "Sequence", "build_map", "compose",
            "evaluate", "initial_errors", "match", "match_options", "odometry_options", "option_fields",
            "pose_matrices", "pose_matrix", "read_map", "read_pcd", "read_sequence", "read_tum", "set_threads",
            "simulate", "write_map", "write_tum", "Task", "plan", "run_task", "sweep"]

@@ -148,6 +148,34 @@ class RadarOdometry:
     def trajectory(self: RadarOdometry) -> tuple:
         """(stamps (N,), poses (N, 7)) so far"""
 
+class RadarSlam:
+    """Radar SLAM (docs/design.md, "SLAM"): odometry, keyframes with submaps, place recognition, verified loops on a pose graph. Keywords: descriptor ('scan-context' or 'radon'), submap_distance, min_loop_path, candidates, loop_rejection ('loss', 'switchable', 'graduated'), and any keyword of RadarOdometry."""
+    def __init__(self: RadarSlam, descriptor: str = 'scan-context', submap_distance: float = 10.0, min_loop_path: float = 150.0, candidates: int = 10, loop_rejection: str = 'graduated', **kwargs) -> None:
+        ...
+    def finish(self: RadarSlam) -> None:
+        """Closes the last keyframe (described and searched): call after the last scan."""
+    @property
+    def keyframes(self) -> Any: ...
+    def loops(self: RadarSlam) -> list:
+        """Every compared candidate as a dict: query, candidate, distance, yaw, verified, accepted, relative, reason"""
+    def odometry_trajectory(self: RadarSlam) -> tuple:
+        """(stamps (N,), poses (N, 7)) of the odometry alone"""
+    def place_map(self: RadarSlam, scans: list[Scan]) -> GaussianMap:
+        """The map of the place from the registered scans (in order), with the keyframes as places"""
+    def register(self: RadarSlam, scan: Scan) -> None:
+        """Adds the next scan (stamps must increase)."""
+    def trajectory(self: RadarSlam) -> tuple:
+        """(stamps (N,), poses (N, 7)): every scan at its keyframe's optimised pose"""
+
+class Relocalizer:
+    """Relocalisation in a map of RadarSlam without an initial pose (docs/design.md, "Relocalisation"). Keywords: descriptor, submap_distance, candidates, and any keyword of RadarOdometry."""
+    def __init__(self: Relocalizer, map: GaussianMap, descriptor: str = 'scan-context', submap_distance: float = 10.0, candidates: int = 10, **kwargs) -> None:
+        ...
+    @property
+    def first_fix(self) -> Any: ...
+    def register(self: Relocalizer, scan: Scan) -> dict:
+        """Adds the next scan; a dict with fixed, pose (4x4, or None before a fix), matched, reason"""
+
 class Scan:
     """One radar scan: points (N, 3) in the radar frame, Doppler (m/s, positive receding) and RCS (dBsm), each a copy as a numpy array."""
     def __init__(self: Scan, points: Any, doppler: Any = None, rcs: Any = None, stamp: float = 0.0) -> None:

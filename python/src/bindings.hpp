@@ -32,5 +32,6 @@ void BindData(py::module_& m);
 void BindMap(py::module_& m);
 void BindMatch(py::module_& m);
 void BindOdometry(py::module_& m);
+void BindSlam(py::module_& m);
 
 }  // namespace radargauss::python

@@ -24,6 +24,7 @@ PYBIND11_MODULE(_radargauss, m) {
   radargauss::python::BindMap(m);
   radargauss::python::BindMatch(m);
   radargauss::python::BindOdometry(m);
+  radargauss::python::BindSlam(m);
   m.def(
       "set_threads",
       [](int threads) {

@@ -176,3 +176,29 @@ def test_every_solver_and_loss_of_the_docstring_matches():
 
 def test_help_explains_the_arguments():
     assert "initial" in rg.match.__doc__ and "w_rcs" in rg.match.__doc__ and "solver" in rg.match.__doc__
+
+
+def test_slam_closes_the_yard_and_relocalizes_a_second_run(tmp_path):
+    yard = ("loop_length: 60\nloop_width: 30\ncorner_radius: 8\npoles: 12\nparked_cars: 8\nmoving_cars: 1\n"
+            "min_detections: 150\nmax_detections: 300\nmax_range: 60\n")
+    (tmp_path / "yard.yaml").write_text(yard)
+    (tmp_path / "second.yaml").write_text(yard + "world_seed: 1\nstart_offset: 70\n")
+    drive = rg.simulate(seed=1, scans=500, config=str(tmp_path / "yard.yaml"))
+    slam = rg.RadarSlam(descriptor="radon", min_loop_path=100.0, candidates=20, active_radius=30.0)
+    for scan in drive.scans:
+        slam.register(scan)
+    slam.finish()
+    loops = [loop for loop in slam.loops() if loop["accepted"]]
+    assert slam.keyframes == 30 and len(loops) >= 5
+    corrected = rg.evaluate(slam.trajectory(), (drive.stamps, drive.poses))
+    odometry = rg.evaluate(slam.odometry_trajectory(), (drive.stamps, drive.poses))
+    assert corrected["ate_translation_m"]["rmse"] < odometry["ate_translation_m"]["rmse"]
+    place_map = slam.place_map(drive.scans)
+    second = rg.simulate(seed=7, scans=120, config=str(tmp_path / "second.yaml"))
+    relocalizer = rg.Relocalizer(place_map, descriptor="radon", candidates=20)
+    steps = [relocalizer.register(scan) for scan in second.scans]
+    assert relocalizer.first_fix is not None and relocalizer.first_fix < 60
+    assert all(step["pose"] is None for step in steps[:relocalizer.first_fix])
+    assert steps[relocalizer.first_fix]["fixed"] and steps[relocalizer.first_fix]["pose"].shape == (4, 4)
+    with pytest.raises(ValueError, match="unknown place descriptor"):
+        rg.RadarSlam(descriptor="sift")
