@@ -238,9 +238,9 @@ def relocalisation_table(tool, work, jobs, starts=20, scans=200):
 def real_table(tool, work):
     print("| sample | scans | keyframes | candidates verified | loops accepted | place recognition ms/keyframe |")
     print("|---|---|---|---|---|---|")
-    samples = [("NTU Eagle", ["--sequence", os.path.join(DATA, "ntu4dradlm_loop1_eagle"), "--config",
+    samples = [("NTU Eagle", ["--sequence", os.path.join(DATA, "ntu4dradlm_loop1_eagle", "points"), "--config",
                               os.path.join(ROOT, "configs", "ntu_eagle_odometry.yaml")]),
-               ("smartmicro highway", ["--sequence", os.path.join(DATA, "smartmicro_umrr_highway")])]
+               ("smartmicro highway", ["--sequence", os.path.join(DATA, "smartmicro_umrr_highway", "points")])]
     for name, flags in samples:
         if not os.path.isdir(flags[1]):
             print(f"| {name} | absent | | | | |")
