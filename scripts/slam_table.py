@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""SLAM figures of bench/RESULTS.md, "SLAM": two laps of the 1.8 km loop
+"""SLAM figures of bench/SLAM.md: two laps of the 1.8 km loop
 (configs/synthetic_two_laps.yaml) through `radargauss slam` with each place
 descriptor (ATE, RPE, true revisits closed, false loops, place recognition's
 time, the map's size after one lap and two); the loop rejections of the pose
