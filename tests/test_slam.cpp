@@ -29,8 +29,8 @@ const SimulatedSequence& Yard() {
     config.poles = 12;
     config.parked_cars = 8;
     config.moving_cars = 1;
-    config.min_detections = 150;
-    config.max_detections = 300;
+    config.min_detections = 100;
+    config.max_detections = 200;
     config.max_range = 60.0;
     return new SimulatedSequence(Simulate(config));
   }();

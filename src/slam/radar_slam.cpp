@@ -185,7 +185,8 @@ double RadarSlam::PathThroughGraph(int from, int to) const {
   distance[from] = 0.0;
   queue.emplace(0.0, from);
   while (!queue.empty()) {
-    const auto [d, k] = queue.top();
+    const double d = queue.top().first;
+    const int k = queue.top().second;
     queue.pop();
     if (k == to) return d;
     if (d > distance[k]) continue;
