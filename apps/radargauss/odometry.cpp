@@ -29,20 +29,9 @@ int RunOdometry(const OdometrySettings& s) {
   const OdometryOptions options = Resolved(s);
   ValidateOptions(options);
   ImuRotation(s.imu_rotation);
-  SequenceOptions sequence_options = s.sequence;
-  sequence_options.ground_truth.clear();  // every scan, not only those the reference covers
-  Sequence sequence = LoadSequence(sequence_options);
-  SelectScans(s, sequence);
-  if (sequence.scans.empty()) throw DataError("the sequence has no scans");
-  CheckRcsWeights(sequence, {options.match.matching.w_rcs});
-  // The reference is read before the run, and the evaluation made before any
-  // output is written: a bad reference fails early and leaves nothing behind.
-  std::optional<Trajectory> reference;
-  if (!s.sequence.ground_truth.empty()) {
-    reference = ReadRadarTrajectory(s.sequence.ground_truth,
-                                    ResolveExtrinsic(s.sequence.extrinsic, s.sequence.ground_truth));
-    CheckReferenceCovers(*reference, sequence, s.sequence.ground_truth);
-  }
+  RunInputs inputs = LoadRunInputs(s, options.match.matching.w_rcs);
+  const Sequence& sequence = inputs.sequence;
+  const std::optional<Trajectory>& reference = inputs.reference;
   StagedFolder folder(s.out);  // a bad --out fails before the run
   RadarOdometry odometry(options, MatcherOf(s.matcher));
   if (!s.imu_topic.empty()) {
@@ -50,17 +39,7 @@ int RunOdometry(const OdometrySettings& s) {
     CheckOverlap(gyro, sequence);
     odometry.AddGyro(gyro);
   }
-  ProgressBar bar;
-  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
-    try {
-      odometry.Register(sequence.scans[k]);
-    } catch (const DataError& e) {
-      throw DataError(sequence.scan_sources[k] + ": " + e.what());
-    }
-    if (k % 16 == 0) bar.Update("odometry", k, sequence.scans.size());
-  }
-  bar.Update("odometry", sequence.scans.size(), sequence.scans.size());
-  bar.Finish();
+  RegisterScans(sequence, "odometry", [&](const RadarScan& scan) { odometry.Register(scan); });
   std::optional<Evaluation> evaluation;
   if (reference) evaluation = EvaluateTrajectory(odometry.trajectory(), *reference);
   WriteOdometry(folder.path(), odometry);

@@ -222,12 +222,24 @@ void AddPlaceRecognitionOptions(CLI::App* app, PlaceRecognitionSettings& s) {
       ->capture_default_str();
 }
 
-void SelectScans(const OdometrySettings& s, Sequence& sequence) {
-  const std::size_t first = std::min(s.first_scan, sequence.scans.size());
-  sequence.scans.erase(sequence.scans.begin(), sequence.scans.begin() + std::ptrdiff_t(first));
-  sequence.scan_sources.erase(sequence.scan_sources.begin(),
-                              sequence.scan_sources.begin() + std::ptrdiff_t(std::min(first, sequence.scan_sources.size())));
-  if (s.max_scans > 0 && sequence.scans.size() > s.max_scans) sequence.scans.resize(s.max_scans);
+RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs) {
+  SequenceOptions sequence_options = s.sequence;
+  sequence_options.ground_truth.clear();
+  RunInputs inputs{LoadSequence(sequence_options), std::nullopt};
+  std::vector<RadarScan>& scans = inputs.sequence.scans;
+  std::vector<std::string>& sources = inputs.sequence.scan_sources;
+  const std::size_t first = std::min(s.first_scan, scans.size());
+  scans.erase(scans.begin(), scans.begin() + std::ptrdiff_t(first));
+  sources.erase(sources.begin(), sources.begin() + std::ptrdiff_t(std::min(first, sources.size())));
+  if (s.max_scans > 0 && scans.size() > s.max_scans) scans.resize(s.max_scans);
+  if (scans.empty()) throw DataError("the sequence has no scans");
+  CheckRcsWeights(inputs.sequence, {w_rcs});
+  if (!s.sequence.ground_truth.empty()) {
+    inputs.reference =
+        ReadRadarTrajectory(s.sequence.ground_truth, ResolveExtrinsic(s.sequence.extrinsic, s.sequence.ground_truth));
+    CheckReferenceCovers(*inputs.reference, inputs.sequence, s.sequence.ground_truth);
+  }
+  return inputs;
 }
 
 }  // namespace radargauss::cli

@@ -5,11 +5,14 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "commands.hpp"
+#include "radargauss/error.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/progress.hpp"
 #include "radargauss/slam/place_recognition.hpp"
 #include "radargauss/trajectory.hpp"
 
@@ -45,8 +48,33 @@ std::vector<GyroSample> GyroOf(const OdometrySettings& s);
 void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence);
 // Throws FileError when fewer than 3 scans lie in the reference's time span.
 void CheckReferenceCovers(const Trajectory& reference, const Sequence& sequence, const std::string& path);
-// --first-scan and --max-scans: the scans to run, in place.
-void SelectScans(const OdometrySettings& s, Sequence& sequence);
+// What odometry, slam and relocalize run on: every scan of the sequence (not
+// only those the reference covers) from --first-scan, at most --max-scans,
+// refused when none is left or when `w_rcs` needs RCS they lack; and with
+// --gt the reference, read and checked before the run, so that a bad one
+// fails early and leaves nothing behind.
+struct RunInputs {
+  Sequence sequence;
+  std::optional<Trajectory> reference;
+};
+RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs);
+
+// Calls register_scan on every scan in order with a progress bar named
+// `stage`; a DataError names the scan's file.
+template <typename RegisterScan>
+void RegisterScans(const Sequence& sequence, const char* stage, RegisterScan&& register_scan) {
+  ProgressBar bar;
+  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
+    try {
+      register_scan(sequence.scans[k]);
+    } catch (const DataError& e) {
+      throw DataError(sequence.scan_sources[k] + ": " + e.what());
+    }
+    if (k % 16 == 0) bar.Update(stage, k, sequence.scans.size());
+  }
+  bar.Update(stage, sequence.scans.size(), sequence.scans.size());
+  bar.Finish();
+}
 // Every flag of OdometrySettings.
 void AddOdometryOptions(CLI::App* app, OdometrySettings& s);
 

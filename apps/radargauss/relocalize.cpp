@@ -68,31 +68,12 @@ int RunRelocalize(const RelocalizeSettings& s) {
   if (map.places.empty()) {
     throw FileError(s.map, "the map has no places to relocalise against (build it with radargauss slam)");
   }
-  SequenceOptions sequence_options = s.odometry.sequence;
-  sequence_options.ground_truth.clear();
-  Sequence sequence = LoadSequence(sequence_options);
-  SelectScans(s.odometry, sequence);
-  if (sequence.scans.empty()) throw DataError("the sequence has no scans");
-  CheckRcsWeights(sequence, {options.odometry.match.matching.w_rcs});
-  std::optional<Trajectory> reference;
-  const SequenceOptions& given = s.odometry.sequence;
-  if (!given.ground_truth.empty()) {
-    reference = ReadRadarTrajectory(given.ground_truth, ResolveExtrinsic(given.extrinsic, given.ground_truth));
-    CheckReferenceCovers(*reference, sequence, given.ground_truth);
-  }
+  RunInputs inputs = LoadRunInputs(s.odometry, options.odometry.match.matching.w_rcs);
+  const Sequence& sequence = inputs.sequence;
+  const std::optional<Trajectory>& reference = inputs.reference;
   StagedFolder folder(s.odometry.out);
   Relocalizer relocalizer(std::move(map), options);
-  ProgressBar bar;
-  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
-    try {
-      relocalizer.Register(sequence.scans[k]);
-    } catch (const DataError& e) {
-      throw DataError(sequence.scan_sources[k] + ": " + e.what());
-    }
-    if (k % 16 == 0) bar.Update("relocalize", k, sequence.scans.size());
-  }
-  bar.Update("relocalize", sequence.scans.size(), sequence.scans.size());
-  bar.Finish();
+  RegisterScans(sequence, "relocalize", [&](const RadarScan& scan) { relocalizer.Register(scan); });
   Trajectory located;
   std::size_t matched = 0;
   for (const RelocalizationStep& step : relocalizer.steps()) {

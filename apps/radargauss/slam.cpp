@@ -42,32 +42,13 @@ SlamOptions Resolved(const SlamSettings& s) {
 int RunSlam(const SlamSettings& s) {
   const SlamOptions options = Resolved(s);
   ValidateOptions(options);
-  SequenceOptions sequence_options = s.odometry.sequence;
-  sequence_options.ground_truth.clear();
-  Sequence sequence = LoadSequence(sequence_options);
-  SelectScans(s.odometry, sequence);
-  if (sequence.scans.empty()) throw DataError("the sequence has no scans");
-  CheckRcsWeights(sequence, {options.odometry.match.matching.w_rcs});
-  std::optional<Trajectory> reference;
-  const SequenceOptions& given = s.odometry.sequence;
-  if (!given.ground_truth.empty()) {
-    reference = ReadRadarTrajectory(given.ground_truth, ResolveExtrinsic(given.extrinsic, given.ground_truth));
-    CheckReferenceCovers(*reference, sequence, given.ground_truth);
-  }
+  RunInputs inputs = LoadRunInputs(s.odometry, options.odometry.match.matching.w_rcs);
+  const Sequence& sequence = inputs.sequence;
+  const std::optional<Trajectory>& reference = inputs.reference;
   StagedFolder folder(s.odometry.out);
   RadarSlam slam(options);
-  ProgressBar bar;
-  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
-    try {
-      slam.Register(sequence.scans[k]);
-    } catch (const DataError& e) {
-      throw DataError(sequence.scan_sources[k] + ": " + e.what());
-    }
-    if (k % 16 == 0) bar.Update("slam", k, sequence.scans.size());
-  }
+  RegisterScans(sequence, "slam", [&](const RadarScan& scan) { slam.Register(scan); });
   slam.Finish();
-  bar.Update("slam", sequence.scans.size(), sequence.scans.size());
-  bar.Finish();
   const GaussianMap map = s.no_map ? GaussianMap{} : BuildPlaceMap(sequence.scans, slam);
   const std::string out = folder.path();
   WriteOdometry((std::filesystem::path(out) / "odometry").string(), slam.odometry());
