@@ -13,8 +13,22 @@ const std::string kPoleMaterial = "pole";
 const std::string kGroundMaterial = "ground";
 const Eigen::Vector3d kCarHalfExtent(2.2, 0.9, 0.75);
 
+// False when the ray cannot reach the box closer than hit.distance: it misses
+// the box's bounding sphere or meets it only beyond the nearest hit so far. A
+// millimetre of margin keeps the test conservative, so it changes no hit.
+bool MayHitBox(const Box& box, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, const Hit& hit) {
+  const double radius = box.half_extent.norm() + 1e-3;
+  const Eigen::Vector3d to_centre = box.centre - origin;
+  const double squared_length = direction.squaredNorm();
+  const double along = to_centre.dot(direction);  // the centre's ray parameter times squared_length
+  const double reach = radius * std::sqrt(squared_length);
+  if (along + reach <= 0.0 || along - reach >= hit.distance * squared_length) return false;
+  return to_centre.squaredNorm() - along * along / squared_length <= radius * radius;
+}
+
 void IntersectBox(const Box& box, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                   Hit& hit) {
+  if (!MayHitBox(box, origin, direction, hit)) return;
   const Eigen::Matrix3d rotation = Eigen::AngleAxisd(box.yaw, Eigen::Vector3d::UnitZ()).matrix();
   const Eigen::Vector3d o = rotation.transpose() * (origin - box.centre);
   const Eigen::Vector3d d = rotation.transpose() * direction;
