@@ -16,6 +16,7 @@
 #include "radargauss/names.hpp"
 #include "radargauss/residuals/relative_pose_residual.hpp"
 #include "radargauss/residuals/robust_loss.hpp"
+#include "radargauss/solvers/pose_graph_initialization.hpp"
 
 namespace radargauss {
 
@@ -29,6 +30,18 @@ LoopRejection LoopRejectionFromString(const std::string& name) {
   return ValueNamed(kLoopRejectionNames, name, "loop rejection");
 }
 std::vector<std::string> LoopRejectionNames() { return NamesOf(kLoopRejectionNames); }
+
+namespace {
+constexpr NamedValue<GraphInitialization> kInitializationNames[] = {{GraphInitialization::kAuto, "auto"},
+                                                                    {GraphInitialization::kCurrent, "current"},
+                                                                    {GraphInitialization::kChordal, "chordal"}};
+}  // namespace
+
+std::string ToString(GraphInitialization initialization) { return NameOf(kInitializationNames, initialization); }
+GraphInitialization GraphInitializationFromString(const std::string& name) {
+  return ValueNamed(kInitializationNames, name, "graph initialization");
+}
+std::vector<std::string> GraphInitializationNames() { return NamesOf(kInitializationNames); }
 
 namespace {
 
@@ -86,11 +99,15 @@ ceres::Solver::Options SolverOptions(const PoseGraphOptions& options) {
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.num_threads = options.threads;
   solver_options.logging_type = ceres::SILENT;
+  solver_options.initial_trust_region_radius = options.initial_trust_region_radius;
   return solver_options;
 }
 
 void Validate(const PoseGraphOptions& options) {
   if (options.max_iterations < 1) throw std::invalid_argument("pose graph: max_iterations must be >= 1");
+  if (!(options.initial_trust_region_radius > 0.0)) {
+    throw std::invalid_argument("pose graph: initial_trust_region_radius must be > 0");
+  }
   if (options.threads < 1) throw std::invalid_argument("pose graph: threads must be >= 1");
   if (!(options.switch_prior_std > 0.0)) throw std::invalid_argument("pose graph: switch_prior_std must be > 0");
   if (!(options.loop_loss.scale > 0.0)) throw std::invalid_argument("pose graph: loop loss scale must be > 0");
@@ -239,6 +256,10 @@ PoseGraphSummary PoseGraph::Optimize(const PoseGraphOptions& options) {
     summary.message = "no keyframes";
     return summary;
   }
+  const bool chordal = options.initialization == GraphInitialization::kChordal ||
+                       (options.initialization == GraphInitialization::kAuto &&
+                        options.loop_rejection == LoopRejection::kGraduated);
+  if (chordal) poses_ = ChordalInitialization(poses_, edges_);
   const std::unique_ptr<Problem> graph = Build(options);
   ceres::Solver::Summary first;  // kGraduated: the quadratic solution it starts from
   ceres::Solve(SolverOptions(options), graph->problem.get(), &first);

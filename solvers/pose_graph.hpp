@@ -30,6 +30,20 @@ std::string ToString(LoopRejection rejection);                        // "loss",
 LoopRejection LoopRejectionFromString(const std::string& name);       // throws std::invalid_argument
 std::vector<std::string> LoopRejectionNames();
 
+// Where Levenberg-Marquardt starts.
+enum class GraphInitialization {
+  kAuto,     // kChordal under kGraduated, kCurrent otherwise
+  kCurrent,  // the current poses
+  // ChordalInitialization (pose_graph_initialization.hpp): rotations, then
+  // translations, from the edges alone. It trusts every loop, as graduated
+  // non-convexity's first, quadratic solve does; a false loop would bend
+  // the start of a robust loss or of switchable constraints.
+  kChordal,
+};
+std::string ToString(GraphInitialization initialization);                  // "auto", "current", "chordal"
+GraphInitialization GraphInitializationFromString(const std::string& name);  // throws std::invalid_argument
+std::vector<std::string> GraphInitializationNames();
+
 struct PoseGraphOptions {
   LoopRejection loop_rejection = LoopRejection::kGraduated;
   // kLoss: the loss of every loop edge on its whitened squared norm (odometry
@@ -39,6 +53,11 @@ struct PoseGraphOptions {
   // literature's 1 drops true loops from a drifted start (docs/design.md).
   double switch_prior_std = 0.1;
   double graduation_factor = 1.4;  // kGraduated: mu's divisor per round
+  GraphInitialization initialization = GraphInitialization::kAuto;
+  // Levenberg-Marquardt's first radius: Ceres's 1e4 damps a start already in
+  // the basin (chordal, or the last optimum) into tens of small steps; 1e8
+  // is nearly Gauss-Newton, and a failed step still shrinks it.
+  double initial_trust_region_radius = 1e8;
   JacobianMode jacobians = JacobianMode::kAnalytic;
   int max_iterations = 100;        // per solve
   int threads = 1;
