@@ -32,8 +32,7 @@ LoopRejection LoopRejectionFromString(const std::string& name) {
 std::vector<std::string> LoopRejectionNames() { return NamesOf(kLoopRejectionNames); }
 
 namespace {
-constexpr NamedValue<GraphInitialization> kInitializationNames[] = {{GraphInitialization::kAuto, "auto"},
-                                                                    {GraphInitialization::kCurrent, "current"},
+constexpr NamedValue<GraphInitialization> kInitializationNames[] = {{GraphInitialization::kCurrent, "current"},
                                                                     {GraphInitialization::kChordal, "chordal"}};
 }  // namespace
 
@@ -99,15 +98,14 @@ ceres::Solver::Options SolverOptions(const PoseGraphOptions& options) {
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.num_threads = options.threads;
   solver_options.logging_type = ceres::SILENT;
-  solver_options.initial_trust_region_radius = options.initial_trust_region_radius;
+  // From the chordal start, in the basin, nearly Gauss-Newton: Ceres's first
+  // radius (1e4) would damp it into tens of small steps.
+  if (options.initialization == GraphInitialization::kChordal) solver_options.initial_trust_region_radius = 1e8;
   return solver_options;
 }
 
 void Validate(const PoseGraphOptions& options) {
   if (options.max_iterations < 1) throw std::invalid_argument("pose graph: max_iterations must be >= 1");
-  if (!(options.initial_trust_region_radius > 0.0)) {
-    throw std::invalid_argument("pose graph: initial_trust_region_radius must be > 0");
-  }
   if (options.threads < 1) throw std::invalid_argument("pose graph: threads must be >= 1");
   if (!(options.switch_prior_std > 0.0)) throw std::invalid_argument("pose graph: switch_prior_std must be > 0");
   if (!(options.loop_loss.scale > 0.0)) throw std::invalid_argument("pose graph: loop loss scale must be > 0");
@@ -256,10 +254,7 @@ PoseGraphSummary PoseGraph::Optimize(const PoseGraphOptions& options) {
     summary.message = "no keyframes";
     return summary;
   }
-  const bool chordal = options.initialization == GraphInitialization::kChordal ||
-                       (options.initialization == GraphInitialization::kAuto &&
-                        options.loop_rejection == LoopRejection::kGraduated);
-  if (chordal) poses_ = ChordalInitialization(poses_, edges_);
+  if (options.initialization == GraphInitialization::kChordal) poses_ = ChordalInitialization(poses_, edges_);
   const std::unique_ptr<Problem> graph = Build(options);
   ceres::Solver::Summary first;  // kGraduated: the quadratic solution it starts from
   ceres::Solve(SolverOptions(options), graph->problem.get(), &first);

@@ -32,15 +32,14 @@ std::vector<std::string> LoopRejectionNames();
 
 // Where Levenberg-Marquardt starts.
 enum class GraphInitialization {
-  kAuto,     // kChordal under kGraduated, kCurrent otherwise
-  kCurrent,  // the current poses
+  kCurrent,  // the current poses (the last optimum plus odometry, in SLAM)
   // ChordalInitialization (pose_graph_initialization.hpp): rotations, then
-  // translations, from the edges alone. It trusts every loop, as graduated
-  // non-convexity's first, quadratic solve does; a false loop would bend
-  // the start of a robust loss or of switchable constraints.
+  // translations, from the edges alone, then LM nearly Gauss-Newton (first
+  // radius 1e8). For a graph solved once from composed odometry; it trusts
+  // every loop, so a false loop bends the start of any robust loss.
   kChordal,
 };
-std::string ToString(GraphInitialization initialization);                  // "auto", "current", "chordal"
+std::string ToString(GraphInitialization initialization);                  // "current", "chordal"
 GraphInitialization GraphInitializationFromString(const std::string& name);  // throws std::invalid_argument
 std::vector<std::string> GraphInitializationNames();
 
@@ -53,11 +52,7 @@ struct PoseGraphOptions {
   // literature's 1 drops true loops from a drifted start (docs/design.md).
   double switch_prior_std = 0.1;
   double graduation_factor = 1.4;  // kGraduated: mu's divisor per round
-  GraphInitialization initialization = GraphInitialization::kAuto;
-  // Levenberg-Marquardt's first radius: Ceres's 1e4 damps a start already in
-  // the basin (chordal, or the last optimum) into tens of small steps; 1e8
-  // is nearly Gauss-Newton, and a failed step still shrinks it.
-  double initial_trust_region_radius = 1e8;
+  GraphInitialization initialization = GraphInitialization::kCurrent;
   JacobianMode jacobians = JacobianMode::kAnalytic;
   int max_iterations = 100;        // per solve
   int threads = 1;

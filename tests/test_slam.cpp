@@ -182,6 +182,22 @@ TEST(Relocalizer, FindsASecondRunInTheSlamMapAndRefusesAnotherYard) {
     EXPECT_FALSE(relocalizer.first_fix().has_value());
     EXPECT_GT(relocalizer.candidates().size(), 0u);
   }
+  {
+    // Every place twice, the copy 50 m away: each verified place has a twin
+    // that verifies as well and disagrees, so no submap may make a fix.
+    GaussianMap aliased = map;
+    for (const MapPlace& place : map.places) {
+      MapPlace copy = place;
+      copy.pose = SE3d(SO3d(), Eigen::Vector3d(50.0, 0.0, 0.0)) * place.pose;
+      aliased.places.push_back(copy);
+    }
+    Relocalizer relocalizer(aliased, options);
+    for (const RadarScan& scan : SecondRun(true).scans) relocalizer.Register(scan);
+    EXPECT_FALSE(relocalizer.first_fix().has_value());
+    std::size_t ambiguous = 0;
+    for (const PlaceCandidate& c : relocalizer.candidates()) ambiguous += c.check.reason.rfind("ambiguous", 0) == 0;
+    EXPECT_GT(ambiguous, 0u);
+  }
   GaussianMap without_places = map;
   without_places.places.clear();
   EXPECT_THROW(Relocalizer(without_places, options), DataError);

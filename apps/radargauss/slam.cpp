@@ -27,6 +27,7 @@ struct SlamSettings {
   bool no_map = false;
   std::string loop_rejection = ToString(PoseGraphOptions().loop_rejection);
   std::string loop_loss = ToString(PoseGraphOptions().loop_loss.type);
+  std::string graph_initialization = ToString(PoseGraphOptions().initialization);
 };
 
 SlamOptions Resolved(const SlamSettings& s) {
@@ -36,6 +37,7 @@ SlamOptions Resolved(const SlamSettings& s) {
   o.place_recognition = s.place_recognition.Resolved();
   o.graph.loop_rejection = LoopRejectionFromString(s.loop_rejection);
   o.graph.loop_loss.type = LossTypeFromString(s.loop_loss);
+  o.graph.initialization = GraphInitializationFromString(s.graph_initialization);
   return o;
 }
 
@@ -98,6 +100,11 @@ void AddSlamOptions(CLI::App* app, SlamSettings& s) {
       ->capture_default_str();
   app->add_option("--loop-loss-scale", o.graph.loop_loss.scale, "Scale of the loop loss")
       ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--graph-initialization", s.graph_initialization,
+                  "Where each pose-graph solve starts: current (the last optimum and the odometry) or chordal "
+                  "(from the edges alone, trusting every loop)")
+      ->check(CLI::IsMember(GraphInitializationNames()))
       ->capture_default_str();
 }
 

@@ -149,8 +149,8 @@ class RadarOdometry:
         """(stamps (N,), poses (N, 7)) so far"""
 
 class RadarSlam:
-    """Radar SLAM (docs/design.md, "SLAM"): odometry, keyframes with submaps, place recognition, verified loops on a pose graph. Keywords: descriptor ('scan-context' or 'radon'), submap_distance, min_loop_path, candidates, loop_rejection ('loss', 'switchable', 'graduated'), and any keyword of RadarOdometry."""
-    def __init__(self: RadarSlam, descriptor: str = 'scan-context', submap_distance: float = 10.0, min_loop_path: float = 150.0, candidates: int = 10, loop_rejection: str = 'graduated', **kwargs) -> None:
+    """Radar SLAM (docs/design.md, "SLAM"): odometry, keyframes with submaps, place recognition, verified loops on a pose graph. Keywords: descriptor ('scan-context' or 'radon'), submap_distance, min_loop_path, candidates, loop_rejection ('loss', 'switchable', 'graduated'), graph_initialization ('current', 'chordal'), and any keyword of RadarOdometry."""
+    def __init__(self: RadarSlam, descriptor: str = 'scan-context', submap_distance: float = 10.0, min_loop_path: float = 150.0, candidates: int = 20, loop_rejection: str = 'graduated', graph_initialization: str = 'current', **kwargs) -> None:
         ...
     def finish(self: RadarSlam) -> None:
         """Closes the last keyframe (described and searched): call after the last scan."""
@@ -169,7 +169,7 @@ class RadarSlam:
 
 class Relocalizer:
     """Relocalisation in a map of RadarSlam without an initial pose (docs/design.md, "Relocalisation"). Keywords: descriptor, submap_distance, candidates, and any keyword of RadarOdometry."""
-    def __init__(self: Relocalizer, map: GaussianMap, descriptor: str = 'scan-context', submap_distance: float = 10.0, candidates: int = 10, **kwargs) -> None:
+    def __init__(self: Relocalizer, map: GaussianMap, descriptor: str = 'scan-context', submap_distance: float = 10.0, candidates: int = 20, **kwargs) -> None:
         ...
     @property
     def first_fix(self) -> Any: ...

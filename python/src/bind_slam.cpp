@@ -36,13 +36,15 @@ py::dict LoopToDict(const LoopCandidate& c) {
 }
 
 std::unique_ptr<RadarSlam> MakeSlam(const std::string& descriptor, double submap_distance, double min_loop_path,
-                                    int candidates, const std::string& loop_rejection, const py::kwargs& kwargs) {
+                                    int candidates, const std::string& loop_rejection,
+                                    const std::string& graph_initialization, const py::kwargs& kwargs) {
   SlamOptions options;
   options.odometry = OptionsFrom(OdometryFields(), kwargs);
   options.place_recognition = PlaceRecognitionFrom(descriptor, candidates);
   options.submap_distance = submap_distance;
   options.min_loop_path = min_loop_path;
   options.graph.loop_rejection = LoopRejectionFromString(loop_rejection);
+  options.graph.initialization = GraphInitializationFromString(graph_initialization);
   return std::make_unique<RadarSlam>(options);  // validates
 }
 
@@ -62,10 +64,11 @@ void BindSlam(py::module_& m) {
                         "Radar SLAM (docs/design.md, \"SLAM\"): odometry, keyframes with submaps, place recognition, "
                         "verified loops on a pose graph. Keywords: descriptor ('scan-context' or 'radon'), "
                         "submap_distance, min_loop_path, candidates, loop_rejection ('loss', 'switchable', "
-                        "'graduated'), and any keyword of RadarOdometry.")
+                        "'graduated'), graph_initialization ('current', 'chordal'), and any keyword of "
+                        "RadarOdometry.")
       .def(py::init(&MakeSlam), py::arg("descriptor") = "scan-context", py::arg("submap_distance") = 10.0,
            py::arg("min_loop_path") = 150.0, py::arg("candidates") = PlaceRecognitionOptions().candidates,
-           py::arg("loop_rejection") = "graduated")
+           py::arg("loop_rejection") = "graduated", py::arg("graph_initialization") = "current")
       .def(
           "register",
           [](RadarSlam& slam, const RadarScan& scan) {

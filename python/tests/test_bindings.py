@@ -202,3 +202,5 @@ def test_slam_closes_the_yard_and_relocalizes_a_second_run(tmp_path):
     assert steps[relocalizer.first_fix]["fixed"] and steps[relocalizer.first_fix]["pose"].shape == (4, 4)
     with pytest.raises(ValueError, match="unknown place descriptor"):
         rg.RadarSlam(descriptor="sift")
+    with pytest.raises(ValueError, match="unknown graph initialization"):
+        rg.RadarSlam(graph_initialization="odometry")

@@ -16,8 +16,9 @@ void ValidateOptions(const RelocalizationOptions& o) {
   if (!(o.submap_distance > 0.0) || !std::isfinite(o.submap_distance)) {
     throw std::invalid_argument("relocalization: submap_distance must be positive");
   }
-  if (!(o.confirm_translation > 0.0) || !(o.confirm_rotation_deg > 0.0)) {
-    throw std::invalid_argument("relocalization: the confirmation tolerances must be positive");
+  if (!(o.confirm_translation > 0.0) || !(o.confirm_rotation_deg > 0.0) || !(o.ambiguous_translation > 0.0) ||
+      !(o.ambiguous_rotation_deg > 0.0)) {
+    throw std::invalid_argument("relocalization: the confirmation and ambiguity tolerances must be positive");
   }
   if (o.max_unmatched_scans < 1) throw std::invalid_argument("relocalization: max_unmatched_scans must be >= 1");
 }
@@ -86,6 +87,12 @@ const RelocalizationStep& Relocalizer::Register(const RadarScan& scan) {
   return steps_.back();
 }
 
+bool Relocalizer::Agree(const SE3d& a, const SE3d& b, double translation, double rotation_deg) {
+  const SE3d disagreement = a.Inverse() * b;
+  return disagreement.translation().norm() <= translation &&
+         disagreement.rotation().Log().norm() * 180.0 / M_PI <= rotation_deg;
+}
+
 void Relocalizer::Search() {
   const int submap = submaps_++;
   const std::vector<RadarPoint> points = DownsampleSubmap(submap_, options_.place_recognition.submap_voxel);
@@ -93,15 +100,14 @@ void Relocalizer::Search() {
   std::vector<int> every(places_.size());
   for (std::size_t p = 0; p < places_.size(); ++p) every[p] = int(p);
   std::optional<SE3d> found;  // T_map_odometry from this submap
+  bool ambiguous = false;     // two verified places that put the submap apart
   for (const PlaceMatch& match : RankPlaces(description, places_, every, options_.place_recognition)) {
     PlaceCandidate candidate;
     candidate.submap = submap;
     candidate.place = match.candidate;
     candidate.distance = match.distance;
     candidate.yaw = match.yaws.front();
-    if (found) {
-      candidate.check.reason = "another candidate was accepted";
-    } else if (!match.close) {
+    if (!match.close) {
       char reason[64];
       std::snprintf(reason, sizeof(reason), "descriptor distance %.3f", match.distance);
       candidate.check.reason = reason;
@@ -116,20 +122,34 @@ void Relocalizer::Search() {
         }
         if (candidate.check.accepted) break;
       }
-      // The place's pose times the match gives the submap's origin in the map.
+      // The place's pose times the match gives the submap's origin in the map;
+      // every close candidate is verified, and two that disagree (places
+      // alias) leave the submap without a fix.
       if (candidate.check.accepted) {
-        found = map_->places[match.candidate].pose * candidate.check.relative * submap_origin_.Inverse();
+        const SE3d here = map_->places[match.candidate].pose * candidate.check.relative * submap_origin_.Inverse();
+        if (found && !Agree(*found, here, options_.ambiguous_translation, options_.ambiguous_rotation_deg)) {
+          ambiguous = true;
+        }
+        if (!found) found = here;
       }
     }
     candidates_.push_back(std::move(candidate));
   }
+  if (ambiguous) {
+    found.reset();
+    for (std::size_t c = candidates_.size(); c-- > 0 && candidates_[c].submap == submap;) {
+      if (candidates_[c].check.accepted) candidates_[c].check.reason = "ambiguous: verified places disagree";
+    }
+  }
   // A fix needs the submap before to have found the same T_map_odometry.
-  if (found && pending_) {
-    const SE3d disagreement = pending_->Inverse() * *found;
-    if (disagreement.translation().norm() <= options_.confirm_translation &&
-        disagreement.rotation().Log().norm() * 180.0 / M_PI <= options_.confirm_rotation_deg) {
-      fix_ = found;
-      candidates_.back().fixed = true;
+  if (found && pending_ &&
+      Agree(*pending_, *found, options_.confirm_translation, options_.confirm_rotation_deg)) {
+    fix_ = found;
+    for (std::size_t c = candidates_.size(); c-- > 0 && candidates_[c].submap == submap;) {
+      if (candidates_[c].check.accepted) {
+        candidates_[c].fixed = true;
+        break;
+      }
     }
   }
   pending_ = found;

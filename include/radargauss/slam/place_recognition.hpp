@@ -27,7 +27,10 @@ struct PlaceRecognitionOptions {
   ScanContextOptions scan_context;
   RadonOptions radon;
   double submap_voxel = 0.25;  // m: a submap keeps the first point of each voxel
-  int candidates = 10;         // compared per query, nearest by key
+  // Compared per query, nearest by key. On the two-lap drive (Radon) 10
+  // closed 71 % of the true revisits, 20 81 %, 30 84 %, none false, at
+  // 35 / 39 / 41 ms per keyframe: only close candidates are verified.
+  int candidates = 20;
   // Compared places farther than this (the descriptor's distance) are not verified.
   double max_scan_context_distance = 0.4;
   double max_radon_distance = 0.15;

@@ -4,7 +4,8 @@
 // submap_distance metres; each is described and its nearest places of the
 // map verified (slam/loop_verification.hpp, no graph prior). Two submaps in
 // a row whose verified places put the odometry at the same pose in the map
-// make the fix (one alone is not trusted: places alias).
+// make the fix (one alone is not trusted: places alias); a submap whose
+// verified places lie far apart counts as none.
 // From that fix on, the odometry matches every scan against the fixed map
 // with its motion model and priors (RadarOdometry::LocalizeIn). Before a fix
 // no pose is reported.
@@ -35,6 +36,10 @@ struct RelocalizationOptions {
   // How far the two submaps' poses of the odometry in the map may disagree.
   double confirm_translation = 1.0;  // m
   double confirm_rotation_deg = 2.0;
+  // Two verified places of one submap further apart than this alias (the
+  // laps of a map disagree by less): the submap counts as none.
+  double ambiguous_translation = 5.0;  // m
+  double ambiguous_rotation_deg = 5.0;
   // After this many scans in a row without a match to the map the fix is
   // dropped and the search starts again with a fresh odometry.
   int max_unmatched_scans = 10;
@@ -82,6 +87,8 @@ class Relocalizer {
   void Search();
   // A fresh odometry and submap from the next scan on.
   void Restart();
+  // Two T_map_odometry within `translation` m and `rotation_deg`.
+  static bool Agree(const SE3d& a, const SE3d& b, double translation, double rotation_deg);
 
   RelocalizationOptions options_;
   std::shared_ptr<const GaussianMap> map_;
