@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/slam/relocalization.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -38,7 +39,7 @@ void Relocalizer::Restart() {
   submap_.clear();
   path_ = submap_start_ = 0.0;
   fix_.reset();
-  pending_.reset();
+  pending_.clear();
   unmatched_ = 0;
 }
 
@@ -99,8 +100,7 @@ void Relocalizer::Search() {
   const PlaceDescription description = Describe(points, options_.place_recognition);
   std::vector<int> every(places_.size());
   for (std::size_t p = 0; p < places_.size(); ++p) every[p] = int(p);
-  std::optional<SE3d> found;  // T_map_odometry from this submap
-  bool ambiguous = false;     // two verified places that put the submap apart
+  std::vector<std::pair<SE3d, std::size_t>> found;  // T_map_odometry of each verified place, its candidate
   for (const PlaceMatch& match : RankPlaces(description, places_, every, options_.place_recognition)) {
     PlaceCandidate candidate;
     candidate.submap = submap;
@@ -122,37 +122,50 @@ void Relocalizer::Search() {
         }
         if (candidate.check.accepted) break;
       }
-      // The place's pose times the match gives the submap's origin in the map;
-      // every close candidate is verified, and two that disagree (places
-      // alias) leave the submap without a fix.
+      // The place's pose times the match gives the submap's origin in the map.
       if (candidate.check.accepted) {
-        const SE3d here = map_->places[match.candidate].pose * candidate.check.relative * submap_origin_.Inverse();
-        if (found && !Agree(*found, here, options_.ambiguous_translation, options_.ambiguous_rotation_deg)) {
-          ambiguous = true;
-        }
-        if (!found) found = here;
+        found.emplace_back(map_->places[match.candidate].pose * candidate.check.relative * submap_origin_.Inverse(),
+                           candidates_.size());
       }
     }
     candidates_.push_back(std::move(candidate));
   }
-  if (ambiguous) {
-    found.reset();
-    for (std::size_t c = candidates_.size(); c-- > 0 && candidates_[c].submap == submap;) {
-      if (candidates_[c].check.accepted) candidates_[c].check.reason = "ambiguous: verified places disagree";
-    }
-  }
-  // A fix needs the submap before to have found the same T_map_odometry.
-  if (found && pending_ &&
-      Agree(*pending_, *found, options_.confirm_translation, options_.confirm_rotation_deg)) {
-    fix_ = found;
-    for (std::size_t c = candidates_.size(); c-- > 0 && candidates_[c].submap == submap;) {
-      if (candidates_[c].check.accepted) {
-        candidates_[c].fixed = true;
+  Confirm(found);
+}
+
+// A fix needs a verified place of this submap to agree with one of the
+// submap before (places alias, a true place recurs); when the agreeing
+// places lie far apart, or a better-ranked verified place lies apart from
+// them, the straight aliases along itself and the next submap decides.
+void Relocalizer::Confirm(const std::vector<std::pair<SE3d, std::size_t>>& found) {
+  std::vector<std::pair<SE3d, std::size_t>> agreeing;
+  for (const auto& hypothesis : found) {
+    for (const SE3d& before : pending_) {
+      if (Agree(before, hypothesis.first, options_.confirm_translation, options_.confirm_rotation_deg)) {
+        agreeing.push_back(hypothesis);
         break;
       }
     }
   }
-  pending_ = found;
+  // Unique: the agreeing places lie together, and no place of this submap
+  // that the descriptor ranks better lies apart from them.
+  bool unique = !agreeing.empty();
+  for (const auto& other : found) {
+    const bool apart = !Agree(agreeing.empty() ? other.first : agreeing.front().first, other.first,
+                              options_.ambiguous_translation, options_.ambiguous_rotation_deg);
+    const bool agreeing_one =
+        std::any_of(agreeing.begin(), agreeing.end(), [&](const auto& a) { return a.second == other.second; });
+    const bool ranked_better = !agreeing.empty() && other.second < agreeing.front().second;
+    unique = unique && !(apart && (agreeing_one || ranked_better));
+  }
+  if (unique) {
+    fix_ = agreeing.front().first;
+    candidates_[agreeing.front().second].fixed = true;
+  } else {
+    for (const auto& other : agreeing) candidates_[other.second].check.reason = "ambiguous: agreeing places disagree";
+  }
+  pending_.clear();
+  for (const auto& hypothesis : found) pending_.push_back(hypothesis.first);
 }
 
 }  // namespace radargauss

@@ -4,8 +4,9 @@
 // submap_distance metres; each is described and its nearest places of the
 // map verified (slam/loop_verification.hpp, no graph prior). Two submaps in
 // a row whose verified places put the odometry at the same pose in the map
-// make the fix (one alone is not trusted: places alias); a submap whose
-// verified places lie far apart counts as none.
+// make the fix (one alone is not trusted: places alias); every verified
+// place of both submaps is considered, and agreeing pairs far apart from
+// each other (a straight that aliases along itself) wait for the next.
 // From that fix on, the odometry matches every scan against the fixed map
 // with its motion model and priors (RadarOdometry::LocalizeIn). Before a fix
 // no pose is reported.
@@ -17,6 +18,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "radargauss/map/gaussian_map.hpp"
@@ -36,8 +38,8 @@ struct RelocalizationOptions {
   // How far the two submaps' poses of the odometry in the map may disagree.
   double confirm_translation = 1.0;  // m
   double confirm_rotation_deg = 2.0;
-  // Two verified places of one submap further apart than this alias (the
-  // laps of a map disagree by less): the submap counts as none.
+  // Agreeing places further apart than this alias (the laps of a map
+  // disagree by less): no fix from them.
   double ambiguous_translation = 5.0;  // m
   double ambiguous_rotation_deg = 5.0;
   // After this many scans in a row without a match to the map the fix is
@@ -85,6 +87,9 @@ class Relocalizer {
  private:
   // Describes the closed submap and verifies its candidates; sets fix_ on success.
   void Search();
+  // Makes the fix from this submap's verified T_map_odometry (and their
+  // candidates' indices) and the submap before's.
+  void Confirm(const std::vector<std::pair<SE3d, std::size_t>>& found);
   // A fresh odometry and submap from the next scan on.
   void Restart();
   // Two T_map_odometry within `translation` m and `rotation_deg`.
@@ -102,7 +107,7 @@ class Relocalizer {
   double submap_start_ = 0.0, path_ = 0.0;
   int submaps_ = 0;
   std::optional<SE3d> fix_;         // T_map_odometry at the fix
-  std::optional<SE3d> pending_;     // the last submap's, awaiting confirmation
+  std::vector<SE3d> pending_;       // the last submap's verified T_map_odometry, awaiting confirmation
   std::optional<std::size_t> first_fix_;
   std::size_t fixes_ = 0;                 // how many fixes were made
   int unmatched_ = 0;                     // scans in a row without a match since the fix
