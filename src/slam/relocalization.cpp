@@ -10,6 +10,17 @@
 
 namespace radargauss {
 
+namespace {
+
+// Two T_map_odometry within `translation` m and `rotation_deg`.
+bool Agree(const SE3d& a, const SE3d& b, double translation, double rotation_deg) {
+  const SE3d disagreement = a.Inverse() * b;
+  return disagreement.translation().norm() <= translation &&
+         disagreement.rotation().Log().norm() * 180.0 / M_PI <= rotation_deg;
+}
+
+}  // namespace
+
 void ValidateOptions(const RelocalizationOptions& o) {
   ValidateOptions(o.odometry);
   ValidateOptions(o.place_recognition);
@@ -88,12 +99,6 @@ const RelocalizationStep& Relocalizer::Register(const RadarScan& scan) {
   return steps_.back();
 }
 
-bool Relocalizer::Agree(const SE3d& a, const SE3d& b, double translation, double rotation_deg) {
-  const SE3d disagreement = a.Inverse() * b;
-  return disagreement.translation().norm() <= translation &&
-         disagreement.rotation().Log().norm() * 180.0 / M_PI <= rotation_deg;
-}
-
 void Relocalizer::Search() {
   const int submap = submaps_++;
   const std::vector<RadarPoint> points = DownsampleSubmap(submap_, options_.place_recognition.submap_voxel);
@@ -147,22 +152,21 @@ void Relocalizer::Confirm(const std::vector<std::pair<SE3d, std::size_t>>& found
       }
     }
   }
-  // Unique: the agreeing places lie together, and no place of this submap
-  // that the descriptor ranks better lies apart from them.
-  bool unique = !agreeing.empty();
-  for (const auto& other : found) {
-    const bool apart = !Agree(agreeing.empty() ? other.first : agreeing.front().first, other.first,
-                              options_.ambiguous_translation, options_.ambiguous_rotation_deg);
-    const bool agreeing_one =
-        std::any_of(agreeing.begin(), agreeing.end(), [&](const auto& a) { return a.second == other.second; });
-    const bool ranked_better = !agreeing.empty() && other.second < agreeing.front().second;
-    unique = unique && !(apart && (agreeing_one || ranked_better));
-  }
-  if (unique) {
-    fix_ = agreeing.front().first;
-    candidates_[agreeing.front().second].fixed = true;
-  } else {
-    for (const auto& other : agreeing) candidates_[other.second].check.reason = "ambiguous: agreeing places disagree";
+  // Unique: no agreeing place, and no place the descriptor ranks better
+  // than the best agreeing one, lies apart from that one.
+  if (!agreeing.empty()) {
+    const auto& best = agreeing.front();
+    const auto apart = [&](const auto& h) {
+      return !Agree(best.first, h.first, options_.ambiguous_translation, options_.ambiguous_rotation_deg);
+    };
+    const auto ranked_better_and_apart = [&](const auto& h) { return h.second < best.second && apart(h); };
+    if (std::none_of(agreeing.begin(), agreeing.end(), apart) &&
+        std::none_of(found.begin(), found.end(), ranked_better_and_apart)) {
+      fix_ = best.first;
+      candidates_[best.second].fixed = true;
+    } else {
+      for (const auto& h : agreeing) candidates_[h.second].check.reason = "ambiguous: agreeing places disagree";
+    }
   }
   pending_.clear();
   for (const auto& hypothesis : found) pending_.push_back(hypothesis.first);

@@ -92,8 +92,6 @@ class Relocalizer {
   void Confirm(const std::vector<std::pair<SE3d, std::size_t>>& found);
   // A fresh odometry and submap from the next scan on.
   void Restart();
-  // Two T_map_odometry within `translation` m and `rotation_deg`.
-  static bool Agree(const SE3d& a, const SE3d& b, double translation, double rotation_deg);
 
   RelocalizationOptions options_;
   std::shared_ptr<const GaussianMap> map_;
