@@ -53,11 +53,10 @@ void AddBlock(Triplets& triplets, int row, int col, int size, const Block& block
     for (int c = 0; c < size; ++c) triplets.emplace_back(size * row + r, size * col + c, block(r, c));
 }
 
-// The edge's mean rotational and translational information (diagonal of W^T W).
-void EdgeWeights(const PoseGraphEdge& edge, double& rotation, double& translation) {
-  const Eigen::Matrix<double, 6, 6> information = edge.sqrt_information.transpose() * edge.sqrt_information;
-  rotation = information.diagonal().segment<3>(kRotationOffset).mean();
-  translation = information.diagonal().segment<3>(kTranslationOffset).mean();
+// The mean of the edge's information diagonal (W^T W) over the three
+// coordinates from `offset` (kRotationOffset or kTranslationOffset).
+double EdgeWeight(const PoseGraphEdge& edge, int offset) {
+  return (edge.sqrt_information.transpose() * edge.sqrt_information).diagonal().segment<3>(offset).mean();
 }
 
 // Solves H X = B (H symmetric positive definite, sparse); false when it is not.
@@ -78,8 +77,7 @@ bool ChordalRotations(const std::vector<SE3d>& poses, const std::vector<PoseGrap
   Triplets triplets;
   Eigen::MatrixXd B = Eigen::MatrixXd::Zero(3 * unknowns, 3);
   for (const PoseGraphEdge& edge : edges) {
-    double w = 0.0, unused = 0.0;
-    EdgeWeights(edge, w, unused);
+    const double w = EdgeWeight(edge, kRotationOffset);
     const Eigen::Matrix3d A = edge.measured.rotation().Matrix().transpose();
     const int i = index[edge.from], j = index[edge.to];
     AddBlock(triplets, j, j, 3, w * Eigen::Matrix3d::Identity());
@@ -115,8 +113,7 @@ bool LinearTranslations(const std::vector<SE3d>& poses, const std::vector<PoseGr
   Eigen::MatrixXd B = Eigen::MatrixXd::Zero(unknowns, 3);
   const auto one = [](double value) { return Eigen::Matrix<double, 1, 1>::Constant(value); };
   for (const PoseGraphEdge& edge : edges) {
-    double unused = 0.0, w = 0.0;
-    EdgeWeights(edge, unused, w);
+    const double w = EdgeWeight(edge, kTranslationOffset);
     const Eigen::RowVector3d c = (rotations[edge.from] * edge.measured.translation()).transpose();
     const int i = index[edge.from], j = index[edge.to];
     AddBlock(triplets, i, i, 1, one(w));
