@@ -210,6 +210,9 @@ TEST(RadarSlam, RefusesBadOptions) {
   options = SlamOptions();
   options.verification.min_associated = 2.0;
   EXPECT_THROW(RadarSlam{options}, std::invalid_argument);
+  RelocalizationOptions relocalization;
+  relocalization.confirm_window = 0;
+  EXPECT_THROW(ValidateOptions(relocalization), std::invalid_argument);
   EXPECT_THROW(PlaceDescriptorKindFromString("sift"), std::invalid_argument);
   EXPECT_EQ(PlaceDescriptorKindFromString(ToString(PlaceDescriptorKind::kRadon)), PlaceDescriptorKind::kRadon);
 }

@@ -32,6 +32,7 @@ void ValidateOptions(const RelocalizationOptions& o) {
       !(o.ambiguous_rotation_deg > 0.0)) {
     throw std::invalid_argument("relocalization: the confirmation and ambiguity tolerances must be positive");
   }
+  if (o.confirm_window < 1) throw std::invalid_argument("relocalization: confirm_window must be >= 1");
   if (o.max_unmatched_scans < 1) throw std::invalid_argument("relocalization: max_unmatched_scans must be >= 1");
 }
 
@@ -139,17 +140,18 @@ void Relocalizer::Search() {
 }
 
 // A fix needs a verified place of this submap to agree with one of the
-// submap before (places alias, a true place recurs); when the agreeing
+// recent submaps' (places alias, a true place recurs); when the agreeing
 // places lie far apart, or a better-ranked verified place lies apart from
 // them, the straight aliases along itself and the next submap decides.
 void Relocalizer::Confirm(const std::vector<std::pair<SE3d, std::size_t>>& found) {
   std::vector<std::pair<SE3d, std::size_t>> agreeing;
   for (const auto& hypothesis : found) {
-    for (const SE3d& before : pending_) {
-      if (Agree(before, hypothesis.first, options_.confirm_translation, options_.confirm_rotation_deg)) {
-        agreeing.push_back(hypothesis);
-        break;
-      }
+    const auto agrees = [&](const SE3d& before) {
+      return Agree(before, hypothesis.first, options_.confirm_translation, options_.confirm_rotation_deg);
+    };
+    if (std::any_of(pending_.begin(), pending_.end(),
+                    [&](const std::vector<SE3d>& s) { return std::any_of(s.begin(), s.end(), agrees); })) {
+      agreeing.push_back(hypothesis);
     }
   }
   // Unique: no agreeing place, and no place the descriptor ranks better
@@ -168,8 +170,9 @@ void Relocalizer::Confirm(const std::vector<std::pair<SE3d, std::size_t>>& found
       for (const auto& h : agreeing) candidates_[h.second].check.reason = "ambiguous: agreeing places disagree";
     }
   }
-  pending_.clear();
-  for (const auto& hypothesis : found) pending_.push_back(hypothesis.first);
+  pending_.emplace_back();
+  for (const auto& hypothesis : found) pending_.back().push_back(hypothesis.first);
+  if (int(pending_.size()) > options_.confirm_window) pending_.pop_front();
 }
 
 }  // namespace radargauss

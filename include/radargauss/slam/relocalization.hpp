@@ -2,11 +2,12 @@
 // Relocalisation in a SLAM map without an initial pose (docs/design.md,
 // "Relocalisation"): the run's own odometry accumulates submaps of
 // submap_distance metres; each is described and its nearest places of the
-// map verified (slam/loop_verification.hpp, no graph prior). Two submaps in
-// a row whose verified places put the odometry at the same pose in the map
-// make the fix (one alone is not trusted: places alias); every verified
-// place of both submaps is considered, and agreeing pairs far apart from
-// each other (a straight that aliases along itself) wait for the next.
+// map verified (slam/loop_verification.hpp, no graph prior). Two submaps
+// (within confirm_window of each other) whose verified places put the
+// odometry at the same pose in the map make the fix (one alone is not
+// trusted: places alias); every verified place of both is considered, and
+// agreeing pairs far apart from each other (a straight that aliases along
+// itself) wait for the next.
 // From that fix on, the odometry matches every scan against the fixed map
 // with its motion model and priors (RadarOdometry::LocalizeIn). Before a fix
 // no pose is reported.
@@ -15,6 +16,7 @@
 //   for (const RadarScan& scan : sequence.scans) relocalizer.Register(scan);
 #pragma once
 
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -35,7 +37,9 @@ struct RelocalizationOptions {
   double submap_distance = 10.0;   // m driven per submap
   PlaceRecognitionOptions place_recognition;
   LoopVerificationOptions verification;
-  // How far the two submaps' poses of the odometry in the map may disagree.
+  // A submap's places may confirm those of the confirm_window submaps before
+  // it; the two poses of the odometry in the map may disagree this much.
+  int confirm_window = 3;
   double confirm_translation = 1.0;  // m
   double confirm_rotation_deg = 2.0;
   // Agreeing places further apart than this alias (the laps of a map
@@ -88,7 +92,7 @@ class Relocalizer {
   // Describes the closed submap and verifies its candidates; sets fix_ on success.
   void Search();
   // Makes the fix from this submap's verified T_map_odometry (and their
-  // candidates' indices) and the submap before's.
+  // candidates' indices) and those of the submaps before.
   void Confirm(const std::vector<std::pair<SE3d, std::size_t>>& found);
   // A fresh odometry and submap from the next scan on.
   void Restart();
@@ -105,7 +109,7 @@ class Relocalizer {
   double submap_start_ = 0.0, path_ = 0.0;
   int submaps_ = 0;
   std::optional<SE3d> fix_;         // T_map_odometry at the fix
-  std::vector<SE3d> pending_;       // the last submap's verified T_map_odometry, awaiting confirmation
+  std::deque<std::vector<SE3d>> pending_;  // the last submaps' verified T_map_odometry, awaiting confirmation
   std::optional<std::size_t> first_fix_;
   std::size_t fixes_ = 0;                 // how many fixes were made
   int unmatched_ = 0;                     // scans in a row without a match since the fix
