@@ -7,6 +7,7 @@
 #include <random>
 
 #include "radargauss/io/sequence.hpp"
+#include "radargauss/odometry/mounting.hpp"
 #include "radargauss/simulator.hpp"
 #include "temp_dir.hpp"
 #include "test_util.hpp"
@@ -235,6 +236,51 @@ TEST(EgoVelocity, SimulatedCarFillingTheViewNeedsTheGateOrVoxelSupport) {
     car_inliers += gated.inlier[i] && drive.truth[0][i].kind == DetectionKind::kDynamic;
   }
   EXPECT_LT(car_inliers, moving / 10);
+}
+
+// A radar pitched 1.5 deg up and yawed 0.8 deg right on a vehicle driving a
+// straight, a turn and a slow stretch: the straight's velocities give the
+// planted angles (turns add the lever arm's lateral velocity, slow scans
+// noise: both left out), and the levelled track runs along x at height 0.
+TEST(Mounting, RecoversPlantedPitchAndYawAndLevelsTheTrack) {
+  Mounting planted;
+  planted.pitch_deg = 1.5;
+  planted.yaw_deg = -0.8;
+  const SO3d radar_from_vehicle = planted.vehicle_from_radar().Inverse();
+  std::mt19937 rng(4);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  std::vector<OdometryStep> steps;
+  SE3d vehicle;  // T_vehicle0_vehicle; the world is the first radar frame
+  for (int k = 0; k < 300; ++k) {
+    const bool turning = k >= 100 && k < 150, slow = k >= 250;
+    const double dt = 0.1, speed = slow ? 2.0 : 20.0, yaw_rate = turning ? 0.2 : 0.0;
+    Eigen::Vector3d velocity(speed, turning ? 0.8 : 0.0, 0.0);  // vehicle frame; 4 m lever arm when turning
+    OdometryStep step;
+    step.stamp = dt * k;
+    step.velocity_measured = true;
+    step.velocity = radar_from_vehicle * velocity + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    vehicle = vehicle * SE3d(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, yaw_rate * dt)), velocity * dt);
+    step.pose = SE3d(radar_from_vehicle, Eigen::Vector3d::Zero()) * vehicle *
+                SE3d(radar_from_vehicle.Inverse(), Eigen::Vector3d::Zero());  // T_world_radar
+    steps.push_back(step);
+  }
+  const std::optional<Mounting> mounting = EstimateMounting(steps);
+  ASSERT_TRUE(mounting.has_value());
+  EXPECT_EQ(mounting->scans, 199u);  // the straights at speed
+  EXPECT_NEAR(mounting->pitch_deg, 1.5, 0.05);  // 0.14 deg per scan, 199 scans
+  EXPECT_NEAR(mounting->yaw_deg, -0.8, 0.05);
+  std::vector<StampedPose> poses;
+  for (const OdometryStep& step : steps) poses.push_back({step.stamp, step.pose});
+  const Trajectory levelled = Levelled(Trajectory(poses), *mounting);
+  EXPECT_GT(levelled[99].pose.translation().x(), 190.0);
+  EXPECT_NEAR(levelled[99].pose.translation().y(), 0.0, 0.2);
+  for (const StampedPose& p : levelled) EXPECT_NEAR(p.pose.translation().z(), 0.0, 0.2) << p.time;
+  EXPECT_GT(std::abs(steps[299].pose.translation().z()), 5.0);  // not levelled: the pitch's climb
+  steps.resize(10);
+  EXPECT_FALSE(EstimateMounting(steps).has_value());  // too few straight scans
+  MountingOptions bad;
+  bad.min_speed = 0.0;
+  EXPECT_THROW(EstimateMounting(steps, bad), std::invalid_argument);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/evaluation.hpp"
+#include "radargauss/odometry/mounting.hpp"
 #include "radargauss/progress.hpp"
 
 namespace radargauss::cli {
@@ -46,9 +47,16 @@ int RunOdometry(const OdometrySettings& s) {
   const std::string table = evaluation ? WriteEvaluation(folder.path(), *evaluation) : std::string();
   folder.Commit();
   PrintSummary(Summarise(odometry));
+  const std::optional<Mounting> mounting = EstimateMounting(odometry.steps());
+  if (mounting) {
+    const Trajectory levelled = Levelled(odometry.trajectory(), *mounting);
+    std::printf("mounting: pitch %.2f deg, yaw %.2f deg (%zu straight scans); end height %.2f m levelled\n",
+                mounting->pitch_deg, mounting->yaw_deg, mounting->scans,
+                levelled[levelled.size() - 1].pose.translation().z());
+  }
   std::printf("%s", table.c_str());
-  std::printf("wrote %s (odometry.tum, per_scan.csv, summary.json, map.rgm, map.ply%s)\n", s.out.c_str(),
-              evaluation ? ", evaluation.json, evaluation.md" : "");
+  std::printf("wrote %s (odometry.tum, %sper_scan.csv, summary.json, map.rgm, map.ply%s)\n", s.out.c_str(),
+              mounting ? "levelled.tum, " : "", evaluation ? ", evaluation.json, evaluation.md" : "");
   return 0;
 }
 

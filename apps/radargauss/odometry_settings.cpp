@@ -22,6 +22,14 @@ void AddLocalMapOptions(CLI::App* app, OdometrySettings& s) {
   app->add_option("--active-radius", o.map.active_radius, "Radius of the active map around the radar (m)")
       ->check(Positive())
       ->capture_default_str();
+  app->add_option("--azimuth-std", o.map.azimuth_std_deg,
+                  "Radar's azimuth noise (deg): map Gaussians at least this angle x range wide")
+      ->check(InRange(0.0, 44.9))
+      ->capture_default_str();
+  app->add_option("--elevation-std", o.map.elevation_std_deg,
+                  "Radar's elevation noise (deg): map Gaussians at least this angle x range high")
+      ->check(InRange(0.0, 44.9))
+      ->capture_default_str();
   app->add_option("--region", o.map.region, "Edge of the map regions fitted together (m)")
       ->check(Positive())
       ->capture_default_str();

@@ -76,6 +76,8 @@ class RadarOdometry:
         region_min_points: int = 8,
         refit_growth: float = 0.5,
         active_radius: float = 100.0,
+        azimuth_std_deg: float = 0.0,
+        elevation_std_deg: float = 0.0,
         gaussians_builder: str = 'kmeans',
         gaussians_downsample_voxel: float = 0.25,
         gaussians_points_per_gaussian: float = 4.0,

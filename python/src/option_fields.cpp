@@ -197,6 +197,8 @@ std::vector<OptionField<OdometryOptions>> OwnOdometryFields() {
       RADARGAUSS_FIELD(O, "region_min_points", map.min_points, "points a region needs for its first fit"),
       RADARGAUSS_FIELD(O, "refit_growth", map.refit_growth, "refit once the new points reach this share"),
       RADARGAUSS_FIELD(O, "active_radius", map.active_radius, "m: regions farther from the radar leave"),
+      RADARGAUSS_FIELD(O, "azimuth_std_deg", map.azimuth_std_deg, "deg: Gaussians this angle x range wide horizontally"),
+      RADARGAUSS_FIELD(O, "elevation_std_deg", map.elevation_std_deg, "deg: Gaussians this angle x range high"),
       RADARGAUSS_ENUM(O, "gaussians_builder", map.gaussians.builder, MapBuilderFromString, MapBuilderNames,
                       "region fit: k-means (build-map's) or voxel"),
       RADARGAUSS_FIELD(O, "gaussians_downsample_voxel", map.gaussians.downsample_voxel, "m: voxel downsampling"),

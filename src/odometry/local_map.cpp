@@ -20,6 +20,9 @@ void ValidateOptions(const LocalMapOptions& o) {
           "map region minimum points must be in [1, region capacity]");
   require(o.refit_growth > 0.0 && std::isfinite(o.refit_growth), "map refit growth must be > 0 and finite");
   require(o.active_radius > 0.0, "active map radius must be > 0 m");
+  require(o.azimuth_std_deg >= 0.0 && o.azimuth_std_deg < 45.0 && o.elevation_std_deg >= 0.0 &&
+              o.elevation_std_deg < 45.0,
+          "map azimuth and elevation std must be in [0, 45) deg");
   require(o.gaussians.min_std > 0.0, "minimum std must be > 0 m");
 }
 
@@ -95,6 +98,7 @@ void LocalMap::Refit(Region& region, std::vector<std::uint32_t>& changed, std::v
   std::vector<int> association;
   GaussianMap fitted;
   fitted.gaussians = BuildGaussians(region.points, options_.gaussians, {}, &association);
+  if (options_.azimuth_std_deg > 0.0 || options_.elevation_std_deg > 0.0) FloorAtRange(region, association, fitted);
   if (region.has_rcs) {
     // The members' poses, renumbered for a cloud of this region alone.
     MapCloud cloud;
@@ -114,6 +118,29 @@ void LocalMap::Refit(Region& region, std::vector<std::uint32_t>& changed, std::v
     map_->gaussians[slot] = g;
     region.gaussians.push_back(slot);
     changed.push_back(slot);
+  }
+}
+
+void LocalMap::FloorAtRange(const Region& region, const std::vector<int>& association, GaussianMap& fitted) const {
+  std::vector<double> range_sum(fitted.gaussians.size(), 0.0);
+  std::vector<std::size_t> members(fitted.gaussians.size(), 0);
+  for (std::size_t i = 0; i < region.points.size(); ++i) {
+    if (association[i] < 0) continue;
+    range_sum[association[i]] += (region.points[i] - poses_[region.pose[i]].translation()).norm();
+    ++members[association[i]];
+  }
+  const double azimuth = std::tan(options_.azimuth_std_deg * M_PI / 180.0);
+  const double elevation = std::tan(options_.elevation_std_deg * M_PI / 180.0);
+  const double min_std = options_.gaussians.min_std;
+  for (std::size_t g = 0; g < fitted.gaussians.size(); ++g) {
+    if (members[g] == 0) continue;
+    const double range = range_sum[g] / double(members[g]);
+    const Eigen::Vector3d floor(std::max(min_std, azimuth * range), std::max(min_std, azimuth * range),
+                                std::max(min_std, elevation * range));
+    // Clamped where the floor is the unit sphere, then scaled back.
+    Eigen::Matrix3d& covariance = fitted.gaussians[g].covariance;
+    const Eigen::Matrix3d whitened = floor.cwiseInverse().asDiagonal() * covariance * floor.cwiseInverse().asDiagonal();
+    covariance = floor.asDiagonal() * ClampCovariance(whitened, 1.0) * floor.asDiagonal();
   }
 }
 

@@ -10,6 +10,7 @@
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/map/map_file.hpp"
+#include "radargauss/odometry/mounting.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/stats.hpp"
 
@@ -73,7 +74,7 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
   WriteFileAtomically((out / "per_scan.csv").string(),
                       [&](std::ostream& stream) { WritePerScan(stream, odometry.steps()); });
   const OdometrySummary s = Summarise(odometry);
-  const nlohmann::json summary = {{"scans", s.scans},
+  nlohmann::json summary = {{"scans", s.scans},
                                   {"keyframes", s.keyframes},
                                   {"matched", s.matched},
                                   {"velocity_predicted", s.velocity_predicted},
@@ -85,7 +86,20 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
                                   {"active_gaussians", s.active_gaussians},
                                   {"global_gaussians", s.global_gaussians},
                                   {"active_map_bytes", s.map_bytes}};
-  WriteFileAtomically((out / "summary.json").string(), [&](std::ostream& stream) { stream << summary.dump(2) << "\n"; });
+  summary["mounting"] = nullptr;  // not observable: too few straight scans at speed
+  if (const std::optional<Mounting> mounting = EstimateMounting(odometry.steps())) {
+    const Trajectory levelled = Levelled(odometry.trajectory(), *mounting);
+    const Eigen::Vector3d end = levelled[levelled.size() - 1].pose.translation();  // a mounting needs scans
+    summary["mounting"] = {{"pitch_deg", mounting->pitch_deg},
+                           {"yaw_deg", mounting->yaw_deg},
+                           {"pitch_spread_deg", mounting->pitch_spread_deg},
+                           {"yaw_spread_deg", mounting->yaw_spread_deg},
+                           {"scans", mounting->scans},
+                           {"levelled_end_m", {end.x(), end.y(), end.z()}}};
+    WriteTum((out / "levelled.tum").string(), levelled);
+  }
+  WriteFileAtomically((out / "summary.json").string(),
+                      [&](std::ostream& stream) { stream << summary.dump(2) << "\n"; });
   const GaussianMap map = odometry.map().GlobalMap();
   WriteMap((out / "map.rgm").string(), map);
   ExportPly((out / "map.ply").string(), map);

@@ -43,6 +43,12 @@ struct LocalMapOptions {
   std::size_t min_points = 8;         // points a region needs for its first fit
   double refit_growth = 0.5;          // refit once the points added since the last fit reach this share of those fitted
   double active_radius = 100.0;       // m: regions whose centre is farther from the radar leave
+  // The radar's angular noise: a Gaussian is at least this angle times the
+  // mean range its members were seen at wide, horizontally (azimuth) and
+  // vertically (elevation), and at least min_std, so that far, sparse
+  // returns still gate into the map (docs/design.md, "Odometry").
+  double azimuth_std_deg = 0.0;
+  double elevation_std_deg = 0.0;
   GaussianMapOptions gaussians;       // the estimator of build-map
   RcsFitOptions rcs;                  // incidence model and SH degree of the RCS models
   MatchingMapOptions matching = LocalMatchingMapOptions();  // coarse levels, index cells (always updatable)
@@ -90,6 +96,9 @@ class LocalMap {
   };
   // Fits the Gaussians of `region` again; their slots go to changed/removed.
   void Refit(Region& region, std::vector<std::uint32_t>& changed, std::vector<std::uint32_t>& removed);
+  // Widens each fitted Gaussian to the angular noise at its members' mean
+  // range from the poses they were seen from.
+  void FloorAtRange(const Region& region, const std::vector<int>& association, GaussianMap& fitted) const;
   std::uint32_t NewSlot();
 
   LocalMapOptions options_;

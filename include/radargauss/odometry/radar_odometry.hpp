@@ -212,7 +212,8 @@ struct OdometrySummary {
 };
 OdometrySummary Summarise(const RadarOdometry& odometry);
 
-// Writes odometry.tum (T_world_radar), per_scan.csv, summary.json, map.rgm
+// Writes odometry.tum (T_world_radar), levelled.tum (when the mounting is
+// observable, odometry/mounting.hpp), per_scan.csv, summary.json, map.rgm
 // and map.ply into `dir` (created), each file whole or not at all.
 void WriteOdometry(const std::string& dir, const RadarOdometry& odometry);
 

@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/odometry/mounting.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "radargauss/stats.hpp"
+
+namespace radargauss {
+
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+// 1.4826 x the median absolute deviation from `median`: a robust std.
+double Spread(const std::vector<double>& values, double median) {
+  std::vector<double> deviations;
+  for (const double v : values) deviations.push_back(std::abs(v - median));
+  return 1.4826 * Median(deviations);
+}
+
+}  // namespace
+
+void ValidateOptions(const MountingOptions& o) {
+  if (!(o.min_speed > 0.0) || !std::isfinite(o.min_speed)) {
+    throw std::invalid_argument("mounting: min_speed must be positive");
+  }
+  if (!(o.max_yaw_rate_deg > 0.0)) throw std::invalid_argument("mounting: max_yaw_rate_deg must be positive");
+  if (o.min_scans < 1) throw std::invalid_argument("mounting: min_scans must be >= 1");
+}
+
+// R_radar_vehicle = Rz(-yaw) Ry(pitch) maps the direction of travel e_x to
+// (cos p cos y, -cos p sin y, -sin p) in the radar frame.
+SO3d Mounting::vehicle_from_radar() const {
+  const SO3d yaw = SO3d::Exp(Eigen::Vector3d(0.0, 0.0, -yaw_deg * kDegree));
+  const SO3d pitch = SO3d::Exp(Eigen::Vector3d(0.0, pitch_deg * kDegree, 0.0));
+  return (yaw * pitch).Inverse();
+}
+
+std::optional<Mounting> EstimateMounting(const std::vector<OdometryStep>& steps, const MountingOptions& options) {
+  ValidateOptions(options);
+  std::vector<double> pitch, yaw;
+  for (std::size_t k = 1; k < steps.size(); ++k) {
+    const OdometryStep& step = steps[k];
+    const Eigen::Vector3d& v = step.velocity;
+    if (!step.velocity_measured || v.norm() < options.min_speed) continue;
+    const double dt = step.stamp - steps[k - 1].stamp;
+    const SO3d turn = steps[k - 1].pose.rotation().Inverse() * step.pose.rotation();
+    if (!(dt > 0.0) || std::abs(turn.Log().z()) / dt > options.max_yaw_rate_deg * kDegree) continue;
+    pitch.push_back(std::atan2(v.z(), std::hypot(v.x(), v.y())) / kDegree);
+    yaw.push_back(std::atan2(v.y(), v.x()) / kDegree);
+  }
+  if (pitch.size() < options.min_scans) return std::nullopt;
+  // The measured velocity is the radar's motion: its direction is the vehicle's
+  // forward axis, so the x axis lies opposite to it by the same angles.
+  Mounting mounting;
+  mounting.pitch_deg = -Median(pitch);
+  mounting.yaw_deg = -Median(yaw);
+  mounting.pitch_spread_deg = Spread(pitch, -mounting.pitch_deg);
+  mounting.yaw_spread_deg = Spread(yaw, -mounting.yaw_deg);
+  mounting.scans = pitch.size();
+  return mounting;
+}
+
+Trajectory Levelled(const Trajectory& trajectory, const Mounting& mounting) {
+  const SE3d level(mounting.vehicle_from_radar(), Eigen::Vector3d::Zero());
+  std::vector<StampedPose> poses;
+  for (const StampedPose& p : trajectory) poses.push_back({p.time, level * p.pose});
+  return Trajectory(std::move(poses));
+}
+
+}  // namespace radargauss
