@@ -240,8 +240,9 @@ TEST(EgoVelocity, SimulatedCarFillingTheViewNeedsTheGateOrVoxelSupport) {
 
 // A radar pitched 1.5 deg up and yawed 0.8 deg right on a vehicle driving a
 // straight, a turn and a slow stretch: the straight's velocities give the
-// planted angles (turns add the lever arm's lateral velocity, slow scans
-// noise: both left out), and the levelled track runs along x at height 0.
+// planted angles (turns add the lever arm's lateral velocity: left out of
+// the yaw; slow scans are noise: left out), and the levelled track runs
+// along x at height 0.
 TEST(Mounting, RecoversPlantedPitchAndYawAndLevelsTheTrack) {
   Mounting planted;
   planted.pitch_deg = 1.5;
@@ -266,7 +267,8 @@ TEST(Mounting, RecoversPlantedPitchAndYawAndLevelsTheTrack) {
   }
   const std::optional<Mounting> mounting = EstimateMounting(steps);
   ASSERT_TRUE(mounting.has_value());
-  EXPECT_EQ(mounting->scans, 199u);  // the straights at speed
+  EXPECT_EQ(mounting->pitch_scans, 249u);  // at speed
+  EXPECT_EQ(mounting->yaw_scans, 199u);    // the straights at speed
   EXPECT_NEAR(mounting->pitch_deg, 1.5, 0.05);  // 0.14 deg per scan, 199 scans
   EXPECT_NEAR(mounting->yaw_deg, -0.8, 0.05);
   std::vector<StampedPose> poses;

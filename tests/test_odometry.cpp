@@ -292,7 +292,7 @@ TEST(LocalMap, AngularNoiseWidensGaussiansAtTheirRange) {
 // (configs/smartmicro_highway_odometry.yaml), odometry matches every frame
 // from the fourth on (the map needs three) over the Doppler speed's distance;
 // the whole run's velocity direction gives the radar's pitch, and levelled,
-// the motorway stays within a metre of its start's height.
+// the motorway ends within 1.5 m of its start's height.
 TEST(OdometryRealData, SmartmicroHighwayFramesMatch) {
   const std::string dir = testing::SharedData("smartmicro_umrr_highway");
   if (dir.empty()) GTEST_SKIP() << "shared data not found";
@@ -319,7 +319,7 @@ TEST(OdometryRealData, SmartmicroHighwayFramesMatch) {
   EXPECT_GT(mounting->pitch_deg, 0.8);  // the velocity points 1.3 deg below the x axis
   EXPECT_LT(mounting->pitch_deg, 1.8);
   const Trajectory levelled = Levelled(odometry.trajectory(), *mounting);
-  EXPECT_LT(std::abs(levelled[levelled.size() - 1].pose.translation().z()), 1.0);
+  EXPECT_LT(std::abs(levelled[levelled.size() - 1].pose.translation().z()), 1.5);  // 452 m driven
   EXPECT_GT(std::abs(odometry.trajectory()[levelled.size() - 1].pose.translation().z()), 5.0);  // not levelled
 }
 

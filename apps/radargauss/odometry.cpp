@@ -50,8 +50,8 @@ int RunOdometry(const OdometrySettings& s) {
   const std::optional<Mounting> mounting = EstimateMounting(odometry.steps());
   if (mounting) {
     const Trajectory levelled = Levelled(odometry.trajectory(), *mounting);
-    std::printf("mounting: pitch %.2f deg, yaw %.2f deg (%zu straight scans); end height %.2f m levelled\n",
-                mounting->pitch_deg, mounting->yaw_deg, mounting->scans,
+    std::printf("mounting: pitch %.2f deg (%zu scans), yaw %.2f deg (%zu straight); end height %.2f m levelled\n",
+                mounting->pitch_deg, mounting->pitch_scans, mounting->yaw_deg, mounting->yaw_scans,
                 levelled[levelled.size() - 1].pose.translation().z());
   }
   std::printf("%s", table.c_str());

@@ -44,13 +44,14 @@ std::optional<Mounting> EstimateMounting(const std::vector<OdometryStep>& steps,
     const OdometryStep& step = steps[k];
     const Eigen::Vector3d& v = step.velocity;
     if (!step.velocity_measured || v.norm() < options.min_speed) continue;
+    // A turn adds the lever arm's velocity sideways: the elevation holds, the azimuth not.
+    pitch.push_back(std::atan2(v.z(), std::hypot(v.x(), v.y())) / kDegree);
     const double dt = step.stamp - steps[k - 1].stamp;
     const SO3d turn = steps[k - 1].pose.rotation().Inverse() * step.pose.rotation();
     if (!(dt > 0.0) || std::abs(turn.Log().z()) / dt > options.max_yaw_rate_deg * kDegree) continue;
-    pitch.push_back(std::atan2(v.z(), std::hypot(v.x(), v.y())) / kDegree);
     yaw.push_back(std::atan2(v.y(), v.x()) / kDegree);
   }
-  if (pitch.size() < options.min_scans) return std::nullopt;
+  if (yaw.size() < options.min_scans) return std::nullopt;
   // The measured velocity is the radar's motion: its direction is the vehicle's
   // forward axis, so the x axis lies opposite to it by the same angles.
   Mounting mounting;
@@ -58,7 +59,8 @@ std::optional<Mounting> EstimateMounting(const std::vector<OdometryStep>& steps,
   mounting.yaw_deg = -Median(yaw);
   mounting.pitch_spread_deg = Spread(pitch, -mounting.pitch_deg);
   mounting.yaw_spread_deg = Spread(yaw, -mounting.yaw_deg);
-  mounting.scans = pitch.size();
+  mounting.pitch_scans = pitch.size();
+  mounting.yaw_scans = yaw.size();
   return mounting;
 }
 

@@ -94,7 +94,8 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
                            {"yaw_deg", mounting->yaw_deg},
                            {"pitch_spread_deg", mounting->pitch_spread_deg},
                            {"yaw_spread_deg", mounting->yaw_spread_deg},
-                           {"scans", mounting->scans},
+                           {"pitch_scans", mounting->pitch_scans},
+                           {"yaw_scans", mounting->yaw_scans},
                            {"levelled_end_m", {end.x(), end.y(), end.z()}}};
     WriteTum((out / "levelled.tum").string(), levelled);
   }

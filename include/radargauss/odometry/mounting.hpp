@@ -22,7 +22,7 @@ namespace radargauss {
 struct MountingOptions {
   double min_speed = 5.0;            // m/s: slower scans say little about the direction
   double max_yaw_rate_deg = 2.0;     // deg/s: turning adds the lever arm's lateral velocity
-  std::size_t min_scans = 10;        // straight, measured scans needed for an estimate
+  std::size_t min_scans = 10;        // straight scans at speed needed for an estimate
 };
 
 // Throws std::invalid_argument naming the bad option.
@@ -32,13 +32,13 @@ struct Mounting {
   double pitch_deg = 0.0;  // the radar's x axis above the direction of travel
   double yaw_deg = 0.0;    // the radar's x axis left of the direction of travel
   double pitch_spread_deg = 0.0, yaw_spread_deg = 0.0;  // 1.4826 x median absolute deviation
-  std::size_t scans = 0;   // scans the medians are over
+  std::size_t pitch_scans = 0, yaw_scans = 0;  // scans the medians are over
   SO3d vehicle_from_radar() const;  // R_vehicle_radar: the radar's axes in the levelled frame
 };
 
-// Medians over the scans whose velocity was measured, at least min_speed,
-// with a yaw rate (from consecutive poses) below max_yaw_rate_deg; nullopt
-// when fewer than min_scans qualify.
+// Medians over the scans whose velocity was measured, at least min_speed;
+// the yaw's over those whose yaw rate (from consecutive poses) stays below
+// max_yaw_rate_deg as well. nullopt when fewer than min_scans are straight.
 std::optional<Mounting> EstimateMounting(const std::vector<OdometryStep>& steps, const MountingOptions& options = {});
 
 // The trajectory in the levelled frame.
