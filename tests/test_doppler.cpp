@@ -238,7 +238,7 @@ TEST(EgoVelocity, SimulatedCarFillingTheViewNeedsTheGateOrVoxelSupport) {
   EXPECT_LT(car_inliers, moving / 10);
 }
 
-// A radar pitched 1.5 deg up and yawed 0.8 deg right on a vehicle driving a
+// A radar pitched 1.5 deg down and yawed 0.8 deg right on a vehicle driving a
 // straight, a turn and a slow stretch: the straight's velocities give the
 // planted angles (turns add the lever arm's lateral velocity: left out of
 // the yaw; slow scans are noise: left out), and the levelled track runs

@@ -316,8 +316,8 @@ TEST(OdometryRealData, SmartmicroHighwayFramesMatch) {
   EXPECT_NEAR((steps[19].pose.translation() - steps[0].pose.translation()).norm(), distance, 0.02 * distance);
   const std::optional<Mounting> mounting = EstimateMounting(steps);
   ASSERT_TRUE(mounting.has_value());
-  EXPECT_GT(mounting->pitch_deg, 0.8);  // the velocity points 1.3 deg below the x axis
-  EXPECT_LT(mounting->pitch_deg, 1.8);
+  EXPECT_LT(mounting->pitch_deg, -0.8);  // looking up: the velocity points 1.3 deg below the x axis
+  EXPECT_GT(mounting->pitch_deg, -1.8);
   const Trajectory levelled = Levelled(odometry.trajectory(), *mounting);
   EXPECT_LT(std::abs(levelled[levelled.size() - 1].pose.translation().z()), 1.5);  // 452 m driven
   EXPECT_GT(std::abs(odometry.trajectory()[levelled.size() - 1].pose.translation().z()), 5.0);  // not levelled

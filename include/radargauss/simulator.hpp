@@ -73,7 +73,21 @@ struct SimulationConfig {
   double rcs_noise_db = 1.0;
   double clutter_fraction = 0.05;    // share of detections that are clutter
   double rcs_outlier_fraction = 0.01;  // share with RCS + U(-25, 25) dB
-  // Scene.
+  // The faults of real radars (docs/design.md, "The faults of real radars"),
+  // all off by default.
+  double elevation_bias_deg = 0.0;      // added to every elevation
+  double elevation_noise_growth = 0.0;  // elevation std x (1 + growth (azimuth / azimuth_fov)^2)
+  double mounting_roll_deg = 0.0;       // the radar on the vehicle: T_vehicle_radar = Rz(yaw) Ry(pitch) Rx(roll)
+  double mounting_pitch_deg = 0.0;      // positive: the x axis looking down (about the vehicle's y)
+  double mounting_yaw_deg = 0.0;
+  int rcs_swerling = 0;                 // RCS fluctuation per detection: 0 none, 1 Swerling I, 3 Swerling III
+  double multipath_probability = 0.0;   // a ray that meets a wall or guardrail also returns a ghost
+  double multipath_loss_db = 6.0;       // the ghost's RCS below its target's
+  // Scene: "town" (buildings, poles, parked and moving cars along the loop)
+  // or "motorway" (guardrails, gantries, three lanes each way of traffic).
+  std::string scene = "town";
+  double traffic_min_speed = 25.0;      // m/s: the motorway's cars, drawn uniformly
+  double traffic_max_speed = 40.0;
   int poles = 24;
   int parked_cars = 14;
   int moving_cars = 4;
@@ -84,6 +98,7 @@ struct SimulationConfig {
       {"wall", {0.5, 5.0, 15.0}},
       {"pole", {1.0, 10.0, 20.0}},
       {"car", {2.0, 30.0, 12.0}},
+      {"guardrail", {1.0, 20.0, 8.0}},
   };
 };
 
@@ -95,7 +110,8 @@ void ValidateSimulationConfig(const SimulationConfig& config, const std::string&
 // The configuration as YAML (every key), as written next to a simulation.
 std::string SimulationConfigToYaml(const SimulationConfig& config);
 
-enum class DetectionKind { kStatic, kDynamic, kClutter };
+// kGhost: a multipath image of a target seen by way of a wall or guardrail.
+enum class DetectionKind { kStatic, kDynamic, kClutter, kGhost };
 
 // What the simulator knows about a detection and a test may check.
 struct DetectionTruth {
@@ -104,7 +120,11 @@ struct DetectionTruth {
   double incidence_angle = 0.0;         // rad
   double rcs_noise_free = 0.0;          // dBsm incl. object offset, before noise/outlier
   bool rcs_outlier = false;
-  Eigen::Vector3d position_world = Eigen::Vector3d::Zero();  // noise-free hit
+  Eigen::Vector3d position_world = Eigen::Vector3d::Zero();  // noise-free hit (a ghost's: its target's)
+  // A ghost's reflector: a point of its plane and the plane's normal (world).
+  Eigen::Vector3d reflector_point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d reflector_normal = Eigen::Vector3d::Zero();
+  Eigen::Vector3d target_velocity = Eigen::Vector3d::Zero();  // world, m/s
 };
 
 struct SimulatedSequence {

@@ -29,12 +29,10 @@ void ValidateOptions(const MountingOptions& o) {
   if (o.min_scans < 1) throw std::invalid_argument("mounting: min_scans must be >= 1");
 }
 
-// R_radar_vehicle = Rz(-yaw) Ry(pitch) maps the direction of travel e_x to
-// (cos p cos y, -cos p sin y, -sin p) in the radar frame.
 SO3d Mounting::vehicle_from_radar() const {
-  const SO3d yaw = SO3d::Exp(Eigen::Vector3d(0.0, 0.0, -yaw_deg * kDegree));
+  const SO3d yaw = SO3d::Exp(Eigen::Vector3d(0.0, 0.0, yaw_deg * kDegree));
   const SO3d pitch = SO3d::Exp(Eigen::Vector3d(0.0, pitch_deg * kDegree, 0.0));
-  return (yaw * pitch).Inverse();
+  return yaw * pitch;
 }
 
 std::optional<Mounting> EstimateMounting(const std::vector<OdometryStep>& steps, const MountingOptions& options) {
@@ -45,20 +43,20 @@ std::optional<Mounting> EstimateMounting(const std::vector<OdometryStep>& steps,
     const Eigen::Vector3d& v = step.velocity;
     if (!step.velocity_measured || v.norm() < options.min_speed) continue;
     // A turn adds the lever arm's velocity sideways: the elevation holds, the azimuth not.
-    pitch.push_back(std::atan2(v.z(), std::hypot(v.x(), v.y())) / kDegree);
+    // The direction of travel in the radar frame is R_vehicle_radar^T e_x =
+    // (cos p cos y, -sin y, sin p cos y).
+    pitch.push_back(std::atan2(v.z(), v.x()) / kDegree);
     const double dt = step.stamp - steps[k - 1].stamp;
     const SO3d turn = steps[k - 1].pose.rotation().Inverse() * step.pose.rotation();
     if (!(dt > 0.0) || std::abs(turn.Log().z()) / dt > options.max_yaw_rate_deg * kDegree) continue;
-    yaw.push_back(std::atan2(v.y(), v.x()) / kDegree);
+    yaw.push_back(std::atan2(-v.y(), std::hypot(v.x(), v.z())) / kDegree);
   }
   if (yaw.size() < options.min_scans) return std::nullopt;
-  // The measured velocity is the radar's motion: its direction is the vehicle's
-  // forward axis, so the x axis lies opposite to it by the same angles.
   Mounting mounting;
-  mounting.pitch_deg = -Median(pitch);
-  mounting.yaw_deg = -Median(yaw);
-  mounting.pitch_spread_deg = Spread(pitch, -mounting.pitch_deg);
-  mounting.yaw_spread_deg = Spread(yaw, -mounting.yaw_deg);
+  mounting.pitch_deg = Median(pitch);
+  mounting.yaw_deg = Median(yaw);
+  mounting.pitch_spread_deg = Spread(pitch, mounting.pitch_deg);
+  mounting.yaw_spread_deg = Spread(yaw, mounting.yaw_deg);
   mounting.pitch_scans = pitch.size();
   mounting.yaw_scans = yaw.size();
   return mounting;

@@ -23,7 +23,7 @@ namespace radargauss {
 
 namespace {
 
-using ConfigValue = std::variant<double*, int*, std::uint32_t*>;
+using ConfigValue = std::variant<double*, int*, std::uint32_t*, std::string*>;
 
 std::vector<std::pair<std::string, ConfigValue>> ConfigFields(SimulationConfig& c) {
   return {{"seed", &c.seed},
@@ -53,6 +53,17 @@ std::vector<std::pair<std::string, ConfigValue>> ConfigFields(SimulationConfig& 
           {"rcs_noise_db", &c.rcs_noise_db},
           {"clutter_fraction", &c.clutter_fraction},
           {"rcs_outlier_fraction", &c.rcs_outlier_fraction},
+          {"elevation_bias_deg", &c.elevation_bias_deg},
+          {"elevation_noise_growth", &c.elevation_noise_growth},
+          {"mounting_roll_deg", &c.mounting_roll_deg},
+          {"mounting_pitch_deg", &c.mounting_pitch_deg},
+          {"mounting_yaw_deg", &c.mounting_yaw_deg},
+          {"rcs_swerling", &c.rcs_swerling},
+          {"multipath_probability", &c.multipath_probability},
+          {"multipath_loss_db", &c.multipath_loss_db},
+          {"scene", &c.scene},
+          {"traffic_min_speed", &c.traffic_min_speed},
+          {"traffic_max_speed", &c.traffic_max_speed},
           {"poles", &c.poles},
           {"parked_cars", &c.parked_cars},
           {"moving_cars", &c.moving_cars},
@@ -96,7 +107,19 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
   require(c.rcs_outlier_fraction >= 0.0 && c.rcs_outlier_fraction <= 1.0,
           "rcs_outlier_fraction must be in [0, 1]");
   require(c.poles >= 0 && c.parked_cars >= 0 && c.moving_cars >= 0, "object counts must be >= 0");
-  for (const char* name : {"ground", "wall", "pole", "car"}) {
+  require(std::abs(c.elevation_bias_deg) < c.elevation_fov_deg, "elevation_bias_deg must be within the field of view");
+  require(c.elevation_noise_growth >= 0.0, "elevation_noise_growth must be >= 0");
+  for (const double angle : {c.mounting_roll_deg, c.mounting_pitch_deg, c.mounting_yaw_deg}) {
+    require(std::abs(angle) <= 45.0, "mounting angles must be within +/-45 deg");
+  }
+  require(c.rcs_swerling == 0 || c.rcs_swerling == 1 || c.rcs_swerling == 3, "rcs_swerling must be 0, 1 or 3");
+  require(c.multipath_probability >= 0.0 && c.multipath_probability <= 1.0,
+          "multipath_probability must be in [0, 1]");
+  require(c.multipath_loss_db >= 0.0, "multipath_loss_db must be >= 0");
+  require(c.scene == "town" || c.scene == "motorway", "scene must be town or motorway");
+  require(c.traffic_min_speed >= 0.0 && c.traffic_max_speed >= c.traffic_min_speed,
+          "need 0 <= traffic_min_speed <= traffic_max_speed");
+  for (const char* name : {"ground", "wall", "pole", "car", "guardrail"}) {
     const auto it = c.materials.find(name);
     require(it != c.materials.end(), std::string("material '") + name + "' missing");
     require(std::isfinite(it->second.diffuse) && std::isfinite(it->second.specular) &&
@@ -126,7 +149,7 @@ SimulationConfig LoadSimulationConfig(const std::string& path) {
         for (const auto& material : entry.second) {
           const std::string name = material.first.IsScalar() ? material.first.Scalar() : "";
           if (!config.materials.count(name)) {
-            throw FileError(path, "unknown material '" + name + "' (ground, wall, pole, car)");
+            throw FileError(path, "unknown material '" + name + "' (ground, wall, pole, car, guardrail)");
           }
           Material& m = config.materials[name];
           if (!material.second.IsMap()) throw FileError(path, "material '" + name + "' must be a map");

@@ -84,9 +84,53 @@ void IntersectPole(const Pole& pole, const std::string& material, const Eigen::V
   hit.dynamic = false;
 }
 
-}  // namespace
+// The motorway: the ego in the middle of three lanes (offsets -3.5, 0, 3.5
+// m), a guardrail on the right shoulder and in the median, the oncoming
+// carriageway's three lanes beyond it and its outer guardrail; gantries
+// across both every 400 m; poles on the right verge; traffic both ways.
+Scene BuildMotorway(const SimulationConfig& config, const LoopPath& path, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> offset(0.0, config.object_rcs_spread_db);
+  const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  Scene scene;
+  Eigen::Vector2d p;
+  double heading = 0.0;
+  bool straight = false;
+  const double segment = 4.0;  // m of guardrail per box (corners: chords)
+  for (double s = 0.0; s < path.Perimeter(); s += segment) {
+    path.At(s + 0.5 * segment, p, heading, straight);
+    for (const double lateral : {-5.75, 5.75, 18.25}) {
+      const Eigen::Vector2d centre = p + lateral * LoopPath::Left(heading);
+      scene.static_boxes.push_back({Eigen::Vector3d(centre.x(), centre.y(), 0.55),
+                                    Eigen::Vector3d(0.5 * segment, 0.05, 0.2), heading, "guardrail", offset(rng)});
+    }
+  }
+  for (double s = uniform(0.0, 400.0); s < path.Perimeter(); s += 400.0) {
+    path.At(s, p, heading, straight);
+    const Eigen::Vector2d centre = p + 6.0 * LoopPath::Left(heading);
+    scene.static_boxes.push_back({Eigen::Vector3d(centre.x(), centre.y(), 6.5), Eigen::Vector3d(0.4, 13.5, 0.6),
+                                  heading, "wall", offset(rng)});
+    for (const double lateral : {-7.0, 19.5}) {
+      scene.poles.push_back({p + lateral * LoopPath::Left(heading), 0.25, 7.0, offset(rng)});
+    }
+  }
+  for (int i = 0; i < config.poles; ++i) {
+    path.At(uniform(0.0, path.Perimeter()), p, heading, straight);
+    scene.poles.push_back({p - 8.0 * LoopPath::Left(heading), 0.1, 5.0, offset(rng)});
+  }
+  const double ego = 5.0 + config.start_offset;
+  for (int i = 0; i < config.moving_cars; ++i) {
+    // Alternately with the ego (right or left lane, near it) and oncoming.
+    const bool oncoming = i % 2 == 1;
+    const double lane = oncoming ? 9.25 + 3.5 * std::floor(uniform(0.0, 3.0)) : (unit(rng) < 0.5 ? -3.5 : 3.5);
+    const double s0 = ego + (oncoming ? uniform(0.0, 2500.0) : uniform(-100.0, 300.0));  // met within ~30 s
+    const double speed = uniform(config.traffic_min_speed, config.traffic_max_speed);
+    scene.moving_cars.push_back({s0, lane, oncoming ? -1.0 : 1.0, offset(rng), speed});
+  }
+  return scene;
+}
 
-Scene BuildScene(const SimulationConfig& config, const LoopPath& path, std::mt19937& rng) {
+Scene BuildTown(const SimulationConfig& config, const LoopPath& path, std::mt19937& rng) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> offset(0.0, config.object_rcs_spread_db);
   const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
@@ -133,20 +177,37 @@ Scene BuildScene(const SimulationConfig& config, const LoopPath& path, std::mt19
     // Alternate: oncoming in the left lane, or ahead in the ego lane.
     const bool oncoming = i % 2 == 0;
     scene.moving_cars.push_back({oncoming ? uniform(0.0, path.Perimeter()) : uniform(25.0, 60.0),
-                                 oncoming ? 3.5 : 0.0, oncoming ? -1.0 : 1.0, offset(rng)});
+                                 oncoming ? 3.5 : 0.0, oncoming ? -1.0 : 1.0, offset(rng), config.moving_car_speed});
   }
   return scene;
 }
 
-Box MovingCarBox(const MovingCar& car, const SimulationConfig& config, const LoopPath& path,
+}  // namespace
+
+Scene BuildScene(const SimulationConfig& config, const LoopPath& path, std::mt19937& rng) {
+  return config.scene == "motorway" ? BuildMotorway(config, path, rng) : BuildTown(config, path, rng);
+}
+
+Scene Nearby(const Scene& scene, const Eigen::Vector3d& position, double range) {
+  Scene nearby;
+  for (const Box& box : scene.static_boxes) {
+    if ((box.centre - position).norm() <= range + box.half_extent.norm() + 1e-3) nearby.static_boxes.push_back(box);
+  }
+  for (const Pole& pole : scene.poles) {
+    if ((pole.xy - position.head<2>()).norm() <= range + pole.radius + 1e-3) nearby.poles.push_back(pole);
+  }
+  nearby.moving_cars = scene.moving_cars;
+  return nearby;
+}
+
+Box MovingCarBox(const MovingCar& car, const LoopPath& path,
                  double time) {
   Eigen::Vector2d p;
   double heading = 0.0;
   bool straight = false;
-  path.At(car.s0 + car.direction * config.moving_car_speed * time, p, heading, straight);
+  path.At(car.s0 + car.direction * car.speed * time, p, heading, straight);
   const Eigen::Vector2d centre = p + car.lane_offset * LoopPath::Left(heading);
-  const Eigen::Vector2d velocity =
-      car.direction * config.moving_car_speed * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+  const Eigen::Vector2d velocity = car.direction * car.speed * Eigen::Vector2d(std::cos(heading), std::sin(heading));
   return {Eigen::Vector3d(centre.x(), centre.y(), kCarHalfExtent.z()), kCarHalfExtent, heading,
           "car", car.rcs_offset, Eigen::Vector3d(velocity.x(), velocity.y(), 0.0), true};
 }

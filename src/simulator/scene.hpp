@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The simulator's town loop (docs/design.md, "The synthetic world"): the
-// road, the buildings, poles and cars along it, and ray casting through
-// them. Internal to src/simulator/.
+// The simulator's loop (docs/design.md, "The synthetic world"): the road,
+// the town's buildings, poles and cars or the motorway's guardrails,
+// gantries and traffic along it, and ray casting through them. Internal to
+// src/simulator/.
 #pragma once
 
 #include <cmath>
@@ -87,6 +88,7 @@ struct MovingCar {
   double lane_offset; // m to the left of the road centre line
   double direction;   // +1 with the loop, -1 against it
   double rcs_offset;
+  double speed;       // m/s
 };
 
 struct Hit {
@@ -105,11 +107,17 @@ struct Scene {
 };
 
 
-// The scene of a run, drawn from `rng` (the same for a seed).
+// The scene of a run, drawn from `rng` (the same for a seed): the town or
+// the motorway of config.scene.
 Scene BuildScene(const SimulationConfig& config, const LoopPath& path, std::mt19937& rng);
 
+// The scene's objects that a ray from `position` can meet within `range`
+// (the rest cannot change a hit): ray casting's cost follows the
+// neighbourhood, not the length of the loop.
+Scene Nearby(const Scene& scene, const Eigen::Vector3d& position, double range);
+
 // A moving car's box at `time` (s since the start).
-Box MovingCarBox(const MovingCar& car, const SimulationConfig& config, const LoopPath& path, double time);
+Box MovingCarBox(const MovingCar& car, const LoopPath& path, double time);
 
 // Sensor pose and world velocity at `time`.
 void SensorState(const SimulationConfig& config, const LoopPath& path, double time, SE3d& pose,

@@ -44,6 +44,7 @@ struct Draws {
   double Unit() { return unit(rng); }
   double Normal() { return normal(rng); }
   double Uniform(double lo, double hi) { return lo + (hi - lo) * unit(rng); }
+  double Gamma(double shape) { return std::gamma_distribution<double>(shape, 1.0 / shape)(rng); }  // mean 1
   std::mt19937 rng;
   std::uniform_real_distribution<double> unit{0.0, 1.0};
   std::normal_distribution<double> normal{0.0, 1.0};
@@ -58,10 +59,51 @@ struct ScanState {
   MeasurementStd stds;
 };
 
-// A detection where the ray at (azimuth, elevation) hits a surface, with the
-// detection probability of its RCS and range; false when it is not detected.
-bool Detect(const SimulationConfig& config, const Scene& scene, const ScanState& state, Draws& draws,
-            RadarPoint& point, DetectionTruth& detection) {
+// The point the radar reports for a return along `direction_radar` at
+// `distance`, moving at `velocity_world`: noise in range, azimuth and
+// elevation (biased, growing off boresight), Doppler v_d = u . (v_target -
+// v_sensor) (conventions.hpp), RCS with noise, Swerling fluctuation and outliers.
+RadarPoint Measure(const SimulationConfig& config, const ScanState& state, double azimuth, double elevation,
+                   double distance, const Eigen::Vector3d& velocity_world, double rcs, Draws& draws,
+                   DetectionTruth& detection) {
+  const Eigen::Vector3d direction_radar(std::cos(elevation) * std::cos(azimuth),
+                                        std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+  const double growth =
+      1.0 + config.elevation_noise_growth * std::pow(azimuth / (config.azimuth_fov_deg * kDeg), 2);
+  RadarPoint point;
+  const double range = distance + config.range_noise * draws.Normal();
+  const double az = azimuth + config.azimuth_noise_deg * kDeg * draws.Normal();
+  const double el = elevation + config.elevation_bias_deg * kDeg +
+                    config.elevation_noise_deg * growth * kDeg * draws.Normal();
+  point.position = range * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+  point.doppler = direction_radar.dot(state.R.transpose() * velocity_world - state.velocity_radar) +
+                  config.doppler_noise * draws.Normal();
+  detection.rcs_noise_free = rcs;
+  point.rcs = rcs + config.rcs_noise_db * draws.Normal();
+  if (config.rcs_swerling != 0) point.rcs += 10.0 * std::log10(draws.Gamma(config.rcs_swerling == 1 ? 1.0 : 2.0));
+  if (draws.Unit() < config.rcs_outlier_fraction) {
+    point.rcs += draws.Uniform(-25.0, 25.0);
+    detection.rcs_outlier = true;
+  }
+  point.std_dev = state.stds;
+  point.std_dev->elevation = float(config.elevation_noise_deg * growth * kDeg);
+  return point;
+}
+
+// Whether a return of `rcs` dBsm from `distance` is detected.
+bool Detected(const SimulationConfig& config, double rcs, double distance, Draws& draws) {
+  const double margin = rcs - 20.0 * std::log10(distance / 10.0) - config.detection_threshold_db;
+  return draws.Unit() <= 1.0 / (1.0 + std::exp(-margin / 2.0));
+}
+
+// The ray at (azimuth, elevation): the return of the surface it hits, if
+// detected, and with multipath_probability when that surface is a wall or
+// guardrail, the ghost of what the mirrored ray meets beyond it: seen along
+// the ray at the path's length (the target mirrored across the reflector),
+// with the mirrored target's velocity (docs/design.md, "The faults of real
+// radars"). Appends to `scan` and `truth`.
+void Detect(const SimulationConfig& config, const Scene& scene, const ScanState& state, Draws& draws,
+            RadarScan& scan, std::vector<DetectionTruth>& truth) {
   const double azimuth = draws.Uniform(-config.azimuth_fov_deg, config.azimuth_fov_deg) * kDeg;
   const double elevation = draws.Uniform(-config.elevation_fov_deg, config.elevation_fov_deg) * kDeg;
   const Eigen::Vector3d direction_radar(std::cos(elevation) * std::cos(azimuth),
@@ -69,32 +111,44 @@ bool Detect(const SimulationConfig& config, const Scene& scene, const ScanState&
   const Eigen::Vector3d direction = state.R * direction_radar;
   const Eigen::Vector3d& origin = state.pose.translation();
   const Hit hit = CastRay(scene, state.moving, origin, direction, config.max_range);
-  if (hit.material == nullptr || hit.distance < config.min_range) return false;
+  if (hit.material == nullptr || hit.distance < config.min_range) return;
 
   const double incidence = std::acos(std::min(1.0, std::abs(direction.dot(hit.normal))));
   const double rcs_true = MaterialRcs(config.materials.at(*hit.material), incidence) + hit.rcs_offset;
-  const double margin = rcs_true - 20.0 * std::log10(hit.distance / 10.0) - config.detection_threshold_db;
-  if (draws.Unit() > 1.0 / (1.0 + std::exp(-margin / 2.0))) return false;
-
-  const double range = hit.distance + config.range_noise * draws.Normal();
-  const double az = azimuth + config.azimuth_noise_deg * kDeg * draws.Normal();
-  const double el = elevation + config.elevation_noise_deg * kDeg * draws.Normal();
-  point.position = range * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-  // v_d = u . (v_target - v_sensor), conventions.hpp.
-  point.doppler = direction_radar.dot(state.R.transpose() * hit.velocity - state.velocity_radar) +
-                  config.doppler_noise * draws.Normal();
-  detection.kind = hit.dynamic ? DetectionKind::kDynamic : DetectionKind::kStatic;
-  detection.material = *hit.material;
-  detection.incidence_angle = incidence;
-  detection.rcs_noise_free = rcs_true;
-  detection.position_world = origin + hit.distance * direction;
-  point.rcs = rcs_true + config.rcs_noise_db * draws.Normal();
-  if (draws.Unit() < config.rcs_outlier_fraction) {
-    point.rcs += draws.Uniform(-25.0, 25.0);
-    detection.rcs_outlier = true;
+  if (Detected(config, rcs_true, hit.distance, draws)) {
+    DetectionTruth detection;
+    detection.kind = hit.dynamic ? DetectionKind::kDynamic : DetectionKind::kStatic;
+    detection.material = *hit.material;
+    detection.incidence_angle = incidence;
+    detection.position_world = origin + hit.distance * direction;
+    detection.target_velocity = hit.velocity;
+    scan.points.push_back(
+        Measure(config, state, azimuth, elevation, hit.distance, hit.velocity, rcs_true, draws, detection));
+    truth.push_back(detection);
   }
-  point.std_dev = state.stds;
-  return true;
+  const bool reflector = *hit.material == "wall" || *hit.material == "guardrail";
+  if (config.multipath_probability <= 0.0 || !reflector || draws.Unit() >= config.multipath_probability) return;
+  const Eigen::Vector3d& n = hit.normal;
+  const Eigen::Vector3d wall = origin + hit.distance * direction;
+  const Eigen::Vector3d mirrored = direction - 2.0 * direction.dot(n) * n;
+  const Hit target = CastRay(scene, state.moving, wall + 1e-6 * mirrored, mirrored, config.max_range - hit.distance);
+  if (target.material == nullptr || *target.material == "ground") return;
+  const double path = hit.distance + 1e-6 + target.distance;
+  const double target_incidence = std::acos(std::min(1.0, std::abs(mirrored.dot(target.normal))));
+  const double rcs = MaterialRcs(config.materials.at(*target.material), target_incidence) + target.rcs_offset -
+                     config.multipath_loss_db;
+  if (!Detected(config, rcs, path, draws)) return;
+  DetectionTruth ghost;
+  ghost.kind = DetectionKind::kGhost;
+  ghost.material = *target.material;
+  ghost.incidence_angle = target_incidence;
+  ghost.position_world = wall + (1e-6 + target.distance) * mirrored;
+  ghost.reflector_point = wall;
+  ghost.reflector_normal = n;
+  ghost.target_velocity = target.velocity;
+  const Eigen::Vector3d image_velocity = target.velocity - 2.0 * target.velocity.dot(n) * n;
+  scan.points.push_back(Measure(config, state, azimuth, elevation, path, image_velocity, rcs, draws, ghost));
+  truth.push_back(ghost);
 }
 
 // Clutter: uniform directions, ranges, Doppler and RCS.
@@ -148,6 +202,12 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
   Draws draws(config.seed);
   std::mt19937 world_rng(config.world_seed);
   const Scene scene = BuildScene(config, path, config.world_seed == 0 ? draws.rng : world_rng);
+  const bool mounted = config.mounting_roll_deg != 0.0 || config.mounting_pitch_deg != 0.0 ||
+                       config.mounting_yaw_deg != 0.0;
+  const SE3d mounting(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, config.mounting_yaw_deg * kDeg)) *
+                          SO3d::Exp(Eigen::Vector3d(0.0, config.mounting_pitch_deg * kDeg, 0.0)) *
+                          SO3d::Exp(Eigen::Vector3d(config.mounting_roll_deg * kDeg, 0.0, 0.0)),
+                      Eigen::Vector3d::Zero());
   ScanState state;
   state.stds = {float(config.range_noise), float(config.azimuth_noise_deg * kDeg),
                 float(config.elevation_noise_deg * kDeg), float(config.doppler_noise)};
@@ -156,12 +216,14 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
     sequence.file_stems.push_back(time.stem);
     Eigen::Vector3d velocity_world;
     SensorState(config, path, time.since_start, state.pose, velocity_world);
+    if (mounted) state.pose = state.pose * mounting;  // T_world_vehicle T_vehicle_radar
     state.R = state.pose.rotation().Matrix();
     state.velocity_radar = state.R.transpose() * velocity_world;
     state.moving.clear();
     for (const simulation::MovingCar& car : scene.moving_cars) {
-      state.moving.push_back(MovingCarBox(car, config, path, time.since_start));
+      state.moving.push_back(MovingCarBox(car, path, time.since_start));
     }
+    const Scene nearby = Nearby(scene, state.pose.translation(), config.max_range);
     RadarScan scan;
     scan.timestamp = time.timestamp;
     scan.has_doppler = true;
@@ -172,11 +234,7 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
     const int clutter = static_cast<int>(std::lround(target * config.clutter_fraction));
     const int surface = std::min(target, config.max_detections) - clutter;
     for (int ray = 0; ray < config.max_rays && static_cast<int>(scan.points.size()) < surface; ++ray) {
-      RadarPoint point;
-      DetectionTruth detection;
-      if (!Detect(config, scene, state, draws, point, detection)) continue;
-      scan.points.push_back(point);
-      truth.push_back(detection);
+      Detect(config, nearby, state, draws, scan, truth);
     }
     AddClutter(config, state, clutter, draws, scan, truth);
     sequence.ground_truth.Append(scan.timestamp, state.pose);

@@ -28,8 +28,10 @@ struct MountingOptions {
 // Throws std::invalid_argument naming the bad option.
 void ValidateOptions(const MountingOptions& options);
 
+// R_vehicle_radar = Rz(yaw) Ry(pitch) (roll unobserved, 0), the convention
+// of the simulator's mounting_* (z up: a positive pitch looks down).
 struct Mounting {
-  double pitch_deg = 0.0;  // the radar's x axis above the direction of travel
+  double pitch_deg = 0.0;  // the radar's x axis below the direction of travel
   double yaw_deg = 0.0;    // the radar's x axis left of the direction of travel
   double pitch_spread_deg = 0.0, yaw_spread_deg = 0.0;  // 1.4826 x median absolute deviation
   std::size_t pitch_scans = 0, yaw_scans = 0;  // scans the medians are over
