@@ -167,6 +167,10 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   app->add_option("--velocity-floor", o.velocity_floor, "Std of the velocity term's floor Q (m)")
       ->check(Positive())
       ->capture_default_str();
+  app->add_option("--velocity-vertical-floor", o.velocity_vertical_floor,
+                  "Its floor along the radar's z (m; 0: --velocity-floor); larger leaves the vertical to the map")
+      ->check(NonNegative())
+      ->capture_default_str();
   app->add_option("--rotation-weight", o.rotation_weight, "Weight of the rotation term (0: off)")
       ->check(NonNegative())
       ->capture_default_str();

@@ -189,6 +189,8 @@ std::vector<OptionField<OdometryOptions>> OwnOdometryFields() {
       RADARGAUSS_FIELD(O, "min_static_points", min_static_points, "fewer Doppler inliers: the prediction stands in"),
       RADARGAUSS_FIELD(O, "velocity_weight", velocity_weight, "weight of the Doppler velocity term (0: off)"),
       RADARGAUSS_FIELD(O, "velocity_floor", velocity_floor, "m: std of the velocity term's floor"),
+      RADARGAUSS_FIELD(O, "velocity_vertical_floor", velocity_vertical_floor,
+                       "m: the floor along the radar's z (0: velocity_floor)"),
       RADARGAUSS_FIELD(O, "rotation_weight", rotation_weight, "weight of the rotation term (0: off)"),
       RADARGAUSS_FIELD(O, "rotation_rate_std_deg", rotation_rate_std_deg,
                        "deg/s about x, y, z: rate changes the rotation term allows"),

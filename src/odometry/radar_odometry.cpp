@@ -24,6 +24,7 @@ void ValidateOptions(const OdometryOptions& o) {
   require(o.min_static_points >= 3, "minimum static points must be >= 3");
   require(finite_non_negative(o.velocity_weight), "velocity weight must be >= 0 and finite");
   require(finite_non_negative(o.velocity_floor) && o.velocity_floor > 0.0, "velocity floor must be > 0 m and finite");
+  require(finite_non_negative(o.velocity_vertical_floor), "velocity vertical floor must be >= 0 m and finite");
   require(finite_non_negative(o.rotation_weight), "rotation weight must be >= 0 and finite");
   require(o.rotation_rate_std_deg.allFinite() && (o.rotation_rate_std_deg.array() > 0.0).all(),
           "rotation rate stds must be > 0 deg/s and finite");
@@ -245,9 +246,11 @@ ScanPriors RadarOdometry::PriorsOf(const Prediction& prediction, const Velocity&
     VelocityPrior prior;
     prior.previous = state_->pose;
     prior.displacement = Displacement(prediction, velocity.value);
-    prior.sqrt_information = VelocitySqrtInformation(
-        velocity.covariance, prediction.dt,
-        options_.velocity_floor * options_.velocity_floor * Eigen::Matrix3d::Identity());
+    const double vertical = options_.velocity_vertical_floor > 0.0 ? options_.velocity_vertical_floor
+                                                                     : options_.velocity_floor;
+    const Eigen::Vector3d floor(options_.velocity_floor, options_.velocity_floor, vertical);
+    prior.sqrt_information =
+        VelocitySqrtInformation(velocity.covariance, prediction.dt, floor.cwiseAbs2().asDiagonal());
     prior.weight = options_.velocity_weight;
     priors.velocity = prior;
   }

@@ -49,7 +49,11 @@ struct OdometryOptions {
   double min_gate = 0.5;          // m/s
   std::size_t min_static_points = 10;  // fewer Doppler inliers: the prediction stands in
   double velocity_weight = 1.0;        // of the velocity term in eq. 2 (0: off)
-  double velocity_floor = 0.05;        // m: std of the floor Q = floor^2 I of the term
+  double velocity_floor = 0.05;        // m: std of the floor Q = diag(floor^2, floor^2, vertical^2) of the term
+  // m: the floor along the radar's z. Larger lets the term leave the vertical
+  // to the geometry (an elevation bias tilts the Doppler velocity, not the
+  // scan's fit to the map: docs/design.md, "The faults of real radars"); 0: velocity_floor.
+  double velocity_vertical_floor = 0.0;
   // The rotation term: the match's rotation against the predicted one, with
   // sigma = rotation_rate_std * dt about the radar's x, y, z (roll, pitch,
   // yaw); docs/design.md, "The rotation term".
