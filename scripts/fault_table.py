@@ -5,7 +5,9 @@ radars (docs/design.md, "The faults of real radars"), each alone and all
 together, on the demo's world and on the motorway (configs/synthetic_motorway.yaml).
 Per row: odometry (one thread, defaults) RPE and ATE against the truth, and
 the paper's localisation from 2 m / 5 deg in the map built from the truth:
-within 0.1 m / 1 deg at w_rcs 0 and 0.25. Counter-measures as extra rows.
+within 0.1 m / 1 deg at w_rcs 0 and 0.25. Counter-measures as extra rows:
+the robust RCS loss (off), the mounting given (--mounting), the elevation
+bias estimated (--estimate-elevation-bias), the map's angular noise.
 Prints a Markdown table.
 
     scripts/fault_table.py [--tool build/release/bin/radargauss] [--work /tmp/fault_table] [--only demo,motorway]
@@ -23,6 +25,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ALL = {"elevation_bias_deg": 0.5, "elevation_noise_growth": 1, "mounting_roll_deg": 0.5,
        "mounting_pitch_deg": 1.5, "mounting_yaw_deg": -1, "rcs_swerling": 1, "multipath_probability": 0.2}
+MOUNTED = ["--mounting", "0.5", "1.5", "-1"]
 FAULTS = [("none", {}),
           ("ghosts (20 % of wall rays)", {"multipath_probability": 0.2}),
           ("Swerling I", {"rcs_swerling": 1}),
@@ -33,9 +36,17 @@ FAULTS = [("none", {}),
                                             "mounting_yaw_deg": -1}),
           ("all (configs/synthetic_realistic.yaml)", ALL)]
 SCENES = {"demo": [], "motorway": open(os.path.join(ROOT, "configs", "synthetic_motorway.yaml")).read().splitlines()}
-# Counter-measures: (name, odometry flags, localize flags), measured on and off.
-MEASURES = [("as is", [], []),
-            ("RCS loss trivial (no robust RCS)", [], ["--rcs-loss", "trivial"])]
+# Counter-measures: (name, odometry flags, localize flags) per fault; "as is" for every fault.
+AS_IS = ("as is", [], [])
+MEASURES = {"none": [AS_IS, ("RCS loss trivial (robust Cauchy off)", [], ["--rcs-loss", "trivial"])],
+            "Swerling I": [AS_IS, ("RCS loss trivial (robust Cauchy off)", [], ["--rcs-loss", "trivial"])],
+            "Swerling III": [AS_IS, ("RCS loss trivial (robust Cauchy off)", [], ["--rcs-loss", "trivial"])],
+            "elevation bias 1 deg": [AS_IS, ("bias estimated", ["--estimate-elevation-bias"], [])],
+            "mounting 0.5 / 1.5 / -1 deg": [AS_IS, ("mounting given", MOUNTED, [])],
+            "all (configs/synthetic_realistic.yaml)": [
+                AS_IS, ("mounting given, bias estimated", MOUNTED + ["--estimate-elevation-bias"], []),
+                ("both, and the map's azimuth noise 0.2 deg", MOUNTED + ["--estimate-elevation-bias",
+                                                                        "--azimuth-std", "0.2"], [])]}
 
 
 def run(command):
@@ -60,7 +71,7 @@ def simulate(tool, work, scene, name, faults):
 def measure(tool, sequence, measure):
     name, odometry_flags, localize_flags = measure
     truth = os.path.join(sequence, "gt_radar_tum.txt")
-    tag = name.split()[0]
+    tag = "_".join(name.split()[:2]).replace(",", "")
     odometry = os.path.join(sequence + f"_odometry_{tag}")
     if not os.path.exists(os.path.join(odometry, "evaluation.json")):
         run(tool + ["odometry", "--sequence", sequence, "--gt", truth, "--out", odometry, *odometry_flags])
@@ -92,7 +103,7 @@ def main():
     args = parser.parse_args()
     tool = [args.tool, "--threads", "1"]
     cases = [(scene, name, faults, m) for scene in args.only.split(",") for name, faults in FAULTS
-             for m in MEASURES if scene == "demo" or name in ("none", FAULTS[-1][0])]
+             for m in MEASURES.get(name, [AS_IS]) if scene == "demo" or name in ("none", FAULTS[-1][0])]
     with ThreadPoolExecutor(args.jobs) as pool:
         results = list(pool.map(lambda c: measure(tool, simulate(tool, args.work, c[0], c[1], c[2]), c[3]), cases))
     print("| scene | faults | counter-measure | odometry RPE % | horizontal % | ATE m | localisation within 0.1 m / 1 deg, "

@@ -85,6 +85,7 @@ OdometryOptions Resolved(const OdometrySettings& s) {
   o.map.rcs.incidence = IncidenceModelFromString(s.incidence);
   o.map.matching.coarse = CoarseLevelsFromString(s.coarse_levels);
   o.rotation_rate_std_deg = Eigen::Vector3d(s.rotation_rate_std[0], s.rotation_rate_std[1], s.rotation_rate_std[2]);
+  o.mounting_deg = Eigen::Vector3d(s.mounting[0], s.mounting[1], s.mounting[2]);
   if (o.map.matching.inflation == std::vector<double>{0.0}) o.map.matching.inflation.clear();  // the exact map alone
   return o;
 }
@@ -174,6 +175,18 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   app->add_option("--rotation-weight", o.rotation_weight, "Weight of the rotation term (0: off)")
       ->check(NonNegative())
       ->capture_default_str();
+  app->add_option("--mounting", s.mounting,
+                  "The radar on the vehicle: roll pitch yaw (deg; positive pitch looks down; odometry prints an "
+                  "estimate)")
+      ->expected(3)
+      ->check(InRange(-45.0, 45.0))
+      ->capture_default_str();
+  app->add_option("--elevation-bias", o.elevation_bias.bias_deg,
+                  "The radar's elevation bias (deg), removed from every point; with --estimate-elevation-bias the start")
+      ->check(InRange(-44.9, 44.9))
+      ->capture_default_str();
+  app->add_flag("--estimate-elevation-bias", o.elevation_bias.estimate,
+                "Estimate the elevation bias from the Doppler velocity (needs --mounting right)");
   app->add_option("--rotation-rate-std", s.rotation_rate_std,
                   "Rotation term: change of the rate between scans about x y z (roll pitch yaw, deg/s)")
       ->expected(3)

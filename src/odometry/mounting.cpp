@@ -29,11 +29,7 @@ void ValidateOptions(const MountingOptions& o) {
   if (o.min_scans < 1) throw std::invalid_argument("mounting: min_scans must be >= 1");
 }
 
-SO3d Mounting::vehicle_from_radar() const {
-  const SO3d yaw = SO3d::Exp(Eigen::Vector3d(0.0, 0.0, yaw_deg * kDegree));
-  const SO3d pitch = SO3d::Exp(Eigen::Vector3d(0.0, pitch_deg * kDegree, 0.0));
-  return yaw * pitch;
-}
+SO3d Mounting::vehicle_from_radar() const { return VehicleFromRadar(Eigen::Vector3d(0.0, pitch_deg, yaw_deg)); }
 
 std::optional<Mounting> EstimateMounting(const std::vector<OdometryStep>& steps, const MountingOptions& options) {
   ValidateOptions(options);

@@ -26,6 +26,9 @@ void ValidateOptions(const OdometryOptions& o) {
   require(finite_non_negative(o.velocity_floor) && o.velocity_floor > 0.0, "velocity floor must be > 0 m and finite");
   require(finite_non_negative(o.velocity_vertical_floor), "velocity vertical floor must be >= 0 m and finite");
   require(finite_non_negative(o.rotation_weight), "rotation weight must be >= 0 and finite");
+  require(o.mounting_deg.allFinite() && o.mounting_deg.cwiseAbs().maxCoeff() <= 45.0,
+          "mounting angles must be within +/-45 deg");
+  ValidateOptions(o.elevation_bias);
   require(o.rotation_rate_std_deg.allFinite() && (o.rotation_rate_std_deg.array() > 0.0).all(),
           "rotation rate stds must be > 0 deg/s and finite");
   require(finite_non_negative(o.keyframe_distance), "keyframe distance must be >= 0 m and finite");
@@ -41,7 +44,10 @@ RadarOdometry::RadarOdometry(const OdometryOptions& options)
       }) {}
 
 RadarOdometry::RadarOdometry(const OdometryOptions& options, MatcherFactory factory)
-    : options_(options), factory_(std::move(factory)), map_(options.map) {
+    : options_(options),
+      elevation_bias_(options.elevation_bias, VehicleFromRadar(options.mounting_deg)),
+      factory_(std::move(factory)),
+      map_(options.map) {
   ValidateOptions(options_);
   if (!factory_) throw std::invalid_argument("RadarOdometry needs a matcher factory");
 }
@@ -95,6 +101,12 @@ std::optional<SO3d> RadarOdometry::GyroIncrement(double from, double to) const {
   return increment;
 }
 
+SO3d VehicleFromRadar(const Eigen::Vector3d& roll_pitch_yaw_deg) {
+  const Eigen::Vector3d angles = roll_pitch_yaw_deg * (M_PI / 180.0);
+  return SO3d::Exp(Eigen::Vector3d(0.0, 0.0, angles.z())) * SO3d::Exp(Eigen::Vector3d(0.0, angles.y(), 0.0)) *
+         SO3d::Exp(Eigen::Vector3d(angles.x(), 0.0, 0.0));
+}
+
 RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
   const MotionState& last = *state_;
   Prediction p;
@@ -103,11 +115,12 @@ RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
   if (const std::optional<SO3d> gyro = GyroIncrement(last.stamp, stamp)) {
     increment = *gyro;
     p.gyro = true;
-  } else if (last.before) {  // the last increment's yaw rate; roll and pitch held
+  } else if (last.before) {  // the last increment's yaw rate about the vehicle's vertical; roll and pitch held
     const auto& [before_stamp, before_pose] = *last.before;
+    const Eigen::Vector3d up = VehicleFromRadar(options_.mounting_deg).Inverse() * Eigen::Vector3d::UnitZ();
     const double yaw_rate =
-        (before_pose.rotation().Inverse() * last.pose.rotation()).Log().z() / (last.stamp - before_stamp);
-    increment = SO3d::Exp(Eigen::Vector3d(0.0, 0.0, yaw_rate * p.dt));
+        (before_pose.rotation().Inverse() * last.pose.rotation()).Log().dot(up) / (last.stamp - before_stamp);
+    increment = SO3d::Exp(up * (yaw_rate * p.dt));
   }
   p.increment = increment;
   // A vehicle keeps its velocity in its own frame: the last one, unrotated.
@@ -169,12 +182,16 @@ RadarOdometry::Velocity RadarOdometry::MeasureVelocity(const RadarScan& scan,
 }
 
 // Kiss-icp's shape: each stage returns a value, the step is assembled at the end.
-const OdometryStep& RadarOdometry::Register(const RadarScan& scan) {
+const OdometryStep& RadarOdometry::Register(const RadarScan& input) {
   const auto start = std::chrono::steady_clock::now();
-  CheckStamp(scan);
+  CheckStamp(input);
+  const bool correct = elevation_bias_.active();
+  const RadarScan corrected = correct ? elevation_bias_.Corrected(input) : RadarScan();
+  const RadarScan& scan = correct ? corrected : input;
   std::optional<Prediction> prediction;
   if (state_) prediction = Predict(scan.timestamp);
   const Velocity velocity = MeasureVelocity(scan, prediction);
+  if (velocity.measured && !velocity.standstill) elevation_bias_.Observe(velocity.value);
   const PoseEstimate estimate = EstimatePose(scan, prediction, velocity);
   const bool keyframe = !fixed_map_ && IsKeyframe(estimate.pose, velocity);
   if (keyframe) InsertKeyframe(scan, velocity.static_points, estimate.pose);
@@ -258,7 +275,8 @@ ScanPriors RadarOdometry::PriorsOf(const Prediction& prediction, const Velocity&
     RotationPrior prior;
     prior.predicted = state_->pose.rotation() * prediction.increment;
     const Eigen::Vector3d sigma = options_.rotation_rate_std_deg * (M_PI / 180.0 * prediction.dt);
-    prior.sqrt_information = sigma.cwiseInverse().asDiagonal();
+    // About the vehicle's axes: the residual Log(R_pred^T R) turned into them.
+    prior.sqrt_information = sigma.cwiseInverse().asDiagonal() * VehicleFromRadar(options_.mounting_deg).Matrix();
     prior.weight = options_.rotation_weight;
     priors.rotation = prior;
   }

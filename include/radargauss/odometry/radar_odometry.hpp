@@ -24,6 +24,7 @@
 
 #include "radargauss/doppler.hpp"
 #include "radargauss/lie/se3.hpp"
+#include "radargauss/odometry/elevation_bias.hpp"
 #include "radargauss/odometry/local_map.hpp"
 #include "radargauss/solvers/factory.hpp"
 #include "radargauss/trajectory.hpp"
@@ -65,7 +66,18 @@ struct OdometryOptions {
   double keyframe_angle_deg = 2.0;     // ... or deg: the scan enters the map
   std::size_t min_matched_points = 10; // fewer associated points: the prediction stands in
   SE3d initial_pose;                   // T_world_radar of the first scan
+  // The radar on the vehicle, roll / pitch / yaw in deg (VehicleFromRadar;
+  // `radargauss odometry` prints an estimate): the prediction turns about
+  // the vehicle's vertical and the rotation term's stds are about its axes.
+  Eigen::Vector3d mounting_deg = Eigen::Vector3d::Zero();
+  // A known elevation bias removed from every point, or one estimated from
+  // the Doppler velocity (odometry/elevation_bias.hpp).
+  ElevationBiasOptions elevation_bias;
 };
+
+// R_vehicle_radar = Rz(yaw) Ry(pitch) Rx(roll) (z up, a positive pitch looks
+// down: docs/design.md, "Mounting").
+SO3d VehicleFromRadar(const Eigen::Vector3d& roll_pitch_yaw_deg);
 
 // Throws std::invalid_argument naming the bad option.
 void ValidateOptions(const OdometryOptions& options);
@@ -132,6 +144,8 @@ class RadarOdometry {
   // every point of a scan without Doppler; none when the prediction stood in).
   const std::vector<std::size_t>& last_static_points() const { return last_static_points_; }
   const OdometryOptions& options() const { return options_; }
+  // The elevation bias removed from the points now (deg): the option's, or its estimate.
+  double elevation_bias_deg() const { return elevation_bias_.bias_deg(); }
   // How many matchers the factory has made: one per map version matched against.
   std::size_t matchers_made() const { return matchers_made_; }
 
@@ -194,6 +208,7 @@ class RadarOdometry {
                       const PoseEstimate& estimate, bool keyframe) const;
 
   OdometryOptions options_;
+  ElevationBias elevation_bias_;
   MatcherFactory factory_;
   std::shared_ptr<const ScanMatcher> matcher_;  // for map_ at matcher_version_
   std::size_t matcher_version_ = 0;

@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// A radar's constant elevation bias, removed from every point and estimated
+// from the Doppler velocity (docs/design.md, "The faults of real radars"): a
+// bias b lifts every return by b, and the Doppler fit then lifts the ego
+// velocity by b too, while a vehicle moves along its own x axis. So the
+// corrected velocity's elevation in the vehicle frame is what is left of the
+// bias; the estimate is the median of (that + the bias removed) over the
+// last `window` scans at speed.
+//
+//   ElevationBias bias(options);
+//   const RadarScan corrected = bias.Corrected(scan);
+//   ... (the ego velocity of `corrected`)
+//   bias.Observe(velocity);
+#pragma once
+
+#include <cstddef>
+#include <deque>
+
+#include <Eigen/Core>
+
+#include "radargauss/lie/so3.hpp"
+#include "radargauss/types.hpp"
+
+namespace radargauss {
+
+struct ElevationBiasOptions {
+  double bias_deg = 0.0;   // removed from every elevation (and the estimate's start)
+  bool estimate = false;   // follow the Doppler velocity's elevation
+  std::size_t window = 100;  // scans the median is over
+  double min_speed = 5.0;    // m/s: slower scans are left out
+};
+
+// Throws std::invalid_argument naming the bad option.
+void ValidateOptions(const ElevationBiasOptions& options);
+
+class ElevationBias {
+ public:
+  // vehicle_from_radar: the mounting (R_vehicle_radar).
+  ElevationBias(const ElevationBiasOptions& options, const SO3d& vehicle_from_radar);
+
+  bool active() const { return options_.estimate || bias_ != 0.0; }
+  double bias_deg() const;
+  // The scan with every point's elevation lowered by the current bias
+  // (range and azimuth kept).
+  RadarScan Corrected(const RadarScan& scan) const;
+  // A measured ego velocity (radar frame) of a corrected scan.
+  void Observe(const Eigen::Vector3d& velocity);
+
+ private:
+  ElevationBiasOptions options_;
+  SO3d vehicle_from_radar_;
+  double bias_ = 0.0;           // rad
+  std::deque<double> window_;   // raw elevations: residual + the bias then removed (rad)
+};
+
+}  // namespace radargauss

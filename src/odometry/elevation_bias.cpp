@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/odometry/elevation_bias.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "radargauss/stats.hpp"
+
+namespace radargauss {
+
+void ValidateOptions(const ElevationBiasOptions& o) {
+  if (!(std::abs(o.bias_deg) < 45.0)) throw std::invalid_argument("elevation bias must be within +/-45 deg");
+  if (o.window < 1) throw std::invalid_argument("elevation bias window must be >= 1 scan");
+  if (!(o.min_speed > 0.0) || !std::isfinite(o.min_speed)) {
+    throw std::invalid_argument("elevation bias minimum speed must be positive");
+  }
+}
+
+ElevationBias::ElevationBias(const ElevationBiasOptions& options, const SO3d& vehicle_from_radar)
+    : options_(options), vehicle_from_radar_(vehicle_from_radar), bias_(options.bias_deg * M_PI / 180.0) {
+  ValidateOptions(options_);
+}
+
+double ElevationBias::bias_deg() const { return bias_ * 180.0 / M_PI; }
+
+RadarScan ElevationBias::Corrected(const RadarScan& scan) const {
+  RadarScan corrected = scan;
+  const double cos_b = std::cos(bias_), sin_b = std::sin(bias_);
+  for (RadarPoint& point : corrected.points) {
+    // (cos el, sin el) turned by -b, in the point's vertical plane.
+    const Eigen::Vector3d& p = point.position;
+    const double horizontal = p.head<2>().norm();
+    const double lowered = horizontal * cos_b + p.z() * sin_b;
+    const double z = p.z() * cos_b - horizontal * sin_b;
+    const double scale = horizontal > 0.0 ? lowered / horizontal : 0.0;
+    point.position = Eigen::Vector3d(p.x() * scale, p.y() * scale, z);
+  }
+  return corrected;
+}
+
+void ElevationBias::Observe(const Eigen::Vector3d& velocity) {
+  if (!options_.estimate || velocity.norm() < options_.min_speed) return;
+  const Eigen::Vector3d forward = vehicle_from_radar_ * velocity;
+  window_.push_back(std::atan2(forward.z(), forward.x()) + bias_);
+  if (window_.size() > options_.window) window_.pop_front();
+  bias_ = Median(std::vector<double>(window_.begin(), window_.end()));
+}
+
+}  // namespace radargauss
