@@ -75,6 +75,8 @@ class RadarOdometry:
         mounting_deg: Sequence[float] = [0.0, 0.0, 0.0],
         elevation_bias_deg: float = 0.0,
         estimate_elevation_bias: bool = False,
+        elevation_bias_window: int = 100,
+        elevation_bias_min_speed: float = 5.0,
         region: float = 4.0,
         region_capacity: int = 256,
         region_min_points: int = 8,

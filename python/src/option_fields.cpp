@@ -197,6 +197,8 @@ std::vector<OptionField<OdometryOptions>> OwnOdometryFields() {
       RADARGAUSS_FIELD(O, "mounting_deg", mounting_deg, "roll, pitch, yaw of the radar on the vehicle (deg)"),
       RADARGAUSS_FIELD(O, "elevation_bias_deg", elevation_bias.bias_deg, "deg: removed from every elevation"),
       RADARGAUSS_FIELD(O, "estimate_elevation_bias", elevation_bias.estimate, "follow the Doppler velocity's elevation"),
+      RADARGAUSS_FIELD(O, "elevation_bias_window", elevation_bias.window, "scans the bias's median is over"),
+      RADARGAUSS_FIELD(O, "elevation_bias_min_speed", elevation_bias.min_speed, "m/s: slower scans leave the bias"),
       RADARGAUSS_FIELD(O, "region", map.region, "m: edge of the local map's regions"),
       RADARGAUSS_FIELD(O, "region_capacity", map.region_capacity, "points a region keeps (the newest)"),
       RADARGAUSS_FIELD(O, "region_min_points", map.min_points, "points a region needs for its first fit"),
