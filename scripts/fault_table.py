@@ -7,7 +7,8 @@ Per row: odometry (one thread, defaults) RPE and ATE against the truth, and
 the paper's localisation from 2 m / 5 deg in the map built from the truth:
 within 0.1 m / 1 deg at w_rcs 0 and 0.25. Counter-measures as extra rows:
 the robust RCS loss (off), the mounting given (--mounting), the elevation
-bias estimated (--estimate-elevation-bias), the map's angular noise.
+bias estimated (--estimate-elevation-bias) or given to every command
+(--elevation-bias), the map's angular noise.
 Prints a Markdown table.
 
     scripts/fault_table.py [--tool build/release/bin/radargauss] [--work /tmp/fault_table] [--only demo,motorway]
@@ -41,7 +42,9 @@ AS_IS = ("as is", [], [])
 MEASURES = {"none": [AS_IS, ("RCS loss trivial (robust Cauchy off)", [], ["--rcs-loss", "trivial"])],
             "Swerling I": [AS_IS, ("RCS loss trivial (robust Cauchy off)", [], ["--rcs-loss", "trivial"])],
             "Swerling III": [AS_IS, ("RCS loss trivial (robust Cauchy off)", [], ["--rcs-loss", "trivial"])],
-            "elevation bias 1 deg": [AS_IS, ("bias estimated", ["--estimate-elevation-bias"], [])],
+            "elevation bias 1 deg": [AS_IS, ("bias estimated", ["--estimate-elevation-bias"], []),
+                                     ("bias given (--elevation-bias 1 to every command)", ["--elevation-bias", "1"],
+                                      ["--elevation-bias", "1"])],
             "mounting 0.5 / 1.5 / -1 deg": [AS_IS, ("mounting given", MOUNTED, [])],
             "all (configs/synthetic_realistic.yaml)": [
                 AS_IS, ("mounting given, bias estimated", MOUNTED + ["--estimate-elevation-bias"], []),
@@ -76,9 +79,12 @@ def measure(tool, sequence, measure):
     if not os.path.exists(os.path.join(odometry, "evaluation.json")):
         run(tool + ["odometry", "--sequence", sequence, "--gt", truth, "--out", odometry, *odometry_flags])
     e = json.load(open(os.path.join(odometry, "evaluation.json")))
-    path = sequence + "_map.rgm"
+    # The map takes the sequence's flags of localize (--elevation-bias).
+    sequence_flags = localize_flags if "--elevation-bias" in localize_flags else []
+    path = sequence + (f"_map_{tag}.rgm" if sequence_flags else "_map.rgm")
     if not os.path.exists(path):
-        run(tool + ["build-map", "--sequence", sequence, "--gt", truth, "--extrinsic", "identity", "--out", path])
+        run(tool + ["build-map", "--sequence", sequence, "--gt", truth, "--extrinsic", "identity", "--out", path,
+                    *sequence_flags])
     localize = os.path.join(sequence + f"_localize_{tag}")
     if not os.path.exists(os.path.join(localize, "per_scan.csv")):
         run(tool + ["localize", "--map", path, "--sequence", sequence, "--gt", truth, "--extrinsic", "identity",

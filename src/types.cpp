@@ -26,4 +26,17 @@ void ValidateScan(const RadarScan& scan, const std::string& source) {
   }
 }
 
+void LowerElevations(RadarScan& scan, double angle) {
+  const double cos_a = std::cos(angle), sin_a = std::sin(angle);
+  for (RadarPoint& point : scan.points) {
+    // (cos el, sin el) turned by -angle in the point's vertical plane.
+    const Eigen::Vector3d& p = point.position;
+    const double horizontal = p.head<2>().norm();
+    const double lowered = horizontal * cos_a + p.z() * sin_a;
+    const double z = p.z() * cos_a - horizontal * sin_a;
+    const double scale = horizontal > 0.0 ? lowered / horizontal : 0.0;
+    point.position = Eigen::Vector3d(p.x() * scale, p.y() * scale, z);
+  }
+}
+
 }  // namespace radargauss

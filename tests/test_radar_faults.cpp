@@ -11,10 +11,13 @@
 #include <cmath>
 #include <vector>
 
+#include "radargauss/error.hpp"
 #include "radargauss/evaluation.hpp"
+#include "radargauss/io/sequence.hpp"
 #include "radargauss/odometry/elevation_bias.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/simulator.hpp"
+#include "temp_dir.hpp"
 
 namespace radargauss {
 namespace {
@@ -212,6 +215,28 @@ TEST(ElevationBias, CorrectionUndoesTheBias) {
   }
   options.window = 0;
   EXPECT_THROW(ElevationBias(options, SO3d()), std::invalid_argument);
+}
+
+// Read with the bias given (every command's --elevation-bias), the biased
+// run's files give the unbiased run's points (float32 files: 1e-4 m).
+using ElevationBiasFiles = testing::TempDirTest;
+TEST_F(ElevationBiasFiles, ReadingRemovesAGivenBias) {
+  SimulationConfig biased = Exact(3);
+  biased.elevation_bias_deg = 1.0;
+  const SimulatedSequence a = Simulate(Exact(3));
+  WriteSimulatedSequence(Path("biased"), Simulate(biased));
+  SequenceOptions options;
+  options.sequence_dir = Path("biased");
+  options.elevation_bias_deg = 1.0;
+  const Sequence read = LoadSequence(options);
+  ASSERT_EQ(read.scans.size(), a.scans.size());
+  for (std::size_t k = 0; k < a.scans.size(); ++k) {
+    for (std::size_t i = 0; i < a.scans[k].points.size(); ++i) {
+      ASSERT_LT((read.scans[k].points[i].position - a.scans[k].points[i].position).norm(), 1e-4);
+    }
+  }
+  options.elevation_bias_deg = 50.0;
+  EXPECT_THROW(LoadSequence(options), DataError);
 }
 
 double OdometryRpe(const SimulatedSequence& run, const OdometryOptions& options, double* bias = nullptr) {

@@ -181,12 +181,8 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
       ->expected(3)
       ->check(InRange(-45.0, 45.0))
       ->capture_default_str();
-  app->add_option("--elevation-bias", o.elevation_bias.bias_deg,
-                  "The radar's elevation bias (deg), removed from every point; with --estimate-elevation-bias the start")
-      ->check(InRange(-44.9, 44.9))
-      ->capture_default_str();
   app->add_flag("--estimate-elevation-bias", o.elevation_bias.estimate,
-                "Estimate the elevation bias from the Doppler velocity (needs --mounting right)");
+                "Estimate the elevation bias (beyond --elevation-bias) from the Doppler velocity (needs --mounting)");
   app->add_option("--rotation-rate-std", s.rotation_rate_std,
                   "Rotation term: change of the rate between scans about x y z (roll pitch yaw, deg/s)")
       ->expected(3)

@@ -32,6 +32,10 @@ void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::stri
                   "Multiplies the file's Doppler to get 'positive receding' (+1 or -1)")
       ->check(CLI::IsMember({1.0, -1.0}))
       ->capture_default_str();
+  app->add_option("--elevation-bias", options.elevation_bias_deg,
+                  "The radar's elevation bias (deg), removed from every point as it is read")
+      ->check(CLI::Range(-44.9, 44.9))
+      ->capture_default_str();
 }
 
 void CheckRcsWeights(const Sequence& sequence, const std::vector<double>& weights) {

@@ -42,4 +42,9 @@ struct RadarScan {
 // stages that need points check for that themselves.
 void ValidateScan(const RadarScan& scan, const std::string& source);
 
+// Lowers every point's elevation by `angle` (rad), keeping its range and
+// azimuth: removes a radar's elevation bias (docs/design.md, "The faults of
+// real radars").
+void LowerElevations(RadarScan& scan, double angle);
+
 }  // namespace radargauss

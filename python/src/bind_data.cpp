@@ -100,7 +100,8 @@ void BindSequence(py::module_& m) {
   m.def(
       "read_sequence",
       [](const std::string& path, const std::string& gt, const std::string& extrinsic, const std::string& bag,
-         const std::string& topic, const std::string& rcs_field, const std::string& doppler_field) {
+         const std::string& topic, const std::string& rcs_field, const std::string& doppler_field,
+         double elevation_bias_deg) {
         SequenceOptions options;
         options.sequence_dir = path;
         options.ground_truth = gt;
@@ -109,13 +110,15 @@ void BindSequence(py::module_& m) {
         options.topic = topic;
         options.fields.rcs_field = rcs_field;
         options.fields.doppler_field = doppler_field;
+        options.elevation_bias_deg = elevation_bias_deg;
         py::gil_scoped_release release;
         return LoadSequence(options);
       },
       py::arg("path") = "", py::arg("gt") = "", py::arg("extrinsic") = "auto", py::arg("bag") = "",
-      py::arg("topic") = "", py::arg("rcs_field") = "", py::arg("doppler_field") = "",
+      py::arg("topic") = "", py::arg("rcs_field") = "", py::arg("doppler_field") = "", py::arg("elevation_bias_deg") = 0.0,
       "Reads a sequence as `radargauss info` does: a Snail-Radar folder, a folder of .pcd or .bin scans "
-      "(path), or a ROS1 bag (bag, topic); gt: a TUM file of reference poses, extrinsic T_gt_radar.");
+      "(path), or a ROS1 bag (bag, topic); gt: a TUM file of reference poses, extrinsic T_gt_radar; "
+      "elevation_bias_deg removed from every point.");
   m.def("read_pcd", [](const std::string& path) { return ReadPcdScan(path); }, py::arg("path"),
         "One PCD scan (ascii, binary or binary_compressed); the stamp from a <secs>.<nsecs>.pcd name.");
 }

@@ -2,6 +2,7 @@
 #include "radargauss/io/sequence.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -162,6 +163,10 @@ Sequence LoadSequence(const SequenceOptions& options) {
   }
   sequence.total_scans = scans.size();
   if (scans.empty()) throw DataError("sequence has no scans");
+  if (!(std::abs(options.elevation_bias_deg) < 45.0)) throw DataError("the elevation bias must be within +/-45 deg");
+  if (options.elevation_bias_deg != 0.0) {
+    for (RadarScan& scan : scans) LowerElevations(scan, options.elevation_bias_deg * M_PI / 180.0);
+  }
   for (std::size_t i = 1; i < scans.size(); ++i) {
     if (!(scans[i].timestamp > scans[i - 1].timestamp)) {
       throw FileError(sources[i], "scan time does not increase (missing or repeated timestamps)");

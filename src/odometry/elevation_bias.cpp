@@ -26,16 +26,7 @@ double ElevationBias::bias_deg() const { return bias_ * 180.0 / M_PI; }
 
 RadarScan ElevationBias::Corrected(const RadarScan& scan) const {
   RadarScan corrected = scan;
-  const double cos_b = std::cos(bias_), sin_b = std::sin(bias_);
-  for (RadarPoint& point : corrected.points) {
-    // (cos el, sin el) turned by -b, in the point's vertical plane.
-    const Eigen::Vector3d& p = point.position;
-    const double horizontal = p.head<2>().norm();
-    const double lowered = horizontal * cos_b + p.z() * sin_b;
-    const double z = p.z() * cos_b - horizontal * sin_b;
-    const double scale = horizontal > 0.0 ? lowered / horizontal : 0.0;
-    point.position = Eigen::Vector3d(p.x() * scale, p.y() * scale, z);
-  }
+  LowerElevations(corrected, bias_);
   return corrected;
 }
 

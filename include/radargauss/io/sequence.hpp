@@ -32,6 +32,7 @@ struct SequenceOptions {
   std::string extrinsic = "auto";
   std::string bin_layout = "vod";  // record layout of .bin folders
   FieldMapping fields;
+  double elevation_bias_deg = 0.0;  // removed from every point's elevation (LowerElevations)
 };
 
 struct Sequence {
