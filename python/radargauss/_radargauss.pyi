@@ -73,7 +73,6 @@ class RadarOdometry:
         rotation_weight: float = 1.0,
         rotation_rate_std_deg: Sequence[float] = [1.0, 1.0, 90.0],
         mounting_deg: Sequence[float] = [0.0, 0.0, 0.0],
-        elevation_bias_deg: float = 0.0,
         estimate_elevation_bias: bool = False,
         elevation_bias_window: int = 100,
         elevation_bias_min_speed: float = 5.0,

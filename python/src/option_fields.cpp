@@ -195,7 +195,6 @@ std::vector<OptionField<OdometryOptions>> OwnOdometryFields() {
       RADARGAUSS_FIELD(O, "rotation_rate_std_deg", rotation_rate_std_deg,
                        "deg/s about x, y, z: rate changes the rotation term allows"),
       RADARGAUSS_FIELD(O, "mounting_deg", mounting_deg, "roll, pitch, yaw of the radar on the vehicle (deg)"),
-      RADARGAUSS_FIELD(O, "elevation_bias_deg", elevation_bias.bias_deg, "deg: removed from every elevation"),
       RADARGAUSS_FIELD(O, "estimate_elevation_bias", elevation_bias.estimate, "follow the Doppler velocity's elevation"),
       RADARGAUSS_FIELD(O, "elevation_bias_window", elevation_bias.window, "scans the bias's median is over"),
       RADARGAUSS_FIELD(O, "elevation_bias_min_speed", elevation_bias.min_speed, "m/s: slower scans leave the bias"),

@@ -10,7 +10,6 @@
 namespace radargauss {
 
 void ValidateOptions(const ElevationBiasOptions& o) {
-  if (!(std::abs(o.bias_deg) < 45.0)) throw std::invalid_argument("elevation bias must be within +/-45 deg");
   if (o.window < 1) throw std::invalid_argument("elevation bias window must be >= 1 scan");
   if (!(o.min_speed > 0.0) || !std::isfinite(o.min_speed)) {
     throw std::invalid_argument("elevation bias minimum speed must be positive");
@@ -18,7 +17,7 @@ void ValidateOptions(const ElevationBiasOptions& o) {
 }
 
 ElevationBias::ElevationBias(const ElevationBiasOptions& options, const SO3d& vehicle_from_radar)
-    : options_(options), vehicle_from_radar_(vehicle_from_radar), bias_(options.bias_deg * M_PI / 180.0) {
+    : options_(options), vehicle_from_radar_(vehicle_from_radar) {
   ValidateOptions(options_);
 }
 

@@ -86,7 +86,7 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
                                   {"active_gaussians", s.active_gaussians},
                                   {"global_gaussians", s.global_gaussians},
                                   {"active_map_bytes", s.map_bytes}};
-  if (odometry.options().elevation_bias.estimate || odometry.elevation_bias_deg() != 0.0) {
+  if (odometry.options().elevation_bias.estimate) {
     summary["elevation_bias_deg"] = odometry.elevation_bias_deg();
   }
   summary["mounting"] = nullptr;  // not observable: too few straight scans at speed

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// A radar's constant elevation bias, removed from every point and estimated
-// from the Doppler velocity (docs/design.md, "The faults of real radars"): a
+// A radar's constant elevation bias estimated from the Doppler velocity and
+// removed from every point (docs/design.md, "The faults of real radars"; a
+// known bias is removed as the sequence is read, SequenceOptions): a
 // bias b lifts every return by b, and the Doppler fit then lifts the ego
 // velocity by b too, while a vehicle moves along its own x axis. So the
 // corrected velocity's elevation in the vehicle frame is what is left of the
@@ -24,8 +25,7 @@
 namespace radargauss {
 
 struct ElevationBiasOptions {
-  double bias_deg = 0.0;   // removed from every elevation (and the estimate's start)
-  bool estimate = false;   // follow the Doppler velocity's elevation
+  bool estimate = false;     // follow the Doppler velocity's elevation
   std::size_t window = 100;  // scans the median is over
   double min_speed = 5.0;    // m/s: slower scans are left out
 };
@@ -38,8 +38,8 @@ class ElevationBias {
   // vehicle_from_radar: the mounting (R_vehicle_radar).
   ElevationBias(const ElevationBiasOptions& options, const SO3d& vehicle_from_radar);
 
-  bool active() const { return options_.estimate || bias_ != 0.0; }
-  double bias_deg() const;
+  bool active() const { return options_.estimate; }
+  double bias_deg() const;  // the estimate (0 until a scan at speed)
   // The scan with every point's elevation lowered by the current bias
   // (range and azimuth kept).
   RadarScan Corrected(const RadarScan& scan) const;
