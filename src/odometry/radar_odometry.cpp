@@ -45,7 +45,8 @@ RadarOdometry::RadarOdometry(const OdometryOptions& options)
 
 RadarOdometry::RadarOdometry(const OdometryOptions& options, MatcherFactory factory)
     : options_(options),
-      elevation_bias_(options.elevation_bias, VehicleFromRadar(options.mounting_deg)),
+      vehicle_from_radar_(VehicleFromRadar(options.mounting_deg)),
+      elevation_bias_(options.elevation_bias, vehicle_from_radar_),
       factory_(std::move(factory)),
       map_(options.map) {
   ValidateOptions(options_);
@@ -117,7 +118,7 @@ RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
     p.gyro = true;
   } else if (last.before) {  // the last increment's yaw rate about the vehicle's vertical; roll and pitch held
     const auto& [before_stamp, before_pose] = *last.before;
-    const Eigen::Vector3d up = VehicleFromRadar(options_.mounting_deg).Inverse() * Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d up = vehicle_from_radar_.Inverse() * Eigen::Vector3d::UnitZ();
     const double yaw_rate =
         (before_pose.rotation().Inverse() * last.pose.rotation()).Log().dot(up) / (last.stamp - before_stamp);
     increment = SO3d::Exp(up * (yaw_rate * p.dt));
@@ -276,7 +277,7 @@ ScanPriors RadarOdometry::PriorsOf(const Prediction& prediction, const Velocity&
     prior.predicted = state_->pose.rotation() * prediction.increment;
     const Eigen::Vector3d sigma = options_.rotation_rate_std_deg * (M_PI / 180.0 * prediction.dt);
     // About the vehicle's axes: the residual Log(R_pred^T R) turned into them.
-    prior.sqrt_information = sigma.cwiseInverse().asDiagonal() * VehicleFromRadar(options_.mounting_deg).Matrix();
+    prior.sqrt_information = sigma.cwiseInverse().asDiagonal() * vehicle_from_radar_.Matrix();
     prior.weight = options_.rotation_weight;
     priors.rotation = prior;
   }

@@ -70,8 +70,8 @@ struct OdometryOptions {
   // `radargauss odometry` prints an estimate): the prediction turns about
   // the vehicle's vertical and the rotation term's stds are about its axes.
   Eigen::Vector3d mounting_deg = Eigen::Vector3d::Zero();
-  // A known elevation bias removed from every point, or one estimated from
-  // the Doppler velocity (odometry/elevation_bias.hpp).
+  // The elevation bias estimated from the Doppler velocity and removed
+  // (odometry/elevation_bias.hpp), beyond what the sequence's reading removed.
   ElevationBiasOptions elevation_bias;
 };
 
@@ -144,7 +144,7 @@ class RadarOdometry {
   // every point of a scan without Doppler; none when the prediction stood in).
   const std::vector<std::size_t>& last_static_points() const { return last_static_points_; }
   const OdometryOptions& options() const { return options_; }
-  // The elevation bias removed from the points now (deg): the option's, or its estimate.
+  // The elevation bias removed from the points now (deg): the estimate.
   double elevation_bias_deg() const { return elevation_bias_.bias_deg(); }
   // How many matchers the factory has made: one per map version matched against.
   std::size_t matchers_made() const { return matchers_made_; }
@@ -208,6 +208,7 @@ class RadarOdometry {
                       const PoseEstimate& estimate, bool keyframe) const;
 
   OdometryOptions options_;
+  SO3d vehicle_from_radar_;  // of options_.mounting_deg
   ElevationBias elevation_bias_;
   MatcherFactory factory_;
   std::shared_ptr<const ScanMatcher> matcher_;  // for map_ at matcher_version_
