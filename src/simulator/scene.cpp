@@ -84,14 +84,23 @@ void IntersectPole(const Pole& pole, const std::string& material, const Eigen::V
   hit.dynamic = false;
 }
 
+// The scene's random draws from the run's scene generator, in one order.
+struct SceneDraws {
+  SceneDraws(const SimulationConfig& config, std::mt19937& rng) : rng(rng), offset(0.0, config.object_rcs_spread_db) {}
+  double Unit() { return unit(rng); }
+  double Uniform(double lo, double hi) { return lo + (hi - lo) * unit(rng); }
+  double Offset() { return offset(rng); }  // an object's RCS offset, dB
+  std::mt19937& rng;
+  std::uniform_real_distribution<double> unit{0.0, 1.0};
+  std::normal_distribution<double> offset;
+};
+
 // The motorway: the ego in the middle of three lanes (offsets -3.5, 0, 3.5
 // m), a guardrail on the right shoulder and in the median, the oncoming
 // carriageway's three lanes beyond it and its outer guardrail; gantries
 // across both every 400 m; poles on the right verge; traffic both ways.
 Scene BuildMotorway(const SimulationConfig& config, const LoopPath& path, std::mt19937& rng) {
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::normal_distribution<double> offset(0.0, config.object_rcs_spread_db);
-  const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  SceneDraws draws(config, rng);
   Scene scene;
   Eigen::Vector2d p;
   double heading = 0.0;
@@ -102,47 +111,45 @@ Scene BuildMotorway(const SimulationConfig& config, const LoopPath& path, std::m
     for (const double lateral : {-5.75, 5.75, 18.25}) {
       const Eigen::Vector2d centre = p + lateral * LoopPath::Left(heading);
       scene.static_boxes.push_back({Eigen::Vector3d(centre.x(), centre.y(), 0.55),
-                                    Eigen::Vector3d(0.5 * segment, 0.05, 0.2), heading, "guardrail", offset(rng)});
+                                    Eigen::Vector3d(0.5 * segment, 0.05, 0.2), heading, "guardrail", draws.Offset()});
     }
   }
-  for (double s = uniform(0.0, 400.0); s < path.Perimeter(); s += 400.0) {
+  for (double s = draws.Uniform(0.0, 400.0); s < path.Perimeter(); s += 400.0) {
     path.At(s, p, heading, straight);
     const Eigen::Vector2d centre = p + 6.0 * LoopPath::Left(heading);
     scene.static_boxes.push_back({Eigen::Vector3d(centre.x(), centre.y(), 6.5), Eigen::Vector3d(0.4, 13.5, 0.6),
-                                  heading, "wall", offset(rng)});
+                                  heading, "wall", draws.Offset()});
     for (const double lateral : {-7.0, 19.5}) {
-      scene.poles.push_back({p + lateral * LoopPath::Left(heading), 0.25, 7.0, offset(rng)});
+      scene.poles.push_back({p + lateral * LoopPath::Left(heading), 0.25, 7.0, draws.Offset()});
     }
   }
   for (int i = 0; i < config.poles; ++i) {
-    path.At(uniform(0.0, path.Perimeter()), p, heading, straight);
-    scene.poles.push_back({p - 8.0 * LoopPath::Left(heading), 0.1, 5.0, offset(rng)});
+    path.At(draws.Uniform(0.0, path.Perimeter()), p, heading, straight);
+    scene.poles.push_back({p - 8.0 * LoopPath::Left(heading), 0.1, 5.0, draws.Offset()});
   }
   const double ego = 5.0 + config.start_offset;
   for (int i = 0; i < config.moving_cars; ++i) {
     // Alternately with the ego (right or left lane, near it) and oncoming.
     const bool oncoming = i % 2 == 1;
-    const double lane = oncoming ? 9.25 + 3.5 * std::floor(uniform(0.0, 3.0)) : (unit(rng) < 0.5 ? -3.5 : 3.5);
-    const double s0 = ego + (oncoming ? uniform(0.0, 2500.0) : uniform(-100.0, 300.0));  // met within ~30 s
-    const double speed = uniform(config.traffic_min_speed, config.traffic_max_speed);
-    scene.moving_cars.push_back({s0, lane, oncoming ? -1.0 : 1.0, offset(rng), speed});
+    const double lane = oncoming ? 9.25 + 3.5 * std::floor(draws.Uniform(0.0, 3.0)) : (draws.Unit() < 0.5 ? -3.5 : 3.5);
+    const double s0 = ego + (oncoming ? draws.Uniform(0.0, 2500.0) : draws.Uniform(-100.0, 300.0));  // met within ~30 s
+    const double speed = draws.Uniform(config.traffic_min_speed, config.traffic_max_speed);
+    scene.moving_cars.push_back({s0, lane, oncoming ? -1.0 : 1.0, draws.Offset(), speed});
   }
   return scene;
 }
 
 Scene BuildTown(const SimulationConfig& config, const LoopPath& path, std::mt19937& rng) {
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::normal_distribution<double> offset(0.0, config.object_rcs_spread_db);
-  const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  SceneDraws draws(config, rng);
   Scene scene;
   Eigen::Vector2d p;
   double heading = 0.0;
   bool straight = false;
   // Buildings on both sides of the straights, set back 10 m from the road axis.
   for (const double side : {-1.0, 1.0}) {  // -1 outside (right), +1 inside (left)
-    double s = uniform(0.0, 6.0);
+    double s = draws.Uniform(0.0, 6.0);
     while (s < path.Perimeter()) {
-      const double building_length = uniform(10.0, 25.0);
+      const double building_length = draws.Uniform(10.0, 25.0);
       const double depth = side > 0 ? 8.0 : 10.0;
       bool start_straight = false;
       bool end_straight = false;
@@ -151,33 +158,33 @@ Scene BuildTown(const SimulationConfig& config, const LoopPath& path, std::mt199
       path.At(s + 0.5 * building_length, p, heading, straight);
       if (start_straight && end_straight && straight) {
         const Eigen::Vector2d centre = p + side * (10.0 + 0.5 * depth) * LoopPath::Left(heading);
-        const double height = uniform(6.0, 15.0);
+        const double height = draws.Uniform(6.0, 15.0);
         scene.static_boxes.push_back({Eigen::Vector3d(centre.x(), centre.y(), 0.5 * height),
                                       Eigen::Vector3d(0.5 * building_length, 0.5 * depth,
                                                       0.5 * height),
-                                      heading, "wall", offset(rng)});
+                                      heading, "wall", draws.Offset()});
       }
-      s += building_length + uniform(3.0, 8.0);
+      s += building_length + draws.Uniform(3.0, 8.0);
     }
   }
   for (int i = 0; i < config.poles; ++i) {
-    path.At(uniform(0.0, path.Perimeter()), p, heading, straight);
-    const double side = unit(rng) < 0.5 ? -1.0 : 1.0;
-    scene.poles.push_back({p + side * 5.0 * LoopPath::Left(heading), 0.1, 5.0, offset(rng)});
+    path.At(draws.Uniform(0.0, path.Perimeter()), p, heading, straight);
+    const double side = draws.Unit() < 0.5 ? -1.0 : 1.0;
+    scene.poles.push_back({p + side * 5.0 * LoopPath::Left(heading), 0.1, 5.0, draws.Offset()});
   }
   for (int i = 0; i < config.parked_cars; ++i) {
-    path.At(uniform(0.0, path.Perimeter()), p, heading, straight);
-    const double side = unit(rng) < 0.5 ? -1.0 : 1.0;
+    path.At(draws.Uniform(0.0, path.Perimeter()), p, heading, straight);
+    const double side = draws.Unit() < 0.5 ? -1.0 : 1.0;
     const Eigen::Vector2d centre = p + side * 3.3 * LoopPath::Left(heading);
     scene.static_boxes.push_back({Eigen::Vector3d(centre.x(), centre.y(), kCarHalfExtent.z()),
-                                  kCarHalfExtent, heading + uniform(-0.1, 0.1), "car",
-                                  offset(rng)});
+                                  kCarHalfExtent, heading + draws.Uniform(-0.1, 0.1), "car",
+                                  draws.Offset()});
   }
   for (int i = 0; i < config.moving_cars; ++i) {
     // Alternate: oncoming in the left lane, or ahead in the ego lane.
     const bool oncoming = i % 2 == 0;
-    scene.moving_cars.push_back({oncoming ? uniform(0.0, path.Perimeter()) : uniform(25.0, 60.0),
-                                 oncoming ? 3.5 : 0.0, oncoming ? -1.0 : 1.0, offset(rng), config.moving_car_speed});
+    scene.moving_cars.push_back({oncoming ? draws.Uniform(0.0, path.Perimeter()) : draws.Uniform(25.0, 60.0),
+                                 oncoming ? 3.5 : 0.0, oncoming ? -1.0 : 1.0, draws.Offset(), config.moving_car_speed});
   }
   return scene;
 }

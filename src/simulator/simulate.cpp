@@ -59,15 +59,13 @@ struct ScanState {
   MeasurementStd stds;
 };
 
-// The point the radar reports for a return along `direction_radar` at
-// `distance`, moving at `velocity_world`: noise in range, azimuth and
+// The point the radar reports for a return along `direction_radar` (at
+// azimuth, elevation) at `distance`, moving at `velocity_world`: noise in range, azimuth and
 // elevation (biased, growing off boresight), Doppler v_d = u . (v_target -
 // v_sensor) (conventions.hpp), RCS with noise, Swerling fluctuation and outliers.
 RadarPoint Measure(const SimulationConfig& config, const ScanState& state, double azimuth, double elevation,
-                   double distance, const Eigen::Vector3d& velocity_world, double rcs, Draws& draws,
-                   DetectionTruth& detection) {
-  const Eigen::Vector3d direction_radar(std::cos(elevation) * std::cos(azimuth),
-                                        std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+                   const Eigen::Vector3d& direction_radar, double distance, const Eigen::Vector3d& velocity_world,
+                   double rcs, Draws& draws, DetectionTruth& detection) {
   const double growth =
       1.0 + config.elevation_noise_growth * std::pow(azimuth / (config.azimuth_fov_deg * kDeg), 2);
   RadarPoint point;
@@ -123,7 +121,8 @@ void Detect(const SimulationConfig& config, const Scene& scene, const ScanState&
     detection.position_world = origin + hit.distance * direction;
     detection.target_velocity = hit.velocity;
     scan.points.push_back(
-        Measure(config, state, azimuth, elevation, hit.distance, hit.velocity, rcs_true, draws, detection));
+        Measure(config, state, azimuth, elevation, direction_radar, hit.distance, hit.velocity, rcs_true, draws,
+                detection));
     truth.push_back(detection);
   }
   const bool reflector = *hit.material == "wall" || *hit.material == "guardrail";
@@ -147,7 +146,8 @@ void Detect(const SimulationConfig& config, const Scene& scene, const ScanState&
   ghost.reflector_normal = n;
   ghost.target_velocity = target.velocity;
   const Eigen::Vector3d image_velocity = target.velocity - 2.0 * target.velocity.dot(n) * n;
-  scan.points.push_back(Measure(config, state, azimuth, elevation, path, image_velocity, rcs, draws, ghost));
+  scan.points.push_back(
+      Measure(config, state, azimuth, elevation, direction_radar, path, image_velocity, rcs, draws, ghost));
   truth.push_back(ghost);
 }
 
