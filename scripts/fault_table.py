@@ -37,19 +37,21 @@ FAULTS = [("none", {}),
                                             "mounting_yaw_deg": -1}),
           ("all (configs/synthetic_realistic.yaml)", ALL)]
 SCENES = {"demo": [], "motorway": open(os.path.join(ROOT, "configs", "synthetic_motorway.yaml")).read().splitlines()}
-# Counter-measures: (name, odometry flags, localize flags) per fault; "as is" for every fault.
-AS_IS = ("as is", [], [])
-MEASURES = {"none": [AS_IS, ("RCS loss trivial (robust Cauchy off)", [], ["--rcs-loss", "trivial"])],
-            "Swerling I": [AS_IS, ("RCS loss trivial (robust Cauchy off)", [], ["--rcs-loss", "trivial"])],
-            "Swerling III": [AS_IS, ("RCS loss trivial (robust Cauchy off)", [], ["--rcs-loss", "trivial"])],
-            "elevation bias 1 deg": [AS_IS, ("bias estimated", ["--estimate-elevation-bias"], []),
+# Counter-measures per fault, "as is" for every one: (name, flags of the
+# sequence (odometry, build-map and localize), of odometry, of localize).
+AS_IS = ("as is", [], [], [])
+NO_ROBUST_RCS = ("RCS loss trivial (robust Cauchy off)", [], [], ["--rcs-loss", "trivial"])
+MEASURES = {"none": [AS_IS, NO_ROBUST_RCS],
+            "Swerling I": [AS_IS, NO_ROBUST_RCS],
+            "Swerling III": [AS_IS, NO_ROBUST_RCS],
+            "elevation bias 1 deg": [AS_IS, ("bias estimated", [], ["--estimate-elevation-bias"], []),
                                      ("bias given (--elevation-bias 1 to every command)", ["--elevation-bias", "1"],
-                                      ["--elevation-bias", "1"])],
-            "mounting 0.5 / 1.5 / -1 deg": [AS_IS, ("mounting given", MOUNTED, [])],
+                                      [], [])],
+            "mounting 0.5 / 1.5 / -1 deg": [AS_IS, ("mounting given", [], MOUNTED, [])],
             "all (configs/synthetic_realistic.yaml)": [
-                AS_IS, ("mounting given, bias estimated", MOUNTED + ["--estimate-elevation-bias"], []),
-                ("both, and the map's azimuth noise 0.2 deg", MOUNTED + ["--estimate-elevation-bias",
-                                                                        "--azimuth-std", "0.2"], [])]}
+                AS_IS, ("mounting given, bias estimated", [], MOUNTED + ["--estimate-elevation-bias"], []),
+                ("both, and the map's azimuth noise 0.2 deg", [], MOUNTED + ["--estimate-elevation-bias",
+                                                                            "--azimuth-std", "0.2"], [])]}
 
 
 def run(command):
@@ -72,15 +74,14 @@ def simulate(tool, work, scene, name, faults):
 
 
 def measure(tool, sequence, measure):
-    name, odometry_flags, localize_flags = measure
+    name, sequence_flags, odometry_flags, localize_flags = measure
     truth = os.path.join(sequence, "gt_radar_tum.txt")
     tag = "_".join(name.split()[:2]).replace(",", "")
     odometry = os.path.join(sequence + f"_odometry_{tag}")
     if not os.path.exists(os.path.join(odometry, "evaluation.json")):
-        run(tool + ["odometry", "--sequence", sequence, "--gt", truth, "--out", odometry, *odometry_flags])
+        run(tool + ["odometry", "--sequence", sequence, "--gt", truth, "--out", odometry, *sequence_flags,
+                    *odometry_flags])
     e = json.load(open(os.path.join(odometry, "evaluation.json")))
-    # The map takes the sequence's flags of localize (--elevation-bias).
-    sequence_flags = localize_flags if "--elevation-bias" in localize_flags else []
     path = sequence + (f"_map_{tag}.rgm" if sequence_flags else "_map.rgm")
     if not os.path.exists(path):
         run(tool + ["build-map", "--sequence", sequence, "--gt", truth, "--extrinsic", "identity", "--out", path,
@@ -88,7 +89,7 @@ def measure(tool, sequence, measure):
     localize = os.path.join(sequence + f"_localize_{tag}")
     if not os.path.exists(os.path.join(localize, "per_scan.csv")):
         run(tool + ["localize", "--map", path, "--sequence", sequence, "--gt", truth, "--extrinsic", "identity",
-                    "--w-rcs", "0", "0.25", "--stride", "2", "--out", localize, *localize_flags])
+                    "--w-rcs", "0", "0.25", "--stride", "2", "--out", localize, *sequence_flags, *localize_flags])
     rows = list(csv.DictReader(open(os.path.join(localize, "per_scan.csv"))))
     within = []
     for w in ("0", "0.25"):
