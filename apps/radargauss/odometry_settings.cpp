@@ -36,6 +36,14 @@ void AddLocalMapOptions(CLI::App* app, OdometrySettings& s) {
   app->add_option("--region-capacity", o.map.region_capacity, "Points a region keeps (the newest)")
       ->check(InRange(4, 1000000))
       ->capture_default_str();
+  app->add_option("--map-estimator", s.map_estimator,
+                  "How region Gaussians follow their points: refit (k-means + EM) or incremental")
+      ->check(CLI::IsMember(MapEstimatorNames()))
+      ->capture_default_str();
+  app->add_option("--republish-kl", o.map.republish_kl,
+                  "Incremental map: KL (nats) a Gaussian moves before the matching map gets it again")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app->add_option("--refit-growth", o.map.refit_growth, "Refit a region once its new points reach this share")
       ->check(Positive())
       ->capture_default_str();
@@ -84,6 +92,7 @@ OdometryOptions Resolved(const OdometrySettings& s) {
   o.match.matching.geometric_loss.type = LossTypeFromString(s.loss);
   o.map.rcs.incidence = IncidenceModelFromString(s.incidence);
   o.map.matching.coarse = CoarseLevelsFromString(s.coarse_levels);
+  o.map.estimator = MapEstimatorFromString(s.map_estimator);
   o.rotation_rate_std_deg = Eigen::Vector3d(s.rotation_rate_std[0], s.rotation_rate_std[1], s.rotation_rate_std[2]);
   o.mounting_deg = Eigen::Vector3d(s.mounting[0], s.mounting[1], s.mounting[2]);
   if (o.map.matching.inflation == std::vector<double>{0.0}) o.map.matching.inflation.clear();  // the exact map alone

@@ -28,6 +28,7 @@ struct OdometrySettings {
   std::string loss = "trivial";
   std::string incidence = "offset";
   std::string coarse_levels = ToString(MatchingMapOptions().coarse);
+  std::string map_estimator = ToString(LocalMapOptions().estimator);
   std::string imu_topic;
   std::string imu_stamps = "header";
   std::vector<double> imu_rotation = {0, 0, 0, 1};  // q_radar_imu (x y z w)

@@ -221,6 +221,13 @@ void ValidateOptions(const GaussianMapOptions& o) {
 
 }  // namespace
 
+std::vector<std::vector<std::uint32_t>> KMeansPartition(const std::vector<Eigen::Vector3d>& points, std::size_t k,
+                                                        const GaussianMapOptions& options) {
+  ValidateOptions(options);
+  if (points.empty()) return {};
+  return BisectingKMeans(points, k, options, {});
+}
+
 std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points,
                                  const GaussianIndex& index, double gate) {
   std::vector<int> association(points.size());

@@ -7,8 +7,22 @@
 #include <unordered_map>
 
 #include "radargauss/map/map_cloud.hpp"
+#include "radargauss/names.hpp"
 
 namespace radargauss {
+
+namespace {
+
+const NamedValue<MapEstimator> kEstimatorNames[] = {{MapEstimator::kRefit, "refit"},
+                                                    {MapEstimator::kIncremental, "incremental"}};
+
+}  // namespace
+
+std::string ToString(MapEstimator estimator) { return NameOf(kEstimatorNames, estimator); }
+MapEstimator MapEstimatorFromString(const std::string& name) {
+  return ValueNamed(kEstimatorNames, name, "map estimator");
+}
+std::vector<std::string> MapEstimatorNames() { return NamesOf(kEstimatorNames); }
 
 void ValidateOptions(const LocalMapOptions& o) {
   const auto require = [](bool ok, const char* what) {
@@ -20,6 +34,7 @@ void ValidateOptions(const LocalMapOptions& o) {
           "map region minimum points must be in [1, region capacity]");
   require(o.refit_growth > 0.0 && std::isfinite(o.refit_growth), "map refit growth must be > 0 and finite");
   require(o.active_radius > 0.0, "active map radius must be > 0 m");
+  require(o.republish_kl >= 0.0 && std::isfinite(o.republish_kl), "map republish KL must be >= 0 and finite");
   require(o.azimuth_std_deg >= 0.0 && o.azimuth_std_deg < 45.0 && o.elevation_std_deg >= 0.0 &&
               o.elevation_std_deg < 45.0,
           "map azimuth and elevation std must be in [0, 45) deg");
@@ -43,12 +58,19 @@ std::uint32_t LocalMap::NewSlot() {
   return std::uint32_t(map_->gaussians.size() - 1);
 }
 
+void LocalMap::FreeSlot(std::uint32_t slot, std::vector<std::uint32_t>& removed) {
+  removed.push_back(slot);
+  free_slots_.push_back(slot);
+  map_->gaussians[slot] = Gaussian();
+}
+
 std::size_t LocalMap::Insert(const std::vector<Eigen::Vector3d>& points, const std::vector<double>& rcs,
                              const SE3d& pose) {
   const bool has_rcs = !rcs.empty();
   if (has_rcs && rcs.size() != points.size()) throw std::invalid_argument("LocalMap::Insert: one RCS per point");
   const std::uint32_t pose_id = std::uint32_t(poses_.size());
   poses_.push_back(pose);
+  const bool incremental = options_.estimator == MapEstimator::kIncremental;
   std::vector<VoxelKey> touched;
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (!points[i].allFinite()) continue;
@@ -56,16 +78,24 @@ std::size_t LocalMap::Insert(const std::vector<Eigen::Vector3d>& points, const s
     Region& region = regions_[key];
     region.has_rcs = has_rcs;
     const double value = has_rcs ? rcs[i] : 0.0;
-    if (region.points.size() < options_.region_capacity) {
+    std::size_t slot = region.points.size();
+    if (slot < options_.region_capacity) {
       region.points.push_back(points[i]);
       region.rcs.push_back(value);
       region.pose.push_back(pose_id);
+      if (incremental) {
+        region.member.push_back(-1);
+        region.direction.emplace_back(Eigen::Vector3d::Zero());
+      }
     } else {  // full: the newest point replaces the oldest
-      region.points[region.next] = points[i];
-      region.rcs[region.next] = value;
-      region.pose[region.next] = pose_id;
+      slot = region.next;
+      if (incremental) Forget(region, slot);
+      region.points[slot] = points[i];
+      region.rcs[slot] = value;
+      region.pose[slot] = pose_id;
       region.next = (region.next + 1) % options_.region_capacity;
     }
+    if (incremental) Assign(region, slot);
     ++region.added;
     touched.push_back(key);
   }
@@ -75,6 +105,12 @@ std::size_t LocalMap::Insert(const std::vector<Eigen::Vector3d>& points, const s
   std::size_t refitted = 0;
   for (const VoxelKey& key : touched) {
     Region& region = regions_[key];
+    if (incremental) {
+      const std::size_t before = changed.size() + removed.size();
+      Maintain(region, changed, removed);
+      refitted += changed.size() + removed.size() > before;
+      continue;
+    }
     const bool due = region.fitted == 0 ? region.points.size() >= options_.min_points
                                         : double(region.added) >= options_.refit_growth * double(region.fitted);
     if (!due) continue;
@@ -87,11 +123,7 @@ std::size_t LocalMap::Insert(const std::vector<Eigen::Vector3d>& points, const s
 }
 
 void LocalMap::Refit(Region& region, std::vector<std::uint32_t>& changed, std::vector<std::uint32_t>& removed) {
-  for (const std::uint32_t slot : region.gaussians) {
-    removed.push_back(slot);
-    free_slots_.push_back(slot);
-    map_->gaussians[slot] = Gaussian();
-  }
+  for (const std::uint32_t slot : region.gaussians) FreeSlot(slot, removed);
   region.gaussians.clear();
   region.fitted = region.points.size();
   region.added = 0;

@@ -54,6 +54,12 @@ std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
                                      const ProgressCallback& progress = {},
                                      std::vector<int>* association = nullptr);
 
+// The seeding of kKMeans: `points` split by bisecting k-means (the cluster
+// of largest squared error first, options.seed) into at most k clusters, as
+// the members' indices of each.
+std::vector<std::vector<std::uint32_t>> KMeansPartition(const std::vector<Eigen::Vector3d>& points, std::size_t k,
+                                                        const GaussianMapOptions& options);
+
 // For each point, the Gaussian it belongs to (-1: none within the gate).
 std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points,
                                  const GaussianIndex& index, double gate);

@@ -14,6 +14,8 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -21,6 +23,7 @@
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/map/builder.hpp"
 #include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/map/gaussian_statistics.hpp"
 #include "radargauss/map/rcs_model.hpp"
 #include "radargauss/map/matching_map.hpp"
 
@@ -37,12 +40,24 @@ inline MatchingMapOptions LocalMatchingMapOptions() {
   return options;
 }
 
+// How a region's Gaussians follow its points (docs/design.md, "The
+// incremental map"): kRefit fits them again from all its points with
+// build-map's estimator once enough have come; kIncremental updates each
+// Gaussian's sufficient statistics point by point and publishes a Gaussian
+// to the matching map once it has moved by `republish_kl` since it last was.
+enum class MapEstimator : std::uint8_t { kRefit, kIncremental };
+std::string ToString(MapEstimator estimator);
+MapEstimator MapEstimatorFromString(const std::string& name);  // "refit", "incremental"; throws std::invalid_argument
+std::vector<std::string> MapEstimatorNames();
+
 struct LocalMapOptions {
+  MapEstimator estimator = MapEstimator::kRefit;
   double region = 4.0;                // m: edge of the cubes whose points are fitted together
   std::size_t region_capacity = 256;  // points a region keeps (the newest)
   std::size_t min_points = 8;         // points a region needs for its first fit
   double refit_growth = 0.5;          // refit once the points added since the last fit reach this share of those fitted
   double active_radius = 100.0;       // m: regions whose centre is farther from the radar leave
+  double republish_kl = 1.0;          // nats: KL(updated || published) that republishes a Gaussian (kIncremental)
   // The radar's angular noise: a Gaussian is at least this angle times the
   // mean range its members were seen at wide, horizontally (azimuth) and
   // vertically (elevation), and at least min_std, so that far, sparse
@@ -63,7 +78,8 @@ class LocalMap {
 
   // Adds `points` (world frame; rcs[i] in dBsm, or `rcs` empty when the scan
   // has none) seen from `pose` (T_world_radar), then refits the regions that
-  // gained enough. Returns the number of regions refitted.
+  // gained enough (kIncremental: updates the regions' Gaussians). Returns the
+  // number of regions whose Gaussians changed in the matching map.
   std::size_t Insert(const std::vector<Eigen::Vector3d>& points, const std::vector<double>& rcs, const SE3d& pose);
   // Hands the regions whose centre lies beyond the active radius of
   // `position` to the global map. Returns how many left.
@@ -84,6 +100,18 @@ class LocalMap {
   std::size_t MemoryBytes() const;
 
  private:
+  static constexpr std::uint32_t kNoSlot = 0xffffffffu;
+  // One Gaussian of an incremental region: its members' statistics and what
+  // the matching map has of it.
+  struct Component {
+    PointStatistics points;
+    double range_sum = 0.0;               // members' ranges from the poses they were seen from
+    std::unique_ptr<RcsStatistics> rcs;   // when the region has RCS
+    std::uint32_t slot = kNoSlot;         // in map_, once published
+    Eigen::Matrix3d information = Eigen::Matrix3d::Zero();  // the published covariance's inverse
+    bool changed = false;                 // members came or left since it was published
+    bool reshaped = false;                // seeded or split: publish whatever the KL
+  };
   struct Region {
     std::vector<Eigen::Vector3d> points;  // world frame, at most region_capacity (a ring once full)
     std::vector<double> rcs;
@@ -93,6 +121,15 @@ class LocalMap {
     std::size_t added = 0;                // points since the last fit
     std::vector<std::uint32_t> gaussians; // their slots in map_
     bool has_rcs = false;
+    // kIncremental: each point's component (-1: pending, in no Gaussian's
+    // gate yet) and incidence direction, the components, and the points per
+    // voxel of build-map's downsampling (the number of Gaussians it would fit).
+    std::vector<std::int32_t> member;
+    std::vector<Eigen::Vector3d> direction;
+    std::vector<Component> components;
+    std::size_t pending = 0;
+    std::size_t pending_at_seeding = 0;
+    std::unordered_map<std::int64_t, std::uint32_t> voxels;
   };
   // Fits the Gaussians of `region` again; their slots go to changed/removed.
   void Refit(Region& region, std::vector<std::uint32_t>& changed, std::vector<std::uint32_t>& removed);
@@ -100,6 +137,24 @@ class LocalMap {
   // range from the poses they were seen from.
   void FloorAtRange(const Region& region, const std::vector<int>& association, GaussianMap& fitted) const;
   std::uint32_t NewSlot();
+  void FreeSlot(std::uint32_t slot, std::vector<std::uint32_t>& removed);
+
+  // kIncremental (src/odometry/local_map_incremental.cpp).
+  // Places point `i` of the region, just written, in the nearest component
+  // whose gate holds it, or leaves it pending.
+  void Assign(Region& region, std::size_t i);
+  // Takes point `i`, about to be overwritten, out of its component.
+  void Forget(Region& region, std::size_t i);
+  void Join(Region& region, std::size_t i, std::int32_t component);
+  // Seeds components from the pending points, merges or splits them to
+  // build-map's count, drops the empty ones and publishes those that moved.
+  void Maintain(Region& region, std::vector<std::uint32_t>& changed, std::vector<std::uint32_t>& removed);
+  void Seed(Region& region);
+  void Merge(Region& region, std::size_t target);
+  void Split(Region& region, std::size_t target);
+  void Publish(Region& region, std::vector<std::uint32_t>& changed, std::vector<std::uint32_t>& removed);
+  // Restarts a component's statistics from its members.
+  void Recompute(Region& region, std::int32_t component);
 
   LocalMapOptions options_;
   std::shared_ptr<GaussianMap> map_;        // slots; free ones are in no index

@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/map/gaussian_statistics.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+namespace radargauss {
+
+void PointStatistics::Add(const Eigen::Vector3d& point) {
+  ++count;
+  const Eigen::Vector3d delta = point - mean;
+  mean += delta / double(count);
+  scatter += (double(count - 1) / double(count)) * (delta * delta.transpose());
+}
+
+void PointStatistics::Remove(const Eigen::Vector3d& point) {
+  if (count <= 1) {
+    *this = PointStatistics();
+    return;
+  }
+  // The inverse of Add: the others' mean, then the point's share of the scatter.
+  const double n = double(count);
+  const Eigen::Vector3d others = (n * mean - point) / (n - 1.0);
+  const Eigen::Vector3d delta = point - others;
+  scatter -= ((n - 1.0) / n) * (delta * delta.transpose());
+  mean = others;
+  --count;
+}
+
+void PointStatistics::Merge(const PointStatistics& other) {
+  if (other.count == 0) return;
+  if (count == 0) {
+    *this = other;
+    return;
+  }
+  const double n = double(count), m = double(other.count);
+  const Eigen::Vector3d delta = other.mean - mean;
+  scatter += other.scatter + (n * m / (n + m)) * (delta * delta.transpose());
+  mean += (m / (n + m)) * delta;
+  count += other.count;
+}
+
+bool RcsStatistics::IsInlier(double rcs) const {
+  return normalisation.valid && std::abs(rcs - normalisation.median) <= normalisation.scale;
+}
+
+namespace {
+
+Eigen::Matrix<double, RcsStatistics::kSize, 1> Basis(const Eigen::Vector3d& direction) {
+  Eigen::Matrix<double, RcsStatistics::kSize, 1> values;
+  EvaluateShBasis<kMaxShDegree>(direction, values.data());
+  return values;
+}
+
+}  // namespace
+
+bool RcsStatistics::Add(const Eigen::Vector3d& direction, double rcs) {
+  if (!IsInlier(rcs)) {
+    ++outliers;
+    return false;
+  }
+  const double y = (rcs - normalisation.median) / normalisation.scale;
+  const Eigen::Matrix<double, kSize, 1> basis = Basis(direction);
+  normal.selfadjointView<Eigen::Lower>().rankUpdate(basis);
+  rhs += y * basis;
+  sum_y_squared += y * y;
+  ++inliers;
+  return true;
+}
+
+void RcsStatistics::Remove(const Eigen::Vector3d& direction, double rcs) {
+  if (!IsInlier(rcs)) {
+    outliers -= outliers > 0;
+    return;
+  }
+  const double y = (rcs - normalisation.median) / normalisation.scale;
+  const Eigen::Matrix<double, kSize, 1> basis = Basis(direction);
+  normal.selfadjointView<Eigen::Lower>().rankUpdate(basis, -1.0);
+  rhs -= y * basis;
+  sum_y_squared -= y * y;
+  inliers -= inliers > 0;
+}
+
+RcsModel RcsStatistics::Solve(const RcsFitOptions& options) const {
+  RcsModel model;
+  if (!normalisation.valid || inliers == 0) return model;
+  model.median = normalisation.median;
+  model.scale = normalisation.scale;
+  const double threshold_sq = options.rank_threshold * options.rank_threshold;
+  for (int degree = options.max_degree; degree >= 0; --degree) {
+    const int count = ShCoefficientCount(degree);
+    if (inliers >= std::size_t(count)) {
+      const Eigen::MatrixXd block = normal.topLeftCorner(count, count).selfadjointView<Eigen::Lower>();
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(block);
+      const Eigen::VectorXd& values = solver.eigenvalues();  // ascending
+      const double cut = threshold_sq * std::max(values[count - 1], 0.0);
+      const int rank = int((values.array() > cut).count());
+      if (rank >= std::max(1, count / 2) || !options.adaptive) {
+        const Eigen::VectorXd projected = solver.eigenvectors().transpose() * rhs.head(count);
+        Eigen::VectorXd scaled = Eigen::VectorXd::Zero(count);
+        for (int j = 0; j < count; ++j) {
+          if (values[j] > cut) scaled[j] = projected[j] / values[j];
+        }
+        const Eigen::VectorXd c = solver.eigenvectors() * scaled;
+        model.degree = degree;
+        model.coefficients.fill(0.0);
+        for (int j = 0; j < count; ++j) model.coefficients[j] = c[j];
+        // |A c - y|^2 = sum y^2 - 2 c.r + c^T N c
+        const double residual = sum_y_squared - 2.0 * c.dot(rhs.head(count)) + c.dot(block * c);
+        model.fit_rmse = std::sqrt(std::max(residual, 0.0) / double(inliers));
+        model.inliers = std::uint32_t(inliers);
+        return model;
+      }
+    }
+    if (!options.adaptive) break;
+  }
+  model.degree = -1;
+  return model;
+}
+
+double KullbackLeibler(const Eigen::Vector3d& mean_a, const Eigen::Matrix3d& covariance_a,
+                       const Eigen::Vector3d& mean_b, const Eigen::Matrix3d& covariance_b) {
+  const Eigen::LLT<Eigen::Matrix3d> b(covariance_b);
+  const Eigen::Vector3d delta = mean_a - mean_b;
+  const double trace = b.solve(covariance_a).trace();
+  const double mahalanobis_sq = delta.dot(b.solve(delta));
+  const double log_det_ratio = std::log(covariance_b.determinant() / covariance_a.determinant());
+  return 0.5 * (trace + mahalanobis_sq - 3.0 + log_det_ratio);
+}
+
+}  // namespace radargauss
