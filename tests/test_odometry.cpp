@@ -53,9 +53,11 @@ void ExpectFinite(const RadarOdometry& odometry) {
 // The bound: the drift odometry must reach on the demo sequence, where the
 // peers drift 13-21 % (bench/RESULTS.md); most of it is vertical (the pitch
 // of a 15 deg elevation field of view), the horizontal part stays far below.
-TEST(RadarOdometry, DriftsLittleOnASimulatedDriveWithoutItsGroundTruth) {
+void ExpectLittleDrift(MapEstimator estimator) {
   const SimulatedSequence& drive = Drive();
-  RadarOdometry odometry(StartingAtTruth(drive));
+  OdometryOptions options = StartingAtTruth(drive);
+  options.map.estimator = estimator;
+  RadarOdometry odometry(options);
   for (const RadarScan& scan : drive.scans) odometry.Register(scan);
   ExpectFinite(odometry);
   const Evaluation e = Evaluate(odometry, drive);
@@ -69,13 +71,18 @@ TEST(RadarOdometry, DriftsLittleOnASimulatedDriveWithoutItsGroundTruth) {
   EXPECT_GT(odometry.map().gaussians(), 100u);
 }
 
-// The same run for any thread count (the region fits run in parallel), and
-// again for the same options.
-TEST(RadarOdometry, DeterministicForAnyThreadCount) {
+TEST(RadarOdometry, DriftsLittleOnASimulatedDriveWithoutItsGroundTruth) { ExpectLittleDrift(MapEstimator::kRefit); }
+
+// The same bounds with the map that updates its Gaussians' statistics.
+TEST(RadarOdometry, DriftsLittleWithTheIncrementalMap) { ExpectLittleDrift(MapEstimator::kIncremental); }
+
+void ExpectDeterministic(MapEstimator estimator) {
   const SimulatedSequence& drive = Drive();
   const auto run = [&](std::size_t threads) {
     const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-    RadarOdometry odometry(StartingAtTruth(drive));
+    OdometryOptions options = StartingAtTruth(drive);
+    options.map.estimator = estimator;
+    RadarOdometry odometry(options);
     for (std::size_t k = 0; k < 40; ++k) odometry.Register(drive.scans[k]);
     return odometry.trajectory();
   };
@@ -85,6 +92,15 @@ TEST(RadarOdometry, DeterministicForAnyThreadCount) {
     ASSERT_EQ(one[k].pose.translation(), four[k].pose.translation()) << k;
     ASSERT_EQ(one[k].pose.rotation().quaternion().coeffs(), four[k].pose.rotation().quaternion().coeffs()) << k;
     ASSERT_EQ(four[k].pose.translation(), again[k].pose.translation()) << k;
+  }
+}
+
+// The same run for any thread count (the region fits run in parallel), and
+// again for the same options, with either map estimator.
+TEST(RadarOdometry, DeterministicForAnyThreadCount) {
+  for (const MapEstimator estimator : {MapEstimator::kRefit, MapEstimator::kIncremental}) {
+    SCOPED_TRACE(ToString(estimator));
+    ExpectDeterministic(estimator);
   }
 }
 

@@ -79,6 +79,8 @@ class RadarOdometry:
         region: float = 4.0,
         region_capacity: int = 256,
         region_min_points: int = 8,
+        map_estimator: str = 'refit',
+        republish_kl: float = 1.0,
         refit_growth: float = 0.5,
         active_radius: float = 100.0,
         azimuth_std_deg: float = 0.0,

@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 namespace radargauss {
 
@@ -89,22 +90,24 @@ RcsModel RcsStatistics::Solve(const RcsFitOptions& options) const {
   if (!normalisation.valid || inliers == 0) return model;
   model.median = normalisation.median;
   model.scale = normalisation.scale;
-  const double threshold_sq = options.rank_threshold * options.rank_threshold;
   for (int degree = options.max_degree; degree >= 0; --degree) {
     const int count = ShCoefficientCount(degree);
     if (inliers >= std::size_t(count)) {
+      // A square root M^T M = N and M^T z = r: min |M c - z| is the members'
+      // least squares, and the pivoted QR of M has the R of the members'
+      // basis matrix (it depends on N alone), so the decomposition keeps and
+      // truncates the directions FitRcsModel does.
       const Eigen::MatrixXd block = normal.topLeftCorner(count, count).selfadjointView<Eigen::Lower>();
       const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(block);
-      const Eigen::VectorXd& values = solver.eigenvalues();  // ascending
-      const double cut = threshold_sq * std::max(values[count - 1], 0.0);
-      const int rank = int((values.array() > cut).count());
-      if (rank >= std::max(1, count / 2) || !options.adaptive) {
-        const Eigen::VectorXd projected = solver.eigenvectors().transpose() * rhs.head(count);
-        Eigen::VectorXd scaled = Eigen::VectorXd::Zero(count);
-        for (int j = 0; j < count; ++j) {
-          if (values[j] > cut) scaled[j] = projected[j] / values[j];
-        }
-        const Eigen::VectorXd c = solver.eigenvectors() * scaled;
+      const Eigen::VectorXd roots = solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+      const Eigen::MatrixXd root = roots.asDiagonal() * solver.eigenvectors().transpose();
+      Eigen::VectorXd z = solver.eigenvectors().transpose() * rhs.head(count);
+      for (int j = 0; j < count; ++j) z[j] = roots[j] > 0.0 ? z[j] / roots[j] : 0.0;
+      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+      cod.setThreshold(options.rank_threshold);
+      cod.compute(root);
+      if (cod.rank() >= std::max(1, count / 2) || !options.adaptive) {
+        const Eigen::VectorXd c = cod.solve(z);
         model.degree = degree;
         model.coefficients.fill(0.0);
         for (int j = 0; j < count; ++j) model.coefficients[j] = c[j];

@@ -52,10 +52,9 @@ struct RcsStatistics {
   bool Add(const Eigen::Vector3d& direction, double rcs);
   // Takes out a member added before with the same direction and RCS.
   void Remove(const Eigen::Vector3d& direction, double rcs);
-  // The model of these equations: the degree lowered while the system's
-  // numerical rank (eigenvalues above rank_threshold^2 of the largest, the
-  // squared pivots of FitRcsModel's decomposition) is below half its size,
-  // the minimum-norm solution over the kept eigenvectors.
+  // The model FitRcsModel fits from the same members: the same rank-revealing
+  // decomposition on a square root of the normal equations (the degree
+  // lowered while the rank is below half the coefficients).
   RcsModel Solve(const RcsFitOptions& options) const;
 };
 
