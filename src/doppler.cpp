@@ -78,6 +78,11 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
   };
   std::vector<int> best;
   std::vector<int> consensus;
+  std::vector<double> residual(n);
+  const double* hx = H.col(0).data();
+  const double* hy = H.col(1).data();
+  const double* hz = H.col(2).data();
+  const double* y0 = y.data();
   // Hypotheses the gate turns away do not count: up to kGatedDrawFactor
   // times as many draws find the world's hypotheses among a car's.
   constexpr int kGatedDrawFactor = 50;
@@ -104,9 +109,12 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     const Eigen::Vector3d v = lu.solve(Eigen::Vector3d(y[a], y[b], y[c]));
     if (gate && !gate->Admits(v)) continue;
     ++counted;
+    // The residuals over the columns first (a loop the compiler vectorises),
+    // then the rows within the threshold.
+    for (int k = 0; k < n; ++k) residual[k] = std::abs(y0[k] - (hx[k] * v.x() + hy[k] * v.y() + hz[k] * v.z()));
     consensus.clear();
     for (int k = 0; k < n; ++k) {
-      if (std::abs(y[k] - H.row(k).dot(v)) < options.inlier_threshold) consensus.push_back(k);
+      if (residual[k] < options.inlier_threshold) consensus.push_back(k);
     }
     if (voxel_ids.empty()) {
       if (consensus.size() > best.size()) best.swap(consensus);

@@ -4,7 +4,7 @@
 // entries, and the entries are compacted once stale ones outnumber the live.
 #include <algorithm>
 #include <stdexcept>
-#include <unordered_map>
+#include <utility>
 
 #include "radargauss/map/gaussian_map.hpp"
 
@@ -65,36 +65,41 @@ void GaussianIndex::Update(const std::vector<Gaussian>& gaussians, const std::ve
   };
   for (const std::uint32_t id : removed) leave(id);
   for (const std::uint32_t id : changed) leave(id);
-  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> joining;
+  // (cell, id) of every joining listing, sorted: each cell's joiners are a
+  // run, in id order.
+  std::vector<std::pair<std::int64_t, std::uint32_t>> joining;
   for (const std::uint32_t id : changed) {
     if (!listed_cells_[id].empty()) continue;  // listed twice in `changed`
     Index(gaussians[id], id, listed_cells_[id]);
-    for (const std::int64_t key : listed_cells_[id]) joining[key].push_back(id);
+    for (const std::int64_t key : listed_cells_[id]) joining.emplace_back(key, id);
     dirty.insert(dirty.end(), listed_cells_[id].begin(), listed_cells_[id].end());
   }
+  std::sort(joining.begin(), joining.end());
   std::sort(dirty.begin(), dirty.end());
   dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
   if (cells_.empty() || 2 * (cell_count_ + dirty.size()) > cells_.size()) Compact(dirty.size());
-  // Each touched cell's list: its entries that stay, then those that join,
-  // sorted by id as the static index lists them (ties go to the smallest id).
-  std::vector<std::uint32_t> list;
+  // Each touched cell's list: its entries that stay merged with those that
+  // join, both in id order as the static index lists them (ties go to the
+  // smallest id).
+  std::vector<std::uint32_t> staying, joined;
+  auto next_join = joining.begin();
   for (const std::int64_t key : dirty) {
     Cell& cell = cells_[Slot(key)];
-    list.clear();
+    staying.clear();
     if (cell.key == key) {
       for (std::uint32_t e = cell.begin; e < cell.end; ++e) {
-        if (!leaving[cell_entries_[e]]) list.push_back(cell_entries_[e]);
+        if (!leaving[cell_entries_[e]]) staying.push_back(cell_entries_[e]);
       }
       stale_entries_ += cell.end - cell.begin;
     } else {
       cell.key = key;
       ++cell_count_;
     }
-    const auto joined = joining.find(key);
-    if (joined != joining.end()) list.insert(list.end(), joined->second.begin(), joined->second.end());
-    std::sort(list.begin(), list.end());
+    joined.clear();
+    for (; next_join != joining.end() && next_join->first == key; ++next_join) joined.push_back(next_join->second);
     cell.begin = std::uint32_t(cell_entries_.size());
-    cell_entries_.insert(cell_entries_.end(), list.begin(), list.end());
+    cell_entries_.resize(cell_entries_.size() + staying.size() + joined.size());
+    std::merge(staying.begin(), staying.end(), joined.begin(), joined.end(), cell_entries_.begin() + cell.begin);
     cell.end = std::uint32_t(cell_entries_.size());
   }
   if (stale_entries_ > cell_entries_.size() - stale_entries_ + 1024) Compact(0);

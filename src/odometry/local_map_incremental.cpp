@@ -83,11 +83,11 @@ void LocalMap::Join(Region& region, std::size_t i, std::int32_t c) {
   Component& component = region.components[c];
   const Eigen::Vector3d& point = region.points[i];
   const SE3d& pose = poses_[region.pose[i]];
-  region.direction[i] = IncidenceDirection(pose, point, component.points.mean, options_.rcs.incidence);
+  if (component.rcs) region.direction[i] = IncidenceDirection(pose, point, component.points.mean, options_.rcs.incidence);
   component.points.Add(point);
   component.range_sum += (point - pose.translation()).norm();
   if (component.rcs && region.direction[i].squaredNorm() > 0.0) component.rcs->Add(region.direction[i], region.rcs[i]);
-  component.changed = true;
+  ++component.changes;
   region.member[i] = c;
 }
 
@@ -104,7 +104,7 @@ void LocalMap::Forget(Region& region, std::size_t i) {
   component.points.Remove(point);
   component.range_sum -= (point - poses_[region.pose[i]].translation()).norm();
   if (component.rcs && region.direction[i].squaredNorm() > 0.0) component.rcs->Remove(region.direction[i], region.rcs[i]);
-  component.changed = true;
+  ++component.changes;
   region.member[i] = -1;
 }
 
@@ -125,9 +125,10 @@ void LocalMap::Recompute(Region& region, std::int32_t c) {
   if (region.has_rcs) component.rcs = std::make_unique<RcsStatistics>(NormaliseRcs(rcs));
   // The directions at the mean of all members.
   for (const std::size_t i : members) {
+    if (!component.rcs) break;
     region.direction[i] =
         IncidenceDirection(poses_[region.pose[i]], region.points[i], component.points.mean, options_.rcs.incidence);
-    if (component.rcs && region.direction[i].squaredNorm() > 0.0) component.rcs->Add(region.direction[i], region.rcs[i]);
+    if (region.direction[i].squaredNorm() > 0.0) component.rcs->Add(region.direction[i], region.rcs[i]);
   }
   component.reshaped = true;
 }
@@ -236,6 +237,38 @@ void LocalMap::Split(Region& region, std::size_t target) {
 }
 
 void LocalMap::Publish(Region& region, std::vector<std::uint32_t>& changed, std::vector<std::uint32_t>& removed) {
+  bool emptied = false;
+  for (std::size_t c = 0; c < region.components.size(); ++c) {
+    Component& component = region.components[c];
+    if (component.points.count == 0) {
+      emptied = true;
+      continue;
+    }
+    // The KL is checked once a tenth of the members have come or gone.
+    if (!component.reshaped && 10 * std::size_t(component.changes) < component.points.count) continue;
+    component.changes = 0;
+    const Gaussian current = CurrentGaussian(component.points, component.range_sum, options_);
+    const bool moved = component.slot == kNoSlot || component.reshaped ||
+                       KullbackLeibler(current.mean, current.covariance, map_->gaussians[component.slot].mean,
+                                       map_->gaussians[component.slot].covariance) > options_.republish_kl;
+    if (!moved) continue;
+    if (component.rcs && (!component.rcs->normalisation.valid || component.rcs->outliers > component.rcs->inliers)) {
+      Recompute(region, std::int32_t(c));
+    }
+    if (component.slot == kNoSlot) component.slot = NewSlot();
+    Gaussian& published = map_->gaussians[component.slot];
+    published = current;
+    if (component.rcs) published.rcs = component.rcs->Solve(options_.rcs);
+    component.information = current.covariance.inverse();
+    changed.push_back(component.slot);
+    component.reshaped = false;
+  }
+  if (emptied) Retire(region, removed);
+  region.gaussians.clear();
+  for (const Component& component : region.components) region.gaussians.push_back(component.slot);
+}
+
+void LocalMap::Retire(Region& region, std::vector<std::uint32_t>& removed) {
   std::vector<std::int32_t> renumber(region.components.size(), -1);
   std::vector<Component> kept;
   for (std::size_t c = 0; c < region.components.size(); ++c) {
@@ -245,32 +278,12 @@ void LocalMap::Publish(Region& region, std::vector<std::uint32_t>& changed, std:
       continue;
     }
     renumber[c] = std::int32_t(kept.size());
-    if (component.changed || component.reshaped) {
-      const Gaussian current = CurrentGaussian(component.points, component.range_sum, options_);
-      const bool moved = component.slot == kNoSlot || component.reshaped ||
-                         KullbackLeibler(current.mean, current.covariance, map_->gaussians[component.slot].mean,
-                                         map_->gaussians[component.slot].covariance) > options_.republish_kl;
-      if (moved) {
-        if (component.rcs && (!component.rcs->normalisation.valid || component.rcs->outliers > component.rcs->inliers)) {
-          Recompute(region, std::int32_t(c));
-        }
-        if (component.slot == kNoSlot) component.slot = NewSlot();
-        Gaussian& published = map_->gaussians[component.slot];
-        published = current;
-        if (component.rcs) published.rcs = component.rcs->Solve(options_.rcs);
-        component.information = current.covariance.inverse();
-        changed.push_back(component.slot);
-        component.changed = component.reshaped = false;
-      }
-    }
     kept.push_back(std::move(component));
   }
   region.components = std::move(kept);
   for (std::int32_t& m : region.member) {
     if (m >= 0) m = renumber[m];
   }
-  region.gaussians.clear();
-  for (const Component& component : region.components) region.gaussians.push_back(component.slot);
 }
 
 }  // namespace radargauss

@@ -109,7 +109,7 @@ class LocalMap {
     std::unique_ptr<RcsStatistics> rcs;   // when the region has RCS
     std::uint32_t slot = kNoSlot;         // in map_, once published
     Eigen::Matrix3d information = Eigen::Matrix3d::Zero();  // the published covariance's inverse
-    bool changed = false;                 // members came or left since it was published
+    std::uint32_t changes = 0;            // members that came or left since the last KL check
     bool reshaped = false;                // seeded or split: publish whatever the KL
   };
   struct Region {
@@ -153,6 +153,8 @@ class LocalMap {
   void Merge(Region& region, std::size_t target);
   void Split(Region& region, std::size_t target);
   void Publish(Region& region, std::vector<std::uint32_t>& changed, std::vector<std::uint32_t>& removed);
+  // Frees the slots of the components left without members and renumbers the rest.
+  void Retire(Region& region, std::vector<std::uint32_t>& removed);
   // Restarts a component's statistics from its members.
   void Recompute(Region& region, std::int32_t component);
 
