@@ -79,10 +79,7 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
   std::vector<int> best;
   std::vector<int> consensus;
   std::vector<double> residual(n);
-  const double* hx = H.col(0).data();
-  const double* hy = H.col(1).data();
-  const double* hz = H.col(2).data();
-  const double* y0 = y.data();
+  const double *hx = H.col(0).data(), *hy = H.col(1).data(), *hz = H.col(2).data(), *y0 = y.data();
   // Hypotheses the gate turns away do not count: up to kGatedDrawFactor
   // times as many draws find the world's hypotheses among a car's.
   constexpr int kGatedDrawFactor = 50;

@@ -57,7 +57,7 @@ struct LocalMapOptions {
   std::size_t min_points = 8;         // points a region needs for its first fit
   double refit_growth = 0.5;          // refit once the points added since the last fit reach this share of those fitted
   double active_radius = 100.0;       // m: regions whose centre is farther from the radar leave
-  double republish_kl = 1.0;          // nats: KL(updated || published) that republishes a Gaussian (kIncremental)
+  double republish_kl = 2.0;          // nats: KL(updated || published) that republishes a Gaussian (kIncremental)
   // The radar's angular noise: a Gaussian is at least this angle times the
   // mean range its members were seen at wide, horizontally (azimuth) and
   // vertically (elevation), and at least min_std, so that far, sparse
