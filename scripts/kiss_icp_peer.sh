@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Builds bench/kiss_icp_peer.cpp (kiss-icp's C++ core on radargauss
 # sequences) against build/release: give the checkouts of kiss-icp, Sophus
 # and robin-map (headers only), e.g.
