@@ -80,7 +80,7 @@ class RadarOdometry:
         region_capacity: int = 256,
         region_min_points: int = 8,
         map_estimator: str = 'refit',
-        republish_kl: float = 1.0,
+        republish_kl: float = 2.0,
         refit_growth: float = 0.5,
         active_radius: float = 100.0,
         azimuth_std_deg: float = 0.0,

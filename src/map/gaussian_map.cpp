@@ -88,6 +88,68 @@ bool CellMeetsEllipsoid(Eigen::Vector3d lo, Eigen::Vector3d hi, const Eigen::Vec
   return cell_low <= n.dot(mean) + extent * std::sqrt(n.dot(covariance * n));
 }
 
+// The z-extent of a Gaussian's ellipsoid of `extent` sigmas over a column
+// [x0, x0 + w] x [y0, y0 + w]: for fixed (x, y) it spans z_c +- h with
+// z_c = mu_z - a . d / A_zz, h^2 = (extent^2 - d^T S d) / A_zz, d the (x, y)
+// offset from the mean, A = Sigma^-1, a = A_z,xy and S = Sigma_xy^-1 the
+// marginal's information. Bounded by z_c over the corners (it is linear) and
+// the largest h (at the smallest d^T S d over the rectangle), both widened as
+// CellMeetsEllipsoid widens the cell and the extent: every cell the
+// ellipsoid meets lies within the bound.
+class ColumnBound {
+ public:
+  ColumnBound(const Gaussian& g, double extent) : mean_(g.mean) {
+    const Eigen::Matrix3d information = g.covariance.inverse();
+    marginal_ = g.covariance.topLeftCorner<2, 2>().inverse();
+    a_zz_ = information(2, 2);
+    slope_ = Eigen::Vector2d(information(2, 0), information(2, 1)) / a_zz_;
+    extent_sq_ = extent * (1.0 + 1e-5) * extent * (1.0 + 1e-5);
+  }
+  // false: the column misses the ellipsoid.
+  bool Bounds(double x0, double y0, double width, double& z_low, double& z_high) const {
+    const double margin = 1e-8 * std::max({1.0, std::abs(x0) + width, std::abs(y0) + width});
+    const Eigen::Vector2d lo(x0 - margin - mean_.x(), y0 - margin - mean_.y());
+    const Eigen::Vector2d hi(x0 + width + margin - mean_.x(), y0 + width + margin - mean_.y());
+    const double q = SmallestOverRectangle(lo, hi);
+    if (q > extent_sq_) return false;
+    const double h = std::sqrt((extent_sq_ - q) / a_zz_);
+    double c_low = INFINITY, c_high = -INFINITY;
+    for (const double dx : {lo.x(), hi.x()}) {
+      for (const double dy : {lo.y(), hi.y()}) {
+        const double c = -(slope_.x() * dx + slope_.y() * dy);
+        c_low = std::min(c_low, c);
+        c_high = std::max(c_high, c);
+      }
+    }
+    const double z_margin = 1e-8 * std::max(1.0, std::abs(mean_.z()) + std::abs(c_low) + std::abs(c_high) + h);
+    z_low = mean_.z() + c_low - h - z_margin;
+    z_high = mean_.z() + c_high + h + z_margin;
+    return true;
+  }
+
+ private:
+  // min d^T S d over lo <= d <= hi: 0 inside, else on an edge (convex).
+  double SmallestOverRectangle(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const {
+    if (lo.x() <= 0.0 && hi.x() >= 0.0 && lo.y() <= 0.0 && hi.y() >= 0.0) return 0.0;
+    const Eigen::Matrix2d& S = marginal_;
+    const auto value = [&S](double dx, double dy) { return S(0, 0) * dx * dx + 2.0 * S(0, 1) * dx * dy + S(1, 1) * dy * dy; };
+    double best = INFINITY;
+    for (const double dx : {lo.x(), hi.x()}) {  // edges of fixed x: the best y, clamped
+      best = std::min(best, value(dx, std::clamp(-S(0, 1) * dx / S(1, 1), lo.y(), hi.y())));
+    }
+    for (const double dy : {lo.y(), hi.y()}) {
+      best = std::min(best, value(std::clamp(-S(0, 1) * dy / S(0, 0), lo.x(), hi.x()), dy));
+    }
+    return best;
+  }
+
+  Eigen::Vector3d mean_;
+  Eigen::Matrix2d marginal_;
+  Eigen::Vector2d slope_;
+  double a_zz_ = 1.0;
+  double extent_sq_ = 0.0;
+};
+
 }  // namespace
 
 
@@ -120,10 +182,16 @@ std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vecto
   }
   // Of the box's cells, those the ellipsoid itself meets: an oblique or
   // round Gaussian leaves many of its box's cells empty (fewer candidates
-  // per query, the same answers).
+  // per query, the same answers). Each column of cells is bounded first
+  // (ColumnBound), and only the cells within its bound are tested.
+  const ColumnBound column(g, extent_sigmas_);
   for (auto x = lo.x; x <= hi.x; ++x) {
     for (auto y = lo.y; y <= hi.y; ++y) {
-      for (auto z = lo.z; z <= hi.z; ++z) {
+      double z_low, z_high;
+      if (!column.Bounds(double(x) * cell_size_, double(y) * cell_size_, cell_size_, z_low, z_high)) continue;
+      const auto first = decltype(lo.z)(std::max(double(lo.z), std::floor(z_low / cell_size_)));
+      const auto last = decltype(hi.z)(std::min(double(hi.z), std::floor(z_high / cell_size_)));
+      for (auto z = first; z <= last; ++z) {
         const Eigen::Vector3d corner = Eigen::Vector3d(double(x), double(y), double(z)) * cell_size_;
         if (CellMeetsEllipsoid(corner, corner.array() + cell_size_, g.mean, g.covariance, information,
                                extent_sigmas_)) {
