@@ -54,17 +54,7 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
   for (int v = 0; v < voxel_count; ++v) {
     for (const std::uint32_t k : voxels[v]) voxel_ids[k] = v;
   }
-  std::vector<int> seen(voxels.size(), -1);
-  const auto voxels_of = [&](const std::vector<int>& rows, int stamp) {
-    int covered = 0;
-    for (const int k : rows) {
-      if (seen[voxel_ids[k]] != stamp) {
-        seen[voxel_ids[k]] = stamp;
-        ++covered;
-      }
-    }
-    return covered;
-  };
+  std::vector<int> seen(voxels.size(), -1);  // the draw that last covered each voxel
   int best_voxels = 0;
   std::mt19937 rng(options.seed);
   std::uniform_int_distribution<int> pick(0, n - 1);
@@ -77,7 +67,6 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     return int(rows[std::uniform_int_distribution<std::size_t>(0, rows.size() - 1)(rng)]);
   };
   std::vector<int> best;
-  std::vector<int> consensus;
   std::vector<double> residual(n);
   const double *hx = H.col(0).data(), *hy = H.col(1).data(), *hz = H.col(2).data(), *y0 = y.data();
   // Hypotheses the gate turns away do not count: up to kGatedDrawFactor
@@ -107,20 +96,25 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     if (gate && !gate->Admits(v)) continue;
     ++counted;
     // The residuals over the columns first (a loop the compiler vectorises),
-    // then the rows within the threshold.
+    // then the support; the rows are listed only for a hypothesis that wins.
     for (int k = 0; k < n; ++k) residual[k] = std::abs(y0[k] - (hx[k] * v.x() + hy[k] * v.y() + hz[k] * v.z()));
-    consensus.clear();
+    std::size_t size = 0;
+    int covered = 0;
     for (int k = 0; k < n; ++k) {
-      if (residual[k] < options.inlier_threshold) consensus.push_back(k);
+      if (!(residual[k] < options.inlier_threshold)) continue;
+      ++size;
+      if (!voxel_ids.empty() && seen[voxel_ids[k]] != draw) {
+        seen[voxel_ids[k]] = draw;
+        ++covered;
+      }
     }
-    if (voxel_ids.empty()) {
-      if (consensus.size() > best.size()) best.swap(consensus);
-      continue;
-    }
-    const int covered = voxels_of(consensus, draw);
-    if (covered > best_voxels || (covered == best_voxels && consensus.size() > best.size())) {
-      best_voxels = covered;
-      best.swap(consensus);
+    const bool wins = voxel_ids.empty() ? size > best.size()
+                                        : covered > best_voxels || (covered == best_voxels && size > best.size());
+    if (!wins) continue;
+    best_voxels = covered;
+    best.clear();
+    for (int k = 0; k < n; ++k) {
+      if (residual[k] < options.inlier_threshold) best.push_back(k);
     }
   }
   return best;
