@@ -83,7 +83,14 @@ void GaussianIndex::Update(const std::vector<Gaussian>& gaussians, const std::ve
   // smallest id).
   std::vector<std::uint32_t> staying, joined;
   auto next_join = joining.begin();
-  for (const std::int64_t key : dirty) {
+  // The home slots are fetched a few keys ahead: each is a cache miss.
+  constexpr std::size_t kAhead = 8;
+  for (std::size_t k = 0; k < std::min(kAhead, dirty.size()); ++k) {
+    __builtin_prefetch(&cells_[cells_.HomeSlot(std::uint64_t(dirty[k]))]);
+  }
+  for (std::size_t d = 0; d < dirty.size(); ++d) {
+    if (d + kAhead < dirty.size()) __builtin_prefetch(&cells_[cells_.HomeSlot(std::uint64_t(dirty[d + kAhead]))]);
+    const std::int64_t key = dirty[d];
     Cell& cell = cells_[Slot(key)];
     staying.clear();
     if (cell.key == key) {
