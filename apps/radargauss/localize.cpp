@@ -82,14 +82,17 @@ Experiment MakeExperiment(const Sequence& sequence, const LocalizeSettings& s) {
 }
 
 // The PCL peers' row: the merged map cloud as the target (no w_rcs, no loss).
-ConfigurationRun RunPeer(const std::string& solver, const Sequence& sequence, const MatchingMap& matching,
-                         const Experiment& e, std::vector<Eigen::Vector3d>& map_cloud) {
+ConfigurationRun RunPeer(const std::string& solver, const Sequence& sequence, const LocalizeSettings& s,
+                         const MatchingMap& matching, const Experiment& e, std::vector<Eigen::Vector3d>& map_cloud) {
 #ifdef RADARGAUSS_HAVE_PCL
   if (map_cloud.empty()) map_cloud = BuildMapCloud(sequence).points;
-  const PclPeerMatcher peer(solver == "pcl-ndt" ? PclMethod::kNdt : PclMethod::kGicp, map_cloud);
+  PclPeerOptions options;
+  options.ndt_resolution = s.ndt_resolution;
+  options.ndt_step_size = s.ndt_step;
+  const PclPeerMatcher peer(solver == "pcl-ndt" ? PclMethod::kNdt : PclMethod::kGicp, map_cloud, options);
   return RunConfiguration(solver, 0.0, peer, matching, e.scans, e.references, e.errors, e.first_scan);
 #else
-  (void)sequence, (void)matching, (void)e, (void)map_cloud;
+  (void)sequence, (void)s, (void)matching, (void)e, (void)map_cloud;
   throw DataError("solver '" + solver + "' needs radargauss built with RADARGAUSS_WITH_PCL");
 #endif
 }
@@ -108,7 +111,7 @@ std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const 
       if (solver.rfind("pcl-", 0) == 0) {
         if (m > 0) continue;  // the peers do not use the RCS models: once
         bar.Update("localize", done, total);
-        runs.push_back(RunPeer(solver, sequence, matching, e, map_cloud));
+        runs.push_back(RunPeer(solver, sequence, s, matching, e, map_cloud));
         ++done;
         continue;
       }

@@ -151,6 +151,12 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
   AddSweepOptions(app, s);
   AddInitialErrorOptions(app, s);
   AddCoarseOptions(app, s);
+  app->add_option("--ndt-resolution", s.ndt_resolution, "pcl-ndt: voxel of the NDT peer (m)")
+      ->check(Positive())
+      ->capture_default_str();
+  app->add_option("--ndt-step", s.ndt_step, "pcl-ndt: line-search step of the NDT peer (m)")
+      ->check(Positive())
+      ->capture_default_str();
 }
 
 }  // namespace radargauss::cli

@@ -35,6 +35,8 @@ struct LocalizeSettings {
   double coarse_gate = MatchingMapOptions().coarse_gate;
   bool loss_curvature = false;
   bool geometric_first = ScanMatchingOptions().geometric_first;
+  double ndt_resolution = 1.0;  // m: the PCL NDT peer's voxel
+  double ndt_step = 0.1;        // m: its line-search step
 
   // The sequence options, once the flags that a run needs are checked.
   const SequenceOptions& CheckedSequenceOptions() const;
