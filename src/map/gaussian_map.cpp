@@ -98,8 +98,7 @@ bool CellMeetsEllipsoid(Eigen::Vector3d lo, Eigen::Vector3d hi, const Eigen::Vec
 // ellipsoid meets lies within the bound.
 class ColumnBound {
  public:
-  ColumnBound(const Gaussian& g, double extent) : mean_(g.mean) {
-    const Eigen::Matrix3d information = g.covariance.inverse();
+  ColumnBound(const Gaussian& g, const Eigen::Matrix3d& information, double extent) : mean_(g.mean) {
     marginal_ = g.covariance.topLeftCorner<2, 2>().inverse();
     a_zz_ = information(2, 2);
     slope_ = Eigen::Vector2d(information(2, 0), information(2, 1)) / a_zz_;
@@ -184,7 +183,7 @@ std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vecto
   // round Gaussian leaves many of its box's cells empty (fewer candidates
   // per query, the same answers). Each column of cells is bounded first
   // (ColumnBound), and only the cells within its bound are tested.
-  const ColumnBound column(g, extent_sigmas_);
+  const ColumnBound column(g, information, extent_sigmas_);
   for (auto x = lo.x; x <= hi.x; ++x) {
     for (auto y = lo.y; y <= hi.y; ++y) {
       double z_low, z_high;
