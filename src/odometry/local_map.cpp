@@ -161,19 +161,22 @@ void LocalMap::FloorAtRange(const Region& region, const std::vector<int>& associ
     range_sum[association[i]] += (region.points[i] - poses_[region.pose[i]].translation()).norm();
     ++members[association[i]];
   }
-  const double azimuth = std::tan(options_.azimuth_std_deg * M_PI / 180.0);
-  const double elevation = std::tan(options_.elevation_std_deg * M_PI / 180.0);
-  const double min_std = options_.gaussians.min_std;
   for (std::size_t g = 0; g < fitted.gaussians.size(); ++g) {
     if (members[g] == 0) continue;
-    const double range = range_sum[g] / double(members[g]);
-    const Eigen::Vector3d floor(std::max(min_std, azimuth * range), std::max(min_std, azimuth * range),
-                                std::max(min_std, elevation * range));
-    // Clamped where the floor is the unit sphere, then scaled back.
     Eigen::Matrix3d& covariance = fitted.gaussians[g].covariance;
-    const Eigen::Matrix3d whitened = floor.cwiseInverse().asDiagonal() * covariance * floor.cwiseInverse().asDiagonal();
-    covariance = floor.asDiagonal() * ClampCovariance(whitened, 1.0) * floor.asDiagonal();
+    covariance = FlooredAtRange(covariance, range_sum[g] / double(members[g]), options_);
   }
+}
+
+Eigen::Matrix3d FlooredAtRange(const Eigen::Matrix3d& covariance, double range, const LocalMapOptions& options) {
+  const double azimuth = std::tan(options.azimuth_std_deg * M_PI / 180.0);
+  const double elevation = std::tan(options.elevation_std_deg * M_PI / 180.0);
+  const double min_std = options.gaussians.min_std;
+  const Eigen::Vector3d floor(std::max(min_std, azimuth * range), std::max(min_std, azimuth * range),
+                              std::max(min_std, elevation * range));
+  // Clamped where the floor is the unit sphere, then scaled back.
+  const Eigen::Matrix3d whitened = floor.cwiseInverse().asDiagonal() * covariance * floor.cwiseInverse().asDiagonal();
+  return floor.asDiagonal() * ClampCovariance(whitened, 1.0) * floor.asDiagonal();
 }
 
 std::size_t LocalMap::Evict(const Eigen::Vector3d& position) {

@@ -24,14 +24,7 @@ Gaussian CurrentGaussian(const PointStatistics& stats, double range_sum, const L
   g.covariance = ClampCovariance(stats.Covariance(), options.gaussians.min_std);
   g.point_count = std::uint32_t(stats.count);
   if (options.azimuth_std_deg > 0.0 || options.elevation_std_deg > 0.0) {
-    const double range = range_sum / double(stats.count);
-    const double min_std = options.gaussians.min_std;
-    const double horizontal = std::max(min_std, std::tan(options.azimuth_std_deg * M_PI / 180.0) * range);
-    const Eigen::Vector3d floor(horizontal, horizontal,
-                                std::max(min_std, std::tan(options.elevation_std_deg * M_PI / 180.0) * range));
-    const Eigen::Matrix3d whitened =
-        floor.cwiseInverse().asDiagonal() * g.covariance * floor.cwiseInverse().asDiagonal();
-    g.covariance = floor.asDiagonal() * ClampCovariance(whitened, 1.0) * floor.asDiagonal();
+    g.covariance = FlooredAtRange(g.covariance, range_sum / double(stats.count), options);
   }
   return g;
 }

@@ -72,6 +72,11 @@ struct LocalMapOptions {
 // Throws std::invalid_argument naming the bad option.
 void ValidateOptions(const LocalMapOptions& options);
 
+// `covariance` widened to the radar's angular noise at `range` (m) and at
+// least min_std: Sigma' = F clamp(F^-1 Sigma F^-1, 1) F (docs/design.md,
+// "Odometry").
+Eigen::Matrix3d FlooredAtRange(const Eigen::Matrix3d& covariance, double range, const LocalMapOptions& options);
+
 class LocalMap {
  public:
   explicit LocalMap(const LocalMapOptions& options = {});
