@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The updatable spatial index of odometry's local map (docs/design.md,
 // "Odometry"): the cells a change touches get new lists appended to the
-// entries, and the entries are compacted once stale ones outnumber the live.
+// entries (or rewritten in place when they fit the old), and the entries are
+// compacted once stale ones outnumber the live.
 #include <algorithm>
 #include <stdexcept>
 #include <utility>
@@ -104,10 +105,17 @@ void GaussianIndex::Update(const std::vector<Gaussian>& gaussians, const std::ve
     }
     joined.clear();
     for (; next_join != joining.end() && next_join->first == key; ++next_join) joined.push_back(next_join->second);
-    cell.begin = std::uint32_t(cell_entries_.size());
-    cell_entries_.resize(cell_entries_.size() + staying.size() + joined.size());
+    // A list that fits in the old one is rewritten in its place; a longer
+    // one is appended.
+    const std::size_t length = staying.size() + joined.size();
+    if (cell.end - cell.begin < length) {
+      cell.begin = std::uint32_t(cell_entries_.size());
+      cell_entries_.resize(cell_entries_.size() + length);
+    } else {
+      stale_entries_ -= length;
+    }
     std::merge(staying.begin(), staying.end(), joined.begin(), joined.end(), cell_entries_.begin() + cell.begin);
-    cell.end = std::uint32_t(cell_entries_.size());
+    cell.end = std::uint32_t(cell.begin + length);
   }
   if (stale_entries_ > cell_entries_.size() - stale_entries_ + 1024) Compact(0);
 }
