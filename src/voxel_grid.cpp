@@ -1,24 +1,67 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/voxel_grid.hpp"
 
+#include <algorithm>
 #include <utility>
 
 #include "radargauss/linear_probing_table.hpp"
 
 namespace radargauss {
 
-std::vector<std::vector<std::uint32_t>> GroupByVoxel(const std::vector<Eigen::Vector3d>& points, double voxel) {
-  std::vector<std::pair<VoxelKey, std::uint32_t>> keyed(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) keyed[i] = {VoxelOf(points[i], voxel), std::uint32_t(i)};
-  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) {
-    return a.first < b.first || (a.first == b.first && a.second < b.second);
-  });
+namespace {
+
+int BitWidth(std::uint64_t value) {
+  int bits = 0;
+  for (; value != 0; value >>= 1) ++bits;
+  return bits;
+}
+
+// The groups of `keys` (sorted as `order` gives them) where the key changes.
+template <typename KeyOf>
+std::vector<std::vector<std::uint32_t>> SplitRuns(const std::vector<std::uint32_t>& order, KeyOf key_of) {
   std::vector<std::vector<std::uint32_t>> groups;
-  for (std::size_t k = 0; k < keyed.size(); ++k) {
-    if (k == 0 || !(keyed[k].first == keyed[k - 1].first)) groups.emplace_back();
-    groups.back().push_back(keyed[k].second);
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    if (k == 0 || !(key_of(order[k]) == key_of(order[k - 1]))) groups.emplace_back();
+    groups.back().push_back(order[k]);
   }
   return groups;
+}
+
+}  // namespace
+
+std::vector<std::vector<std::uint32_t>> GroupByVoxel(const std::vector<Eigen::Vector3d>& points, double voxel) {
+  const std::size_t n = points.size();
+  if (n == 0) return {};
+  std::vector<VoxelKey> keys(n);
+  VoxelKey low = VoxelOf(points[0], voxel), high = low;
+  for (std::size_t i = 0; i < n; ++i) {
+    keys[i] = VoxelOf(points[i], voxel);
+    low = {std::min(low.x, keys[i].x), std::min(low.y, keys[i].y), std::min(low.z, keys[i].z)};
+    high = {std::max(high.x, keys[i].x), std::max(high.y, keys[i].y), std::max(high.z, keys[i].z)};
+  }
+  // When the keys' spans and the index fit in 63 bits, one integer per point
+  // (x, y, z offsets, then the index) sorts in the keys' order, ties by index.
+  const int bits_z = BitWidth(std::uint64_t(high.z) - std::uint64_t(low.z));
+  const int bits_y = BitWidth(std::uint64_t(high.y) - std::uint64_t(low.y));
+  const int bits_x = BitWidth(std::uint64_t(high.x) - std::uint64_t(low.x));
+  const int bits_i = BitWidth(n - 1);
+  std::vector<std::uint32_t> order(n);
+  if (bits_x + bits_y + bits_z + bits_i <= 63) {
+    std::vector<std::uint64_t> codes(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      codes[i] = ((std::uint64_t(keys[i].x) - std::uint64_t(low.x)) << (bits_y + bits_z + bits_i)) |
+                 ((std::uint64_t(keys[i].y) - std::uint64_t(low.y)) << (bits_z + bits_i)) |
+                 ((std::uint64_t(keys[i].z) - std::uint64_t(low.z)) << bits_i) | std::uint64_t(i);
+    }
+    std::sort(codes.begin(), codes.end());
+    const std::uint64_t index_mask = (std::uint64_t(1) << bits_i) - 1;
+    for (std::size_t k = 0; k < n; ++k) order[k] = std::uint32_t(codes[k] & index_mask);
+    return SplitRuns(order, [&](std::uint32_t i) { return keys[i]; });
+  }
+  for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(i);
+  std::sort(order.begin(), order.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b] || (keys[a] == keys[b] && a < b); });
+  return SplitRuns(order, [&](std::uint32_t i) { return keys[i]; });
 }
 
 std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points, double voxel,

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <random>
 
 #include "radargauss/error.hpp"
@@ -19,6 +20,7 @@
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/rcs_model.hpp"
 #include "radargauss/simulator.hpp"
+#include "radargauss/voxel_grid.hpp"
 #include "temp_dir.hpp"
 #include "map_fixtures.hpp"
 
@@ -231,6 +233,28 @@ TEST(GaussianIndexTest, EmptyIndexAssociatesNothing) {
   associations.assign(points.size(), 7);
   GaussianIndex({}, 0.5).AssociateAll(points.data(), points.size(), 9.0, associations.data());
   EXPECT_EQ(associations, std::vector<int>(points.size(), -1));
+}
+
+// GroupByVoxel against a std::map of voxel keys: the packed-integer sort of
+// a scan and the comparison sort of keys too far apart to pack agree with it.
+TEST(GroupByVoxelTest, GroupsAsAnOrderedMapOfKeys) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> near(-60.0, 60.0);
+  for (const double spread : {1.0, 1e15}) {  // 1e15 m at 0.5 m voxels: spans beyond 63 bits
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i < 3000; ++i) {
+      const Eigen::Vector3d p(near(rng), near(rng), near(rng) / 10.0);
+      points.push_back(i % 7 == 0 ? Eigen::Vector3d(spread * p) : p);
+      if (i % 5 == 0) points.push_back(points.back());  // duplicates share a voxel
+    }
+    std::map<VoxelKey, std::vector<std::uint32_t>> reference;
+    for (std::size_t i = 0; i < points.size(); ++i) reference[VoxelOf(points[i], 0.5)].push_back(std::uint32_t(i));
+    std::vector<std::vector<std::uint32_t>> expected;
+    for (const auto& entry : reference) expected.push_back(entry.second);
+    EXPECT_EQ(GroupByVoxel(points, 0.5), expected) << "spread " << spread;
+  }
+  EXPECT_TRUE(GroupByVoxel({}, 0.5).empty());
+  EXPECT_EQ(GroupByVoxel({Eigen::Vector3d(1, 2, 3)}, 0.5), std::vector<std::vector<std::uint32_t>>{{0}});
 }
 
 }  // namespace
