@@ -98,14 +98,20 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     // The residuals over the columns first (a loop the compiler vectorises),
     // then the support; the rows are listed only for a hypothesis that wins.
     for (int k = 0; k < n; ++k) residual[k] = std::abs(y0[k] - (hx[k] * v.x() + hy[k] * v.y() + hz[k] * v.z()));
+    // Without branches: whether a row is an inlier is a coin toss to the
+    // branch predictor.
     std::size_t size = 0;
     int covered = 0;
-    for (int k = 0; k < n; ++k) {
-      if (!(residual[k] < options.inlier_threshold)) continue;
-      ++size;
-      if (!voxel_ids.empty() && seen[voxel_ids[k]] != draw) {
-        seen[voxel_ids[k]] = draw;
-        ++covered;
+    if (voxel_ids.empty()) {
+      for (int k = 0; k < n; ++k) size += residual[k] < options.inlier_threshold;
+    } else {
+      for (int k = 0; k < n; ++k) {
+        const bool inlier = residual[k] < options.inlier_threshold;
+        int& last = seen[voxel_ids[k]];
+        const bool fresh = inlier & (last != draw);
+        size += inlier;
+        covered += fresh;
+        last = fresh ? draw : last;
       }
     }
     const bool wins = voxel_ids.empty() ? size > best.size()
