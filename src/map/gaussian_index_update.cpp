@@ -45,6 +45,49 @@ void GaussianIndex::Compact(std::size_t extra_cells) {
   stale_entries_ = 0;
 }
 
+void GaussianIndex::ListingChanges(const std::vector<Gaussian>& gaussians, const std::vector<std::uint32_t>& changed,
+                                   const std::vector<std::uint32_t>& removed, std::vector<Listing>& leaving,
+                                   std::vector<Listing>& joining) {
+  // 1: changed, not yet listed again; 2: done (each id once; changed wins
+  // over removed).
+  std::vector<char> state(gaussians_.size(), 0);
+  for (const std::uint32_t id : changed) state[id] = 1;
+  for (const std::uint32_t id : removed) {
+    if (id >= state.size() || state[id] != 0) continue;
+    state[id] = 2;
+    for (const std::int64_t key : listed_cells_[id]) leaving.emplace_back(key, id);
+    std::vector<std::int64_t>().swap(listed_cells_[id]);  // frees the capacity (`= {}` keeps it)
+  }
+  // A changed Gaussian leaves the cells it has left and joins the new
+  // ones; the cells it meets before and after keep their lists.
+  std::vector<std::int64_t> cells;
+  for (const std::uint32_t id : changed) {
+    if (state[id] != 1) continue;
+    state[id] = 2;
+    cells.clear();
+    Index(gaussians[id], id, cells);
+    std::sort(cells.begin(), cells.end());
+    const std::vector<std::int64_t>& before = listed_cells_[id];
+    auto old = before.begin();
+    auto now = cells.begin();
+    while (old != before.end() || now != cells.end()) {
+      if (now == cells.end() || (old != before.end() && *old < *now)) {
+        leaving.emplace_back(*old++, id);
+      } else if (old == before.end() || *now < *old) {
+        joining.emplace_back(*now++, id);
+      } else {
+        ++old, ++now;
+      }
+    }
+    // A list that shrank gives its memory back.
+    std::vector<std::int64_t>& listed = listed_cells_[id];
+    if (listed.capacity() > 2 * cells.size() + 8) std::vector<std::int64_t>().swap(listed);
+    listed.assign(cells.begin(), cells.end());
+  }
+  std::sort(leaving.begin(), leaving.end());
+  std::sort(joining.begin(), joining.end());
+}
+
 void GaussianIndex::Update(const std::vector<Gaussian>& gaussians, const std::vector<std::uint32_t>& changed,
                            const std::vector<std::uint32_t>& removed) {
   if (!updatable_) throw std::logic_error("GaussianIndex::Update needs an index made by GaussianIndex::Updatable");
@@ -55,28 +98,15 @@ void GaussianIndex::Update(const std::vector<Gaussian>& gaussians, const std::ve
   }
   gaussians_.resize(top);
   listed_cells_.resize(top);
-  // The ids leaving their cells, and the cells each changed Gaussian joins.
-  std::vector<char> leaving(top, 0);
+  // (cell, id) of every listing that goes and of every one that comes,
+  // sorted: each cell's are a run, in id order.
+  std::vector<Listing> leaving, joining;
+  ListingChanges(gaussians, changed, removed, leaving, joining);
   std::vector<std::int64_t> dirty;
-  const auto leave = [&](std::uint32_t id) {
-    if (id >= top || leaving[id]) return;
-    leaving[id] = 1;
-    dirty.insert(dirty.end(), listed_cells_[id].begin(), listed_cells_[id].end());
-    std::vector<std::int64_t>().swap(listed_cells_[id]);  // frees the capacity (`= {}` keeps it)
-  };
-  for (const std::uint32_t id : removed) leave(id);
-  for (const std::uint32_t id : changed) leave(id);
-  // (cell, id) of every joining listing, sorted: each cell's joiners are a
-  // run, in id order.
-  std::vector<std::pair<std::int64_t, std::uint32_t>> joining;
-  for (const std::uint32_t id : changed) {
-    if (!listed_cells_[id].empty()) continue;  // listed twice in `changed`
-    Index(gaussians[id], id, listed_cells_[id]);
-    for (const std::int64_t key : listed_cells_[id]) joining.emplace_back(key, id);
-    dirty.insert(dirty.end(), listed_cells_[id].begin(), listed_cells_[id].end());
-  }
-  std::sort(joining.begin(), joining.end());
-  std::sort(dirty.begin(), dirty.end());
+  dirty.reserve(leaving.size() + joining.size());
+  for (const Listing& listing : leaving) dirty.push_back(listing.first);
+  for (const Listing& listing : joining) dirty.push_back(listing.first);
+  std::inplace_merge(dirty.begin(), dirty.begin() + std::ptrdiff_t(leaving.size()), dirty.end());
   dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
   if (cells_.empty() || 2 * (cell_count_ + dirty.size()) > cells_.size()) Compact(dirty.size());
   // Each touched cell's list: its entries that stay merged with those that
@@ -84,6 +114,7 @@ void GaussianIndex::Update(const std::vector<Gaussian>& gaussians, const std::ve
   // smallest id).
   std::vector<std::uint32_t> staying, joined;
   auto next_join = joining.begin();
+  auto next_leave = leaving.begin();
   // The home slots are fetched a few keys ahead: each is a cache miss.
   constexpr std::size_t kAhead = 8;
   for (std::size_t k = 0; k < std::min(kAhead, dirty.size()); ++k) {
@@ -96,13 +127,17 @@ void GaussianIndex::Update(const std::vector<Gaussian>& gaussians, const std::ve
     staying.clear();
     if (cell.key == key) {
       for (std::uint32_t e = cell.begin; e < cell.end; ++e) {
-        if (!leaving[cell_entries_[e]]) staying.push_back(cell_entries_[e]);
+        const std::uint32_t id = cell_entries_[e];
+        while (next_leave != leaving.end() && next_leave->first == key && next_leave->second < id) ++next_leave;
+        if (next_leave != leaving.end() && next_leave->first == key && next_leave->second == id) continue;
+        staying.push_back(id);
       }
       stale_entries_ += cell.end - cell.begin;
     } else {
       cell.key = key;
       ++cell_count_;
     }
+    while (next_leave != leaving.end() && next_leave->first == key) ++next_leave;
     joined.clear();
     for (; next_join != joining.end() && next_join->first == key; ++next_join) joined.push_back(next_join->second);
     // A list that fits in the old one is rewritten in its place; a longer

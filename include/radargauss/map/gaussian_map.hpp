@@ -168,6 +168,12 @@ class GaussianIndex {
   // Rebuilds the cell lists without stale entries or empty cells, with room
   // for `extra_cells` more.
   void Compact(std::size_t extra_cells);
+  // An update's listings, (cell key, id): those that go (removed Gaussians,
+  // cells a changed one has left) and those that come, each sorted.
+  using Listing = std::pair<std::int64_t, std::uint32_t>;
+  void ListingChanges(const std::vector<Gaussian>& gaussians, const std::vector<std::uint32_t>& changed,
+                      const std::vector<std::uint32_t>& removed, std::vector<Listing>& leaving,
+                      std::vector<Listing>& joining);
 
   double cell_size_ = 1.0;
   double extent_sigmas_ = 3.0;
