@@ -58,7 +58,7 @@ void GaussianIndex::ListingChanges(const std::vector<Gaussian>& gaussians, const
     for (const std::int64_t key : listed_cells_[id]) leaving.emplace_back(key, id);
     std::vector<std::int64_t>().swap(listed_cells_[id]);  // frees the capacity (`= {}` keeps it)
   }
-  // A changed Gaussian leaves the cells it has left and joins the new
+  // A changed Gaussian leaves the cells it has moved out of and joins the new
   // ones; the cells it meets before and after keep their lists.
   std::vector<std::int64_t> cells;
   for (const std::uint32_t id : changed) {
