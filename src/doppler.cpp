@@ -40,6 +40,36 @@ bool SolveLeastSquares(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
   return v.allFinite();
 }
 
+// The rows of H v = y regrouped voxel by voxel (`opens` marks each voxel's
+// first row), so that a hypothesis's voxels are counted in one pass without
+// branches or lookups; without voxels, the rows as they are.
+struct VoxelOrderedRows {
+  std::vector<char> opens;
+  std::vector<double> hx, hy, hz, y;
+};
+
+VoxelOrderedRows RegroupByVoxel(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
+                                const std::vector<std::vector<std::uint32_t>>& voxels) {
+  const int n = static_cast<int>(y.size());
+  std::vector<int> row_of(n);
+  VoxelOrderedRows rows{std::vector<char>(n, 0), std::vector<double>(n), std::vector<double>(n),
+                        std::vector<double>(n), std::vector<double>(n)};
+  if (voxels.empty()) {
+    for (int k = 0; k < n; ++k) row_of[k] = k;
+  } else {
+    int k = 0;
+    for (const std::vector<std::uint32_t>& members : voxels) {
+      rows.opens[k] = 1;
+      for (const std::uint32_t row : members) row_of[k++] = int(row);
+    }
+  }
+  for (int k = 0; k < n; ++k) {
+    rows.hx[k] = H(row_of[k], 0), rows.hy[k] = H(row_of[k], 1), rows.hz[k] = H(row_of[k], 2);
+    rows.y[k] = y[row_of[k]];
+  }
+  return rows;
+}
+
 // RANSAC over 3-point draws of the rows of H v = y: the consensus set (row
 // indices) of largest support over `iterations` counted draws. Support is the
 // number of rows, or with options.consensus_voxel > 0 the number of voxels
@@ -50,11 +80,7 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
                                   const std::vector<std::vector<std::uint32_t>>& voxels) {
   const int n = static_cast<int>(y.size());
   const int voxel_count = static_cast<int>(voxels.size());
-  std::vector<int> voxel_ids(voxels.empty() ? 0 : y.size());
-  for (int v = 0; v < voxel_count; ++v) {
-    for (const std::uint32_t k : voxels[v]) voxel_ids[k] = v;
-  }
-  std::vector<int> seen(voxels.size(), -1);  // the draw that last covered each voxel
+  const VoxelOrderedRows rows = RegroupByVoxel(H, y, voxels);
   int best_voxels = 0;
   std::mt19937 rng(options.seed);
   std::uniform_int_distribution<int> pick(0, n - 1);
@@ -66,9 +92,9 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     const std::vector<std::uint32_t>& rows = voxels[voxel];
     return int(rows[std::uniform_int_distribution<std::size_t>(0, rows.size() - 1)(rng)]);
   };
-  std::vector<int> best;
+  std::size_t best_size = 0;
+  Eigen::Vector3d best_velocity = Eigen::Vector3d::Zero();
   std::vector<double> residual(n);
-  const double *hx = H.col(0).data(), *hy = H.col(1).data(), *hz = H.col(2).data(), *y0 = y.data();
   // Hypotheses the gate turns away do not count: up to kGatedDrawFactor
   // times as many draws find the world's hypotheses among a car's.
   constexpr int kGatedDrawFactor = 50;
@@ -95,33 +121,34 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     const Eigen::Vector3d v = lu.solve(Eigen::Vector3d(y[a], y[b], y[c]));
     if (gate && !gate->Admits(v)) continue;
     ++counted;
-    // The residuals over the columns first (a loop the compiler vectorises),
-    // then the support; the rows are listed only for a hypothesis that wins.
+    // The residuals (a loop the compiler vectorises), then the support
+    // without branches (whether a row is an inlier is a coin toss to the
+    // branch predictor); the rows are listed for the winner only.
+    const double *hx = rows.hx.data(), *hy = rows.hy.data(), *hz = rows.hz.data(), *y0 = rows.y.data();
     for (int k = 0; k < n; ++k) residual[k] = std::abs(y0[k] - (hx[k] * v.x() + hy[k] * v.y() + hz[k] * v.z()));
-    // Without branches: whether a row is an inlier is a coin toss to the
-    // branch predictor.
     std::size_t size = 0;
     int covered = 0;
-    if (voxel_ids.empty()) {
-      for (int k = 0; k < n; ++k) size += residual[k] < options.inlier_threshold;
-    } else {
-      for (int k = 0; k < n; ++k) {
-        const bool inlier = residual[k] < options.inlier_threshold;
-        int& last = seen[voxel_ids[k]];
-        const bool fresh = inlier & (last != draw);
-        size += inlier;
-        covered += fresh;
-        last = fresh ? draw : last;
-      }
+    int voxel_has_inlier = 0;
+    for (int k = 0; k < n; ++k) {
+      const int inlier = residual[k] < options.inlier_threshold;
+      voxel_has_inlier &= rows.opens[k] ^ 1;
+      size += std::size_t(inlier);
+      covered += inlier & (voxel_has_inlier ^ 1);
+      voxel_has_inlier |= inlier;
     }
-    const bool wins = voxel_ids.empty() ? size > best.size()
-                                        : covered > best_voxels || (covered == best_voxels && size > best.size());
+    const bool wins = voxels.empty() ? size > best_size
+                                     : covered > best_voxels || (covered == best_voxels && size > best_size);
     if (!wins) continue;
     best_voxels = covered;
-    best.clear();
-    for (int k = 0; k < n; ++k) {
-      if (residual[k] < options.inlier_threshold) best.push_back(k);
-    }
+    best_size = size;
+    best_velocity = v;
+  }
+  // The winner's rows, in row order.
+  std::vector<int> best;
+  for (int k = 0; best_size > 0 && k < n; ++k) {
+    const double r = std::abs(y[k] - (H(k, 0) * best_velocity.x() + H(k, 1) * best_velocity.y() +
+                                      H(k, 2) * best_velocity.z()));
+    if (r < options.inlier_threshold) best.push_back(k);
   }
   return best;
 }
