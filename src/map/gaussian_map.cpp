@@ -149,6 +149,31 @@ class ColumnBound {
   double extent_sq_ = 0.0;
 };
 
+// Sorts (cell key, id) listings by key, equal keys in the order given (the
+// ids come ascending, so this is std::sort's order): an LSD radix sort over
+// the keys' span, 11 bits a pass, linear where a comparison sort of a
+// map's millions of listings is not.
+void SortListingsByKey(std::vector<std::pair<std::int64_t, std::uint32_t>>& listings) {
+  if (listings.size() < 2) return;
+  std::uint64_t low = ~std::uint64_t(0), high = 0;
+  for (const auto& listing : listings) {
+    low = std::min(low, std::uint64_t(listing.first));
+    high = std::max(high, std::uint64_t(listing.first));
+  }
+  constexpr int kDigitBits = 11;
+  constexpr std::uint64_t kDigitMask = (std::uint64_t(1) << kDigitBits) - 1;
+  std::vector<std::pair<std::int64_t, std::uint32_t>> sorted(listings.size());
+  std::vector<std::size_t> start(kDigitMask + 2);
+  for (int shift = 0; shift < 64 && ((high - low) >> shift) != 0; shift += kDigitBits) {
+    std::fill(start.begin(), start.end(), 0);
+    const auto digit = [&](std::int64_t key) { return ((std::uint64_t(key) - low) >> shift) & kDigitMask; };
+    for (const auto& listing : listings) ++start[digit(listing.first) + 1];
+    for (std::size_t d = 1; d < start.size(); ++d) start[d] += start[d - 1];
+    for (const auto& listing : listings) sorted[start[digit(listing.first)]++] = listing;
+    listings.swap(sorted);
+  }
+}
+
 }  // namespace
 
 
@@ -221,7 +246,7 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
     }
     for (const std::int64_t key : cell_keys) entries.emplace_back(key, static_cast<std::uint32_t>(i));
   }
-  std::sort(entries.begin(), entries.end());
+  SortListingsByKey(entries);
   cell_entries_.resize(entries.size());
   std::size_t cell_count = 0;
   for (std::size_t k = 0; k < entries.size(); ++k) cell_count += k == 0 || entries[k].first != entries[k - 1].first;
