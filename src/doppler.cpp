@@ -44,6 +44,7 @@ bool SolveLeastSquares(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
 // first row), so that a hypothesis's voxels are counted in one pass without
 // branches or lookups; without voxels, the rows as they are.
 struct VoxelOrderedRows {
+  std::vector<int> row_of;  // the row of H at each position
   std::vector<char> opens;
   std::vector<double> hx, hy, hz, y;
 };
@@ -51,9 +52,9 @@ struct VoxelOrderedRows {
 VoxelOrderedRows RegroupByVoxel(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
                                 const std::vector<std::vector<std::uint32_t>>& voxels) {
   const int n = static_cast<int>(y.size());
-  std::vector<int> row_of(n);
-  VoxelOrderedRows rows{std::vector<char>(n, 0), std::vector<double>(n), std::vector<double>(n),
-                        std::vector<double>(n), std::vector<double>(n)};
+  VoxelOrderedRows rows{std::vector<int>(n), std::vector<char>(n, 0), std::vector<double>(n),
+                        std::vector<double>(n), std::vector<double>(n), std::vector<double>(n)};
+  std::vector<int>& row_of = rows.row_of;
   if (voxels.empty()) {
     for (int k = 0; k < n; ++k) row_of[k] = k;
   } else {
@@ -89,12 +90,17 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
   const bool by_voxel = voxel_count >= 3;
   std::uniform_int_distribution<int> pick_voxel(0, std::max(0, voxel_count - 1));
   const auto row_in = [&](int voxel) {
-    const std::vector<std::uint32_t>& rows = voxels[voxel];
-    return int(rows[std::uniform_int_distribution<std::size_t>(0, rows.size() - 1)(rng)]);
+    const std::vector<std::uint32_t>& members = voxels[voxel];
+    return int(members[std::uniform_int_distribution<std::size_t>(0, members.size() - 1)(rng)]);
   };
   std::size_t best_size = 0;
   Eigen::Vector3d best_velocity = Eigen::Vector3d::Zero();
   std::vector<double> residual(n);
+  // |y - H v| at each position (a loop the compiler vectorises).
+  const auto residuals = [&](const Eigen::Vector3d& v) {
+    const double *hx = rows.hx.data(), *hy = rows.hy.data(), *hz = rows.hz.data(), *y0 = rows.y.data();
+    for (int k = 0; k < n; ++k) residual[k] = std::abs(y0[k] - (hx[k] * v.x() + hy[k] * v.y() + hz[k] * v.z()));
+  };
   // Hypotheses the gate turns away do not count: up to kGatedDrawFactor
   // times as many draws find the world's hypotheses among a car's.
   constexpr int kGatedDrawFactor = 50;
@@ -121,11 +127,9 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     const Eigen::Vector3d v = lu.solve(Eigen::Vector3d(y[a], y[b], y[c]));
     if (gate && !gate->Admits(v)) continue;
     ++counted;
-    // The residuals (a loop the compiler vectorises), then the support
-    // without branches (whether a row is an inlier is a coin toss to the
-    // branch predictor); the rows are listed for the winner only.
-    const double *hx = rows.hx.data(), *hy = rows.hy.data(), *hz = rows.hz.data(), *y0 = rows.y.data();
-    for (int k = 0; k < n; ++k) residual[k] = std::abs(y0[k] - (hx[k] * v.x() + hy[k] * v.y() + hz[k] * v.z()));
+    // The support without branches (whether a row is an inlier is a coin
+    // toss to the branch predictor); the rows are listed for the winner only.
+    residuals(v);
     std::size_t size = 0;
     int covered = 0;
     int voxel_has_inlier = 0;
@@ -145,10 +149,12 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
   }
   // The winner's rows, in row order.
   std::vector<int> best;
-  for (int k = 0; best_size > 0 && k < n; ++k) {
-    const double r = std::abs(y[k] - (H(k, 0) * best_velocity.x() + H(k, 1) * best_velocity.y() +
-                                      H(k, 2) * best_velocity.z()));
-    if (r < options.inlier_threshold) best.push_back(k);
+  if (best_size == 0) return best;
+  residuals(best_velocity);
+  std::vector<char> inlier(n, 0);
+  for (int k = 0; k < n; ++k) inlier[rows.row_of[k]] = residual[k] < options.inlier_threshold;
+  for (int row = 0; row < n; ++row) {
+    if (inlier[row]) best.push_back(row);
   }
   return best;
 }

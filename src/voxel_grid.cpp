@@ -16,7 +16,7 @@ int BitWidth(std::uint64_t value) {
   return bits;
 }
 
-// The groups of `keys` (sorted as `order` gives them) where the key changes.
+// The indices of `order` (sorted by key) cut into runs of one key each.
 template <typename KeyOf>
 std::vector<std::vector<std::uint32_t>> SplitRuns(const std::vector<std::uint32_t>& order, KeyOf key_of) {
   std::vector<std::vector<std::uint32_t>> groups;
