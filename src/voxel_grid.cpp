@@ -17,11 +17,11 @@ int BitWidth(std::uint64_t value) {
 }
 
 // The indices of `order` (sorted by key) cut into runs of one key each.
-template <typename KeyOf>
-std::vector<std::vector<std::uint32_t>> SplitRuns(const std::vector<std::uint32_t>& order, KeyOf key_of) {
+std::vector<std::vector<std::uint32_t>> SplitRuns(const std::vector<std::uint32_t>& order,
+                                                  const std::vector<VoxelKey>& keys) {
   std::vector<std::vector<std::uint32_t>> groups;
   for (std::size_t k = 0; k < order.size(); ++k) {
-    if (k == 0 || !(key_of(order[k]) == key_of(order[k - 1]))) groups.emplace_back();
+    if (k == 0 || !(keys[order[k]] == keys[order[k - 1]])) groups.emplace_back();
     groups.back().push_back(order[k]);
   }
   return groups;
@@ -56,12 +56,12 @@ std::vector<std::vector<std::uint32_t>> GroupByVoxel(const std::vector<Eigen::Ve
     std::sort(codes.begin(), codes.end());
     const std::uint64_t index_mask = (std::uint64_t(1) << bits_i) - 1;
     for (std::size_t k = 0; k < n; ++k) order[k] = std::uint32_t(codes[k] & index_mask);
-    return SplitRuns(order, [&](std::uint32_t i) { return keys[i]; });
+  } else {
+    for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(i);
+    std::sort(order.begin(), order.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b] || (keys[a] == keys[b] && a < b); });
   }
-  for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(i);
-  std::sort(order.begin(), order.end(),
-            [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b] || (keys[a] == keys[b] && a < b); });
-  return SplitRuns(order, [&](std::uint32_t i) { return keys[i]; });
+  return SplitRuns(order, keys);
 }
 
 std::vector<Eigen::Vector3d> VoxelDownsample(const std::vector<Eigen::Vector3d>& points, double voxel,
