@@ -4,8 +4,11 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
+#include <sys/stat.h>
+#include <sys/xattr.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +16,8 @@
 #include <fstream>
 #include <mutex>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include "radargauss/error.hpp"
 
@@ -58,11 +63,12 @@ void RemoveStaleTemporaries(const fs::path& directory) {
 // The files and folders of `old_dir` that `new_dir` lacks, hard-linked there
 // (copied where links cannot be made): what a run did not write. A folder
 // the run wrote replaces the old one whole.
-void CarryOver(const fs::path& old_dir, const fs::path& new_dir) {
+void CarryOver(const fs::path& old_dir, const fs::path& new_dir, const std::vector<std::string>& superseded) {
   for (const fs::directory_entry& entry : fs::directory_iterator(old_dir)) {
     const fs::path there = new_dir / entry.path().filename();
     std::error_code error;
     if (fs::exists(fs::symlink_status(there, error)) || IsStaleTemporary(there.filename().string())) continue;
+    if (std::find(superseded.begin(), superseded.end(), there.filename().string()) != superseded.end()) continue;
     if (entry.is_symlink(error)) {
       fs::copy_symlink(entry.path(), there, error);
     } else {
@@ -70,6 +76,24 @@ void CarryOver(const fs::path& old_dir, const fs::path& new_dir) {
       if (error) fs::copy(entry.path(), there, fs::copy_options::recursive, error);
     }
     if (error) throw FileError(entry.path().string(), "cannot keep it in the new results: " + error.message());
+  }
+}
+
+// The old folder's mode (sticky, setgid and all), owner where permitted, and
+// ACLs given to the staged folder that takes its place.
+void KeepAttributes(const std::string& old_dir, const std::string& new_dir) {
+  struct stat old_status {};
+  if (::stat(old_dir.c_str(), &old_status) != 0) return;
+  if (::chown(new_dir.c_str(), old_status.st_uid, old_status.st_gid) != 0) {
+    [[maybe_unused]] const int ignored = ::chown(new_dir.c_str(), ::geteuid(), old_status.st_gid);  // the group alone
+  }
+  if (::chmod(new_dir.c_str(), old_status.st_mode & 07777) != 0) {
+    throw FileError(old_dir, std::string("cannot give the new results the folder's mode: ") + std::strerror(errno));
+  }
+  for (const char* acl : {"system.posix_acl_access", "system.posix_acl_default"}) {
+    std::vector<char> value(4096);
+    const ssize_t size = ::getxattr(old_dir.c_str(), acl, value.data(), value.size());
+    if (size > 0) ::setxattr(new_dir.c_str(), acl, value.data(), std::size_t(size), 0);
   }
 }
 
@@ -96,11 +120,18 @@ void CheckOutputFile(const std::string& path) {
   if (!parent.empty() && !fs::is_directory(parent, error)) throw FileError(path, "its folder does not exist");
 }
 
-StagedFolder::StagedFolder(const std::string& target) {
+StagedFolder::StagedFolder(const std::string& target, std::vector<std::string> superseded)
+    : superseded_(std::move(superseded)) {
   const fs::path path = FolderPath(target);
   std::error_code error;
   if (fs::exists(path, error) && !fs::is_directory(path, error)) {
     throw FileError(target, "exists and is not a folder; refused as an output folder");
+  }
+  // Replacing a folder replaces its inode: not the root, not a shared folder.
+  if (path == path.root_path()) throw FileError(target, "is the root folder; refused as an output folder");
+  struct stat status {};
+  if (::stat(path.c_str(), &status) == 0 && (status.st_mode & S_ISVTX)) {
+    throw FileError(target, "is a shared folder (sticky bit, as /tmp); name a folder of its own inside it");
   }
   fs::create_directories(path.parent_path(), error);
   if (error) throw FileError(target, "cannot create the output folder: " + error.message());
@@ -128,7 +159,8 @@ void StagedFolder::Commit() {
     committed_ = true;
     return;
   }
-  CarryOver(target_, staging_);
+  CarryOver(target_, staging_, superseded_);
+  KeepAttributes(target_, staging_);
   // One exchange: the target is the old folder or the new one, never a mix.
   // A file system without exchanges gets two renames (the old folder set
   // aside under the staging name's pattern, removed as stale if killed).

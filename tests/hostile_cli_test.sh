@@ -76,10 +76,17 @@ for sigma in 1e300 1e160 101; do
   expect_fail "coarse sigma $sigma, at once" "coarse-sigmas: $sigma is not in \[0, 100\]" -- \
     "$tool" odometry --coarse-sigmas "$sigma" "${seq[@]}" --out "$work/o"
 done
-expect_fail "an index cell of 1e300" "index-cell: 1e300 is not in (0, 100\]" -- \
+expect_fail "an index cell of 1e300" "index-cell: 1e300 is not in \[0.1, 100\]" -- \
   "$tool" odometry --index-cell 1e300 "${seq[@]}" --out "$work/o"
-expect_fail "a zero quaternion without an IMU" "--imu-rotation: not a unit quaternion (x y z w), its norm is 0" -- \
-  "$tool" odometry --imu-rotation 0 0 0 0 "${seq[@]}" --out "$work/o"
+expect_fail "a zero quaternion" "--imu-rotation: not a unit quaternion (x y z w), its norm is 0" -- \
+  "$tool" odometry --imu-topic /imu --imu-rotation 0 0 0 0 "${seq[@]}" --out "$work/o"
+# The IMU's settings without its topic, and its topic without a bag: refused, each flag named.
+expect_fail "--imu-rotation without --imu-topic" "--imu-rotation requires --imu-topic" -- \
+  "$tool" odometry --imu-rotation 0 0 0 1 "${seq[@]}" --out "$work/o"
+expect_fail "--imu-stamps without --imu-topic" "--imu-stamps requires --imu-topic" -- \
+  "$tool" odometry --imu-stamps record "${seq[@]}" --out "$work/o"
+expect_fail "--imu-topic without --bag" "--imu-topic needs --bag" -- \
+  "$tool" odometry --imu-topic /imu "${seq[@]}" --out "$work/o"
 awk '{ $2 = 5; $3 = 5; $4 = 5; print }' "$work/seq/gt_radar_tum.txt" >"$work/still.tum"
 expect_fail "sim3 of an estimate that never moves" "a sim3 alignment needs an estimate that moves" -- \
   "$tool" evaluate --align sim3 --est "$work/still.tum" --ref "$work/seq/gt_radar_tum.txt"

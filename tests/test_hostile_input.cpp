@@ -217,6 +217,50 @@ TEST_F(HostileInput, ConfigFilesAreOneBoundedDocumentWithoutRepeatedKeys) {
             Path("w.yaml") + ":2: key 'seed' given twice (first on line 1)");
 }
 
+// Aliases of aliases expand exponentially: a few hundred bytes would take
+// minutes to walk. The node count with aliases expanded is bounded before
+// any walk, whatever the shape: sequences, maps, merge keys, one long chain.
+TEST_F(HostileInput, ConfigFilesBoundTheirNodesWithAliasesExpanded) {
+  const auto laughs = [](int levels, bool maps) {
+    std::string text = maps ? "l0: &l0 {a: x, b: x, c: x, d: x, e: x, f: x, g: x, h: x, i: x, j: x}\n"
+                            : "l0: &l0 [x, x, x, x, x, x, x, x, x, x]\n";
+    for (int level = 1; level < levels; ++level) {
+      const std::string alias = "*l" + std::to_string(level - 1);
+      text += "l" + std::to_string(level) + ": &l" + std::to_string(level) + (maps ? " {" : " [");
+      for (int k = 0; k < 10; ++k) {
+        if (k > 0) text += ", ";
+        text += maps ? std::string(1, char('a' + k)) + ": " + alias : alias;
+      }
+      text += maps ? "}\n" : "]\n";
+    }
+    return text;
+  };
+  const std::string path = Path("c.yaml");
+  const std::string refused = path + ":6: more than 262144 YAML nodes with aliases expanded";  // the 10^6 level
+  for (const bool maps : {false, true}) {
+    EXPECT_EQ(ErrorOf([&] { ReadYamlDocument(WriteFile("c.yaml", laughs(10, maps)), "configuration file"); }), refused)
+        << (maps ? "maps" : "sequences");
+    EXPECT_EQ(ErrorOf([&] { ReadYamlDocument(WriteFile("c.yaml", laughs(4, maps)), "configuration file"); }), "")
+        << "10^4 nodes are within the bound";
+  }
+  // Merge keys and a list of one alias repeated: the same count, other shapes.
+  std::string merges = "base: &base " + laughs(1, true).substr(8);
+  for (int level = 1; level < 7; ++level) {
+    merges += "m" + std::to_string(level) + ": &m" + std::to_string(level) + " {";
+    for (int k = 0; k < 10; ++k) {
+      merges += std::string(k > 0 ? ", " : "") + char('a' + k) + ": *" +
+                (level == 1 ? std::string("base") : "m" + std::to_string(level - 1));
+    }
+    merges += "}\n";
+  }
+  EXPECT_EQ(ErrorOf([&] { ReadYamlDocument(WriteFile("c.yaml", merges + "top: {<<: *m6}\n"), "configuration file"); }),
+            path + ":6: more than 262144 YAML nodes with aliases expanded");
+  std::string chain = "x: &x [" + std::string(100, '1') + "]\nlist: [";
+  for (int k = 0; k < 140000; ++k) chain += k > 0 ? ", *x" : "*x";
+  EXPECT_EQ(ErrorOf([&] { ReadYamlDocument(WriteFile("c.yaml", chain + "]\n"), "configuration file"); }),
+            path + ":2: more than 262144 YAML nodes with aliases expanded");
+}
+
 TEST_F(HostileInput, OutputsAreRegularFilesInExistingFolders) {
   const auto write = [](const std::string& path) {
     WriteFileAtomically(path, [](std::ostream& out) { out << "x"; });

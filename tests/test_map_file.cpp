@@ -156,6 +156,37 @@ TEST_F(MapFiles, PlacesRoundTripAndVersionOneStillReads) {
   }
 }
 
+// A place lies within the map's coordinates and its points within a submap's
+// reach of it (WriteMap writes what it is given, as a hostile file would be).
+TEST_F(MapFiles, PlacesOutsideTheirBoundsAreRefused) {
+  const auto error_of = [&](const Eigen::Vector3d& position, const Eigen::Vector3d& point) -> std::string {
+    GaussianMap map = ExampleMap();
+    MapPlace place;
+    place.pose = SE3d(SO3d(), Eigen::Vector3d(1.0, 2.0, 0.0));
+    for (int k = 0; k < 4; ++k) place.points.push_back(RadarPoint{});
+    map.places.push_back(place);
+    place.pose = SE3d(SO3d(), position);
+    place.points[2].position = point;
+    map.places.push_back(place);
+    WriteMap(Path("p.rgm"), map);
+    try {
+      return std::to_string(ReadMap(Path("p.rgm")).places.size());
+    } catch (const DataError& e) {
+      return e.what();
+    }
+  };
+  const std::string path = Path("p.rgm");
+  EXPECT_EQ(error_of(Eigen::Vector3d(5e6, -5e6, 0.0), Eigen::Vector3d(2e4, -2e4, 5.0)), "2");
+  EXPECT_EQ(error_of(Eigen::Vector3d(1e300, 0.0, 0.0), Eigen::Vector3d::Zero()),
+            path + ": place 1: position beyond 10000000 m of the origin");
+  EXPECT_EQ(error_of(Eigen::Vector3d(0.0, 0.0, -2e7), Eigen::Vector3d::Zero()),
+            path + ": place 1: position beyond 10000000 m of the origin");
+  EXPECT_EQ(error_of(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 2e5, 0.0)),
+            path + ": place 1: point beyond 100000 m of its place");
+  EXPECT_EQ(error_of(Eigen::Vector3d::Zero(), Eigen::Vector3d(-3e9, 0.0, 0.0)),
+            path + ": place 1: point beyond 100000 m of its place");
+}
+
 TEST_F(MapFiles, PlyHasThe3dgsLayout) {
   const GaussianMap map = ExampleMap();
   ExportPly(Path("map.ply"), map);

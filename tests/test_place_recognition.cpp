@@ -145,6 +145,34 @@ TEST(RadonDescriptor, ShiftedRotatedCopyRetrievesThePlaceWithItsYaw) {
 
 // A planted relative pose, 3 m and 25 deg from the descriptor's guess of 20
 // deg: verification recovers it; another place is refused and says why.
+// The bird's-eye search finds a planted whole-cell shift with every query
+// cell overlapping; a few far points (a hostile place, 1e5 m to 3e9 m away)
+// change neither the answer nor the memory (no dense grid over their span).
+TEST(LoopVerification, BirdsEyeFindsAPlantedShiftWhateverTheExtent) {
+  const double cell = 0.5;
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> uniform(-80, 80);
+  std::vector<Eigen::Vector3d> candidate, query;
+  const Eigen::Vector2i planted(3, -5);
+  for (int k = 0; k < 300; ++k) {
+    const Eigen::Vector2i c(uniform(rng), uniform(rng));
+    candidate.emplace_back((c.x() + 0.5) * cell, (c.y() + 0.5) * cell, 0.0);
+    query.emplace_back((c.x() - planted.x() + 0.5) * cell, (c.y() - planted.y() + 0.5) * cell, 1.0);
+  }
+  const auto [shift, overlap] = AlignBirdsEye(query, candidate, cell, 4.0);
+  EXPECT_EQ(shift, planted.cast<double>() * cell);
+  EXPECT_EQ(overlap, 1.0);
+  for (const double far : {1e5, 3e9}) {
+    std::vector<Eigen::Vector3d> wide = candidate;
+    wide.emplace_back(far, -far, 0.0);
+    wide.emplace_back(-far, far, 0.0);
+    const auto [wide_shift, wide_overlap] = AlignBirdsEye(query, wide, cell, 4.0);
+    EXPECT_EQ(wide_shift, shift) << far;
+    EXPECT_EQ(wide_overlap, overlap) << far;
+  }
+  EXPECT_EQ(AlignBirdsEye({}, candidate, cell, 4.0).second, 0.0);
+}
+
 TEST(LoopVerification, RecoversAPlantedLoopAndRefusesAnotherPlace) {
   const std::vector<RadarPoint> place = RandomPlace(7);
   const double yaw = 25.0 * M_PI / 180.0;

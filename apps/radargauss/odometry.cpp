@@ -33,7 +33,7 @@ int RunOdometry(const OdometrySettings& s) {
   RunInputs inputs = LoadRunInputs(s, options.match.matching.w_rcs);
   const Sequence& sequence = inputs.sequence;
   const std::optional<Trajectory>& reference = inputs.reference;
-  StagedFolder folder(s.out);  // a bad --out fails before the run
+  StagedFolder folder = RunFolder(s, {"odometry.tum", "levelled.tum", "map.rgm", "map.ply"});  // before the run
   RadarOdometry odometry(options, MatcherOf(s.matcher));
   if (!s.imu_topic.empty()) {
     const std::vector<GyroSample> gyro = GyroOf(s);

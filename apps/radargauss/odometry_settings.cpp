@@ -1,8 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "odometry_settings.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <system_error>
+#include <utility>
 
 #include "radargauss/error.hpp"
 #include "radargauss/evaluation.hpp"
@@ -24,17 +28,18 @@ void AddLocalMapOptions(CLI::App* app, OdometrySettings& s) {
       ->capture_default_str();
   app->add_option("--azimuth-std", o.map.azimuth_std_deg,
                   "Radar's azimuth noise (deg): map Gaussians at least this angle x range wide")
-      ->check(InRange(0.0, 44.9))
+      ->check(InRange(0.0, kMaxAngularNoiseDeg))
       ->capture_default_str();
   app->add_option("--elevation-std", o.map.elevation_std_deg,
                   "Radar's elevation noise (deg): map Gaussians at least this angle x range high")
-      ->check(InRange(0.0, 44.9))
+      ->check(InRange(0.0, kMaxAngularNoiseDeg))
       ->capture_default_str();
   app->add_option("--region", o.map.region, "Edge of the map regions fitted together (m)")
       ->check(Positive())
       ->capture_default_str();
-  app->add_option("--region-capacity", o.map.region_capacity, "Points a region keeps (the newest)")
-      ->check(InRange(4, 1000000))
+  app->add_option("--region-capacity", o.map.region_capacity,
+                  "Points a region keeps (the newest); at least the points a region's first fit needs")
+      ->check(InRange(o.map.min_points, std::size_t(1000000)))
       ->capture_default_str();
   app->add_option("--map-estimator", s.map_estimator,
                   "How region Gaussians follow their points: refit (k-means + EM) or incremental")
@@ -62,7 +67,7 @@ void AddLocalMapOptions(CLI::App* app, OdometrySettings& s) {
       ->check(InRange(0.0, kMaxCoarseSigma))
       ->capture_default_str();
   app->add_option("--index-cell", o.map.matching.index_cell, "Cell of the active map's spatial index (m)")
-      ->check(InRange(0.0, kMaxIndexCell, true))
+      ->check(InRange(kMinIndexCell, kMaxIndexCell))
       ->capture_default_str();
 }
 
@@ -212,12 +217,16 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
       ->capture_default_str();
   AddLocalMapOptions(app, s);
   app->add_option("--seed", o.ego_velocity.seed, "Seed of the Doppler RANSAC")->capture_default_str();
-  app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
+  CLI::Option* imu_topic =
+      app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
+  // The IMU's settings without its topic would be read by nothing: refused.
   app->add_option("--imu-stamps", s.imu_stamps, "Stamp the IMU by its header or by the bag's record time")
       ->check(CLI::IsMember({"header", "record"}))
+      ->needs(imu_topic)
       ->capture_default_str();
   app->add_option("--imu-rotation", s.imu_rotation, "q_radar_imu as x y z w (rotates gyro rates into the radar frame)")
       ->expected(4)
+      ->needs(imu_topic)
       ->capture_default_str();
   app->add_option("--first-scan", s.first_scan, "Skip the scans before this one (0: none)")->capture_default_str();
   app->add_option("--max-scans", s.max_scans, "Only the first N scans from --first-scan (0: all)")->capture_default_str();
@@ -252,6 +261,15 @@ void AddPlaceRecognitionOptions(CLI::App* app, PlaceRecognitionSettings& s) {
       ->capture_default_str();
 }
 
+namespace {
+
+// The sequence as messages name it: its folder, or its bag and topic.
+std::string SequenceName(const SequenceOptions& sequence) {
+  return sequence.bag.empty() ? sequence.sequence_dir : sequence.bag + " (topic " + sequence.topic + ")";
+}
+
+}  // namespace
+
 RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs) {
   SequenceOptions sequence_options = s.sequence;
   sequence_options.ground_truth.clear();
@@ -262,7 +280,15 @@ RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs) {
   scans.erase(scans.begin(), scans.begin() + std::ptrdiff_t(first));
   sources.erase(sources.begin(), sources.begin() + std::ptrdiff_t(std::min(first, sources.size())));
   if (s.max_scans > 0 && scans.size() > s.max_scans) scans.resize(s.max_scans);
-  if (scans.empty()) throw DataError("the sequence has no scans");
+  const std::string name = SequenceName(s.sequence);
+  if (scans.empty()) {
+    throw DataError(first > 0 ? "--first-scan " + std::to_string(s.first_scan) + " skips every one of the " +
+                                    std::to_string(first) + " scans of " + name
+                              : name + ": the sequence has no scans");
+  }
+  if (std::all_of(scans.begin(), scans.end(), [](const RadarScan& scan) { return scan.points.empty(); })) {
+    throw DataError(name + ": every one of the " + std::to_string(scans.size()) + " scans has no points");
+  }
   CheckRcsWeights(inputs.sequence, {w_rcs});
   if (!s.sequence.ground_truth.empty()) {
     inputs.reference =
@@ -270,6 +296,19 @@ RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs) {
     CheckReferenceCovers(*inputs.reference, inputs.sequence, s.sequence.ground_truth);
   }
   return inputs;
+}
+
+}  // namespace radargauss::cli
+
+namespace radargauss::cli {
+
+StagedFolder RunFolder(const OdometrySettings& s, std::vector<std::string> outputs) {
+  std::error_code error;
+  if (!s.sequence.sequence_dir.empty() && std::filesystem::equivalent(s.out, s.sequence.sequence_dir, error)) {
+    throw FileError(s.out, "is the sequence's own folder; refused as an output folder");
+  }
+  outputs.insert(outputs.end(), {"evaluation.json", "evaluation.md"});
+  return StagedFolder(s.out, std::move(outputs));
 }
 
 }  // namespace radargauss::cli

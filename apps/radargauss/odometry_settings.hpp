@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/progress.hpp"
@@ -60,6 +61,11 @@ struct RunInputs {
   std::optional<Trajectory> reference;
 };
 RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs);
+
+// The results folder --out of a run on the sequence: refused when it is the
+// sequence's own folder; `outputs` (the command's files) and the evaluation's
+// are never kept from an earlier run (StagedFolder).
+StagedFolder RunFolder(const OdometrySettings& s, std::vector<std::string> outputs);
 
 // Calls register_scan on every scan in order with a progress bar named
 // `stage`; a DataError names the scan's file.

@@ -68,10 +68,11 @@ int RunRelocalize(const RelocalizeSettings& s) {
   if (map.places.empty()) {
     throw FileError(s.map, "the map has no places to relocalise against (build it with radargauss slam)");
   }
+  if (map.gaussians.empty()) throw FileError(s.map, "the map has no Gaussians to match against");
   RunInputs inputs = LoadRunInputs(s.odometry, options.odometry.match.matching.w_rcs);
   const Sequence& sequence = inputs.sequence;
   const std::optional<Trajectory>& reference = inputs.reference;
-  StagedFolder folder(s.odometry.out);
+  StagedFolder folder = RunFolder(s.odometry, {"relocalization.tum"});
   Relocalizer relocalizer(std::move(map), options);
   RegisterScans(sequence, "relocalize", [&](const RadarScan& scan) { relocalizer.Register(scan); });
   Trajectory located;

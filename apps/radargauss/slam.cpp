@@ -47,11 +47,17 @@ int RunSlam(const SlamSettings& s) {
   RunInputs inputs = LoadRunInputs(s.odometry, options.odometry.match.matching.w_rcs);
   const Sequence& sequence = inputs.sequence;
   const std::optional<Trajectory>& reference = inputs.reference;
-  StagedFolder folder(s.odometry.out);
+  StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "odometry", "map.rgm", "map.ply"});
   RadarSlam slam(options);
   RegisterScans(sequence, "slam", [&](const RadarScan& scan) { slam.Register(scan); });
   slam.Finish();
-  const GaussianMap map = s.no_map ? GaussianMap{} : BuildPlaceMap(sequence.scans, slam);
+  GaussianMap map;
+  try {
+    if (!s.no_map) map = BuildPlaceMap(sequence.scans, slam);
+  } catch (const DataError& e) {  // no static point in the whole run: known only now
+    throw DataError(std::string(e.what()) + " in " + s.odometry.sequence.sequence_dir + s.odometry.sequence.bag +
+                    " (--no-map writes the trajectory without a map)");
+  }
   const std::string out = folder.path();
   WriteOdometry((std::filesystem::path(out) / "odometry").string(), slam.odometry());
   WriteSlam(out, slam);

@@ -8,6 +8,7 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace radargauss {
 
@@ -31,13 +32,17 @@ void CheckOutputFile(const std::string& path);
 // (an exchange when the target exists), so the target holds either its old
 // content or the complete new one. The files and folders of an existing
 // target that this run did not write are kept (hard links); a folder it
-// wrote replaces the old one whole. Without Commit() the staging folder is
-// removed and the target is left as it was.
+// wrote replaces the old one whole, and the `superseded` names (the
+// command's outputs: an old evaluation.json describes an old trajectory) are
+// not kept whether or not this run wrote them. The new folder takes the old
+// one's mode, owner (where permitted) and ACLs. Without Commit() the staging
+// folder is removed and the target is left as it was.
 class StagedFolder {
  public:
-  // Throws DataError naming `target` when it exists and is not a folder, or
-  // the staging folder cannot be made.
-  explicit StagedFolder(const std::string& target);
+  // Throws DataError naming `target` when it exists and is not a folder, is
+  // the root or a shared folder (sticky bit, as /tmp), or the staging folder
+  // cannot be made.
+  explicit StagedFolder(const std::string& target, std::vector<std::string> superseded = {});
   ~StagedFolder();
   StagedFolder(const StagedFolder&) = delete;
   StagedFolder& operator=(const StagedFolder&) = delete;
@@ -48,6 +53,7 @@ class StagedFolder {
  private:
   std::string target_;
   std::string staging_;
+  std::vector<std::string> superseded_;
   bool committed_ = false;
 };
 

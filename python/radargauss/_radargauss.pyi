@@ -52,7 +52,7 @@ class MatchResult:
     def time_ms(self) -> Any: ...
 
 class RadarOdometry:
-    """Radar odometry on a map it builds as it goes (docs/design.md, "Odometry"): register scans in time order."""
+    """Radar odometry on a map it builds as it goes (docs/design.md, "Odometry"): register scans in time order. Threads may share one: its calls take turns."""
     def __init__(self: RadarOdometry, *,
         ego_min_range: float = 0.25,
         ego_max_range: float = 100.0,
@@ -158,7 +158,7 @@ class RadarOdometry:
         """(stamps (N,), poses (N, 7)) so far"""
 
 class RadarSlam:
-    """Radar SLAM (docs/design.md, "SLAM"): odometry, keyframes with submaps, place recognition, verified loops on a pose graph. Keywords: descriptor ('scan-context' or 'radon'), submap_distance, min_loop_path, candidates, loop_rejection ('loss', 'switchable', 'graduated'), graph_initialization ('current', 'chordal'), and any keyword of RadarOdometry."""
+    """Radar SLAM (docs/design.md, "SLAM"): odometry, keyframes with submaps, place recognition, verified loops on a pose graph. Keywords: descriptor ('scan-context' or 'radon'), submap_distance, min_loop_path, candidates, loop_rejection ('loss', 'switchable', 'graduated'), graph_initialization ('current', 'chordal'), and any keyword of RadarOdometry. Threads may share one: its calls take turns."""
     def __init__(self: RadarSlam, descriptor: str = 'scan-context', submap_distance: float = 10.0, min_loop_path: float = 150.0, candidates: int = 20, loop_rejection: str = 'graduated', graph_initialization: str = 'current', **kwargs) -> None:
         ...
     def finish(self: RadarSlam) -> None:
@@ -177,7 +177,7 @@ class RadarSlam:
         """(stamps (N,), poses (N, 7)): every scan at its keyframe's optimised pose"""
 
 class Relocalizer:
-    """Relocalisation in a map of RadarSlam without an initial pose (docs/design.md, "Relocalisation"). Keywords: descriptor, submap_distance, candidates, and any keyword of RadarOdometry."""
+    """Relocalisation in a map of RadarSlam without an initial pose (docs/design.md, "Relocalisation"). Keywords: descriptor, submap_distance, candidates, and any keyword of RadarOdometry. Threads may share one: its calls take turns."""
     def __init__(self: Relocalizer, map: GaussianMap, descriptor: str = 'scan-context', submap_distance: float = 10.0, candidates: int = 20, **kwargs) -> None:
         ...
     @property

@@ -41,7 +41,7 @@ py::dict StepToDict(const OdometryStep& s) {
 const char* OdometryDoc() {
   static const std::string doc =
       "Radar odometry on a map it builds as it goes (docs/design.md, \"Odometry\"): register scans in time "
-      "order.\n\nParameters\n----------\n"
+      "order. Threads may share one: its calls take turns.\n\nParameters\n----------\n"
       "**options\n    any of the keywords below (odometry_options() gives them all with their values)\n" +
       ParametersDoc(OdometryFields());
   return doc.c_str();
@@ -56,30 +56,43 @@ OdometryOptions OdometryOptionsFrom(const py::kwargs& kwargs) {
 }  // namespace
 
 void BindOdometry(py::module_& m) {
-  py::class_<RadarOdometry>(m, "RadarOdometry", OdometryDoc())
-      .def(py::init([](const py::kwargs& kwargs) { return std::make_unique<RadarOdometry>(OdometryOptionsFrom(kwargs)); }))
+  using LockedOdometry = Locked<RadarOdometry>;
+  py::class_<LockedOdometry>(m, "RadarOdometry", OdometryDoc())
+      .def(py::init([](const py::kwargs& kwargs) {
+        return std::make_unique<LockedOdometry>(std::make_unique<RadarOdometry>(OdometryOptionsFrom(kwargs)));
+      }))
       .def(
           "register",
-          [](RadarOdometry& odometry, const RadarScan& scan) {
-            const OdometryStep* step = nullptr;
-            {
-              py::gil_scoped_release release;
-              step = &odometry.Register(scan);
-            }
-            return StepToDict(*step);
+          [](LockedOdometry& odometry, const RadarScan& scan) {
+            return StepToDict(odometry.With([&](RadarOdometry& o) { return o.Register(scan); }));
           },
           py::arg("scan"),
           "Adds the next scan (stamps must increase); returns what happened to it as a dict: pose (4x4), "
           "velocity, matched, keyframe, reason, the information matrices, ...")
-      .def("trajectory", [](const RadarOdometry& o) { return TrajectoryToArrays(o.trajectory()); },
-           "(stamps (N,), poses (N, 7)) so far")
-      .def("map", [](const RadarOdometry& o) { return std::make_shared<PyMap>(o.map().GlobalMap()); },
-           "The map built so far, the Gaussians that left the active radius included")
-      .def("options", [](const RadarOdometry& o) { return OptionsToDict(OdometryFields(), o.options()); },
-           "Every option by keyword, as odometry_options gives them")
-      .def_property_readonly("matchers_made", &RadarOdometry::matchers_made,
-                             "Matchers made so far: one per version of the local map matched against")
-      .def("__len__", [](const RadarOdometry& o) { return o.steps().size(); });
+      .def(
+          "trajectory",
+          [](LockedOdometry& odometry) {
+            return TrajectoryToArrays(odometry.With([](RadarOdometry& o) { return o.trajectory(); }));
+          },
+          "(stamps (N,), poses (N, 7)) so far")
+      .def(
+          "map",
+          [](LockedOdometry& odometry) {
+            return std::make_shared<PyMap>(odometry.With([](RadarOdometry& o) { return o.map().GlobalMap(); }));
+          },
+          "The map built so far, the Gaussians that left the active radius included")
+      .def(
+          "options",
+          [](LockedOdometry& odometry) {
+            return OptionsToDict(OdometryFields(), odometry.With([](RadarOdometry& o) { return o.options(); }));
+          },
+          "Every option by keyword, as odometry_options gives them")
+      .def_property_readonly(
+          "matchers_made",
+          [](LockedOdometry& odometry) { return odometry.With([](RadarOdometry& o) { return o.matchers_made(); }); },
+          "Matchers made so far: one per version of the local map matched against")
+      .def("__len__",
+           [](LockedOdometry& odometry) { return odometry.With([](RadarOdometry& o) { return o.steps().size(); }); });
   m.def(
       "odometry_options", [](const py::kwargs& kwargs) { return OptionsToDict(OdometryFields(), OdometryOptionsFrom(kwargs)); },
       "Every option of RadarOdometry, the given keywords set (checked), as a dict.");

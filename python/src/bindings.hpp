@@ -3,6 +3,8 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
+#include <utility>
 
 #include "convert.hpp"
 #include "radargauss/map/gaussian_map.hpp"
@@ -22,6 +24,29 @@ class PyMap {
  private:
   std::shared_ptr<const GaussianMap> map_;
   mutable std::shared_ptr<const MatchingMap> matching_;
+};
+
+// An object with mutable state that Python threads may share (RadarOdometry,
+// RadarSlam, Relocalizer): every call runs under the object's own lock, taken
+// with the GIL released, so a thread waiting for the lock never holds the GIL
+// that the running call needs back. Calls on one object are serialised.
+template <typename T>
+class Locked {
+ public:
+  explicit Locked(std::unique_ptr<T> object) : object_(std::move(object)) {}
+
+  // fn(object) under the lock without the GIL: fn touches no Python object
+  // and returns its result by value (a copy of any reference into the object).
+  template <typename Fn>
+  auto With(Fn&& fn) {
+    py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return fn(*object_);
+  }
+
+ private:
+  std::unique_ptr<T> object_;
+  std::mutex mutex_;
 };
 
 // (stamps (N,), poses (N, 7)) and back; poses may also be (N, 4, 4).

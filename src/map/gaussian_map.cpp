@@ -200,9 +200,9 @@ std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vecto
   const double box = (double(hi.x) - double(lo.x) + 1.0) * (double(hi.y) - double(lo.y) + 1.0) *
                      (double(hi.z) - double(lo.z) + 1.0);
   if (!(box <= double(kMaxIndexCellsPerGaussian))) {
-    throw DataError("Gaussian " + std::to_string(id) + " spans " + Brief(box) + " index cells of " +
-                    Brief(cell_size_) + " m (at most " + std::to_string(kMaxIndexCellsPerGaussian) +
-                    "): too large a Gaussian, or too small an index cell");
+    throw DataError("Gaussian " + std::to_string(id) + " spans " + Brief(box) + " index cells of " + Brief(cell_size_) +
+                    " m (at most " + std::to_string(kMaxIndexCellsPerGaussian) +
+                    "): too large a Gaussian, or too small an index cell (index_cell, --index-cell)");
   }
   // Of the box's cells, those the ellipsoid itself meets: an oblique or
   // round Gaussian leaves many of its box's cells empty (fewer candidates

@@ -135,9 +135,15 @@ std::vector<MapPlace> ReadPlaces(Reader& reader, std::size_t end, const std::str
     for (double& v : t) v = reader.Get<double>();
     const std::uint64_t points = reader.Get<std::uint64_t>();
     const Eigen::Quaterniond quaternion(q[3], q[0], q[1], q[2]);
+    const auto fail = [&](const std::string& what) {
+      return FileError(path, "place " + std::to_string(k) + ": " + what);
+    };
     if (!quaternion.coeffs().allFinite() || std::abs(quaternion.norm() - 1.0) > 1e-6 ||
         !Eigen::Vector3d(t[0], t[1], t[2]).allFinite()) {
-      throw FileError(path, "place " + std::to_string(k) + ": non-finite or non-unit pose");
+      throw fail("non-finite or non-unit pose");
+    }
+    if (Eigen::Vector3d(t[0], t[1], t[2]).cwiseAbs().maxCoeff() > kMaxMapCoordinate) {
+      throw fail("position beyond " + std::to_string(int(kMaxMapCoordinate)) + " m of the origin");
     }
     if (points > (end - reader.position()) / kPointBytes) throw FileError(path, "truncated places section");
     places[k].pose = SE3d(SO3d(quaternion), Eigen::Vector3d(t[0], t[1], t[2]));
@@ -146,7 +152,10 @@ std::vector<MapPlace> ReadPlaces(Reader& reader, std::size_t end, const std::str
       float v[4];
       for (float& x : v) x = reader.Get<float>();
       if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]) || !std::isfinite(v[3])) {
-        throw FileError(path, "place " + std::to_string(k) + ": non-finite point");
+        throw fail("non-finite point");
+      }
+      if (std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}) > kMaxPlaceRadius) {
+        throw fail("point beyond " + std::to_string(int(kMaxPlaceRadius)) + " m of its place");
       }
       point.position = Eigen::Vector3d(v[0], v[1], v[2]);
       point.rcs = v[3];

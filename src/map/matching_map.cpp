@@ -62,8 +62,8 @@ MatchingMap::MatchingMap(std::shared_ptr<const GaussianMap> shared, const Matchi
     : map_(std::move(shared)), coarse_gate_(options.coarse_gate), coarse_(options.coarse) {
   if (!map_) throw std::invalid_argument("MatchingMap needs a map");
   const GaussianMap& map = *map_;
-  if (!(options.index_cell > 0.0 && options.index_cell <= kMaxIndexCell)) {
-    throw std::invalid_argument("index cell must be in (0, " + std::to_string(int(kMaxIndexCell)) + "] m");
+  if (!(options.index_cell >= kMinIndexCell && options.index_cell <= kMaxIndexCell)) {
+    throw std::invalid_argument("index_cell must be in [0.1, " + std::to_string(int(kMaxIndexCell)) + "] m");
   }
   if (!(options.coarse_gate > 0.0)) throw std::invalid_argument("coarse gate must be > 0");
   for (const double sigma : options.inflation) {

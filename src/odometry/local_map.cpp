@@ -30,14 +30,17 @@ void ValidateOptions(const LocalMapOptions& o) {
   };
   require(o.region > 0.0 && std::isfinite(o.region), "map region must be > 0 m and finite");
   require(o.region_capacity >= 4, "map region capacity must be >= 4 points");
-  require(o.min_points >= 1 && o.min_points <= o.region_capacity,
-          "map region minimum points must be in [1, region capacity]");
+  if (!(o.min_points >= 1 && o.min_points <= o.region_capacity)) {
+    throw std::invalid_argument("map region_capacity (" + std::to_string(o.region_capacity) +
+                                ", --region-capacity) must be >= min_points (" + std::to_string(o.min_points) +
+                                "), the points a region's first fit needs, and min_points >= 1");
+  }
   require(o.refit_growth > 0.0 && std::isfinite(o.refit_growth), "map refit growth must be > 0 and finite");
   require(o.active_radius > 0.0, "active map radius must be > 0 m");
   require(o.republish_kl >= 0.0 && std::isfinite(o.republish_kl), "map republish KL must be >= 0 and finite");
-  require(o.azimuth_std_deg >= 0.0 && o.azimuth_std_deg < 45.0 && o.elevation_std_deg >= 0.0 &&
-              o.elevation_std_deg < 45.0,
-          "map azimuth and elevation std must be in [0, 45) deg");
+  require(o.azimuth_std_deg >= 0.0 && o.azimuth_std_deg <= kMaxAngularNoiseDeg && o.elevation_std_deg >= 0.0 &&
+              o.elevation_std_deg <= kMaxAngularNoiseDeg,
+          "map azimuth_std_deg and elevation_std_deg must be in [0, 5] deg");
   require(o.gaussians.min_std > 0.0, "minimum std must be > 0 m");
 }
 

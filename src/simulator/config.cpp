@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <sstream>
+#include <utility>
 #include <variant>
 
 #include "radargauss/atomic_file.hpp"
@@ -22,6 +23,15 @@ namespace radargauss {
 // Configuration file.
 
 namespace {
+
+constexpr double kMaxSimulatedSpeed = 150.0;  // m/s: 540 km/h, beyond any road vehicle
+constexpr double kMaxSimulatedLength = 1e6;   // m: a loop, a range, an offset
+
+std::string Number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
 
 using ConfigValue = std::variant<double*, int*, std::uint32_t*, std::string*>;
 
@@ -71,6 +81,45 @@ std::vector<std::pair<std::string, ConfigValue>> ConfigFields(SimulationConfig& 
           {"object_rcs_spread_db", &c.object_rcs_spread_db}};
 }
 
+// Upper bounds of what a radar on a road vehicle sees: beyond them a draw
+// overflows to inf or NaN (a growth of 1e300, traffic at 1e300 m/s).
+void ValidateMagnitudes(const SimulationConfig& c, const std::string& source) {
+  const auto bounded = [&](double value, double low, double high, const std::string& key) {
+    if (!(value >= low && value <= high)) {
+      throw FileError(source, key + " must be in [" + Number(low) + ", " + Number(high) + "], not " + Number(value));
+    }
+  };
+  bounded(c.rate_hz, 1e-3, 1e4, "rate_hz");
+  bounded(c.start_time, 0.0, 1e10, "start_time");
+  for (const auto& [key, speed] : {std::pair<const char*, double>{"speed", c.speed},
+                                   {"moving_car_speed", c.moving_car_speed},
+                                   {"traffic_min_speed", c.traffic_min_speed},
+                                   {"traffic_max_speed", c.traffic_max_speed}}) {
+    bounded(speed, 0.0, kMaxSimulatedSpeed, key);
+  }
+  for (const auto& [key, length] : {std::pair<const char*, double>{"loop_length", c.loop_length},
+                                    {"loop_width", c.loop_width},
+                                    {"start_offset", c.start_offset},
+                                    {"max_range", c.max_range},
+                                    {"sensor_height", c.sensor_height}}) {
+    bounded(length, 0.0, kMaxSimulatedLength, key);
+  }
+  for (const auto& [key, angle] : {std::pair<const char*, double>{"attitude_wobble_deg", c.attitude_wobble_deg},
+                                   {"azimuth_noise_deg", c.azimuth_noise_deg},
+                                   {"elevation_noise_deg", c.elevation_noise_deg}}) {
+    bounded(angle, 0.0, 45.0, key);
+  }
+  bounded(c.elevation_noise_growth, 0.0, 100.0, "elevation_noise_growth");
+  bounded(c.range_noise, 0.0, 100.0, "range_noise");
+  bounded(c.doppler_noise, 0.0, 100.0, "doppler_noise");
+  for (const auto& [key, db] : {std::pair<const char*, double>{"rcs_noise_db", c.rcs_noise_db},
+                                {"object_rcs_spread_db", c.object_rcs_spread_db},
+                                {"multipath_loss_db", c.multipath_loss_db}}) {
+    bounded(db, 0.0, 200.0, key);
+  }
+  bounded(c.detection_threshold_db, -200.0, 200.0, "detection_threshold_db");
+}
+
 }  // namespace
 
 void ValidateSimulationConfig(const SimulationConfig& c, const std::string& source) {
@@ -83,6 +132,7 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
       require(std::isfinite(*number), key + " must be a finite number");
     }
   }
+  ValidateMagnitudes(c, source);
   require(c.scans >= 1, "scans must be >= 1");
   require(c.rate_hz > 0.0, "rate_hz must be > 0");
   require(std::isfinite(c.start_time) && c.start_time >= 0.0, "start_time must be >= 0");
@@ -125,6 +175,8 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
     require(std::isfinite(it->second.diffuse) && std::isfinite(it->second.specular) &&
                 std::isfinite(it->second.lobe_width_deg),
             std::string("material '") + name + "' needs finite numbers");
+    require(it->second.diffuse <= 1e6 && it->second.specular <= 1e6 && it->second.lobe_width_deg <= 180.0,
+            std::string("material '") + name + "' needs diffuse, specular <= 1e6 m^2 and lobe_width_deg <= 180");
     require(it->second.diffuse >= 0.0 && it->second.specular >= 0.0 &&
                 it->second.lobe_width_deg > 0.0 &&
                 it->second.diffuse + it->second.specular > 0.0,

@@ -242,6 +242,11 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
     sequence.scans.push_back(std::move(scan));
     sequence.truth.push_back(std::move(truth));
   }
+  // What the simulator writes, its readers accept: a scan they would refuse is
+  // a configuration the validation let through, refused here, not written.
+  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
+    ValidateScan(sequence.scans[k], "simulation config (scan " + std::to_string(k) + ")");
+  }
   return sequence;
 }
 

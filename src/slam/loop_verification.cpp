@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-#include <unordered_set>
+#include <utility>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -30,38 +30,73 @@ void ValidateOptions(const LoopVerificationOptions& o) {
   require(o.match.matching.w_rcs == 0.0, "the match is geometric (w_rcs 0)");
 }
 
+namespace {
+
+// A dense occupancy grid over a submap's extent is at most this many cells
+// (4 MB); points spread wider (a hostile map's far points) use a sorted list.
+constexpr std::int64_t kMaxDenseBirdsEyeCells = std::int64_t(1) << 22;
+
+using Cell = std::pair<std::int64_t, std::int64_t>;  // (x, y) in cells, 64-bit: no coordinate overflows it
+
+Cell CellOf(const Eigen::Vector3d& p, double cell) { return {FloorToInt(p.x() / cell), FloorToInt(p.y() / cell)}; }
+
+// The candidate's occupied cells, asked one cell at a time.
+class BirdsEyeOccupancy {
+ public:
+  explicit BirdsEyeOccupancy(std::vector<Cell> cells) {
+    low_ = high_ = cells.front();
+    for (const Cell& c : cells) {
+      low_ = {std::min(low_.first, c.first), std::min(low_.second, c.second)};
+      high_ = {std::max(high_.first, c.first), std::max(high_.second, c.second)};
+    }
+    // The extent in double: the span of two far cells overflows no integer.
+    const double area =
+        (double(high_.first) - double(low_.first) + 1.0) * (double(high_.second) - double(low_.second) + 1.0);
+    if (area <= double(kMaxDenseBirdsEyeCells)) {
+      width_ = high_.first - low_.first + 1;
+      dense_.assign(std::size_t(area), 0);
+      for (const Cell& c : cells) dense_[std::size_t((c.second - low_.second) * width_ + c.first - low_.first)] = 1;
+    } else {
+      std::sort(cells.begin(), cells.end());
+      cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+      sparse_ = std::move(cells);
+    }
+  }
+
+  int operator()(std::int64_t x, std::int64_t y) const {
+    if (x < low_.first || y < low_.second || x > high_.first || y > high_.second) return 0;
+    if (!dense_.empty()) return dense_[std::size_t((y - low_.second) * width_ + x - low_.first)];
+    return std::binary_search(sparse_.begin(), sparse_.end(), Cell(x, y)) ? 1 : 0;
+  }
+
+ private:
+  Cell low_, high_;
+  std::int64_t width_ = 0;
+  std::vector<char> dense_;
+  std::vector<Cell> sparse_;
+};
+
+}  // namespace
+
 std::pair<Eigen::Vector2d, double> AlignBirdsEye(const std::vector<Eigen::Vector3d>& query,
                                                  const std::vector<Eigen::Vector3d>& candidate, double cell,
                                                  double search) {
-  // The candidate's occupancy as a dense grid over its extent, the query's as unique cells.
-  std::vector<Eigen::Vector2i> query_cells;
-  std::unordered_set<std::int64_t> seen;
-  for (const Eigen::Vector3d& p : query) {
-    const Eigen::Vector2i c(int(FloorToInt(p.x() / cell)), int(FloorToInt(p.y() / cell)));
-    if (seen.insert(PackVoxelKey(c.x(), c.y(), 0)).second) query_cells.push_back(c);
-  }
+  // The query as unique cells, the candidate's occupancy as a grid to look them up in.
+  std::vector<Cell> query_cells;
+  for (const Eigen::Vector3d& p : query) query_cells.push_back(CellOf(p, cell));
+  std::sort(query_cells.begin(), query_cells.end());
+  query_cells.erase(std::unique(query_cells.begin(), query_cells.end()), query_cells.end());
   if (query_cells.empty() || candidate.empty()) return {Eigen::Vector2d::Zero(), 0.0};
-  Eigen::Vector2i low(INT32_MAX, INT32_MAX), high(INT32_MIN, INT32_MIN);
-  std::vector<Eigen::Vector2i> candidate_cells;
-  for (const Eigen::Vector3d& p : candidate) {
-    const Eigen::Vector2i c(int(FloorToInt(p.x() / cell)), int(FloorToInt(p.y() / cell)));
-    candidate_cells.push_back(c);
-    low = low.cwiseMin(c);
-    high = high.cwiseMax(c);
-  }
-  const Eigen::Vector2i size = high - low + Eigen::Vector2i::Ones();
-  std::vector<char> occupied(std::size_t(size.x()) * size.y(), 0);
-  for (const Eigen::Vector2i& c : candidate_cells) occupied[std::size_t(c.y() - low.y()) * size.x() + c.x() - low.x()] = 1;
+  std::vector<Cell> candidate_cells;
+  for (const Eigen::Vector3d& p : candidate) candidate_cells.push_back(CellOf(p, cell));
+  const BirdsEyeOccupancy occupied(std::move(candidate_cells));
   const int reach = int(std::floor(search / cell));
   int best_count = -1;
   Eigen::Vector2i best(0, 0);
   for (int dy = -reach; dy <= reach; ++dy) {
     for (int dx = -reach; dx <= reach; ++dx) {
       int count = 0;
-      for (const Eigen::Vector2i& c : query_cells) {
-        const int x = c.x() + dx - low.x(), y = c.y() + dy - low.y();
-        if (x >= 0 && y >= 0 && x < size.x() && y < size.y()) count += occupied[std::size_t(y) * size.x() + x];
-      }
+      for (const Cell& c : query_cells) count += occupied(c.first + dx, c.second + dy);
       // Ties go to the smaller shift: the keyframes' origins are the prior.
       if (count > best_count || (count == best_count && dx * dx + dy * dy < best.squaredNorm())) {
         best_count = count;

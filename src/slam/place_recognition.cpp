@@ -63,23 +63,32 @@ const Eigen::VectorXd& KeyOf(const PlaceDescription& description, const PlaceRec
 
 std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vector<PlaceDescription>& places,
                                    const std::vector<int>& eligible, const PlaceRecognitionOptions& options) {
+  return RankPlaces(query, places, eligible, options, nullptr);
+}
+
+std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vector<PlaceDescription>& keys,
+                                   const std::vector<int>& eligible, const PlaceRecognitionOptions& options,
+                                   const std::function<PlaceDescription(int)>& describe) {
   const Eigen::VectorXd& query_key = KeyOf(query, options);
   std::vector<std::pair<double, int>> nearest;
-  for (const int c : eligible) nearest.emplace_back((query_key - KeyOf(places[c], options)).norm(), c);
+  for (const int c : eligible) nearest.emplace_back((query_key - KeyOf(keys[c], options)).norm(), c);
   const std::size_t kept = std::min<std::size_t>(nearest.size(), std::size_t(options.candidates));
   std::partial_sort(nearest.begin(), nearest.begin() + kept, nearest.end());
   nearest.resize(kept);
   std::vector<PlaceMatch> matches;
+  PlaceDescription described;
   for (const auto& [key_distance, c] : nearest) {
+    if (describe) described = describe(c);
+    const PlaceDescription& candidate = describe ? described : keys[c];
     PlaceMatch match;
     match.candidate = c;
     if (options.descriptor == PlaceDescriptorKind::kScanContext) {
-      const ScanContextMatch m = CompareScanContexts(query.scan_context, places[c].scan_context, options.scan_context);
+      const ScanContextMatch m = CompareScanContexts(query.scan_context, candidate.scan_context, options.scan_context);
       match.distance = m.distance;
       match.yaws = {m.yaw};
       match.close = m.distance <= options.max_scan_context_distance;
     } else {
-      const RadonMatch m = CompareRadonDescriptors(query.radon, places[c].radon, options.radon);
+      const RadonMatch m = CompareRadonDescriptors(query.radon, candidate.radon, options.radon);
       match.distance = m.distance;
       match.yaws = {m.yaw, m.yaw - M_PI};  // known up to pi
       match.close = m.distance <= options.max_radon_distance;
@@ -89,6 +98,13 @@ std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vec
   std::stable_sort(matches.begin(), matches.end(),
                    [](const PlaceMatch& a, const PlaceMatch& b) { return a.distance < b.distance; });
   return matches;
+}
+
+PlaceDescription KeyOnly(PlaceDescription description) {
+  description.scan_context.geometric.resize(0, 0);
+  description.scan_context.rcs.resize(0, 0);
+  description.radon.spectra.resize(0, 0);
+  return description;
 }
 
 }  // namespace radargauss

@@ -39,10 +39,12 @@ void ValidateOptions(const RelocalizationOptions& o) {
 Relocalizer::Relocalizer(GaussianMap map, const RelocalizationOptions& options) : options_(options) {
   ValidateOptions(options_);
   if (map.places.empty()) throw DataError("the map has no places to relocalise against (build it with radargauss slam)");
-  if (map.gaussians.empty()) throw DataError("the map has no Gaussians");
+  if (map.gaussians.empty()) throw DataError("the map has no Gaussians to match against");
   map_ = std::make_shared<const GaussianMap>(std::move(map));
   matching_ = std::make_shared<const MatchingMap>(map_);
-  for (const MapPlace& place : map_->places) places_.push_back(Describe(place.points, options_.place_recognition));
+  // Keys only: a place's full descriptor is made again when it is compared.
+  for (const MapPlace& place : map_->places)
+    places_.push_back(KeyOnly(Describe(place.points, options_.place_recognition)));
   Restart();
 }
 
@@ -107,7 +109,8 @@ void Relocalizer::Search() {
   std::vector<int> every(places_.size());
   for (std::size_t p = 0; p < places_.size(); ++p) every[p] = int(p);
   std::vector<std::pair<SE3d, std::size_t>> found;  // T_map_odometry of each verified place, its candidate
-  for (const PlaceMatch& match : RankPlaces(description, places_, every, options_.place_recognition)) {
+  const auto describe = [&](int place) { return Describe(map_->places[place].points, options_.place_recognition); };
+  for (const PlaceMatch& match : RankPlaces(description, places_, every, options_.place_recognition, describe)) {
     PlaceCandidate candidate;
     candidate.submap = submap;
     candidate.place = match.candidate;

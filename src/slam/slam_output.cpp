@@ -46,11 +46,16 @@ void WriteLoops(std::ostream& out, const RadarSlam& slam) {
 }  // namespace
 
 GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& slam) {
+  const std::vector<SE3d> poses = slam.Poses();
+  if (scans.size() != poses.size()) {
+    throw DataError("the map of the place needs the " + std::to_string(poses.size()) +
+                    " registered scans in order, not " + std::to_string(scans.size()));
+  }
   MapOptions options;
   options.cloud.ego_velocity = slam.options().odometry.ego_velocity;
   options.gaussians = slam.options().odometry.map.gaussians;
   options.rcs = slam.options().odometry.map.rcs;
-  MapGeometry geometry = BuildMapGeometry(scans, slam.Poses(), options);
+  MapGeometry geometry = BuildMapGeometry(scans, poses, options);
   FitRcsModels(geometry.map, geometry.cloud, geometry.association, options.rcs);  // as BuildMap
   GaussianMap map = std::move(geometry.map);
   for (std::size_t k = 0; k < slam.keyframes().size(); ++k) {

@@ -15,11 +15,15 @@ namespace radargauss {
 constexpr std::size_t kMaxConfigFileBytes = std::size_t(1) << 20;
 // Maps and lists nested deeper than this are not a configuration.
 constexpr int kMaxConfigDepth = 32;
+// Nodes in the document with every alias expanded (a "billion laughs" of
+// aliases of aliases is a few hundred bytes): counted before any walk.
+constexpr std::size_t kMaxConfigNodes = std::size_t(1) << 18;
 
 // The one YAML document in `path` ("<what>" in messages). Throws DataError
 // naming the file (and the line where there is one) when it is not a regular
 // file, exceeds kMaxConfigFileBytes, is not YAML, holds a second document,
-// nests deeper than kMaxConfigDepth, or gives a key twice in one map.
+// nests deeper than kMaxConfigDepth,
+// holds more than kMaxConfigNodes nodes with its aliases expanded, or gives a key twice in one map.
 YAML::Node ReadYamlDocument(const std::string& path, const std::string& what);
 
 }  // namespace radargauss

@@ -39,11 +39,17 @@ inline constexpr std::uint32_t kMapFileVersion = 2;
 inline constexpr double kMaxMapCoordinate = 1e7;  // m
 inline constexpr double kMinMapStd = 1e-4;        // m
 inline constexpr double kMaxMapStd = 100.0;       // m
+// What it accepts of a place: its position within kMaxMapCoordinate like a
+// Gaussian's mean, and its submap's points within kMaxPlaceRadius of it (a
+// submap is a few hundred metres of driving seen by a radar, not a country).
+inline constexpr double kMaxPlaceRadius = 1e5;  // m
 
 void WriteMap(const std::string& path, const GaussianMap& map);
 // Throws DataError naming the file for a missing or truncated file, a wrong
 // magic or version, a CRC mismatch, a Gaussian outside the bounds above, or
-// a place with a non-finite or non-unit pose or a non-finite point.
+// a place with a non-finite or non-unit pose, a position beyond
+// kMaxMapCoordinate, or a point that is not finite or lies beyond
+// kMaxPlaceRadius of its place.
 GaussianMap ReadMap(const std::string& path);
 
 void ExportPly(const std::string& path, const GaussianMap& map);

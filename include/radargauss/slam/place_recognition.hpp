@@ -6,6 +6,7 @@
 // relocalisation a map's places.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -62,5 +63,13 @@ struct PlaceMatch {
 // indices of `places`, compared in full, nearest first.
 std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vector<PlaceDescription>& places,
                                    const std::vector<int>& eligible, const PlaceRecognitionOptions& options);
+// The same for a database that keeps only the keys of its places (a few
+// hundred bytes a place, not the descriptor's kilobytes): the compared
+// candidates' full descriptions are made by describe(index).
+std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vector<PlaceDescription>& keys,
+                                   const std::vector<int>& eligible, const PlaceRecognitionOptions& options,
+                                   const std::function<PlaceDescription(int)>& describe);
+// The description with its key alone (what the second RankPlaces needs of a place).
+PlaceDescription KeyOnly(PlaceDescription description);
 
 }  // namespace radargauss

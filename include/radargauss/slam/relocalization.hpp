@@ -100,7 +100,7 @@ class Relocalizer {
   RelocalizationOptions options_;
   std::shared_ptr<const GaussianMap> map_;
   std::shared_ptr<const MatchingMap> matching_;
-  std::vector<PlaceDescription> places_;
+  std::vector<PlaceDescription> places_;  // each place's key (KeyOnly)
   std::unique_ptr<RadarOdometry> odometry_;
   std::vector<RelocalizationStep> steps_;
   std::vector<PlaceCandidate> candidates_;

@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""Documented ranges are the accepted ones (docs/design.md, "Bounds on
+input"): every numeric flag whose `--help` states a range, in every
+subcommand that runs on a sequence, is tried at each end of that range (a
+closed end is accepted and the run ends, within a time and memory bound),
+just outside it (refused in one line naming the flag), and, for an open
+end, at the end itself (refused) and just inside it (accepted or refused in
+one line naming the flag, never a crash, a hang or memory exhaustion).
+
+    option_ranges_test.py <path to radargauss>
+"""
+import math
+import os
+import re
+import resource
+import subprocess
+import sys
+import tempfile
+
+TIMEOUT_S = 60
+MEMORY_BYTES = 4 << 30  # a run that needs more has exhausted what a flag's range should allow
+RANGE = re.compile(r"^\s+(--[a-z0-9-]+) (FLOAT|INT|UINT):([\[(])([^,\]]+), ([^\])]+)([\])])(?:\S* x (\d+))?")
+
+
+def limit_memory():
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_BYTES, MEMORY_BYTES))
+
+
+def run(command, sanitized):
+    try:
+        result = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT_S,
+                                preexec_fn=None if sanitized else limit_memory)
+    except subprocess.TimeoutExpired:
+        return None, "timed out after %d s" % TIMEOUT_S
+    return result.returncode, result.stderr.strip()
+
+
+def ranges(tool, command):
+    """(flag, type, low, high, low_closed, high_closed, values) of every ranged numeric flag."""
+    text = subprocess.run([tool, command, "--help"], capture_output=True, text=True, check=True).stdout
+    found = []
+    for line in text.splitlines():
+        match = RANGE.match(line)
+        if match:
+            flag, kind, left, low, high, right, count = match.groups()
+            found.append((flag, kind, float(low), float(high), left == "[", right == "]", int(count or 1)))
+    return found
+
+
+def outside(value, kind, direction):
+    if kind != "FLOAT":
+        return int(value) + direction
+    return value + direction * max(abs(value) * 1e-6, 1e-6)
+
+
+def inside(value, kind, direction):
+    if kind != "FLOAT":
+        return int(value) + direction
+    return value + direction * max(abs(value) * 1e-12, 1e-300)
+
+
+def text(value):
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def main():
+    tool = sys.argv[1]
+    sanitized = "asan" in subprocess.run(["ldd", tool], capture_output=True, text=True).stdout
+    work = tempfile.mkdtemp()
+    sequence = os.path.join(work, "seq")
+    subprocess.run([tool, "simulate", "--out", sequence, "--scans", "6", "--seed", "2"], check=True,
+                   stdout=subprocess.DEVNULL)
+    gt = os.path.join(sequence, "gt_radar_tum.txt")
+    slam_out = os.path.join(work, "slam")
+    subprocess.run([tool, "slam", "--sequence", sequence, "--out", slam_out, "--submap-distance", "2"], check=True,
+                   stdout=subprocess.DEVNULL)
+    inputs = ["--sequence", sequence, "--gt", gt]
+    commands = {
+        "odometry": inputs + ["--out", os.path.join(work, "o")],
+        "slam": inputs + ["--out", os.path.join(work, "s")],
+        "relocalize": inputs + ["--map", os.path.join(slam_out, "map.rgm"), "--out", os.path.join(work, "r")],
+        "localize": inputs + ["--out", os.path.join(work, "l")],
+        "build-map": inputs + ["--out", os.path.join(work, "m.rgm")],
+    }
+    passed, failures = 0, []
+
+    def expect(command, flag, value, accepted, count):
+        nonlocal passed
+        status, error = run([tool, command] + commands[command] + [flag] + [text(value)] * count, sanitized)
+        lines = [line for line in error.splitlines() if line and not line.startswith("Run with --help")]
+        one_line = len(lines) <= 1
+        crashed = status is None or status < 0 or status > 125 or "out of memory" in error or "bad_alloc" in error
+        if accepted is True:
+            ok = status == 0
+        elif accepted is False:
+            ok = status not in (0, None) and not crashed and one_line and flag.lstrip("-") in error
+        else:  # either, but cleanly
+            ok = not crashed and (status == 0 or (one_line and flag.lstrip("-") in error))
+        if ok:
+            passed += 1
+        else:
+            wanted = {True: "accepted", False: "refused naming the flag", None: "accepted or refused cleanly"}[accepted]
+            failures.append("%s %s %s: wanted %s, exit %s: %s" % (command, flag, text(value), wanted, status,
+                                                                   error.replace("\n", " | ")[:300]))
+
+    for command in commands:
+        for flag, kind, low, high, low_closed, high_closed, count in ranges(tool, command):
+            for end, closed, direction in ((low, low_closed, -1), (high, high_closed, +1)):
+                if math.isinf(end):
+                    continue
+                if closed:
+                    expect(command, flag, int(end) if kind != "FLOAT" else end, True, count)
+                    expect(command, flag, outside(end, kind, direction), False, count)
+                else:
+                    expect(command, flag, int(end) if kind != "FLOAT" else end, False, count)
+                    expect(command, flag, inside(end, kind, -direction), None, count)
+    for failure in failures:
+        print("FAIL:", failure)
+    print("option ranges: %d passed, %d failed" % (passed, len(failures)))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
