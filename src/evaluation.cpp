@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
@@ -42,8 +44,34 @@ void MatchByTime(const Trajectory& estimate, const Trajectory& reference, double
   }
 }
 
-// T_ref_est (and the scale) that the alignment applies to the estimate.
-SE3d AlignmentOf(const std::vector<SE3d>& est, const std::vector<SE3d>& ref, Alignment alignment, double& scale) {
+// The spread of points about their mean: the stds along the principal axes, largest last.
+Eigen::Vector3d PrincipalSpread(const std::vector<Eigen::Vector3d>& points, Eigen::Vector3d& mean) {
+  mean.setZero();
+  for (const Eigen::Vector3d& p : points) mean += p;
+  mean /= double(points.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : points) scatter += (p - mean) * (p - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter / double(points.size()), Eigen::EigenvaluesOnly);
+  return solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+}
+
+// The rotation closest to the mean of R_ref R_est^T over the pairs: the
+// alignment's rotation as the orientations give it (docs/design.md, "Evaluation").
+SO3d OrientationAlignment(const std::vector<SE3d>& est, const std::vector<SE3d>& ref) {
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  for (std::size_t k = 0; k < est.size(); ++k) sum += (ref[k].rotation() * est[k].rotation().Inverse()).Matrix();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d sign = Eigen::Matrix3d::Identity();
+  sign(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  return SO3d::FromMatrix(svd.matrixU() * sign * svd.matrixV().transpose());
+}
+
+// T_ref_est (and the scale) that the alignment applies to the estimate. The
+// reference positions fix the rotation unless they lie on a line (its
+// second principal spread below kThinTrajectory of its first): then the
+// rotation comes from the orientations, and `note` says so.
+SE3d AlignmentOf(const std::vector<SE3d>& est, const std::vector<SE3d>& ref, Alignment alignment, double& scale,
+                 std::string& note) {
   scale = 1.0;
   if (alignment == Alignment::kNone) return SE3d();
   if (alignment == Alignment::kFirst) return ref.front() * est.front().Inverse();
@@ -52,7 +80,18 @@ SE3d AlignmentOf(const std::vector<SE3d>& est, const std::vector<SE3d>& ref, Ali
     p.push_back(est[k].translation());
     q.push_back(ref[k].translation());
   }
-  return AlignPoints(p, q, alignment == Alignment::kSim3, scale);
+  Eigen::Vector3d p_mean, q_mean;
+  const Eigen::Vector3d q_spread = PrincipalSpread(q, q_mean), p_spread = PrincipalSpread(p, p_mean);
+  if (q_spread[1] > kThinTrajectory * q_spread[2]) return AlignPoints(p, q, alignment == Alignment::kSim3, scale);
+  note = "rotation from the orientations: the reference positions lie on a line";
+  if (alignment == Alignment::kSim3) {
+    scale = q_spread.norm() / p_spread.norm();
+    if (!(scale > 0.0 && std::isfinite(scale))) {
+      throw DataError("a sim3 alignment needs an estimate that moves (its positions all coincide); use se3 or first");
+    }
+  }
+  const SO3d rotation = OrientationAlignment(est, ref);
+  return SE3d(rotation, q_mean - scale * (rotation * p_mean));
 }
 
 SE3d Aligned(const SE3d& pose, const SE3d& alignment, double scale) {
@@ -129,7 +168,7 @@ Evaluation EvaluateTrajectory(const Trajectory& estimate, const Trajectory& refe
   }
   Evaluation e;
   e.matched = est.size();
-  e.alignment = AlignmentOf(est, ref, options.alignment, e.scale);
+  e.alignment = AlignmentOf(est, ref, options.alignment, e.scale, e.alignment_note);
   std::vector<double> translation, rotation, distance = {0.0};
   for (std::size_t k = 0; k < est.size(); ++k) {
     est[k] = Aligned(est[k], e.alignment, e.scale);
@@ -172,6 +211,7 @@ std::string Markdown(const Evaluation& e) {
      << "| RPE r deg/m |\n|---|---|---|---|---|---|---|---|\n| " << e.matched << " | " << e.path_length << " | "
      << e.ate_translation.rmse << " | " << e.ate_translation.max << " | " << e.ate_rotation.rmse << " | "
      << e.rpe_mean.translation << " | " << e.rpe_mean.horizontal << " | " << e.rpe_mean.rotation << " |\n";
+  if (!e.alignment_note.empty()) md << "\nAlignment: " << e.alignment_note << ".\n";
   md << "\n| segment m | segments | t % | horizontal % | r deg/m |\n|---|---|---|---|---|\n";
   for (const std::vector<SegmentDrift>* list : {&e.rpe, &e.kitti}) {
     for (const SegmentDrift& d : *list) {
@@ -192,7 +232,7 @@ std::string WriteEvaluation(const std::string& dir, const Evaluation& e) {
   nlohmann::json json = {{"matched", e.matched}, {"path_length_m", e.path_length}, {"scale", e.scale},
                          {"ate_translation_m", ToJson(e.ate_translation)}, {"ate_rotation_deg", ToJson(e.ate_rotation)},
                          {"rpe", ToJson(e.rpe_mean)}, {"rpe_segments", nlohmann::json::array()},
-                         {"kitti_segments", nlohmann::json::array()}};
+                         {"kitti_segments", nlohmann::json::array()}, {"alignment_note", e.alignment_note}};
   for (const SegmentDrift& d : e.rpe) json["rpe_segments"].push_back(ToJson(d));
   for (const SegmentDrift& d : e.kitti) json["kitti_segments"].push_back(ToJson(d));
   WriteFileAtomically((fs::path(dir) / "evaluation.json").string(), [&](std::ostream& out) { out << json.dump(2) << "\n"; });

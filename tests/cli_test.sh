@@ -101,6 +101,35 @@ expect_ok "relocalize says when nothing verifies" "relocalize: no fix" -- \
   --max-scan-context-distance 0 --out "$work/relocalized"
 [[ -s "$work/relocalized/per_scan.csv" && ! -s "$work/relocalized/relocalization.tum" ]] ||
   { echo "FAIL: relocalize without a fix wrote no per_scan.csv or a pose"; failed=1; }
+# The evaluation in memory (odometry --gt) and from the files (evaluate) agree
+# field by field, here on the straight drive whose positions lie on a line.
+"$tool" simulate --out "$work/straight" --scans 120 --seed 3 >/dev/null
+"$tool" odometry --sequence "$work/straight" --gt "$work/straight/gt_radar_tum.txt" --out "$work/straight_odometry" \
+  >/dev/null
+"$tool" evaluate --est "$work/straight_odometry/odometry.tum" --ref "$work/straight/gt_radar_tum.txt" \
+  --out "$work/straight_evaluate" >/dev/null
+if /usr/bin/python3 - "$work/straight_odometry/evaluation.json" "$work/straight_evaluate/evaluation.json" <<'PY'
+import json, math, sys
+def flat(value, prefix=""):
+    if isinstance(value, dict):
+        return {k: v for key in value for k, v in flat(value[key], prefix + key + ".").items()}
+    if isinstance(value, list):
+        return {k: v for i, item in enumerate(value) for k, v in flat(item, prefix + str(i) + ".").items()}
+    return {prefix: value}
+memory, files = (flat(json.load(open(path))) for path in sys.argv[1:])
+assert memory.keys() == files.keys(), set(memory) ^ set(files)
+for key, value in memory.items():
+    other = files[key]
+    same = value == other if isinstance(value, str) else math.isclose(value, other, rel_tol=1e-6, abs_tol=1e-9)
+    assert same, "%s: %r in memory, %r from the files" % (key, value, other)
+assert memory["alignment_note."].startswith("rotation from the orientations"), memory["alignment_note."]
+assert memory["ate_rotation_deg.max."] < 5.0, memory["ate_rotation_deg.max."]
+PY
+then
+  passed=$((passed + 1))
+else
+  echo "FAIL: odometry's evaluation and evaluate's differ"; failed=$((failed + 1))
+fi
 expect_fail "odometry on a scan folder with a repeated stamp" "does not increase" -- \
   "$tool" odometry --sequence "$work/backwards" --out "$work/odometry_backwards"
 [[ ! -e "$work/odometry_backwards/odometry.tum" ]] || { echo "FAIL: a failed odometry left outputs"; failed=1; }

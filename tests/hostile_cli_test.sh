@@ -144,6 +144,61 @@ expect_fail "slam on an empty sequence" "empty: no scans found" -- "$tool" slam 
 expect_fail "slam with a PCL matcher" "slam: --matcher must be gaussians" -- \
   "$tool" slam --matcher pcl-ndt "${seq[@]}" --out "$work/sl"
 
+# Empty input is refused before the run, naming the sequence or the flag.
+expect_fail "slam --first-scan past the end" "--first-scan 40 skips every one of the 4 scans of $work/seq" -- \
+  "$tool" slam --first-scan 40 "${seq[@]}" --out "$work/sl"
+expect_fail "odometry --first-scan 2^64-1" "--first-scan 18446744073709551615 skips every one of the 4 scans" -- \
+  "$tool" odometry --first-scan 18446744073709551615 "${seq[@]}" --out "$work/o"
+mkdir -p "$work/hollow/ars548/points"
+for pcd in "$work"/seq/ars548/points/*.pcd; do
+  sed -n '1,11p' "$pcd" | sed -e 's/^WIDTH .*/WIDTH 0/' -e 's/^POINTS .*/POINTS 0/' >"$work/hollow/ars548/points/$(basename "$pcd")"
+done
+expect_fail "slam on scans without points" "hollow: every one of the 4 scans has no points" -- \
+  "$tool" slam --sequence "$work/hollow" --out "$work/sl"
+[[ ! -e "$work/sl" ]] || { echo "FAIL: a refused slam left its output"; failed=$((failed + 1)); }
+# A map with places and no Gaussian: named with the fault.
+"$tool" slam "${seq[@]}" --submap-distance 2 --out "$work/slam" >/dev/null
+/usr/bin/python3 - "$work/slam/map.rgm" "$work/placesonly.rgm" <<'PY'
+import struct, sys, zlib
+data = open(sys.argv[1], "rb").read()
+count = struct.unpack_from("<Q", data, 16)[0]
+body = data[:16] + struct.pack("<Q", 0) + data[24 + 236 * count:-4]
+open(sys.argv[2], "wb").write(body + struct.pack("<I", zlib.crc32(body)))
+PY
+expect_fail "relocalize on a map without Gaussians" "placesonly.rgm: the map has no Gaussians to match against" -- \
+  "$tool" relocalize --map "$work/placesonly.rgm" "${seq[@]}" --out "$work/rl"
+
+# Results folders: not the sequence's own folder, not a shared one; an
+# earlier run's evaluation does not stay beside a new trajectory.
+expect_fail "odometry into the sequence's folder" "seq: is the sequence's own folder" -- \
+  "$tool" odometry "${seq[@]}" --out "$work/seq"
+expect_fail "odometry into /tmp" "/tmp: is a shared folder" -- "$tool" odometry "${seq[@]}" --out /tmp
+mkdir -p "$work/private" && chmod 0700 "$work/private"
+"$tool" slam "${seq[@]}" --submap-distance 2 --out "$work/private" >/dev/null
+[ -e "$work/private/evaluation.json" ] || { echo "FAIL: slam --gt wrote no evaluation"; failed=$((failed + 1)); }
+"$tool" slam --sequence "$work/seq" --submap-distance 2 --out "$work/private" >/dev/null
+if [ -e "$work/private/evaluation.json" ] || [ -e "$work/private/odometry/evaluation.json" ]; then
+  echo "FAIL: an earlier run's evaluation stayed beside the new trajectory"; failed=$((failed + 1))
+else
+  passed=$((passed + 1))
+fi
+[ "$(stat -c %a "$work/private")" = 700 ] && passed=$((passed + 1)) ||
+  { echo "FAIL: the results folder lost its mode 0700 ($(stat -c %a "$work/private"))"; failed=$((failed + 1)); }
+
+# Aliases of aliases ("billion laughs"): refused at once by every command.
+{
+  echo 'l0: &l0 [x, x, x, x, x, x, x, x, x, x]'
+  for level in 1 2 3 4 5 6 7 8 9; do
+    echo "l$level: &l$level [$(printf "*l$((level - 1)), %.0s" 1 2 3 4 5 6 7 8 9)*l$((level - 1))]"
+  done
+} >"$work/laughs.yaml"
+for command in build-map simulate odometry localize slam relocalize; do
+  inputs=("${seq[@]}")
+  [ "$command" = simulate ] && inputs=()
+  expect_fail "$command: a billion laughs" "laughs.yaml:6: more than 262144 YAML nodes with aliases expanded" -- \
+    "$tool" "$command" --config "$work/laughs.yaml" "${inputs[@]}" --out "$work/laughs"
+done
+
 # Negative stamps order numerically (as text -1 would come before -2).
 mkdir -p "$work/negative"
 stamps=(-2.000000000 -1.000000000 0.500000000)

@@ -126,6 +126,50 @@ TEST(Evaluation, AlignmentsUndoTransformsOfTheEstimate) {
 }
 
 // Poses pair by the nearest time within the tolerance; too few pairs is an error.
+// Positions on a line leave the rotation about it free: Umeyama on a
+// straight drive with 5 cm of noise gave 1 deg or 179 deg by the noise's
+// draw. The alignment takes its rotation from the orientations there, says
+// so, and gives the planted 0.8 deg whatever the draw, the estimate's frame,
+// or the 9 decimals of the TUM files it went through.
+TEST(Evaluation, PositionsOnALineTakeTheRotationFromTheOrientations) {
+  const Trajectory reference = StraightDrive(72);
+  for (const std::uint32_t seed : {1u, 2u, 3u, 4u, 5u}) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, 0.05);
+    Trajectory estimate;
+    for (const StampedPose& sample : reference) {
+      // Rolled +-0.8 deg about the line itself, in turn: no mean offset to align away.
+      const double roll = (int(sample.time) % 2 == 0 ? 0.8 : -0.8) * kDeg;
+      estimate.Append(sample.time, SE3d(sample.pose.rotation() * SO3d::Exp(Eigen::Vector3d(roll, 0.0, 0.0)),
+                                        sample.pose.translation() + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))));
+    }
+    const SE3d moved(SO3d::Exp(Eigen::Vector3d(0.3, -0.2, 1.2)), Eigen::Vector3d(40.0, -7.0, 3.0));
+    for (const Trajectory& input : {estimate, Transformed(estimate, moved)}) {
+      const Evaluation e = EvaluateTrajectory(input, reference);
+      EXPECT_EQ(e.alignment_note, "rotation from the orientations: the reference positions lie on a line");
+      EXPECT_NEAR(e.ate_rotation.max, 0.8, 1e-9) << seed;
+      EXPECT_NEAR(e.ate_rotation.mean, 0.8, 1e-9) << seed;
+      EXPECT_LT(e.ate_translation.rmse, 0.15) << seed;
+    }
+    // Through TUM files (9 decimals), as `radargauss evaluate` reads them: the same figures.
+    const Evaluation in_memory = EvaluateTrajectory(estimate, reference);
+    const std::string path = ::testing::TempDir() + "/straight_" + std::to_string(seed) + ".tum";
+    WriteTum(path, estimate);
+    const Evaluation from_file = EvaluateTrajectory(ReadTum(path), reference);
+    EXPECT_NEAR(from_file.ate_rotation.rmse, in_memory.ate_rotation.rmse, 1e-6);
+    EXPECT_NEAR(from_file.ate_translation.rmse, in_memory.ate_translation.rmse, 1e-6);
+    EXPECT_NEAR(from_file.rpe_mean.translation, in_memory.rpe_mean.translation, 1e-6);
+  }
+  // A drive with a corner determines the rotation by its positions: Umeyama, no note.
+  EXPECT_EQ(EvaluateTrajectory(CurvedDrive(), CurvedDrive()).alignment_note, "");
+  // Sim3 on a line: the scale from the spreads, the rotation from the orientations.
+  EvaluationOptions sim3;
+  sim3.alignment = Alignment::kSim3;
+  const Evaluation scaled = EvaluateTrajectory(Transformed(reference, SE3d(), 0.8), reference, sim3);
+  EXPECT_NEAR(scaled.scale, 1.25, 1e-9);
+  EXPECT_LT(scaled.ate_translation.max, 1e-9);
+}
+
 TEST(Evaluation, MatchesPosesByTime) {
   const Trajectory reference = StraightDrive(30);
   Trajectory shifted;

@@ -306,6 +306,38 @@ TEST_F(HostileInput, StagedFoldersReplaceTheOldResultsWhole) {
   EXPECT_EQ(entries, 0u) << "a staging folder was left";
 }
 
+// A results folder that is replaced keeps what the user set on it (mode,
+// setgid), loses the earlier run's files that describe its outputs
+// (superseded), and is never the root or a shared (sticky) folder.
+TEST_F(HostileInput, StagedFoldersKeepTheFoldersModeAndDropSupersededFiles) {
+  namespace fs = std::filesystem;
+  const std::string out = Path("kept");
+  fs::create_directories(out);
+  WriteFile("kept/evaluation.json", "{\"an\": \"earlier run\"}");
+  WriteFile("kept/notes.txt", "the user's");
+  for (const mode_t mode : {mode_t(0700), mode_t(02750), mode_t(0755)}) {
+    ASSERT_EQ(::chmod(out.c_str(), mode), 0);
+    StagedFolder folder(out, {"evaluation.json", "evaluation.md"});
+    WriteFileAtomically(folder.path() + "/odometry.tum", [](std::ostream& o) { o << "0 0 0 0 0 0 0 1\n"; });
+    folder.Commit();
+    struct stat status {};
+    ASSERT_EQ(::stat(out.c_str(), &status), 0);
+    EXPECT_EQ(status.st_mode & 07777, mode) << std::oct << mode;
+  }
+  EXPECT_FALSE(fs::exists(Path("kept/evaluation.json"))) << "an earlier run's evaluation beside a new trajectory";
+  EXPECT_TRUE(fs::exists(Path("kept/notes.txt")));
+  EXPECT_TRUE(fs::exists(Path("kept/odometry.tum")));
+  const std::string shared = Path("shared");
+  fs::create_directories(shared);
+  ASSERT_EQ(::chmod(shared.c_str(), 01777), 0);
+  EXPECT_EQ(ErrorOf([&] { StagedFolder folder(shared); }),
+            shared + ": is a shared folder (sticky bit, as /tmp); name a folder of its own inside it");
+  EXPECT_EQ(ErrorOf([&] { StagedFolder folder("/tmp"); }),
+            "/tmp: is a shared folder (sticky bit, as /tmp); name a folder of its own inside it");
+  EXPECT_EQ(ErrorOf([&] { StagedFolder folder("/"); }), "/: is the root folder; refused as an output folder");
+  EXPECT_EQ(ErrorOf([&] { StagedFolder folder(shared + "/mine"); }), "") << "a folder of its own inside it";
+}
+
 TEST(HostileIndex, BlursAndCellsBeyondTheirBoundsAreRefusedAtOnce) {
   GaussianMap map;
   map.gaussians = {RoundGaussian(Eigen::Vector3d::Zero(), 0.3)};

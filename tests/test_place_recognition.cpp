@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Place recognition: a yaw-rotated, shifted and noisy copy of a place
-// retrieves that place among others with the yaw within one sector (Scan
+// retrieves that place among others with the yaw the sector multiple nearest it (Scan
 // Context, each channel) or one angle step up to pi (the Radon descriptor);
 // verification recovers a planted relative pose and refuses another place.
 #include <gtest/gtest.h>
@@ -77,14 +77,15 @@ TEST(ScanContext, RotatedCopyRetrievesThePlaceWithItsYaw) {
         }
       }
       EXPECT_EQ(best, 3) << "yaw " << yaw << ", channel " << int(channel);
-      EXPECT_LE(AngleBetween(best_match.yaw, yaw), sector) << "yaw " << yaw << ", channel " << int(channel);
+      // The sector multiple nearest the yaw (measured within 0.40 sector): one sector off fails.
+      EXPECT_LE(AngleBetween(best_match.yaw, yaw), 0.5 * sector) << "yaw " << yaw << ", channel " << int(channel);
       EXPECT_LT((query.ring_key - places[3].ring_key).norm(), 0.35);
     }
   }
 }
 
-// A query turned by k sectors, without a shift: the yaw is k sectors and the
-// aligned distance small.
+// A query turned by k sectors, without a shift: the yaw is exactly k sectors
+// and the aligned distance small.
 TEST(ScanContext, ExactSectorTurnGivesItsShift) {
   ScanContextOptions options;
   const std::vector<RadarPoint> place = RandomPlace(5);
@@ -93,7 +94,7 @@ TEST(ScanContext, ExactSectorTurnGivesItsShift) {
   for (const int k : {1, 7, 30, 59}) {
     const ScanContext query = MakeScanContext(SeenFrom(place, k * sector, Eigen::Vector3d::Zero(), 3), options);
     const ScanContextMatch match = CompareScanContexts(query, candidate, options);
-    EXPECT_LE(AngleBetween(match.yaw, k * sector), sector) << k;
+    EXPECT_LT(AngleBetween(match.yaw, k * sector), 1e-9) << k;  // the very shift: one sector off fails
     EXPECT_LT(match.distance, 0.1) << k;
   }
 }

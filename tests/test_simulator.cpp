@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <sstream>
 
 #include "radargauss/error.hpp"
 #include "radargauss/io/pcd.hpp"
@@ -190,6 +191,41 @@ TEST_F(SimulatorFiles, ConfigFileOverridesAndValidates) {
   expect_error("materials: {glass: {diffuse: 1}}\n", "unknown material");
   expect_error("scans: [1, 2\n", "YAML");
   EXPECT_THROW(LoadSimulationConfig(Path("absent.yaml")), DataError);
+}
+
+// Every number of the configuration is bounded: 1e300 and -1e300 in any key
+// are refused naming that key, and the largest accepted magnitudes (noise
+// growth, traffic and ego speeds, noise) still simulate scans that the
+// readers accept (Simulate validates every scan it returns).
+TEST_F(SimulatorFiles, EveryNumberIsBoundedAndTheBoundsSimulate) {
+  std::istringstream defaults(SimulationConfigToYaml(SimulationConfig{}));
+  std::size_t keys = 0;
+  for (std::string line; std::getline(defaults, line) && line != "materials:";) {
+    const std::string key = line.substr(0, line.find(':'));
+    if (key == "scene") continue;
+    for (const char* huge : {"1e300", "-1e300"}) {
+      const std::string path = WriteFile("huge.yaml", key + ": " + huge + "\n");
+      try {
+        LoadSimulationConfig(path);
+        ADD_FAILURE() << key << ": " << huge << " accepted";
+      } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+      }
+    }
+    ++keys;
+  }
+  EXPECT_GT(keys, 40u);
+  SimulationConfig config;
+  config.scene = "motorway";
+  config.scans = 3;
+  config.elevation_noise_growth = 100.0;
+  config.traffic_min_speed = config.traffic_max_speed = 150.0;
+  config.speed = 150.0;
+  config.doppler_noise = config.range_noise = 100.0;
+  config.rcs_noise_db = 200.0;
+  const SimulatedSequence sequence = Simulate(config);
+  ASSERT_EQ(sequence.scans.size(), 3u);
+  for (const RadarScan& scan : sequence.scans) EXPECT_NO_THROW(ValidateScan(scan, "scan"));
 }
 
 TEST(Simulator, TimestampStems) {

@@ -29,8 +29,9 @@ int RunEvaluate(const EvaluateSettings& s) {
     WriteEvaluation(folder.path(), evaluation);
     folder.Commit();
   }
-  std::printf("%zu poses paired, reference path %.1f m, %s alignment (scale %.4f)\n", evaluation.matched,
-              evaluation.path_length, s.alignment.c_str(), evaluation.scale);
+  std::printf("%zu poses paired, reference path %.1f m, %s alignment (scale %.4f)%s%s\n", evaluation.matched,
+              evaluation.path_length, s.alignment.c_str(), evaluation.scale,
+              evaluation.alignment_note.empty() ? "" : "; ", evaluation.alignment_note.c_str());
   std::printf("ATE translation: RMSE %.3f m, mean %.3f, median %.3f, max %.3f\n", evaluation.ate_translation.rmse,
               evaluation.ate_translation.mean, evaluation.ate_translation.median, evaluation.ate_translation.max);
   std::printf("ATE rotation: RMSE %.3f deg, mean %.3f, median %.3f, max %.3f\n", evaluation.ate_rotation.rmse,

@@ -25,6 +25,12 @@ std::string ToString(Alignment alignment);
 Alignment AlignmentFromString(const std::string& name);  // throws std::invalid_argument
 std::vector<std::string> AlignmentNames();
 
+// Reference positions whose second principal spread is below this share of
+// the first lie on a line: they leave the rotation about it free, and kSe3 /
+// kSim3 take their rotation from the orientations instead (the mean of
+// R_ref R_est^T projected on SO(3)).
+inline constexpr double kThinTrajectory = 0.01;
+
 struct EvaluationOptions {
   Alignment alignment = Alignment::kSe3;
   double time_tolerance = 0.02;  // s: an estimate pairs with the reference sample nearest in time within this
@@ -49,6 +55,7 @@ struct Evaluation {
   double path_length = 0.0;         // m, of the matched reference poses
   SE3d alignment;                   // applied to the estimate: T_ref_est
   double scale = 1.0;               // kSim3's scale (1 otherwise)
+  std::string alignment_note;       // how the alignment was found when not as asked (empty: as asked)
   ErrorStatistics ate_translation;  // m
   ErrorStatistics ate_rotation;     // deg
   std::vector<SegmentDrift> rpe;    // per segment fraction

@@ -117,6 +117,7 @@ void BindMatch(py::module_& m) {
         py::dict out;
         out["matched"] = e.matched;
         out["path_length_m"] = e.path_length;
+        out["alignment_note"] = e.alignment_note;
         out["ate_translation_m"] = StatisticsToDict(e.ate_translation);
         out["ate_rotation_deg"] = StatisticsToDict(e.ate_rotation);
         out["rpe"] = DriftToDict(e.rpe_mean);

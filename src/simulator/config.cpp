@@ -159,8 +159,10 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
   require(c.poles >= 0 && c.parked_cars >= 0 && c.moving_cars >= 0, "object counts must be >= 0");
   require(std::abs(c.elevation_bias_deg) < c.elevation_fov_deg, "elevation_bias_deg must be within the field of view");
   require(c.elevation_noise_growth >= 0.0, "elevation_noise_growth must be >= 0");
-  for (const double angle : {c.mounting_roll_deg, c.mounting_pitch_deg, c.mounting_yaw_deg}) {
-    require(std::abs(angle) <= 45.0, "mounting angles must be within +/-45 deg");
+  for (const auto& [key, angle] : {std::pair<const char*, double>{"mounting_roll_deg", c.mounting_roll_deg},
+                                   {"mounting_pitch_deg", c.mounting_pitch_deg},
+                                   {"mounting_yaw_deg", c.mounting_yaw_deg}}) {
+    require(std::abs(angle) <= 45.0, std::string(key) + " must be within +/-45 deg");
   }
   require(c.rcs_swerling == 0 || c.rcs_swerling == 1 || c.rcs_swerling == 3, "rcs_swerling must be 0, 1 or 3");
   require(c.multipath_probability >= 0.0 && c.multipath_probability <= 1.0,
