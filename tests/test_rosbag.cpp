@@ -16,7 +16,7 @@ namespace radargauss {
 namespace {
 
 using testing::SharedData;
-using BagFiles = testing::TempDirTest;
+using RosbagRealDataFiles = testing::TempDirTest;  // cases on the real bag
 constexpr const char* kBag = "ti_mmwave_demo/demo_ti_mmwave_rospkg_format.bag";
 constexpr const char* kTopic = "/ti_mmwave/radar_scan_pcl";
 
@@ -121,7 +121,7 @@ TEST(RosbagRealData, TiMmwaveDemoBag) {
   EXPECT_EQ(LoadSequence(options).scans.size(), 412u);
 }
 
-TEST_F(BagFiles, BadBagsAndTopicsGiveErrors) {
+TEST_F(RosbagRealDataFiles, BadBagsAndTopicsGiveErrors) {
   if (!RosbagSupported()) GTEST_SKIP() << "built without ROS1 bag support";
   const std::string bag = SharedData(kBag);
   if (bag.empty()) GTEST_SKIP() << "shared data not found";

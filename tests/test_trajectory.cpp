@@ -158,7 +158,7 @@ TEST(Trajectory, RightMultipliedAppliesExtrinsic) {
 }
 
 // The NTU Eagle sample's recommended ground truth (see shared/data).
-TEST(Trajectory, ReadsNtuGroundTruth) {
+TEST(TrajectoryRealData, ReadsNtuGroundTruth) {
   const fs::path path =
       fs::path(RADARGAUSS_SHARED_DATA_DIR) / "ntu4dradlm_loop1_eagle" / "gt_tum.txt";
   if (!fs::exists(path)) GTEST_SKIP() << "shared data not found at " << path;

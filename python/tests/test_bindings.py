@@ -178,6 +178,22 @@ def test_help_explains_the_arguments():
     assert "initial" in rg.match.__doc__ and "w_rcs" in rg.match.__doc__ and "solver" in rg.match.__doc__
 
 
+def aligned_first_pose(drive, stamps, poses):
+    """T_world_map: the SE(3) alignment of SLAM's trajectory to the drive's
+    truth, found as rg.evaluate finds it (Umeyama on the paired positions)."""
+    truth = dict(zip(drive.stamps, drive.poses[:, :3]))
+    p = np.array(poses[:, :3])
+    q = np.array([truth[t] for t in stamps])
+    p_mean, q_mean = p.mean(axis=0), q.mean(axis=0)
+    u, _, vt = np.linalg.svd((q - q_mean).T @ (p - p_mean))
+    d = np.diag([1.0, 1.0, np.sign(np.linalg.det(u @ vt))])
+    rotation = u @ d @ vt
+    pose = np.eye(4)
+    pose[:3, :3] = rotation
+    pose[:3, 3] = q_mean - rotation @ p_mean
+    return pose
+
+
 def test_slam_closes_the_yard_and_relocalizes_a_second_run(tmp_path):
     yard = ("loop_length: 60\nloop_width: 30\ncorner_radius: 8\npoles: 12\nparked_cars: 8\nmoving_cars: 1\n"
             "min_detections: 150\nmax_detections: 300\nmax_range: 60\n")
@@ -200,6 +216,21 @@ def test_slam_closes_the_yard_and_relocalizes_a_second_run(tmp_path):
     assert relocalizer.first_fix is not None and relocalizer.first_fix < 60
     assert all(step["pose"] is None for step in steps[:relocalizer.first_fix])
     assert steps[relocalizer.first_fix]["fixed"] and steps[relocalizer.first_fix]["pose"].shape == (4, 4)
+    # Against the truth: the map's frame is SLAM's, T_world_map the alignment of
+    # its trajectory to the first drive's truth (as tests/test_slam.cpp); every
+    # reported pose within 1 m, the first fix within 0.5 m and 2.5 deg.
+    stamps, poses = slam.trajectory()
+    map_in_world = rg.pose_matrix(aligned_first_pose(drive, stamps, poses))
+    truth = dict(zip(second.stamps, second.poses_matrix))
+    for k, step in enumerate(steps):
+        if not step["fixed"]:
+            continue
+        error = np.linalg.inv(map_in_world @ step["pose"]) @ truth[step["stamp"]]
+        limit = 0.5 if k == relocalizer.first_fix else 1.0
+        assert np.linalg.norm(error[:3, 3]) < limit, (k, error[:3, 3])
+        if k == relocalizer.first_fix:
+            angle = np.degrees(np.arccos(np.clip((np.trace(error[:3, :3]) - 1.0) / 2.0, -1.0, 1.0)))
+            assert angle < 2.5, angle
     with pytest.raises(ValueError, match="unknown place descriptor"):
         rg.RadarSlam(descriptor="sift")
     with pytest.raises(ValueError, match="unknown graph initialization"):
