@@ -3,6 +3,7 @@
 
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <cstdio>
 #include <cstring>
@@ -17,6 +18,7 @@
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/simulator.hpp"
+#include "radargauss/slam/place_recognition.hpp"
 #include "radargauss/trajectory.hpp"
 
 namespace radargauss::fuzz {
@@ -69,6 +71,30 @@ void MapFile(const std::uint8_t* data, std::size_t size) {
     const GaussianMap map = ReadMap(path);
     const GaussianIndex index(map.gaussians);
     for (const Gaussian& g : map.gaussians) index.Associate(g.mean, 9.0);
+  });
+}
+
+// A map whose CRC this entry point writes (the input's last four bytes are
+// replaced), so that the fuzzer reaches the places section that the CRC
+// hides from map_file; every place that reads is described by both
+// descriptors, as the relocaliser describes them.
+void MapPlaces(const std::uint8_t* data, std::size_t size) {
+  if (size < 4) return;
+  std::string bytes(reinterpret_cast<const char*>(data), size);
+  const std::uint32_t crc = std::uint32_t(
+      crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), uInt(bytes.size() - 4)));
+  std::memcpy(&bytes[bytes.size() - 4], &crc, 4);
+  const std::string path =
+      WriteInput(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size(), "places.rgm");
+  Expecting([&] {
+    const GaussianMap map = ReadMap(path);
+    PlaceRecognitionOptions options;
+    for (const PlaceDescriptorKind kind : {PlaceDescriptorKind::kScanContext, PlaceDescriptorKind::kRadon}) {
+      options.descriptor = kind;
+      for (const MapPlace& place : map.places) {
+        KeyOnly(Describe(DownsampleSubmap(place.points, options.submap_voxel), options));
+      }
+    }
   });
 }
 
@@ -151,7 +177,7 @@ const std::vector<Target>& Targets() {
   static const std::vector<Target> targets = {
       {"pcd", Pcd},         {"kitti_bin", KittiBin},           {"tum", Tum},          {"map_file", MapFile},
       {"pointcloud2", PointCloud2}, {"simulator_yaml", SimulatorYaml}, {"cli_yaml", CliYaml},
-      {"shard_json", ShardJson}};
+      {"shard_json", ShardJson}, {"map_places", MapPlaces}};
   return targets;
 }
 

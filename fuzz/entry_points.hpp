@@ -22,7 +22,7 @@ struct Target {
 };
 
 // pcd, kitti_bin, tum, map_file, pointcloud2, simulator_yaml, cli_yaml,
-// shard_json.
+// shard_json, map_places.
 const std::vector<Target>& Targets();
 
 }  // namespace radargauss::fuzz

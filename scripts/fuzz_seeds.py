@@ -89,6 +89,27 @@ def map_bytes(gaussians, incidence=1):
     return body + struct.pack("<I", zlib.crc32(body) & 0xFFFFFFFF)
 
 
+def places_map_bytes(gaussians, places):
+    """A version-2 .rgm with places (pose, then points x y z rcs as float32)."""
+    body = map_bytes(gaussians)[:-4]
+    body = body[:8] + struct.pack("<I", 2) + body[12:]
+    body += struct.pack("<Q", len(places))
+    for (x, y, yaw), points in places:
+        body += struct.pack("<4d3dQ", 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2), x, y, 0.0, len(points))
+        for point in points:
+            body += struct.pack("<4f", *point)
+    return body + struct.pack("<I", zlib.crc32(body) & 0xFFFFFFFF)
+
+
+def map_places_seeds(rng):
+    gaussians = [((rng.uniform(-20, 20), rng.uniform(-20, 20), rng.uniform(0, 3)),
+                  (0.3, 0.01, 0.0, 0.2, 0.0, 0.05), 0) for _ in range(3)]
+    place = [(rng.uniform(-40, 40), rng.uniform(-40, 40), rng.uniform(0, 2), rng.uniform(-10, 20)) for _ in range(40)]
+    yield "two_places.rgm", places_map_bytes(gaussians, [((0.0, 0.0, 0.0), place), ((10.0, 2.0, 0.3), place[:7])])
+    yield "empty_place.rgm", places_map_bytes(gaussians, [((0.0, 0.0, 0.0), [])])
+    yield "far_points.rgm", places_map_bytes(gaussians, [((5.0, 5.0, 1.0), place[:5] + [(9e4, -9e4, 0.0, 1.0)])])
+
+
 def map_seeds(rng):
     gaussians = [((rng.uniform(-20, 20), rng.uniform(-20, 20), rng.uniform(0, 3)),
                   (0.3, 0.01, 0.0, 0.2, 0.0, 0.05), rng.choice([-1, 0, 2])) for _ in range(6)]
@@ -151,7 +172,7 @@ def main():
         "pcd": pcd_seeds(rng), "kitti_bin": kitti_seeds(rng), "tum": tum_seeds(rng), "map_file": map_seeds(rng),
         "pointcloud2": pointcloud2_seeds(rng), "simulator_yaml": files("configs/synthetic_world.yaml", "configs/synthetic_long_drive.yaml"),
         "cli_yaml": files("configs/*_localize.yaml", "configs/*_odometry.yaml"),
-        "shard_json": shard_json_seeds(rng),
+        "shard_json": shard_json_seeds(rng), "map_places": map_places_seeds(rng),
     }
     for target, items in seeds.items():
         folder = os.path.join(sys.argv[1], target)
