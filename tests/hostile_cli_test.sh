@@ -215,7 +215,19 @@ expect_fail "relocalize on a map without Gaussians" "placesonly.rgm: the map has
 # earlier run's evaluation does not stay beside a new trajectory.
 expect_fail "odometry into the sequence's folder" "seq: is the sequence's own folder" -- \
   "$tool" odometry "${seq[@]}" --out "$work/seq"
-expect_fail "odometry into /tmp" "/tmp: is a shared folder" -- "$tool" odometry "${seq[@]}" --out /tmp
+mkdir -p "$work/shared" && chmod 1777 "$work/shared"
+"$tool" build-map "${seq[@]}" --out "$work/shared_map.rgm" >/dev/null
+for args in "odometry" "slam" "relocalize --map $work/slam/map.rgm" "localize --map $work/shared_map.rgm" \
+  "refine --poses $work/seq/gt_radar_tum.txt --extrinsic identity --map $work/shared_map.rgm"; do
+  read -r -a command <<<"$args"
+  expect_fail "${command[0]} into a sticky shared folder" "shared: is a shared folder (sticky bit" -- \
+    "$tool" "${command[@]}" "${seq[@]}" --out "$work/shared"
+done
+expect_fail "evaluate into a sticky shared folder" "shared: is a shared folder (sticky bit" -- \
+  "$tool" evaluate --est "$work/seq/gt_radar_tum.txt" --ref "$work/seq/gt_radar_tum.txt" --out "$work/shared"
+expect_fail "simulate into a sticky shared folder" "shared: is a shared folder (sticky bit" -- \
+  "$tool" simulate --scans 2 --out "$work/shared"
+[ -z "$(ls -A "$work/shared")" ] || { echo "FAIL: a refused run wrote into the shared folder"; failed=$((failed + 1)); }
 mkdir -p "$work/private" && chmod 0700 "$work/private"
 "$tool" slam "${seq[@]}" --submap-distance 2 --out "$work/private" >/dev/null
 [ -e "$work/private/evaluation.json" ] || { echo "FAIL: slam --gt wrote no evaluation"; failed=$((failed + 1)); }
