@@ -2,16 +2,22 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # End-to-end checks of the radargauss command-line tool: good runs work, bad
 # input gives a one-line error on stderr and a non-zero exit.
-#   cli_test.sh <path to radargauss> [optional]
+#   cli_test.sh <path to radargauss> [pcl|bag]
 set -u
 tool=$1
 source "$(dirname "${BASH_SOURCE[0]}")/cli_expect.sh"
 
-# The cases on optional parts (PCL, the ROS1 bag reader, the TI bag of
-# ../shared) run as a test of their own, "optional", which exits with 77
-# (ctest: skipped) when one of them is absent.
-if [ "${2:-}" = optional ]; then
-  skipped=0
+# The cases on optional parts run as tests of their own: "pcl" (the PCL
+# peers) and "bag" (the ROS1 bag reader and the TI bag of ../shared); each
+# exits with 77 (ctest: skipped) when its part is absent.
+skipped=0
+finish_section() {
+  echo "cli, $1: $passed passed, $failed failed, $skipped skipped"
+  [ "$failed" -eq 0 ] || exit 1
+  [ "$skipped" -eq 0 ] || exit 77
+  exit 0
+}
+if [ "${2:-}" = pcl ]; then
   "$tool" simulate --out "$work/seq10" --scans 10 >/dev/null
   if "$tool" odometry --sequence "$work/seq10" --matcher pcl-gicp --max-scans 2 --out "$work/odometry_probe" \
        2>&1 | grep -q "RADARGAUSS_WITH_PCL"; then
@@ -20,6 +26,9 @@ if [ "${2:-}" = optional ]; then
     expect_ok "odometry with PCL GICP as the loop's matcher" "wrote $work/odometry_gicp" -- \
       "$tool" odometry --sequence "$work/seq10" --matcher pcl-gicp --out "$work/odometry_gicp"
   fi
+  finish_section pcl
+fi
+if [ "${2:-}" = bag ]; then
   ti_bag="$(cd "$(dirname "$0")/.." && pwd)/../shared/data/ti_mmwave_demo/demo_ti_mmwave_rospkg_format.bag"
   if [[ -f "$ti_bag" ]] && "$tool" info --bag "$ti_bag" >/dev/null 2>&1; then
     expect_ok "odometry on the TI bag with its IMU" "wrote $work/ti" -- \
@@ -37,10 +46,7 @@ if [ "${2:-}" = optional ]; then
   else
     echo "skipped: the TI mmWave bag or ROS1 bag support is absent"; skipped=$((skipped + 1))
   fi
-  echo "cli, optional parts: $passed passed, $failed failed, $skipped skipped"
-  [ "$failed" -eq 0 ] || exit 1
-  [ "$skipped" -eq 0 ] || exit 77
-  exit 0
+  finish_section bag
 fi
 
 expect_fail "no subcommand" "subcommand" -- "$tool"
