@@ -201,9 +201,10 @@ class JointProblem {
 void CheckCoverage(std::size_t associated, std::size_t points, double min_share) {
   const double share = points ? double(associated) / double(points) : 0.0;
   if (share < min_share) {
-    char text[200];
+    char text[240];
     std::snprintf(text, sizeof(text), "%.1f %% of the scans' points lie near the map at their poses (at least %.0f %% "
-                  "needed): a map of another sequence, or poses in another frame?", 100.0 * share, 100.0 * min_share);
+                  "needed, --min-associated-share): a map of another sequence, or poses in another frame?",
+                  100.0 * share, 100.0 * min_share);
     throw DataError(text);
   }
 }
