@@ -202,8 +202,8 @@ void CheckCoverage(std::size_t associated, std::size_t points, double min_share)
   const double share = points ? double(associated) / double(points) : 0.0;
   if (share < min_share) {
     char text[240];
-    std::snprintf(text, sizeof(text), "%.1f %% of the scans' points lie near the map at their poses (at least %.0f %% "
-                  "needed, --min-associated-share): a map of another sequence, or poses in another frame?",
+    std::snprintf(text, sizeof(text), "%.1f %% of the scans' points lie near the map at their poses "
+                  "(--min-associated-share: %.0f %%): a map of another sequence, or poses in another frame?",
                   100.0 * share, 100.0 * min_share);
     throw DataError(text);
   }
