@@ -20,6 +20,21 @@ includes=$(grep -o 'INTERFACE_INCLUDE_DIRECTORIES "[^"]*"' "$targets")
 if [ "$includes" != 'INTERFACE_INCLUDE_DIRECTORIES "${_IMPORT_PREFIX}/include"' ]; then
   echo "FAIL: installed include path is $includes"; exit 1
 fi
+# Only the public headers: none of RADARGAUSS_INTERNAL_HEADERS, and every
+# radargauss/ include of an installed header names an installed file.
+/usr/bin/python3 - "$source" "$prefix/include" <<'PY' || exit 1
+import pathlib, re, sys
+source, installed = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+listed = re.search(r"set\(RADARGAUSS_INTERNAL_HEADERS([^)]*)\)", (source / "CMakeLists.txt").read_text()).group(1).split()
+headers = sorted(installed.rglob("*.hpp"))
+problems = ["installed: " + name for name in listed if (installed / "radargauss" / name).exists()]
+for header in headers:
+    for name in re.findall(r'^\s*#\s*include\s+"(radargauss/[^"]+)"', header.read_text(), re.M):
+        if not (installed / name).exists():
+            problems.append("%s includes %s, which is not installed" % (header.relative_to(installed), name))
+print("\n".join(problems) or "installed headers: %d, none internal, every include resolves" % len(headers))
+sys.exit(1 if problems or len(listed) < 5 else 0)
+PY
 cmake -S "$source/examples" -B "$work/examples" -DCMAKE_PREFIX_PATH="$prefix" \
   -DCMAKE_BUILD_TYPE=Release >"$work/configure.log"
 cmake --build "$work/examples" -j 2 >"$work/build.log" || { cat "$work/build.log"; exit 1; }

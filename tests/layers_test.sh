@@ -28,6 +28,14 @@ fi
 grep -qF "$expect" "$tmp/planted.log" || { cat "$tmp/planted.log"; echo "FAIL: not named: $expect"; exit 1; }
 
 cp "$root/include/radargauss/map/gaussian_map.hpp" "$planted"
+# An include that resolves only through a link the build would make.
+sed -i '/#pragma once/a #include "radargauss/solvers/gauss_newton_linked.hpp"' "$planted"
+expect="include/radargauss/map/gaussian_map.hpp: includes radargauss/solvers/gauss_newton_linked.hpp, which names no file"
+if $check "$tmp/copy" > "$tmp/planted.log"; then
+  echo "FAIL: an include of no file passed"; exit 1
+fi
+grep -qF "$expect" "$tmp/planted.log" || { cat "$tmp/planted.log"; echo "FAIL: not named: $expect"; exit 1; }
+cp "$root/include/radargauss/map/gaussian_map.hpp" "$planted"
 echo '// SPDX-License-Identifier: BSD-3-Clause' > "$tmp/copy/include/radargauss/stray.hpp"
 if $check "$tmp/copy" > "$tmp/stray.log"; then
   echo "FAIL: a file in no layer passed"; exit 1
