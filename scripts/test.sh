@@ -30,8 +30,9 @@ RADARGAUSS_DEPS_EXTRA="librosbag-storage-dev libsensor-msgs-dev libpcl-dev pytho
   ${RADARGAUSS_DEPS_EXTRA:-}" \
   "$root/scripts/deps.sh"
 
-# The product's own rules: file and function lengths, README and RESULTS
-# lengths, no narrative of the work, design citations that resolve.
+# The product's own rules: no narrative of the work, design citations and
+# includes that resolve, the layers; lengths of files, functions, README and
+# RESULTS as warnings.
 /usr/bin/python3 "$root/scripts/check_sources.py" "$root"
 
 for tree in $trees; do
