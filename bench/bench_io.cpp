@@ -48,16 +48,20 @@ void BM_ReadPcd(benchmark::State& state, PcdFormat format, const char* name) {
 }
 BENCHMARK_CAPTURE(BM_ReadPcd, ascii, PcdFormat::kAscii, "scan_ascii.pcd");
 BENCHMARK_CAPTURE(BM_ReadPcd, binary, PcdFormat::kBinary, "scan_binary.pcd");
-BENCHMARK_CAPTURE(BM_ReadPcd, binary_compressed, PcdFormat::kBinaryCompressed,
-                  "scan_compressed.pcd");
+BENCHMARK_CAPTURE(BM_ReadPcd, binary_compressed, PcdFormat::kBinaryCompressed, "scan_compressed.pcd");
 
 void BM_ReadKittiBin(benchmark::State& state) {
   const std::string path = BenchmarkFile("scan.bin");
   {
     std::ofstream out(path, std::ios::binary);
     for (const RadarPoint& p : BenchmarkScan().points) {
-      const float record[7] = {float(p.position.x()), float(p.position.y()), float(p.position.z()),
-                               float(p.rcs), float(p.doppler), 0.0f, 0.0f};
+      const float record[7] = {float(p.position.x()),
+                               float(p.position.y()),
+                               float(p.position.z()),
+                               float(p.rcs),
+                               float(p.doppler),
+                               0.0f,
+                               0.0f};
       out.write(reinterpret_cast<const char*>(record), sizeof(record));
     }
   }
@@ -74,8 +78,7 @@ BENCHMARK(BM_ReadKittiBin);
 
 // The whole TI mmWave demo bag (412 messages, 17,872 points), when present.
 void BM_ReadBag(benchmark::State& state) {
-  const std::string bag = std::string(RADARGAUSS_SHARED_DATA_DIR) +
-                          "/ti_mmwave_demo/demo_ti_mmwave_rospkg_format.bag";
+  const std::string bag = std::string(RADARGAUSS_SHARED_DATA_DIR) + "/ti_mmwave_demo/demo_ti_mmwave_rospkg_format.bag";
   if (!RosbagSupported() || !fs::exists(bag)) {
     state.SkipWithError("no ROS1 bag support or no shared data");
     return;

@@ -31,9 +31,10 @@ void BM_JointRefinement(benchmark::State& state) {
   for (std::size_t k = 0; k < n; ++k) {
     scans.push_back(world.drive.scans[k * stride]);
     const SE3d& truth = world.drive.ground_truth[k * stride].pose;
-    poses.push_back(k == 0 ? truth
-                           : SE3d(truth.rotation() * SO3d::Exp(0.005 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng))),
-                                  truth.translation() + 0.1 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng))));
+    poses.push_back(
+        k == 0 ? truth
+               : SE3d(truth.rotation() * SO3d::Exp(0.005 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng))),
+                      truth.translation() + 0.1 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng))));
   }
   JointRefinementOptions options;
   options.matching.w_rcs = 0.25;

@@ -33,8 +33,8 @@ MapCloud TownCloud(std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t w = i % walls;
     const Eigen::Vector3d normal(-along[w].y(), along[w].x(), 0.0);
-    cloud.points.push_back(origin[w] + 10.0 * unit(rng) * along[w] +
-                           Eigen::Vector3d(0, 0, 5.0 * unit(rng)) + noise(rng) * normal);
+    cloud.points.push_back(origin[w] + 10.0 * unit(rng) * along[w] + Eigen::Vector3d(0, 0, 5.0 * unit(rng)) +
+                           noise(rng) * normal);
     cloud.rcs.push_back(5.0 + 3.0 * std::sin(7.0 * unit(rng)) + noise(rng) * 20.0);
     cloud.scan.push_back(std::uint32_t(rng() % cloud.poses.size()));
   }

@@ -27,24 +27,20 @@ void BM_MatchScan(benchmark::State& state) {
   const SimulatedSequence& scans = world.scans.at(int(state.range(0)));
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(2)) / 100.0;
-  MatchScans(state, *Solver(int(state.range(1)), options), *world.matching, scans, InitialPoses(scans),
-             options.w_rcs);
+  MatchScans(state, *Solver(int(state.range(1)), options), *world.matching, scans, InitialPoses(scans), options.w_rcs);
 }
-BENCHMARK(BM_MatchScan)
-    ->ArgsProduct({{150, 800, 4000}, {0, 1, 2}, {0, 25}})
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MatchScan)->ArgsProduct({{150, 800, 4000}, {0, 1, 2}, {0, 25}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MatchScan)->Args({800, 3, 0})->Args({800, 3, 25})->Unit(benchmark::kMillisecond);
 
 // Matches the 800-point scans on the map with merged coarse levels
 // (CoarseLevels::kMerged) and the coarse gate `coarse_gate_x10` / 10 from the
 // paper's errors, one thread.
-void MatchScansMerged(benchmark::State& state, int solver, const ScanMatchingOptions& options,
-                      int coarse_gate_x10) {
+void MatchScansMerged(benchmark::State& state, int solver, const ScanMatchingOptions& options, int coarse_gate_x10) {
   const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const MatchingWorld& world = World();
   const SimulatedSequence& scans = world.scans.at(800);
-  MatchScans(state, *Solver(solver, options), *world.merged_matching.at(coarse_gate_x10), scans,
-             InitialPoses(scans), options.w_rcs);
+  MatchScans(state, *Solver(solver, options), *world.merged_matching.at(coarse_gate_x10), scans, InitialPoses(scans),
+             options.w_rcs);
 }
 
 // Args: solver (0 gn, 2 ceres), w_rcs x 100, coarse_points, coarse gate x 10,
@@ -215,8 +211,8 @@ void ReportPaired(benchmark::State& state, const PairedRuns& runs, const std::st
 }
 
 // Ceres LM against the own GN when tracking, paired (MatchPaired): the
-// medians of their per-scan times and the ratio of the medians. Args: w_rcs x 100, Ceres's blocks (0 square root, the default;
-// 1 shared rows; 2 a block per term).
+// medians of their per-scan times and the ratio of the medians. Args: w_rcs x 100, Ceres's blocks (0 square root, the
+// default; 1 shared rows; 2 a block per term).
 void BM_RefineScanCeresOverGn(benchmark::State& state) {
   const Tracking tracking;
   ScanMatchingOptions options;
@@ -228,8 +224,8 @@ void BM_RefineScanCeresOverGn(benchmark::State& state) {
   const CeresSolver ceres(options, ceres_options);
   const PairedRuns runs =
       MatchPaired(state, *Solver(0, options), ceres, tracking.exact, tracking.scans, tracking.initial);
-  state.SetLabel("ceres (" + std::string(block_names[state.range(1)]) + ") / gn, w=" +
-                 std::to_string(options.w_rcs).substr(0, 4));
+  state.SetLabel("ceres (" + std::string(block_names[state.range(1)]) +
+                 ") / gn, w=" + std::to_string(options.w_rcs).substr(0, 4));
   ReportPaired(state, runs, "gn", "ceres");
   state.counters["ratio"] = Median(runs.times[1]) / Median(runs.times[0]);
 }
@@ -246,8 +242,8 @@ void BM_MatchScanCeresOverGn(benchmark::State& state) {
   const MatchingMap& map = merged ? *world.merged_matching.at(30) : *world.matching;
   ScanMatchingOptions options;
   options.w_rcs = double(state.range(0)) / 100.0;
-  const PairedRuns runs = MatchPaired(state, *Solver(0, options), *Solver(2, options), map, tracking.scans,
-                                      InitialPoses(tracking.scans));
+  const PairedRuns runs =
+      MatchPaired(state, *Solver(0, options), *Solver(2, options), map, tracking.scans, InitialPoses(tracking.scans));
   state.SetLabel(std::string("ceres / gn, ") + (merged ? "merged" : "inflated") +
                  ", w=" + std::to_string(options.w_rcs).substr(0, 4));
   ReportPaired(state, runs, "gn", "ceres");

@@ -24,12 +24,11 @@ namespace radargauss {
 
 struct MatchingWorld {
   GaussianMap map;
-  std::unique_ptr<MatchingMap> matching;         // inflated coarse levels
+  std::unique_ptr<MatchingMap> matching;                        // inflated coarse levels
   std::map<int, std::unique_ptr<MatchingMap>> merged_matching;  // merged coarse levels, by coarse gate x 10
-  std::map<int, SimulatedSequence> scans;  // by detections per scan
-  SimulatedSequence drive;                 // the 1000-scan drive of the map
+  std::map<int, SimulatedSequence> scans;                       // by detections per scan
+  SimulatedSequence drive;                                      // the 1000-scan drive of the map
 };
-
 
 inline const MatchingWorld& World() {
   static const MatchingWorld* world = [] {
@@ -79,7 +78,6 @@ inline std::vector<SE3d> TrackingPoses(const SimulatedSequence& sequence) {
   return initial;
 }
 
-
 // Solvers by index: 0 gn, 1 gn-autodiff, 2 ceres, 3 mh-gn.
 inline std::unique_ptr<ScanMatcher> Solver(int kind, const ScanMatchingOptions& options) {
   static const char* names[] = {"gn", "gn-autodiff", "ceres", "mh-gn"};
@@ -89,7 +87,7 @@ inline std::unique_ptr<ScanMatcher> Solver(int kind, const ScanMatchingOptions& 
 // Matches the scans in turn from `initial` and reports the median time the
 // solver measured, iterations, convergence and the mean final errors.
 inline void MatchScans(benchmark::State& state, const ScanMatcher& solver, const MatchingMap& map,
-                const SimulatedSequence& scans, const std::vector<SE3d>& initial, double w_rcs) {
+                       const SimulatedSequence& scans, const std::vector<SE3d>& initial, double w_rcs) {
   std::size_t k = 0, points = 0, converged = 0, runs = 0, iterations = 0, within = 0;
   double translation_error = 0.0, rotation_error = 0.0;
   std::vector<double> times;

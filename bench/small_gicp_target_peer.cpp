@@ -71,10 +71,10 @@ int main(int argc, char** argv) try {
   small_gicp::GaussianVoxelMap voxels(1.0);
   voxels.insert(*downsampled);
   const double voxelmap = SecondsSince(start);
-  std::printf("small_gicp: %zu points after downsampling %.3f s, k-d tree %.3f s, covariances %.3f s, "
-              "voxel map %.3f s, all %.3f s\n",
-              downsampled->size(), downsampling, kdtree, covariances, voxelmap,
-              downsampling + kdtree + covariances + voxelmap);
+  std::printf(
+      "small_gicp: %zu points after downsampling %.3f s, k-d tree %.3f s, covariances %.3f s, "
+      "voxel map %.3f s, all %.3f s\n",
+      downsampled->size(), downsampling, kdtree, covariances, voxelmap, downsampling + kdtree + covariances + voxelmap);
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "small_gicp_target_peer: %s\n", e.what());

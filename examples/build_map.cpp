@@ -17,8 +17,8 @@ int main(int argc, char** argv) {
     input.ground_truth = argv[2];  // reference poses: the map is built in their frame
     const radargauss::Sequence sequence = radargauss::LoadSequence(input);
 
-    radargauss::MapOptions options;         // the defaults of `radargauss build-map`
-    options.rcs.max_degree = 3;             // SH degree of the RCS models
+    radargauss::MapOptions options;  // the defaults of `radargauss build-map`
+    options.rcs.max_degree = 3;      // SH degree of the RCS models
     const radargauss::GaussianMap map = radargauss::BuildMap(sequence, options);
     radargauss::WriteMap(argv[3], map);
 

@@ -30,15 +30,14 @@ int main(int argc, char** argv) {
     const SE3d& reference = sequence.poses[k];
     const SE3d initial = reference * SE3d::Exp(error);
 
-    MatchOptions options;             // the own Gauss-Newton (options.solver)
-    options.matching.w_rcs = 0.25;    // eq. 2's weight of the RCS term
+    MatchOptions options;           // the own Gauss-Newton (options.solver)
+    options.matching.w_rcs = 0.25;  // eq. 2's weight of the RCS term
     const ScanMatchingResult result = Match(sequence.scans[k], map, initial, options);
 
     const double translation = (result.pose.translation() - reference.translation()).norm();
     const double rotation = (reference.rotation().Inverse() * result.pose.rotation()).Log().norm() * 180.0 / M_PI;
     std::printf("scan %zu: %s after %d iterations, %zu geometric and %zu RCS residuals\n", k,
-                result.converged ? "converged" : result.reason.c_str(), result.iterations, result.n_geo,
-                result.n_rcs);
+                result.converged ? "converged" : result.reason.c_str(), result.iterations, result.n_geo, result.n_rcs);
     std::printf("error: translation %.4f m, rotation %.4f deg\n", translation, rotation);
     std::printf("information diagonal [dt; dphi]:");
     for (int i = 0; i < 6; ++i) std::printf(" %.4g", result.information(i, i));

@@ -81,11 +81,10 @@ void MapFile(const std::uint8_t* data, std::size_t size) {
 void MapPlaces(const std::uint8_t* data, std::size_t size) {
   if (size < 4) return;
   std::string bytes(reinterpret_cast<const char*>(data), size);
-  const std::uint32_t crc = std::uint32_t(
-      crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), uInt(bytes.size() - 4)));
+  const std::uint32_t crc =
+      std::uint32_t(crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), uInt(bytes.size() - 4)));
   std::memcpy(&bytes[bytes.size() - 4], &crc, 4);
-  const std::string path =
-      WriteInput(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size(), "places.rgm");
+  const std::string path = WriteInput(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size(), "places.rgm");
   Expecting([&] {
     const GaussianMap map = ReadMap(path);
     PlaceRecognitionOptions options;
@@ -134,8 +133,7 @@ void PointCloud2(const std::uint8_t* data, std::size_t size) {
   if (!bytes.U32(cloud.height) || !bytes.U32(cloud.width) || !bytes.U8(field_count)) return;
   cloud.fields.resize(field_count);
   for (PointCloud2Field& field : cloud.fields) {
-    if (!bytes.Text(field.name) || !bytes.U32(field.offset) || !bytes.U8(field.datatype) ||
-        !bytes.U32(field.count)) {
+    if (!bytes.Text(field.name) || !bytes.U32(field.offset) || !bytes.U8(field.datatype) || !bytes.U32(field.count)) {
       return;
     }
   }
@@ -175,9 +173,9 @@ void ShardJson(const std::uint8_t* data, std::size_t size) {
 
 const std::vector<Target>& Targets() {
   static const std::vector<Target> targets = {
-      {"pcd", Pcd},         {"kitti_bin", KittiBin},           {"tum", Tum},          {"map_file", MapFile},
-      {"pointcloud2", PointCloud2}, {"simulator_yaml", SimulatorYaml}, {"cli_yaml", CliYaml},
-      {"shard_json", ShardJson}, {"map_places", MapPlaces}};
+      {"pcd", Pcd},          {"kitti_bin", KittiBin},      {"tum", Tum},
+      {"map_file", MapFile}, {"pointcloud2", PointCloud2}, {"simulator_yaml", SimulatorYaml},
+      {"cli_yaml", CliYaml}, {"shard_json", ShardJson},    {"map_places", MapPlaces}};
   return targets;
 }
 

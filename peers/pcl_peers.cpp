@@ -72,9 +72,11 @@ PclPeerMatcher::PclPeerMatcher(PclMethod method, const std::vector<Eigen::Vector
   impl_->options = options;
   impl_->target = Cloud::Ptr(new Cloud);
   const bool reduce = method == PclMethod::kGicp && options.gicp_local_target && options.gicp_target_voxel > 0.0;
-  const std::vector<Eigen::Vector3d> points = reduce ? VoxelDownsample(map_cloud, options.gicp_target_voxel) : map_cloud;
+  const std::vector<Eigen::Vector3d> points =
+      reduce ? VoxelDownsample(map_cloud, options.gicp_target_voxel) : map_cloud;
   impl_->target->reserve(points.size());
-  for (const Eigen::Vector3d& p : points) impl_->target->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+  for (const Eigen::Vector3d& p : points)
+    impl_->target->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
   if (method == PclMethod::kGicp && options.gicp_local_target && !impl_->target->empty()) {
     impl_->target_tree.setInputCloud(impl_->target);
   }
@@ -132,8 +134,9 @@ ScanMatchingResult PclPeerMatcher::Match(const RadarScan& scan, const MatchingMa
   }
   result.final_cost = registration->getFitnessScore();
   if (impl_->method == PclMethod::kNdt) {
-    result.iterations = static_cast<pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ>*>(
-                            registration.get())->getFinalNumIteration();
+    result.iterations =
+        static_cast<pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ>*>(registration.get())
+            ->getFinalNumIteration();
   }
   result.n_geo = scan.points.size();
   result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

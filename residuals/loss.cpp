@@ -11,12 +11,9 @@ namespace radargauss {
 namespace {
 
 const NamedValue<LossType> kLossNames[] = {
-    {LossType::kTrivial, "trivial"},
-    {LossType::kHuber, "huber"},
-    {LossType::kCauchy, "cauchy"},
-    {LossType::kGemanMcClure, "geman-mcclure"},
-    {LossType::kTukey, "tukey"},
-    {LossType::kDcs, "dcs"},
+    {LossType::kTrivial, "trivial"}, {LossType::kHuber, "huber"},
+    {LossType::kCauchy, "cauchy"},   {LossType::kGemanMcClure, "geman-mcclure"},
+    {LossType::kTukey, "tukey"},     {LossType::kDcs, "dcs"},
 };
 
 }  // namespace
@@ -43,12 +40,18 @@ void ValidateScale(const LossConfig& config) {
 ceres::LossFunction* MakeLoss(const LossConfig& config) {
   ValidateScale(config);
   switch (config.type) {
-    case LossType::kTrivial: return nullptr;
-    case LossType::kHuber: return new ceres::HuberLoss(config.scale);
-    case LossType::kCauchy: return new ceres::CauchyLoss(config.scale);
-    case LossType::kGemanMcClure: return new GemanMcClureLoss(config.scale);
-    case LossType::kTukey: return new ceres::TukeyLoss(config.scale);
-    case LossType::kDcs: return new DcsLoss(config.scale);
+    case LossType::kTrivial:
+      return nullptr;
+    case LossType::kHuber:
+      return new ceres::HuberLoss(config.scale);
+    case LossType::kCauchy:
+      return new ceres::CauchyLoss(config.scale);
+    case LossType::kGemanMcClure:
+      return new GemanMcClureLoss(config.scale);
+    case LossType::kTukey:
+      return new ceres::TukeyLoss(config.scale);
+    case LossType::kDcs:
+      return new DcsLoss(config.scale);
   }
   return nullptr;
 }

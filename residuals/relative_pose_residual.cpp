@@ -5,8 +5,7 @@
 
 namespace radargauss {
 
-bool RelativePoseCostFunction::Evaluate(double const* const* parameters, double* residuals,
-                                        double** jacobians) const {
+bool RelativePoseCostFunction::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
   const SO3d Ri = SO3d::FromXyzw(parameters[0]);
   const SO3d Rj = SO3d::FromXyzw(parameters[2]);
   const Eigen::Map<const Eigen::Vector3d> ti(parameters[1]);

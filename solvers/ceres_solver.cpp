@@ -44,9 +44,8 @@ class ExactMapStop final : public ceres::IterationCallback {
                    step.rotation().Log().norm() < options_.rotation_tolerance;
     }
     previous_ = pose;
-    return !small_step && KeepsAssociation(true, associated_at_, pose, options_)
-               ? ceres::SOLVER_CONTINUE
-               : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    return !small_step && KeepsAssociation(true, associated_at_, pose, options_) ? ceres::SOLVER_CONTINUE
+                                                                                 : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
   }
 
  private:

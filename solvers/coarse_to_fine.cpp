@@ -52,7 +52,8 @@ CoarseToFine::CoarseToFine(const RadarScan& scan, const MatchingMap& map, const 
     stage.options = options;
     stage.options.w_rcs = stage.full_cost ? w : 0.0;
     stage.max_iterations = stage.full_cost ? options.max_iterations : options.coarse_iterations;
-    stage.translation_tolerance = stage.full_cost ? options.translation_tolerance : options.coarse_translation_tolerance;
+    stage.translation_tolerance =
+        stage.full_cost ? options.translation_tolerance : options.coarse_translation_tolerance;
     stage.rotation_tolerance = stage.full_cost ? options.rotation_tolerance : options.coarse_rotation_tolerance;
     stages_.push_back(stage);
   }
@@ -61,16 +62,16 @@ CoarseToFine::CoarseToFine(const RadarScan& scan, const MatchingMap& map, const 
 void CoarseToFine::Begin(const Stage& stage) {
   const bool voxels = options_.coarse_voxel_per_sigma > 0.0;
   if (!stage.finest && reduce_ && (voxels || stage.level == 0)) {  // strided points: the same on every level
-    coarse_scan_ = CoarseScan(positions_, options_.coarse_voxel_per_sigma * map_.sigma(stage.level),
-                              options_.coarse_points);
+    coarse_scan_ =
+        CoarseScan(positions_, options_.coarse_voxel_per_sigma * map_.sigma(stage.level), options_.coarse_points);
   }
   stage_scan_ = stage.finest || !reduce_ ? &scan_ : &coarse_scan_;
   gate_ = stage.finest ? options_.gate : map_.coarse_gate();
   if (stage.full_cost && geometric_first_ && KeepsAssociation(true, correspondences_.pose, result_.pose, options_)) {
     AddRcsTerms(scan_, map_, correspondences_);  // eq. 2 on the geometric stage's last association (same level)
   } else {
-    correspondences_ = FindCorrespondences(*stage_scan_, map_, stage.level, result_.pose, gate_,
-                                           stage.options.w_rcs > 0.0);
+    correspondences_ =
+        FindCorrespondences(*stage_scan_, map_, stage.level, result_.pose, gate_, stage.options.w_rcs > 0.0);
   }
   evaluated_.known = false;
 }
@@ -79,8 +80,8 @@ bool CoarseToFine::Associate(const Stage& stage, int iteration) {
   if (iteration == 1) {
     Begin(stage);
   } else if (!KeepsAssociation(stage.finest, correspondences_.pose, result_.pose, options_)) {
-    correspondences_ = FindCorrespondences(*stage_scan_, map_, stage.level, result_.pose, gate_,
-                                           stage.options.w_rcs > 0.0);
+    correspondences_ =
+        FindCorrespondences(*stage_scan_, map_, stage.level, result_.pose, gate_, stage.options.w_rcs > 0.0);
     evaluated_.known = false;
   }
   if (!CheckCorrespondences(*stage_scan_, correspondences_, stage.options, result_.reason)) return false;
@@ -107,9 +108,9 @@ void CoarseToFine::FinishCounts(ScanMatchingResult& result) const {
   const ScanPriors& priors = priors_;
   const Correspondences& c = correspondences_;
   const bool last_is_final = KeepsAssociation(c.index == &map.index(), c.pose, result.pose, options);
-  const Correspondences final_c = last_is_final ? c
-                                                : FindCorrespondences(scan_, map, map.levels() - 1, result.pose,
-                                                                      options.gate, options.w_rcs > 0.0);
+  const Correspondences final_c =
+      last_is_final ? c
+                    : FindCorrespondences(scan_, map, map.levels() - 1, result.pose, options.gate, options.w_rcs > 0.0);
   result.n_geo = final_c.geometric.size();
   result.n_rcs = final_c.rcs.size();
   // On the exact map the steps' options are these (w_rcs is the requested w there).

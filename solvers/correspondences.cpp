@@ -20,8 +20,8 @@ std::vector<int> AssociateScan(const RadarScan& scan, const GaussianIndex& index
   return associations;
 }
 
-Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level,
-                                    const SE3d& pose, double gate, bool with_rcs) {
+Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level, const SE3d& pose,
+                                    double gate, bool with_rcs) {
   Correspondences out;
   out.index = &map.level(level);
   out.pose = pose;
@@ -96,8 +96,8 @@ double EvaluateCost(const Correspondences& c, const SE3d& pose, const ScanMatchi
   return f;
 }
 
-bool CheckCorrespondences(const RadarScan& scan, const Correspondences& c,
-                          const ScanMatchingOptions& options, std::string& reason) {
+bool CheckCorrespondences(const RadarScan& scan, const Correspondences& c, const ScanMatchingOptions& options,
+                          std::string& reason) {
   if (scan.points.empty()) {
     reason = "empty scan";
     return false;
@@ -111,12 +111,12 @@ bool CheckCorrespondences(const RadarScan& scan, const Correspondences& c,
     return false;
   }
   // Enough residuals for the degrees of freedom the weighted terms drive.
-  const std::size_t residuals = (options.w_rcs < 1.0 ? 3 * c.geometric.size() : 0) +
-                                (options.w_rcs > 0.0 ? c.rcs.size() : 0);
+  const std::size_t residuals =
+      (options.w_rcs < 1.0 ? 3 * c.geometric.size() : 0) + (options.w_rcs > 0.0 ? c.rcs.size() : 0);
   const std::size_t freedom = options.w_rcs < 1.0 || options.rcs_translation == RcsTranslation::kFull ? 6 : 3;
   if (residuals < freedom) {
-    reason = "too few residuals (" + std::to_string(residuals) + ") for " + std::to_string(freedom) +
-             " degrees of freedom";
+    reason =
+        "too few residuals (" + std::to_string(residuals) + ") for " + std::to_string(freedom) + " degrees of freedom";
     return false;
   }
   return true;

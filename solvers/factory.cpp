@@ -14,10 +14,8 @@ namespace radargauss {
 namespace {
 
 const NamedValue<SolverKind> kSolverNames[] = {
-    {SolverKind::kGaussNewton, "gn"},
-    {SolverKind::kGaussNewtonAutoDiff, "gn-autodiff"},
-    {SolverKind::kCeres, "ceres"},
-    {SolverKind::kCeresDogleg, "ceres-dogleg"},
+    {SolverKind::kGaussNewton, "gn"},        {SolverKind::kGaussNewtonAutoDiff, "gn-autodiff"},
+    {SolverKind::kCeres, "ceres"},           {SolverKind::kCeresDogleg, "ceres-dogleg"},
     {SolverKind::kMultiHypothesis, "mh-gn"},
 };
 
@@ -53,9 +51,8 @@ std::unique_ptr<ScanMatcher> MakeScanMatcher(const MatchOptions& options) {
       ceres.dogleg = true;
       return std::make_unique<CeresSolver>(matching, ceres);
     case SolverKind::kMultiHypothesis:
-      return std::make_unique<MultiHypothesisSolver>(std::make_shared<GaussNewtonSolver>(matching, options.gauss_newton),
-                                                     matching,
-                                                     options.hypotheses);
+      return std::make_unique<MultiHypothesisSolver>(
+          std::make_shared<GaussNewtonSolver>(matching, options.gauss_newton), matching, options.hypotheses);
   }
   throw std::invalid_argument("unknown solver kind");
 }

@@ -64,7 +64,7 @@ struct StepCheck {
   std::optional<Waiting> waiting;        // a step whose check waits for the next system
   const GaussianIndex* index = nullptr;  // the association the last waiting step was taken on
   SE3d associated_at;
-  bool taken_back = false;               // a step on that association was taken back
+  bool taken_back = false;  // a step on that association was taken back
   bool On(const Correspondences& c) const { return c.index == index && SamePose(c.pose, associated_at); }
 };
 
@@ -91,12 +91,13 @@ Vector6 Backtrack(CoarseToFine& match, const Stage& stage, const SE3d& from, con
 // Takes dx on the exact map (eq. 2 at the match's pose: cost). Checked now
 // when it ends the stage, follows a taken-back step on this association, or
 // leaves the association; otherwise it waits for the next system.
-Vector6 TakeChecked(CoarseToFine& match, const Stage& stage, StepCheck& check, bool same_association,
-                    const Vector6& dx, double cost, bool last_iteration, int max_halvings) {
+Vector6 TakeChecked(CoarseToFine& match, const Stage& stage, StepCheck& check, bool same_association, const Vector6& dx,
+                    double cost, bool last_iteration, int max_halvings) {
   const Correspondences& c = match.correspondences();
   const SE3d next = Step(match.pose(), dx);
   if (stage.SmallStep(dx.segment<3>(kTranslationOffset).norm(), dx.segment<3>(kRotationOffset).norm()) ||
-      last_iteration || (same_association && check.taken_back) || !KeepsAssociation(true, c.pose, next, stage.options)) {
+      last_iteration || (same_association && check.taken_back) ||
+      !KeepsAssociation(true, c.pose, next, stage.options)) {
     return Backtrack(match, stage, match.pose(), dx, cost, 1.0, 0, max_halvings);
   }
   check.waiting = StepCheck::Waiting{match.pose(), dx, cost};
@@ -151,8 +152,8 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
         if (!stage.finest || max_halvings == 0) {  // plain steps: coarse levels only steer
           match.pose() = Step(match.pose(), dx);
         } else {
-          dx = TakeChecked(match, stage, check, same_association, dx, system.cost,
-                           iteration == stage.max_iterations, max_halvings);
+          dx = TakeChecked(match, stage, check, same_association, dx, system.cost, iteration == stage.max_iterations,
+                           max_halvings);
         }
       }
       converged = stage.SmallStep(dx.segment<3>(kTranslationOffset).norm(), dx.segment<3>(kRotationOffset).norm());

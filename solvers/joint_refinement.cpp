@@ -29,8 +29,10 @@ class RelativePoseResidual {
 
   template <typename T>
   bool operator()(const T* ri, const T* ti, const T* rj, const T* tj, T* residual) const {
-    const SE3<T> a(SO3<T>(Eigen::Quaternion<T>(ri[3], ri[0], ri[1], ri[2])), Eigen::Matrix<T, 3, 1>(ti[0], ti[1], ti[2]));
-    const SE3<T> b(SO3<T>(Eigen::Quaternion<T>(rj[3], rj[0], rj[1], rj[2])), Eigen::Matrix<T, 3, 1>(tj[0], tj[1], tj[2]));
+    const SE3<T> a(SO3<T>(Eigen::Quaternion<T>(ri[3], ri[0], ri[1], ri[2])),
+                   Eigen::Matrix<T, 3, 1>(ti[0], ti[1], ti[2]));
+    const SE3<T> b(SO3<T>(Eigen::Quaternion<T>(rj[3], rj[0], rj[1], rj[2])),
+                   Eigen::Matrix<T, 3, 1>(tj[0], tj[1], tj[2]));
     const Eigen::Matrix<T, 6, 1> error = (measured_inverse_.cast<T>() * (a.Inverse() * b)).Log();
     for (int k = 0; k < 6; ++k) residual[k] = T(weight_) * error[k];
     return true;
@@ -43,8 +45,8 @@ class RelativePoseResidual {
 
 }  // namespace
 
-double RcsResidualRms(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
-                      const GaussianMap& map, double gate) {
+double RcsResidualRms(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses, const GaussianMap& map,
+                      double gate) {
   const MatchingMap matching(map, ExactMapOnly());
   double sum = 0.0;
   std::size_t n = 0;
@@ -68,16 +70,19 @@ void CheckOptions(const std::vector<RadarScan>& scans, const std::vector<SE3d>& 
     throw std::invalid_argument("joint refinement needs one initial pose per scan (and a scan)");
   }
   if (options.rounds < 1 || options.max_iterations_per_round < 1 || options.relative_pose_prior < 0.0 ||
-      options.coefficient_prior < 0.0 || !(options.min_associated_share >= 0.0 && options.min_associated_share <= 1.0)) {
-    throw std::invalid_argument("joint refinement: rounds and iterations must be >= 1, priors >= 0, the associated "
-                                "share in [0, 1]");
+      options.coefficient_prior < 0.0 ||
+      !(options.min_associated_share >= 0.0 && options.min_associated_share <= 1.0)) {
+    throw std::invalid_argument(
+        "joint refinement: rounds and iterations must be >= 1, priors >= 0, the associated "
+        "share in [0, 1]");
   }
 }
 
 // The parameter blocks of the joint problem: a rotation and a translation per
 // scan, the SH coefficients of every Gaussian with a model.
 struct JointBlocks {
-  JointBlocks(const std::vector<SE3d>& poses, const GaussianMap& map) : rotations(poses.size()), translations(poses.size()) {
+  JointBlocks(const std::vector<SE3d>& poses, const GaussianMap& map)
+      : rotations(poses.size()), translations(poses.size()) {
     for (std::size_t k = 0; k < poses.size(); ++k) {
       rotations[k] = poses[k].rotation().quaternion().coeffs();
       translations[k] = poses[k].translation();
@@ -86,7 +91,8 @@ struct JointBlocks {
     for (std::size_t g = 0; g < map.gaussians.size(); ++g) {
       const RcsModel& model = map.gaussians[g].rcs;
       if (model.valid()) {
-        coefficients[g].assign(model.coefficients.begin(), model.coefficients.begin() + ShCoefficientCount(model.degree));
+        coefficients[g].assign(model.coefficients.begin(),
+                               model.coefficients.begin() + ShCoefficientCount(model.degree));
       }
     }
   }
@@ -102,7 +108,9 @@ struct JointBlocks {
 class JointProblem {
  public:
   JointProblem(JointBlocks& blocks, const JointRefinementOptions& options)
-      : blocks_(blocks), options_(options), problem_(ProblemOptions()),
+      : blocks_(blocks),
+        options_(options),
+        problem_(ProblemOptions()),
         ordering_(std::make_shared<ceres::ParameterBlockOrdering>()) {
     for (std::size_t k = 0; k < blocks_.rotations.size(); ++k) {
       problem_.AddParameterBlock(blocks_.rotations[k].data(), 4, &so3_);
@@ -123,8 +131,8 @@ class JointProblem {
         problem_.AddResidualBlock(
             new GeometricCostFunction(term.point_radar, c.index->Mean(term.gaussian),
                                       c.index->SqrtInformationT(term.gaussian)),
-            new ceres::ScaledLoss(MakeLoss(options_.matching.geometric_loss), weight, ceres::TAKE_OWNERSHIP),
-            rotation, translation);
+            new ceres::ScaledLoss(MakeLoss(options_.matching.geometric_loss), weight, ceres::TAKE_OWNERSHIP), rotation,
+            translation);
       }
     }
     if (w > 0.0 && !c.rcs.empty()) {
@@ -163,7 +171,8 @@ class JointProblem {
     if (options_.coefficient_prior > 0.0) {
       for (const auto& [g, used] : used_coefficients_) {
         const int count = int(blocks_.coefficients[g].size());
-        const Eigen::VectorXd initial = Eigen::Map<const Eigen::VectorXd>(map.gaussians[g].rcs.coefficients.data(), count);
+        const Eigen::VectorXd initial =
+            Eigen::Map<const Eigen::VectorXd>(map.gaussians[g].rcs.coefficients.data(), count);
         problem_.AddResidualBlock(
             new ceres::NormalPrior(options_.coefficient_prior * Eigen::MatrixXd::Identity(count, count), initial),
             nullptr, blocks_.coefficients[g].data());
@@ -202,7 +211,8 @@ void CheckCoverage(std::size_t associated, std::size_t points, double min_share)
   const double share = points ? double(associated) / double(points) : 0.0;
   if (share < min_share) {
     char text[240];
-    std::snprintf(text, sizeof(text), "%.1f %% of the scans' points lie near the map at their poses "
+    std::snprintf(text, sizeof(text),
+                  "%.1f %% of the scans' points lie near the map at their poses "
                   "(--min-associated-share: %.0f %%): a map of another sequence, or poses in another frame?",
                   100.0 * share, 100.0 * min_share);
     throw DataError(text);
@@ -211,9 +221,8 @@ void CheckCoverage(std::size_t associated, std::size_t points, double min_share)
 
 }  // namespace
 
-JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
-                                    const std::vector<SE3d>& initial_poses, const GaussianMap& map,
-                                    const JointRefinementOptions& options) {
+JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans, const std::vector<SE3d>& initial_poses,
+                                    const GaussianMap& map, const JointRefinementOptions& options) {
   CheckOptions(scans, initial_poses, options);
   const auto start = std::chrono::steady_clock::now();
   JointRefinementResult result;

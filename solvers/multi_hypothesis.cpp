@@ -12,9 +12,9 @@ namespace radargauss {
 std::vector<Eigen::Vector3d> HypothesisOffsets(const MultiHypothesisOptions& o) {
   const double d = o.xy_offset;
   const double a = o.yaw_offset;
-  const std::vector<Eigen::Vector3d> pattern = {
-      {0, 0, 0},  {d, 0, 0},  {-d, 0, 0}, {0, d, 0},  {0, -d, 0}, {0, 0, a},  {0, 0, -a},
-      {d, d, 0},  {d, -d, 0}, {-d, d, 0}, {-d, -d, 0}, {d, 0, a}, {d, 0, -a}};
+  const std::vector<Eigen::Vector3d> pattern = {{0, 0, 0},   {d, 0, 0},  {-d, 0, 0}, {0, d, 0},  {0, -d, 0},
+                                                {0, 0, a},   {0, 0, -a}, {d, d, 0},  {d, -d, 0}, {-d, d, 0},
+                                                {-d, -d, 0}, {d, 0, a},  {d, 0, -a}};
   if (o.starts < 1 || o.starts > int(pattern.size())) {
     throw std::invalid_argument("multi-hypothesis starts must be in 1..13");
   }
@@ -55,8 +55,7 @@ ScanMatchingResult MultiHypothesisSolver::Match(const RadarScan& scan, const Mat
   bool have_best = false;
   int total_iterations = 0;
   for (const Eigen::Vector3d& offset : HypothesisOffsets(hypotheses_)) {
-    const SE3d perturbation(SO3d::Exp(Eigen::Vector3d(0, 0, offset.z())),
-                            Eigen::Vector3d(offset.x(), offset.y(), 0.0));
+    const SE3d perturbation(SO3d::Exp(Eigen::Vector3d(0, 0, offset.z())), Eigen::Vector3d(offset.x(), offset.y(), 0.0));
     ScanMatchingResult candidate = inner_->Match(scan, map, initial * perturbation, priors);
     total_iterations += candidate.iterations;
     const double score = Score(scan, map, candidate.pose, options_.gate);

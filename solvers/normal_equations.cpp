@@ -87,12 +87,16 @@ struct Lanes;
 template <>
 struct Lanes<double> {
   template <typename F>
-  static double Of(F&& f) { return f(0); }
+  static double Of(F&& f) {
+    return f(0);
+  }
 };
 template <>
 struct Lanes<Eigen::Array2d> {
   template <typename F>
-  static Eigen::Array2d Of(F&& f) { return Eigen::Array2d(f(0), f(1)); }
+  static Eigen::Array2d Of(F&& f) {
+    return Eigen::Array2d(f(0), f(1));
+  }
 };
 
 // The inputs of term k, and of term k + 1 in the second lane of a pair.
@@ -132,8 +136,8 @@ void AddGeometricTerm(const GeometricTermInputs<T>& in, GeometricSums<T>& sums, 
   const T* e = in.e;
   const T information_e[3] = {i00 * e[0] + i01 * e[1] + i02 * e[2], i01 * e[0] + i11 * e[1] + i12 * e[2],
                               i02 * e[0] + i12 * e[1] + i22 * e[2]};
-  const T weight = weight_of(e[0] * information_e[0] + e[1] * information_e[1] + e[2] * information_e[2],
-                             information_e);
+  const T weight =
+      weight_of(e[0] * information_e[0] + e[1] * information_e[1] + e[2] * information_e[2], information_e);
   // B = w Sigma^-1 [q]x column by column (column k is Sigma^-1 (w q x e_k)),
   // then the upper triangle of [q]x B as components of cross products: the
   // zeros of [q]x never enter a product.
@@ -223,8 +227,8 @@ LinearSystem AutoDiffGeometricSystem(const Correspondences& c, const SE3d& pose,
 
 }  // namespace
 
-LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
-                                  const ScanMatchingOptions& options, bool loss_curvature) {
+LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose, const ScanMatchingOptions& options,
+                                  bool loss_curvature) {
   if (options.jacobians == JacobianMode::kAutoDiff) return AutoDiffGeometricSystem(c, pose, options, loss_curvature);
   LinearSystem system;
   LossSum loss(options.geometric_loss);
@@ -278,8 +282,8 @@ LinearSystem BuildGeometricSystem(const Correspondences& c, const SE3d& pose,
   return system;
 }
 
-LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
-                            const ScanMatchingOptions& options, bool loss_curvature) {
+LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose, const ScanMatchingOptions& options,
+                            bool loss_curvature) {
   LinearSystem system;
   LossSum loss(options.rcs_loss);
   // Rotation-only: the translation is the association's constant.
@@ -325,9 +329,8 @@ LinearSystem BuildRcsSystem(const Correspondences& c, const SE3d& pose,
   return system;
 }
 
-CombinedSystem BuildCombinedSystem(const Correspondences& c, const SE3d& pose,
-                                   const ScanMatchingOptions& options, const ScanPriors& priors,
-                                   bool loss_curvature) {
+CombinedSystem BuildCombinedSystem(const Correspondences& c, const SE3d& pose, const ScanMatchingOptions& options,
+                                   const ScanPriors& priors, bool loss_curvature) {
   CombinedSystem combined;
   const double w = options.w_rcs;
   const auto add = [&](const LinearSystem& system, double weight) {

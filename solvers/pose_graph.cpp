@@ -21,8 +21,9 @@
 namespace radargauss {
 
 namespace {
-constexpr NamedValue<LoopRejection> kLoopRejectionNames[] = {
-    {LoopRejection::kLoss, "loss"}, {LoopRejection::kSwitchable, "switchable"}, {LoopRejection::kGraduated, "graduated"}};
+constexpr NamedValue<LoopRejection> kLoopRejectionNames[] = {{LoopRejection::kLoss, "loss"},
+                                                             {LoopRejection::kSwitchable, "switchable"},
+                                                             {LoopRejection::kGraduated, "graduated"}};
 }  // namespace
 
 std::string ToString(LoopRejection rejection) { return NameOf(kLoopRejectionNames, rejection); }

@@ -176,8 +176,7 @@ void StagedFolder::Commit() {
   fs::remove_all(staging_, error);  // the old content
 }
 
-void WriteFileAtomically(const std::string& path,
-                         const std::function<void(std::ostream&)>& write, bool binary) {
+void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write, bool binary) {
   CheckOutputFile(path);
   RemoveStaleTemporaries(fs::path(path).parent_path());
   const std::string temporary = TemporaryOf(path);

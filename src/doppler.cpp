@@ -15,15 +15,14 @@ namespace radargauss {
 int RansacIterations(double outlier_probability, double success_probability) {
   const double clean_draw = std::pow(1.0 - outlier_probability, 3);
   if (clean_draw >= 1.0) return 1;  // no outliers expected: one draw suffices
-  return std::max(1, static_cast<int>(std::ceil(std::log(1.0 - success_probability) /
-                                                std::log(1.0 - clean_draw))));
+  return std::max(1, static_cast<int>(std::ceil(std::log(1.0 - success_probability) / std::log(1.0 - clean_draw))));
 }
 
 namespace {
 
 // Least squares on the rows `rows` of (H, y): v, sigma^2 (H^T H)^-1.
-bool SolveLeastSquares(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
-                       const std::vector<int>& rows, Eigen::Vector3d& v, Eigen::Matrix3d& cov) {
+bool SolveLeastSquares(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y, const std::vector<int>& rows,
+                       Eigen::Vector3d& v, Eigen::Matrix3d& cov) {
   Eigen::Matrix3d hth = Eigen::Matrix3d::Zero();
   Eigen::Vector3d hty = Eigen::Vector3d::Zero();
   for (const int i : rows) {
@@ -52,8 +51,8 @@ struct VoxelOrderedRows {
 VoxelOrderedRows RegroupByVoxel(const Eigen::MatrixX3d& H, const Eigen::VectorXd& y,
                                 const std::vector<std::vector<std::uint32_t>>& voxels) {
   const int n = static_cast<int>(y.size());
-  VoxelOrderedRows rows{std::vector<int>(n), std::vector<char>(n, 0), std::vector<double>(n),
-                        std::vector<double>(n), std::vector<double>(n), std::vector<double>(n)};
+  VoxelOrderedRows rows{std::vector<int>(n),    std::vector<char>(n, 0), std::vector<double>(n),
+                        std::vector<double>(n), std::vector<double>(n),  std::vector<double>(n)};
   std::vector<int>& row_of = rows.row_of;
   if (voxels.empty()) {
     for (int k = 0; k < n; ++k) row_of[k] = k;
@@ -140,8 +139,8 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
       covered += inlier & (voxel_has_inlier ^ 1);
       voxel_has_inlier |= inlier;
     }
-    const bool wins = voxels.empty() ? size > best_size
-                                     : covered > best_voxels || (covered == best_voxels && size > best_size);
+    const bool wins =
+        voxels.empty() ? size > best_size : covered > best_voxels || (covered == best_voxels && size > best_size);
     if (!wins) continue;
     best_voxels = covered;
     best_size = size;
@@ -173,8 +172,7 @@ EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOp
   std::vector<int> gated;
   for (std::size_t i = 0; i < scan.points.size(); ++i) {
     const double range = scan.points[i].position.norm();
-    if (range >= options.min_range && range <= options.max_range &&
-        std::isfinite(scan.points[i].doppler)) {
+    if (range >= options.min_range && range <= options.max_range && std::isfinite(scan.points[i].doppler)) {
       gated.push_back(static_cast<int>(i));
     }
   }
@@ -208,8 +206,7 @@ EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOp
   }
 
   // RANSAC over 3-point draws, keeping the largest consensus set.
-  result.ransac_iterations = RansacIterations(options.outlier_probability,
-                                              options.success_probability);
+  result.ransac_iterations = RansacIterations(options.outlier_probability, options.success_probability);
   std::vector<std::vector<std::uint32_t>> voxels;
   if (options.consensus_voxel > 0.0) {
     std::vector<Eigen::Vector3d> positions(n);
@@ -228,8 +225,7 @@ EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOp
     return result;
   }
   for (int k = 0; k < n; ++k) {
-    result.inlier[gated[k]] = std::abs(y[k] - H.row(k).dot(result.velocity)) <
-                              options.inlier_threshold;
+    result.inlier[gated[k]] = std::abs(y[k] - H.row(k).dot(result.velocity)) < options.inlier_threshold;
   }
   result.success = true;
   return result;

@@ -25,8 +25,8 @@ const NamedValue<Alignment> kAlignmentNames[] = {
 
 // The estimate and reference poses that pair up: for each estimate sample
 // the reference sample nearest in time, within the tolerance, each once.
-void MatchByTime(const Trajectory& estimate, const Trajectory& reference, double tolerance,
-                 std::vector<SE3d>& est, std::vector<SE3d>& ref) {
+void MatchByTime(const Trajectory& estimate, const Trajectory& reference, double tolerance, std::vector<SE3d>& est,
+                 std::vector<SE3d>& ref) {
   std::vector<double> times;
   for (const StampedPose& sample : reference) times.push_back(sample.time);
   std::size_t last = times.size();  // the reference sample paired last
@@ -200,8 +200,11 @@ nlohmann::json ToJson(const ErrorStatistics& s) {
 }
 
 nlohmann::json ToJson(const SegmentDrift& d) {
-  return {{"length_m", d.length}, {"segments", d.segments}, {"translation_percent", d.translation},
-          {"horizontal_percent", d.horizontal}, {"rotation_deg_per_m", d.rotation}};
+  return {{"length_m", d.length},
+          {"segments", d.segments},
+          {"translation_percent", d.translation},
+          {"horizontal_percent", d.horizontal},
+          {"rotation_deg_per_m", d.rotation}};
 }
 
 std::string Markdown(const Evaluation& e) {
@@ -229,13 +232,19 @@ std::string WriteEvaluation(const std::string& dir, const Evaluation& e) {
   std::error_code error;
   fs::create_directories(dir, error);
   if (error) throw FileError(dir, "cannot create the output folder: " + error.message());
-  nlohmann::json json = {{"matched", e.matched}, {"path_length_m", e.path_length}, {"scale", e.scale},
-                         {"ate_translation_m", ToJson(e.ate_translation)}, {"ate_rotation_deg", ToJson(e.ate_rotation)},
-                         {"rpe", ToJson(e.rpe_mean)}, {"rpe_segments", nlohmann::json::array()},
-                         {"kitti_segments", nlohmann::json::array()}, {"alignment_note", e.alignment_note}};
+  nlohmann::json json = {{"matched", e.matched},
+                         {"path_length_m", e.path_length},
+                         {"scale", e.scale},
+                         {"ate_translation_m", ToJson(e.ate_translation)},
+                         {"ate_rotation_deg", ToJson(e.ate_rotation)},
+                         {"rpe", ToJson(e.rpe_mean)},
+                         {"rpe_segments", nlohmann::json::array()},
+                         {"kitti_segments", nlohmann::json::array()},
+                         {"alignment_note", e.alignment_note}};
   for (const SegmentDrift& d : e.rpe) json["rpe_segments"].push_back(ToJson(d));
   for (const SegmentDrift& d : e.kitti) json["kitti_segments"].push_back(ToJson(d));
-  WriteFileAtomically((fs::path(dir) / "evaluation.json").string(), [&](std::ostream& out) { out << json.dump(2) << "\n"; });
+  WriteFileAtomically((fs::path(dir) / "evaluation.json").string(),
+                      [&](std::ostream& out) { out << json.dump(2) << "\n"; });
   const std::string markdown = Markdown(e);
   WriteFileAtomically((fs::path(dir) / "evaluation.md").string(), [&](std::ostream& out) { out << markdown; });
   return markdown;

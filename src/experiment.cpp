@@ -89,11 +89,10 @@ void WritePerScanCsv(const std::string& path, const std::vector<ConfigurationRun
     out.precision(9);
     for (const ConfigurationRun& run : runs) {
       for (const ScanOutcome& o : run.outcomes) {
-        out << o.scan << ',' << std::fixed << o.time << std::defaultfloat << ',' << run.name << ','
-            << run.w_rcs << ',' << o.initial_translation_error << ',' << o.initial_rotation_error_deg
-            << ',' << o.translation_error << ',' << o.rotation_error_deg << ',' << o.result.iterations
-            << ',' << o.result.final_cost << ',' << o.result.n_geo << ',' << o.result.n_rcs << ','
-            << (o.result.converged ? 1 : 0) << ',' << o.result.time_ms << '\n';
+        out << o.scan << ',' << std::fixed << o.time << std::defaultfloat << ',' << run.name << ',' << run.w_rcs << ','
+            << o.initial_translation_error << ',' << o.initial_rotation_error_deg << ',' << o.translation_error << ','
+            << o.rotation_error_deg << ',' << o.result.iterations << ',' << o.result.final_cost << ',' << o.result.n_geo
+            << ',' << o.result.n_rcs << ',' << (o.result.converged ? 1 : 0) << ',' << o.result.time_ms << '\n';
       }
     }
   });

@@ -37,10 +37,18 @@ json PoseToJson(const SE3d& pose) {
 
 json OutcomeToJson(const ScanOutcome& o) {
   const ScanMatchingResult& r = o.result;
-  return {{"scan", o.scan}, {"time", o.time}, {"initial", {o.initial_translation_error, o.initial_rotation_error_deg}},
-          {"error", {o.translation_error, o.rotation_error_deg}}, {"pose", PoseToJson(r.pose)},
-          {"iterations", r.iterations}, {"cost", r.final_cost}, {"n_geo", r.n_geo}, {"n_rcs", r.n_rcs},
-          {"converged", r.converged}, {"reason", r.reason}, {"time_ms", r.time_ms}};
+  return {{"scan", o.scan},
+          {"time", o.time},
+          {"initial", {o.initial_translation_error, o.initial_rotation_error_deg}},
+          {"error", {o.translation_error, o.rotation_error_deg}},
+          {"pose", PoseToJson(r.pose)},
+          {"iterations", r.iterations},
+          {"cost", r.final_cost},
+          {"n_geo", r.n_geo},
+          {"n_rcs", r.n_rcs},
+          {"converged", r.converged},
+          {"reason", r.reason},
+          {"time_ms", r.time_ms}};
 }
 
 // Typed reads of one shard.json: "<folder>: shard.json: '<field>' <fault>".
@@ -177,7 +185,8 @@ void AppendShard(const json& file, const ShardHeader& h, const ShardFields& f, s
                  std::vector<SE3d>& references) {
   const std::size_t held = h.end - h.first;
   const json& poses = f.List(f.Member(file, "", "references"), "references", held);
-  for (std::size_t k = 0; k < held; ++k) references.push_back(f.Pose(poses[k], "references[" + std::to_string(k) + "]"));
+  for (std::size_t k = 0; k < held; ++k)
+    references.push_back(f.Pose(poses[k], "references[" + std::to_string(k) + "]"));
   const json& shard_runs = f.Member(file, "", "runs");
   if (!shard_runs.is_array() || shard_runs.empty()) f.Refuse("runs", "must be a list of configurations");
   if (runs.empty()) runs.resize(shard_runs.size());
@@ -187,7 +196,8 @@ void AppendShard(const json& file, const ShardHeader& h, const ShardFields& f, s
     const std::string name = f.Text(f.Member(shard_runs[r], field, "name"), field + ".name");
     const double w_rcs = f.Finite(f.Member(shard_runs[r], field, "w_rcs"), field + ".w_rcs");
     if (runs[r].name.empty()) runs[r].name = name, runs[r].w_rcs = w_rcs;
-    if (runs[r].name != name) f.Refuse(field + ".name", "is '" + name + "' where the other shards ran '" + runs[r].name + "'");
+    if (runs[r].name != name)
+      f.Refuse(field + ".name", "is '" + name + "' where the other shards ran '" + runs[r].name + "'");
     const json& outcomes = f.List(f.Member(shard_runs[r], field, "outcomes"), field + ".outcomes", held);
     for (std::size_t k = 0; k < held; ++k) {
       const std::string outcome_field = field + ".outcomes[" + std::to_string(k) + "]";
@@ -218,11 +228,13 @@ Shard ParseShard(const std::string& text) {
   return shard;
 }
 
-void WriteShard(const std::string& dir, const Shard& shard, std::size_t total_scans,
-                const ExperimentIdentity& identity, const std::vector<ConfigurationRun>& runs,
-                const std::vector<SE3d>& references) {
-  json file = {{"shard", shard.index}, {"of", shard.count}, {"scans", total_scans},
-               {"first_scan", shard.Begin(total_scans)}, {"end_scan", shard.End(total_scans)}};
+void WriteShard(const std::string& dir, const Shard& shard, std::size_t total_scans, const ExperimentIdentity& identity,
+                const std::vector<ConfigurationRun>& runs, const std::vector<SE3d>& references) {
+  json file = {{"shard", shard.index},
+               {"of", shard.count},
+               {"scans", total_scans},
+               {"first_scan", shard.Begin(total_scans)},
+               {"end_scan", shard.End(total_scans)}};
   json identity_json = json::object();
   for (const auto& [key, value] : identity) identity_json[key] = value;
   file["experiment"] = identity_json;
@@ -258,7 +270,8 @@ std::vector<ConfigurationRun> MergeShards(const std::vector<std::string>& dirs, 
                                    (difference.empty() ? "shard " + std::to_string(h.shard.index) + " of " +
                                                              std::to_string(h.shard.count) + " of " +
                                                              std::to_string(h.scans) + " scans"
-                                                       : difference) + ")");
+                                                       : difference) +
+                                   ")");
     }
     std::size_t& slot = order[h.shard.index - 1];
     if (slot != dirs.size()) throw FileError(dirs[s], "shard " + std::to_string(h.shard.index) + " given twice");

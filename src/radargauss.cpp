@@ -5,8 +5,7 @@
 
 namespace radargauss {
 
-GaussianMap BuildMap(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
-                     const MapOptions& options) {
+GaussianMap BuildMap(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses, const MapOptions& options) {
   MapGeometry geometry = BuildMapGeometry(scans, poses, options);
   FitRcsModels(geometry.map, geometry.cloud, geometry.association, options.rcs);
   return std::move(geometry.map);

@@ -21,8 +21,8 @@ namespace {
 void RequireIncreasing(double previous, double time) {
   if (!std::isfinite(time)) throw std::invalid_argument("trajectory time is not finite");
   if (!(time > previous)) {
-    throw std::invalid_argument("trajectory times must strictly increase (" +
-                                std::to_string(previous) + " then " + std::to_string(time) + ")");
+    throw std::invalid_argument("trajectory times must strictly increase (" + std::to_string(previous) + " then " +
+                                std::to_string(time) + ")");
   }
 }
 
@@ -49,15 +49,13 @@ void Trajectory::Append(double time, const SE3d& pose) {
 
 std::optional<SE3d> Trajectory::Interpolate(double time) const {
   if (poses_.empty() || !(time >= StartTime()) || !(time <= EndTime())) return std::nullopt;
-  const auto after = std::lower_bound(
-      poses_.begin(), poses_.end(), time,
-      [](const StampedPose& sample, double t) { return sample.time < t; });
+  const auto after = std::lower_bound(poses_.begin(), poses_.end(), time,
+                                      [](const StampedPose& sample, double t) { return sample.time < t; });
   if (after->time == time) return after->pose;
   const StampedPose& before = *(after - 1);
   const double s = (time - before.time) / (after->time - before.time);
   // slerp: R_a Exp(s Log(R_a^-1 R_b)); linear translation.
-  const Eigen::Vector3d relative_rotation =
-      (before.pose.rotation().Inverse() * after->pose.rotation()).Log();
+  const Eigen::Vector3d relative_rotation = (before.pose.rotation().Inverse() * after->pose.rotation()).Log();
   return SE3d(before.pose.rotation() * SO3d::Exp(s * relative_rotation),
               (1.0 - s) * before.pose.translation() + s * after->pose.translation());
 }
@@ -91,16 +89,14 @@ Trajectory ReadTum(const std::string& path) {
       ++count;
     }
     if (count != v.size()) {
-      throw FileError(path, line_number,
-                      "expected 8 columns (t x y z qx qy qz qw), found " + std::to_string(count));
+      throw FileError(path, line_number, "expected 8 columns (t x y z qx qy qz qw), found " + std::to_string(count));
     }
     for (const double value : v) {
       if (!std::isfinite(value)) throw FileError(path, line_number, "non-finite value");
     }
     const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     if (std::abs(q.norm() - 1.0) > kTumQuaternionNormTolerance) {
-      throw FileError(path, line_number,
-                      "quaternion norm " + std::to_string(q.norm()) + " is not 1");
+      throw FileError(path, line_number, "quaternion norm " + std::to_string(q.norm()) + " is not 1");
     }
     if (!trajectory.empty() && !(v[0] > trajectory.EndTime())) {
       throw FileError(path, line_number, "time does not increase");

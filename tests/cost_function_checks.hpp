@@ -31,8 +31,8 @@ inline Eigen::VectorXd EvaluateWithJacobians(const ceres::CostFunction& cost, co
   jacobians.clear();
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     const int n = cost.parameter_block_sizes()[b];
-    jacobians.push_back(Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-        storage[b].data(), m, n));
+    jacobians.push_back(
+        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(storage[b].data(), m, n));
   }
   return residuals;
 }

@@ -45,8 +45,7 @@ inline Planted PlantGaussians(int per, std::uint32_t seed) {
       g.mean = Eigen::Vector3d(6.0 * i, 6.0 * j, 1.0 + 0.5 * i);
       const Eigen::Matrix3d axes = SO3d::Exp(RandomUnitVector(rng)).Matrix();
       const Eigen::Vector3d stds(uniform(rng), uniform(rng), uniform(rng));
-      g.covariance = ClampCovariance(axes * stds.array().square().matrix().asDiagonal() * axes.transpose(),
-                                     0.0);
+      g.covariance = ClampCovariance(axes * stds.array().square().matrix().asDiagonal() * axes.transpose(), 0.0);
       const Eigen::Matrix3d root = axes * stds.asDiagonal();
       for (int k = 0; k < per; ++k) {
         planted.points.push_back(g.mean + root * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)));

@@ -135,9 +135,9 @@ inline std::unique_ptr<ScanMatcher> MakeSolver(const std::string& name, const Sc
 // IncidenceVector and FacingSign are tested against): d = normalize(u),
 // u = p_r - mu_r (offset) or -mu_r (view), flipped when d.x > 0.
 inline Eigen::Vector3d PaperIncidenceDirection(IncidenceModel incidence, const Eigen::Vector3d& point_radar,
-                                        const Eigen::Vector3d& mean_radar) {
-  Eigen::Vector3d d = incidence == IncidenceModel::kOffset ? Eigen::Vector3d(point_radar - mean_radar)
-                                                           : Eigen::Vector3d(-mean_radar);
+                                               const Eigen::Vector3d& mean_radar) {
+  Eigen::Vector3d d =
+      incidence == IncidenceModel::kOffset ? Eigen::Vector3d(point_radar - mean_radar) : Eigen::Vector3d(-mean_radar);
   d.normalize();
   if (d.x() > 0.0) d = -d;
   return d;
@@ -184,7 +184,8 @@ inline PlantedRcsWorld MakePlantedRcsWorld(IncidenceModel incidence, double rcs_
     for (const int elevation : {-8, 0, 8}) {
       const double range = 6.0 + 3.0 * ((azimuth / 10 + elevation / 8 + 9) % 3);
       const double a = azimuth * M_PI / 180.0, e = elevation * M_PI / 180.0;
-      const Eigen::Vector3d mean_radar = range * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+      const Eigen::Vector3d mean_radar =
+          range * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
       Gaussian g;
       g.mean = world.truth * mean_radar;
       g.covariance = 0.15 * 0.15 * Eigen::Matrix3d::Identity();

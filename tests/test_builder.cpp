@@ -32,11 +32,10 @@ using testing::RandomUnitVector;
 // skipped; many random clouds give the same centroids in both orders.
 TEST(VoxelDownsample, CentroidsPerVoxelInEitherOrder) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const std::vector<Eigen::Vector3d> points = {
-      {1.2, 0.1, 0.1}, {-0.5, 0.5, 0.5}, {1.6, 0.3, 0.9}, {nan, 0.0, 0.0}, {-0.7, 0.1, 0.3}, {0.5, 0.5, 0.5}};
+  const std::vector<Eigen::Vector3d> points = {{1.2, 0.1, 0.1}, {-0.5, 0.5, 0.5}, {1.6, 0.3, 0.9},
+                                               {nan, 0.0, 0.0}, {-0.7, 0.1, 0.3}, {0.5, 0.5, 0.5}};
   // Voxels of 1 m: (1,0,0) first, then (-1,0,0), then (0,0,0).
-  const std::vector<Eigen::Vector3d> by_first = {
-      {1.4, 0.2, 0.5}, {-0.6, 0.3, 0.4}, {0.5, 0.5, 0.5}};
+  const std::vector<Eigen::Vector3d> by_first = {{1.4, 0.2, 0.5}, {-0.6, 0.3, 0.4}, {0.5, 0.5, 0.5}};
   const std::vector<Eigen::Vector3d> first = VoxelDownsample(points, 1.0, VoxelOrder::kFirstPoint);
   const std::vector<Eigen::Vector3d> keyed = VoxelDownsample(points, 1.0);
   ASSERT_EQ(first.size(), 3u);
@@ -82,8 +81,9 @@ TEST(GaussianBuilder, RecoversPlantedGaussians) {
       if ((b.mean - p.mean).norm() < (nearest->mean - p.mean).norm()) nearest = &b;
     }
     EXPECT_LT((nearest->mean - p.mean).norm(), 0.1) << p.mean.transpose();
-    EXPECT_LT((nearest->covariance - p.covariance).norm(), 0.15 * p.covariance.norm())
-        << "planted\n" << p.covariance << "\nbuilt\n" << nearest->covariance;
+    EXPECT_LT((nearest->covariance - p.covariance).norm(), 0.15 * p.covariance.norm()) << "planted\n"
+                                                                                       << p.covariance << "\nbuilt\n"
+                                                                                       << nearest->covariance;
     EXPECT_GT(nearest->point_count, 1900u);  // members within tau = 3 of 2000 samples
   }
 }

@@ -147,11 +147,12 @@ struct Layout {
   int threads;
   const char* name;
 };
-const Layout kLayoutList[] = {{JacobianMode::kAutoDiff, CeresBlocks::kSquareRoot, 1, "autodiff"},
-                              {JacobianMode::kAnalytic, CeresBlocks::kShared, 1, "analytic, shared rows"},
-                              {JacobianMode::kAnalytic, CeresBlocks::kPerTerm, 1, "analytic, a block per term"},
-                              {JacobianMode::kAnalytic, CeresBlocks::kSquareRoot, 1, "analytic, square root"},
-                              {JacobianMode::kAnalytic, CeresBlocks::kSquareRoot, 3, "analytic, square root, 3 threads"}};
+const Layout kLayoutList[] = {
+    {JacobianMode::kAutoDiff, CeresBlocks::kSquareRoot, 1, "autodiff"},
+    {JacobianMode::kAnalytic, CeresBlocks::kShared, 1, "analytic, shared rows"},
+    {JacobianMode::kAnalytic, CeresBlocks::kPerTerm, 1, "analytic, a block per term"},
+    {JacobianMode::kAnalytic, CeresBlocks::kSquareRoot, 1, "analytic, square root"},
+    {JacobianMode::kAnalytic, CeresBlocks::kSquareRoot, 3, "analytic, square root, 3 threads"}};
 
 // The residual blocks of n terms in a layout.
 std::size_t BlocksOf(const Layout& layout, std::size_t n) {
@@ -202,9 +203,8 @@ void ExpectBlockCounts(CeresScanProblem& problem, const Layout& layout, const Co
 // The problem's Jacobian `dense` (at the blocks' values) against central
 // differences of its residuals along the tangent coordinates x = [dphi; dt]
 // (Ceres's Jacobian columns: rotation, then translation), entry by entry.
-void ExpectCentralDifferenceJacobian(CeresScanProblem& problem, Eigen::Vector4d& rotation,
-                                     Eigen::Vector3d& translation, const Eigen::MatrixXd& dense,
-                                     const std::string& label) {
+void ExpectCentralDifferenceJacobian(CeresScanProblem& problem, Eigen::Vector4d& rotation, Eigen::Vector3d& translation,
+                                     const Eigen::MatrixXd& dense, const std::string& label) {
   const Eigen::Vector4d rotation0 = rotation;
   const Eigen::Vector3d translation0 = translation;
   const Eigen::MatrixXd numeric = NumericJacobian(
@@ -259,7 +259,7 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
                             {&full_scan, map.levels() - 1, 1.0},  {&full_scan, map.levels() - 1, 0.25}};
   for (const bool trivial : {false, true}) {
     for (const RcsTranslation mode : {RcsTranslation::kRotationOnly, RcsTranslation::kFull}) {
-      std::vector<double> gradients[kLayouts];  // per layout, all updates in a row
+      std::vector<double> gradients[kLayouts];                 // per layout, all updates in a row
       std::vector<Eigen::Matrix<double, 6, 6>> shared_normal;  // J^T J of the shared rows, per update
       for (int l = 0; l < kLayouts; ++l) {
         const Layout& layout = layouts[l];
@@ -291,8 +291,8 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
           EXPECT_NEAR(2.0 * cost, f, 1e-12 * f) << "w " << update.w << " level " << update.level << ", " << layout.name;
           // With residuals only (a candidate step's cost), the same cost.
           double cost_only = 0.0;
-          ASSERT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost_only, nullptr, nullptr,
-                                                 nullptr));
+          ASSERT_TRUE(
+              problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &cost_only, nullptr, nullptr, nullptr));
           EXPECT_NEAR(cost_only, cost, 1e-14 * cost) << layout.name;
           gradients[l].insert(gradients[l].end(), gradient.begin(), gradient.end());
           if (!analytic) continue;
@@ -314,7 +314,8 @@ TEST(CeresScanProblem, HoldsExactlyTheLatestAssociation) {
         }
       }
       for (int l = 1; l < kLayouts; ++l) {
-        ExpectSameGradient(gradients[l], gradients[0], std::string(layouts[l].name) + (trivial ? ", trivial" : ", robust"));
+        ExpectSameGradient(gradients[l], gradients[0],
+                           std::string(layouts[l].name) + (trivial ? ", trivial" : ", robust"));
       }
     }
   }
@@ -343,8 +344,8 @@ TEST(CeresScanProblem, SquareRootOfARankDeficientBlock) {
     problem.Update(c, 0.5);
     Evaluation e;
     ceres::CRSMatrix jacobian;
-    EXPECT_TRUE(problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &e.cost, nullptr, &e.gradient,
-                                           &jacobian));
+    EXPECT_TRUE(
+        problem.problem().Evaluate(ceres::Problem::EvaluateOptions(), &e.cost, nullptr, &e.gradient, &jacobian));
     const Eigen::MatrixXd dense = Dense(jacobian);
     EXPECT_TRUE(dense.allFinite());
     e.normal = dense.transpose() * dense;

@@ -155,8 +155,8 @@ TEST(MergedCoarseLevels, ConvergesFromTwoMetresFiveDegrees) {
             double dt = 0.0, dr = 0.0;
             PoseErrors(result.pose, truth, dt, dr);
             const std::string where = name + " w " + std::to_string(w) + " coarse points " +
-                                      std::to_string(coarse_points) + " coarse gate " +
-                                      std::to_string(coarse_gate) + " seed " + std::to_string(seed);
+                                      std::to_string(coarse_points) + " coarse gate " + std::to_string(coarse_gate) +
+                                      " seed " + std::to_string(seed);
             EXPECT_TRUE(result.converged) << result.reason << " " << where;
             EXPECT_LT(dt, 0.05) << where;
             EXPECT_LT(dr, 0.2) << where;
@@ -176,7 +176,7 @@ TEST(CoarseGate, CoarseLevelsAssociateWithinIt) {
   const GaussianMap map = OneGaussianAtTheOrigin();
   const RadarScan scan = ScanOf({Eigen::Vector3d(1.5, 0, 0), Eigen::Vector3d(0, 1.5, 0), Eigen::Vector3d(0, 0, -1.5),
                                  Eigen::Vector3d(2.6, 0, 0), Eigen::Vector3d(0, -2.6, 0), Eigen::Vector3d(0, 0, 2.6)});
-  ScanMatchingOptions options;  // gate 3 on the exact map
+  ScanMatchingOptions options;           // gate 3 on the exact map
   options.coarse_voxel_per_sigma = 0.0;  // the points themselves
   for (const double coarse_gate : {3.0, 2.0}) {
     MatchingMapOptions map_options;

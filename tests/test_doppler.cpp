@@ -19,10 +19,8 @@ using testing::RandomUnitVector;
 
 // A scan of static points seen from a sensor moving at `velocity`, plus
 // `outliers` points whose Doppler is 1..10 m/s off the static model.
-RadarScan PlantedScan(const Eigen::Vector3d& velocity, int inliers, int outliers, double noise,
-                      std::mt19937& rng) {
-  std::uniform_real_distribution<double> azimuth(-1.0, 1.0), elevation(-0.25, 0.25), range(2, 80),
-      doppler(-10, 10);
+RadarScan PlantedScan(const Eigen::Vector3d& velocity, int inliers, int outliers, double noise, std::mt19937& rng) {
+  std::uniform_real_distribution<double> azimuth(-1.0, 1.0), elevation(-0.25, 0.25), range(2, 80), doppler(-10, 10);
   std::normal_distribution<double> normal(0.0, noise);
   RadarScan scan;
   scan.has_doppler = true;
@@ -132,8 +130,7 @@ TEST(EgoVelocity, SimulatedScansWithFortyPercentOutliers) {
     const EgoVelocityResult result = EstimateEgoVelocity(scan);
     good += result.success && (result.velocity - sequence.sensor_velocity[k]).norm() < 0.05;
   }
-  EXPECT_GE(good, static_cast<int>(std::ceil(0.95 * sequence.scans.size())))
-      << good << " of " << sequence.scans.size();
+  EXPECT_GE(good, static_cast<int>(std::ceil(0.95 * sequence.scans.size()))) << good << " of " << sequence.scans.size();
 }
 
 // NTU Eagle: speed from Doppler against speed from the reference poses (the
@@ -151,18 +148,15 @@ TEST(EgoVelocityRealData, NtuEagleSpeedAgreesWithGroundTruth) {
     const auto before = sequence.trajectory.Interpolate(scan.timestamp - dt);
     const auto after = sequence.trajectory.Interpolate(scan.timestamp + dt);
     if (!before || !after) continue;
-    const double reference_speed =
-        (after->translation() - before->translation()).norm() / (2.0 * dt);
+    const double reference_speed = (after->translation() - before->translation()).norm() / (2.0 * dt);
     const EgoVelocityResult result = EstimateEgoVelocity(scan);
     ASSERT_TRUE(result.success) << result.reason;
     differences.push_back(std::abs(result.velocity.norm() - reference_speed));
   }
   ASSERT_GT(differences.size(), 480u);
-  std::nth_element(differences.begin(), differences.begin() + differences.size() / 2,
-                   differences.end());
+  std::nth_element(differences.begin(), differences.begin() + differences.size() / 2, differences.end());
   const double median = differences[differences.size() / 2];
-  std::printf("NTU Eagle: median |speed_doppler - speed_gt| = %.4f m/s over %zu scans\n", median,
-              differences.size());
+  std::printf("NTU Eagle: median |speed_doppler - speed_gt| = %.4f m/s over %zu scans\n", median, differences.size());
   EXPECT_LT(median, 0.06);
 }
 
@@ -267,8 +261,8 @@ TEST(Mounting, RecoversPlantedPitchAndYawAndLevelsTheTrack) {
   }
   const std::optional<Mounting> mounting = EstimateMounting(steps);
   ASSERT_TRUE(mounting.has_value());
-  EXPECT_EQ(mounting->pitch_scans, 249u);  // at speed
-  EXPECT_EQ(mounting->yaw_scans, 199u);    // the straights at speed
+  EXPECT_EQ(mounting->pitch_scans, 249u);       // at speed
+  EXPECT_EQ(mounting->yaw_scans, 199u);         // the straights at speed
   EXPECT_NEAR(mounting->pitch_deg, 1.5, 0.05);  // 0.14 deg per scan, 199 scans
   EXPECT_NEAR(mounting->yaw_deg, -0.8, 0.05);
   std::vector<StampedPose> poses;

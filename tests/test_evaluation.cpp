@@ -140,8 +140,9 @@ TEST(Evaluation, PositionsOnALineTakeTheRotationFromTheOrientations) {
     for (const StampedPose& sample : reference) {
       // Rolled +-0.8 deg about the line itself, in turn: no mean offset to align away.
       const double roll = (int(sample.time) % 2 == 0 ? 0.8 : -0.8) * kDeg;
-      estimate.Append(sample.time, SE3d(sample.pose.rotation() * SO3d::Exp(Eigen::Vector3d(roll, 0.0, 0.0)),
-                                        sample.pose.translation() + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))));
+      estimate.Append(sample.time,
+                      SE3d(sample.pose.rotation() * SO3d::Exp(Eigen::Vector3d(roll, 0.0, 0.0)),
+                           sample.pose.translation() + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))));
     }
     const SE3d moved(SO3d::Exp(Eigen::Vector3d(0.3, -0.2, 1.2)), Eigen::Vector3d(40.0, -7.0, 3.0));
     for (const Trajectory& input : {estimate, Transformed(estimate, moved)}) {

@@ -48,8 +48,8 @@ TEST_F(Experiment, ShortSequenceEndToEnd) {
   for (const double w : {0.0, 0.25}) {
     ScanMatchingOptions options;
     options.w_rcs = w;
-    runs.push_back(RunConfiguration("gn-w" + std::to_string(w), w, GaussNewtonSolver(options), matching,
-                                    sequence.scans, sequence.poses, errors));
+    runs.push_back(RunConfiguration("gn-w" + std::to_string(w), w, GaussNewtonSolver(options), matching, sequence.scans,
+                                    sequence.poses, errors));
   }
   const std::string table = WriteExperimentResults(dir_.string(), runs);
   EXPECT_NE(table.find("**"), std::string::npos);  // a best value is marked

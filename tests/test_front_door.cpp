@@ -118,8 +118,8 @@ TEST(Information, IsTheGaussNewtonMatrixOfEq2) {
   ScanMatchingOptions options;
   options.w_rcs = 0.25;
   options.rcs_loss = {LossType::kTrivial, 1.0};
-  const Eigen::MatrixXd J = NumericJacobian(
-      [&](const Eigen::VectorXd& d) { return StackedResiduals(c, pose, d); }, Eigen::VectorXd::Zero(6));
+  const Eigen::MatrixXd J =
+      NumericJacobian([&](const Eigen::VectorXd& d) { return StackedResiduals(c, pose, d); }, Eigen::VectorXd::Zero(6));
   const std::size_t n_geo = c.geometric.size(), n_rcs = c.rcs.size();
   const Eigen::MatrixXd J_geo = J.topRows(3 * n_geo), J_rcs = J.bottomRows(n_rcs);
   EXPECT_LT(J_rcs.leftCols<3>().norm(), 1e-9);
@@ -144,8 +144,8 @@ TEST(Information, ResultCarriesItAtTheFinalPose) {
     options.reassociation_rotation = 0.0;
     const ScanMatchingResult result = MakeScanMatcher(name, options)->Match(scan, *world.matching, initial);
     ASSERT_TRUE(result.converged) << name << ": " << result.reason;
-    const Correspondences final_c = FindCorrespondences(scan, *world.matching, world.matching->levels() - 1,
-                                                        result.pose, options.gate, true);
+    const Correspondences final_c =
+        FindCorrespondences(scan, *world.matching, world.matching->levels() - 1, result.pose, options.gate, true);
     // (gn-autodiff forms it with Jets: the same to rounding)
     EXPECT_LT(Relative(result.information, InformationMatrix(final_c, result.pose, options)), 1e-12) << name;
     using Eigen6 = Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>;

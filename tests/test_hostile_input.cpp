@@ -82,8 +82,9 @@ std::string ReadOne(const std::string& path, const Gaussian& g) {
 
 TEST_F(HostileInput, MapFileBoundsMeansStdsAndRcs) {
   const std::string path = Path("m.rgm");
-  EXPECT_NE(ReadOne(path, RoundGaussian(Eigen::Vector3d::Zero(), 1e4)).find(path + ": Gaussian 1: covariance with "
-                                                                            "principal stds outside"),
+  EXPECT_NE(ReadOne(path, RoundGaussian(Eigen::Vector3d::Zero(), 1e4))
+                .find(path + ": Gaussian 1: covariance with "
+                             "principal stds outside"),
             std::string::npos);  // 10 km: hung the index
   EXPECT_NE(ReadOne(path, RoundGaussian(Eigen::Vector3d(1e300, 0, 0), 0.3)).find("mean beyond"), std::string::npos);
   EXPECT_NE(ReadOne(path, RoundGaussian(Eigen::Vector3d::Zero(), 1e-6)).find("principal stds"), std::string::npos);
@@ -205,8 +206,7 @@ TEST_F(HostileInput, ConfigFilesAreOneBoundedDocumentWithoutRepeatedKeys) {
   EXPECT_EQ(error("seed: 1\nscans: 4\nseed: 2\n"), path + ":3: key 'seed' given twice (first on line 1)");
   EXPECT_EQ(error("materials:\n  wall: {diffuse: 1, diffuse: 2}\n"),
             path + ":2: key 'diffuse' given twice (first on line 2)");
-  EXPECT_EQ(error("seed: 1\n---\nseed: 2\n"),
-            path + ": more than one YAML document (a configuration file is one)");
+  EXPECT_EQ(error("seed: 1\n---\nseed: 2\n"), path + ": more than one YAML document (a configuration file is one)");
   EXPECT_EQ(error(", "), path + ": more than one YAML document (a configuration file is one)");  // LoadAll hung
   EXPECT_EQ(error(std::string(40, '[') + std::string(40, ']')), path + ":1: nested more than 32 levels");
   EXPECT_EQ(error("seed: 1\n" + std::string(kMaxConfigFileBytes, '#')),
@@ -262,9 +262,7 @@ TEST_F(HostileInput, ConfigFilesBoundTheirNodesWithAliasesExpanded) {
 }
 
 TEST_F(HostileInput, OutputsAreRegularFilesInExistingFolders) {
-  const auto write = [](const std::string& path) {
-    WriteFileAtomically(path, [](std::ostream& out) { out << "x"; });
-  };
+  const auto write = [](const std::string& path) { WriteFileAtomically(path, [](std::ostream& out) { out << "x"; }); };
   const std::string fifo = Path("fifo");
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   EXPECT_EQ(ErrorOf([&] { write(fifo); }), fifo + ": is not a regular file (a device or FIFO?); refused as an output");
@@ -298,7 +296,7 @@ TEST_F(HostileInput, StagedFoldersReplaceTheOldResultsWhole) {
   EXPECT_EQ(ErrorOf([&] { run({"a.csv", "b.csv"}, true); }), "the run failed");
   EXPECT_FALSE(fs::exists(Path("results/b.csv")));
   run({"a.csv", "runs/two.tum"}, false);
-  EXPECT_TRUE(fs::exists(Path("results/plot.png")));      // kept
+  EXPECT_TRUE(fs::exists(Path("results/plot.png")));  // kept
   EXPECT_TRUE(fs::exists(Path("results/runs/two.tum")));
   EXPECT_FALSE(fs::exists(Path("results/runs/one.tum")));  // its folder was rewritten
   std::size_t entries = 0;

@@ -26,7 +26,8 @@ std::vector<Eigen::Vector3d> PlantedPoints(std::size_t n, std::uint32_t seed) {
   std::normal_distribution<double> normal(0.0, 1.0);
   std::vector<Eigen::Vector3d> points;
   const Eigen::Vector3d far(3.0e3, -2.0e3, 40.0);  // a large offset tests the cancellation
-  for (std::size_t k = 0; k < n; ++k) points.push_back(far + Eigen::Vector3d(2.0 * normal(rng), 0.5 * normal(rng), 0.1 * normal(rng)));
+  for (std::size_t k = 0; k < n; ++k)
+    points.push_back(far + Eigen::Vector3d(2.0 * normal(rng), 0.5 * normal(rng), 0.1 * normal(rng)));
   return points;
 }
 
@@ -133,7 +134,8 @@ TEST(RcsStatistics, NormalEquationsEqualTheBatchSumsAndSolveAsFitRcsModel) {
   EXPECT_EQ(model.inliers, expected.inliers);
   EXPECT_EQ(model.median, expected.median);
   EXPECT_EQ(model.scale, expected.scale);
-  for (int j = 0; j < RcsStatistics::kSize; ++j) EXPECT_NEAR(model.coefficients[j], expected.coefficients[j], 1e-8) << j;
+  for (int j = 0; j < RcsStatistics::kSize; ++j)
+    EXPECT_NEAR(model.coefficients[j], expected.coefficients[j], 1e-8) << j;
   EXPECT_NEAR(model.fit_rmse, expected.fit_rmse, 1e-9);
 }
 
@@ -158,10 +160,18 @@ std::vector<std::vector<Eigen::Vector3d>> StaticScene() {
     for (int k = 0; k < 300; ++k) {
       const double u = along(rng), v = along(rng);
       switch (k % 4) {
-        case 0: scan.emplace_back(12.0 * u, 6.0 + noise(rng), 3.0 * v); break;
-        case 1: scan.emplace_back(12.0 * u, -6.0 + noise(rng), 3.0 * v); break;
-        case 2: scan.emplace_back(12.0 + noise(rng), -6.0 + 12.0 * u, 3.0 * v); break;
-        default: scan.emplace_back(5.0 + noise(rng), 1.0 + noise(rng), 3.0 * v); break;
+        case 0:
+          scan.emplace_back(12.0 * u, 6.0 + noise(rng), 3.0 * v);
+          break;
+        case 1:
+          scan.emplace_back(12.0 * u, -6.0 + noise(rng), 3.0 * v);
+          break;
+        case 2:
+          scan.emplace_back(12.0 + noise(rng), -6.0 + 12.0 * u, 3.0 * v);
+          break;
+        default:
+          scan.emplace_back(5.0 + noise(rng), 1.0 + noise(rng), 3.0 * v);
+          break;
       }
     }
   }
@@ -171,8 +181,8 @@ std::vector<std::vector<Eigen::Vector3d>> StaticScene() {
 // How far a point is from the planted scene: the walls y = +-6 m and x = 12 m,
 // the pole's axis at (5, 1).
 double DistanceFromScene(const Eigen::Vector3d& p) {
-  return std::min({std::abs(p.y() - 6.0), std::abs(p.y() + 6.0), std::abs(p.x() - 12.0),
-                   std::hypot(p.x() - 5.0, p.y() - 1.0)});
+  return std::min(
+      {std::abs(p.y() - 6.0), std::abs(p.y() + 6.0), std::abs(p.x() - 12.0), std::hypot(p.x() - 5.0, p.y() - 1.0)});
 }
 
 struct MapSummary {

@@ -62,8 +62,7 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
       EXPECT_NEAR(d2, best, 1e-9);
       ++associated;
       // ||L^T e||^2 is the Mahalanobis^2 too, and so is MahalanobisSq.
-      EXPECT_NEAR((index.SqrtInformationT(expected) * (p - index.Mean(expected))).squaredNorm(), best,
-                  1e-9);
+      EXPECT_NEAR((index.SqrtInformationT(expected) * (p - index.Mean(expected))).squaredNorm(), best, 1e-9);
       EXPECT_NEAR(index.MahalanobisSq(expected, p - index.Mean(expected)), best, 1e-9);
     }
   }
@@ -105,8 +104,8 @@ TEST(GaussianIndexTest, MatchesBruteForceAssociation) {
 // minimum of a convex quadratic over a box is where some coordinates lie on
 // a face and the others minimise it given them; the least of those points
 // that are in the box (27 face choices).
-double SmallestMahalanobisSqOverBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-                                    const Eigen::Vector3d& mean, const Eigen::Matrix3d& information) {
+double SmallestMahalanobisSqOverBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, const Eigen::Vector3d& mean,
+                                    const Eigen::Matrix3d& information) {
   double smallest = std::numeric_limits<double>::infinity();
   for (int choice = 0; choice < 27; ++choice) {
     int face[3];  // 0: free, 1: on lo, 2: on hi
@@ -201,8 +200,7 @@ TEST(GaussianIndexTest, GateIsInclusiveAndTiesGoToTheSmallestId) {
   far.mean = Eigen::Vector3d(10.0, 0.0, 0.0);
   const GaussianIndex index({far, unit, unit}, 0.5);  // ids 1 and 2 coincide
   const std::vector<Eigen::Vector3d> points = {Eigen::Vector3d(3.0, 0.0, 0.0), Eigen::Vector3d(0.0, -3.0, 0.0),
-                                               Eigen::Vector3d(0.0, 0.0, 3.0000001),
-                                               Eigen::Vector3d(1.0, 2.0, 2.0)};
+                                               Eigen::Vector3d(0.0, 0.0, 3.0000001), Eigen::Vector3d(1.0, 2.0, 2.0)};
   const std::vector<int> expected = {1, 1, -1, 1};  // |p|^2 = 9, 9, > 9, 9
   for (std::size_t k = 0; k < points.size(); ++k) {
     double d2 = -1.0;

@@ -72,10 +72,11 @@ TEST(JointRefinement, LowersPoseErrorAndRcsResidual) {
     mean_error(result.poses, t1, r1);
     const double rms0 = RcsResidualRms(scans, perturbed, world.map, 3.0);
     const double rms1 = RcsResidualRms(scans, result.poses, result.map, 3.0);
-    std::printf("joint refinement (%s, %zu scans): pose error %.3f m / %.3f deg -> %.3f m / %.3f deg; "
-                "RCS residual RMS %.4f -> %.4f; %d iterations, %.0f ms\n",
-                schur ? "SPARSE_SCHUR" : "SPARSE_NORMAL_CHOLESKY", scans.size(), t0, r0, t1, r1, rms0, rms1,
-                result.iterations, result.time_ms);
+    std::printf(
+        "joint refinement (%s, %zu scans): pose error %.3f m / %.3f deg -> %.3f m / %.3f deg; "
+        "RCS residual RMS %.4f -> %.4f; %d iterations, %.0f ms\n",
+        schur ? "SPARSE_SCHUR" : "SPARSE_NORMAL_CHOLESKY", scans.size(), t0, r0, t1, r1, rms0, rms1, result.iterations,
+        result.time_ms);
     EXPECT_LT(t1, 0.5 * t0);
     EXPECT_LT(r1, r0);
     EXPECT_LT(rms1, rms0);
@@ -100,7 +101,8 @@ TEST(JointRefinement, LowersPoseErrorAndRcsResidual) {
       const double analytic = schur_result.map.gaussians[g].rcs.coefficients[i];
       largest_coefficient_change =
           std::max(largest_coefficient_change, std::abs(analytic - world.map.gaussians[g].rcs.coefficients[i]));
-      largest_difference = std::max(largest_difference, std::abs(autodiff.map.gaussians[g].rcs.coefficients[i] - analytic));
+      largest_difference =
+          std::max(largest_difference, std::abs(autodiff.map.gaussians[g].rcs.coefficients[i] - analytic));
     }
   }
   EXPECT_GT(largest_coefficient_change, 1e-3);  // the coefficients did move
@@ -124,8 +126,7 @@ TEST(JointRefinement, RefusesAMapTheScansDoNotLieOn) {
     RefineJointly(scans, poses, elsewhere, options);
     ADD_FAILURE() << "a map 1 km away was refined";
   } catch (const DataError& e) {
-    EXPECT_NE(std::string(e.what()).find("0.0 % of the scans' points lie near the map"), std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find("0.0 % of the scans' points lie near the map"), std::string::npos) << e.what();
   }
   EXPECT_NO_THROW(RefineJointly(scans, poses, world.map, options));
   options.min_associated_share = 0.0;  // the check off

@@ -44,9 +44,7 @@ TEST(SE3Manifold, InvariantsHold) {
   const SE3Manifold manifold;
   std::mt19937 rng(6);
   std::uniform_real_distribution<double> uniform(-5.0, 5.0);
-  const auto random_translation = [&] {
-    return Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
-  };
+  const auto random_translation = [&] { return Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng)); };
   const auto ambient = [](const SE3d& pose) {
     Eigen::VectorXd v(7);
     v << pose.rotation().quaternion().coeffs(), pose.translation();
@@ -56,8 +54,7 @@ TEST(SE3Manifold, InvariantsHold) {
     const Eigen::VectorXd x = ambient(SE3d(rotation, random_translation()));
     Eigen::VectorXd delta(6);
     delta << random_translation(), 0.7 * RandomUnitVector(rng);
-    const Eigen::VectorXd y =
-        ambient(SE3d(SO3d::Exp(2.0 * RandomUnitVector(rng)), random_translation()));
+    const Eigen::VectorXd y = ambient(SE3d(SO3d::Exp(2.0 * RandomUnitVector(rng)), random_translation()));
     EXPECT_THAT_MANIFOLD_INVARIANTS_HOLD(manifold, x, delta, y, kTolerance);
   }
 }

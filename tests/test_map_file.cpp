@@ -108,7 +108,8 @@ TEST_F(MapFiles, PlacesRoundTripAndVersionOneStillReads) {
   for (int k = 0; k < 3; ++k) {
     MapPlace place;
     place.pose = SE3d::Exp((Eigen::Matrix<double, 6, 1>() << 10 * normal(rng), normal(rng), 0.1 * normal(rng),
-                            0.1 * normal(rng), 0.1 * normal(rng), normal(rng)).finished());
+                            0.1 * normal(rng), 0.1 * normal(rng), normal(rng))
+                               .finished());
     for (int i = 0; i < 5 + k; ++i) {
       RadarPoint point;
       point.position = 20.0 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
@@ -123,8 +124,10 @@ TEST_F(MapFiles, PlacesRoundTripAndVersionOneStillReads) {
   for (std::size_t k = 0; k < 3; ++k) {
     EXPECT_EQ(read.places[k].pose.translation(), map.places[k].pose.translation());
     // Renormalised on reading: equal to the last bit or two.
-    EXPECT_LT((read.places[k].pose.rotation().quaternion().coeffs() -
-               map.places[k].pose.rotation().quaternion().coeffs()).norm(), 1e-15);
+    EXPECT_LT(
+        (read.places[k].pose.rotation().quaternion().coeffs() - map.places[k].pose.rotation().quaternion().coeffs())
+            .norm(),
+        1e-15);
     ASSERT_EQ(read.places[k].points.size(), map.places[k].points.size());
     for (std::size_t i = 0; i < map.places[k].points.size(); ++i) {
       EXPECT_EQ(read.places[k].points[i].position, map.places[k].points[i].position.cast<float>().cast<double>());

@@ -342,7 +342,7 @@ TEST(OdometryRealData, SmartmicroHighwayFramesMatch) {
   EXPECT_LT(mounting->pitch_deg, -0.8);  // looking up: the velocity points 1.3 deg below the x axis
   EXPECT_GT(mounting->pitch_deg, -1.8);
   const Trajectory levelled = Levelled(odometry.trajectory(), *mounting);
-  EXPECT_LT(std::abs(levelled[levelled.size() - 1].pose.translation().z()), 1.5);  // 452 m driven
+  EXPECT_LT(std::abs(levelled[levelled.size() - 1].pose.translation().z()), 1.5);               // 452 m driven
   EXPECT_GT(std::abs(odometry.trajectory()[levelled.size() - 1].pose.translation().z()), 5.0);  // not levelled
 }
 

@@ -29,8 +29,8 @@ TEST(PclPeers, LowerTheErrorsOnAShortSequence) {
         RunConfiguration(peer.Name(), 0.0, peer, matching, sequence.scans, sequence.poses, errors);
     double initial = 0.0;
     for (const ScanOutcome& o : run.outcomes) initial += o.initial_translation_error / run.outcomes.size();
-    std::printf("%s: translation error %.3f -> %.3f m (median %.3f), rotation median %.3f deg\n",
-                peer.Name().c_str(), initial, run.translation.mean, run.translation.median, run.rotation.median);
+    std::printf("%s: translation error %.3f -> %.3f m (median %.3f), rotation median %.3f deg\n", peer.Name().c_str(),
+                initial, run.translation.mean, run.translation.median, run.rotation.median);
     EXPECT_LT(run.translation.median, 0.5 * initial) << peer.Name();
   }
 }

@@ -32,7 +32,8 @@ std::vector<RadarPoint> RandomPlace(std::uint32_t seed) {
     const double rcs = 15.0 * uniform(rng);
     for (int k = 0; k < 15; ++k) {
       RadarPoint point;
-      point.position = centre + extent.cwiseProduct(Eigen::Vector3d(uniform(rng), uniform(rng), std::abs(uniform(rng))));
+      point.position =
+          centre + extent.cwiseProduct(Eigen::Vector3d(uniform(rng), uniform(rng), std::abs(uniform(rng))));
       point.rcs = rcs + noise(rng);
       points.push_back(point);
     }
@@ -48,7 +49,8 @@ std::vector<RadarPoint> SeenFrom(const std::vector<RadarPoint>& place, double ya
   const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   std::vector<RadarPoint> seen = place;
   for (RadarPoint& point : seen) {
-    point.position = R.transpose() * (point.position - shift) + 0.05 * Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    point.position =
+        R.transpose() * (point.position - shift) + 0.05 * Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
     point.rcs += noise(rng);
   }
   return seen;

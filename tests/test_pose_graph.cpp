@@ -224,8 +224,8 @@ TEST(PoseGraph, FalseLoopAgainstEachLoopRejection) {
                         {"graduated", LoopRejection::kGraduated, {LossType::kGemanMcClure, 3.0}, 0.425 / 1.3}};
   for (const Case& c : cases) {
     PoseGraph graph = DriftedGraph(truth, 7);
-    const int false_loop = graph.AddLoop(10, 10 + kLap / 2, SE3d(SO3d(), Eigen::Vector3d(2.0, 0.0, 0.0)),
-                                         OdometrySqrtInformation());
+    const int false_loop =
+        graph.AddLoop(10, 10 + kLap / 2, SE3d(SO3d(), Eigen::Vector3d(2.0, 0.0, 0.0)), OdometrySqrtInformation());
     PoseGraphOptions options;
     options.loop_rejection = c.rejection;
     options.loop_loss = c.loss;

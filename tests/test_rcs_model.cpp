@@ -46,7 +46,7 @@ TEST(RcsNormalisationTest, EdgeCases) {
   n = NormaliseRcs({1.0, 1.0, 1.0, 5.0});
   EXPECT_FALSE(n.valid);  // median 1 = min: one side empty
   n = NormaliseRcs({0.0, 2.0});
-  ASSERT_TRUE(n.valid);   // two points: median 1, scale 1, y = -1 and +1
+  ASSERT_TRUE(n.valid);  // two points: median 1, scale 1, y = -1 and +1
   EXPECT_EQ(n.median, 1.0);
   EXPECT_EQ(n.scale, 1.0);
   EXPECT_FALSE(NormaliseRcs({4.0}).valid);
@@ -88,8 +88,8 @@ TEST(RcsModelFit, RecoversPlantedCoefficientsExactly) {
     ASSERT_EQ(model.degree, degree);
     EXPECT_LT(model.fit_rmse, 1e-9);
     for (int j = 0; j < ShCoefficientCount(degree); ++j) {
-      const double expected = (4.0 * planted[j] + (j == 0 ? (5.0 - model.median) / sh_constants::kC0 : 0.0)) /
-                              model.scale;
+      const double expected =
+          (4.0 * planted[j] + (j == 0 ? (5.0 - model.median) / sh_constants::kC0 : 0.0)) / model.scale;
       EXPECT_NEAR(model.coefficients[j], expected, 1e-9) << "degree " << degree << " j " << j;
     }
     // Predictions equal the normalised measurements of the inliers.
@@ -150,11 +150,11 @@ TEST(RcsModelFit, SimulatedSequenceCoverage) {
     fit.incidence = incidence;
     const RcsFitStats stats = FitRcsModels(map, cloud, association, fit);
     const double coverage = double(stats.with_model) / double(stats.gaussians);
-    std::printf("incidence %s: %zu Gaussians, %.1f%% with a model (degree 0/1/2/3: %zu/%zu/%zu/%zu), "
-                "mean fit RMSE %.4f\n",
-                ToString(incidence).c_str(), stats.gaussians, 100.0 * coverage,
-                stats.degree_histogram[0], stats.degree_histogram[1], stats.degree_histogram[2],
-                stats.degree_histogram[3], stats.mean_fit_rmse);
+    std::printf(
+        "incidence %s: %zu Gaussians, %.1f%% with a model (degree 0/1/2/3: %zu/%zu/%zu/%zu), "
+        "mean fit RMSE %.4f\n",
+        ToString(incidence).c_str(), stats.gaussians, 100.0 * coverage, stats.degree_histogram[0],
+        stats.degree_histogram[1], stats.degree_histogram[2], stats.degree_histogram[3], stats.mean_fit_rmse);
     EXPECT_GT(coverage, 0.7);
     EXPECT_GT(stats.mean_fit_rmse, 0.0);
     EXPECT_LT(stats.mean_fit_rmse, 0.7);

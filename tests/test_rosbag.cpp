@@ -26,8 +26,7 @@ PointCloud2Data MakeCloud(bool big_endian) {
   PointCloud2Data cloud;
   cloud.height = 2;
   cloud.width = 2;
-  cloud.fields = {{"x", 0, 7, 1}, {"y", 4, 7, 1}, {"z", 8, 7, 1}, {"rcs", 12, 4, 1},
-                  {"velocity", 16, 8, 1}};
+  cloud.fields = {{"x", 0, 7, 1}, {"y", 4, 7, 1}, {"z", 8, 7, 1}, {"rcs", 12, 4, 1}, {"velocity", 16, 8, 1}};
   cloud.is_bigendian = big_endian;
   cloud.point_step = 28;
   cloud.row_step = 60;
@@ -91,8 +90,7 @@ TEST(RosbagRealData, TiMmwaveDemoBag) {
   if (bag.empty()) GTEST_SKIP() << "shared data not found";
   const std::vector<BagTopic> topics = ListBagTopics(bag);
   ASSERT_EQ(topics.size(), 4u);
-  const auto radar = std::find_if(topics.begin(), topics.end(),
-                                  [](const BagTopic& t) { return t.name == kTopic; });
+  const auto radar = std::find_if(topics.begin(), topics.end(), [](const BagTopic& t) { return t.name == kTopic; });
   ASSERT_NE(radar, topics.end());
   EXPECT_EQ(radar->type, "sensor_msgs/PointCloud2");
   EXPECT_EQ(radar->messages, 412u);

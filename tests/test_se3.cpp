@@ -75,14 +75,10 @@ TEST(SE3, RightAndLeftJacobiansMatchNumeric) {
   for (const Vector6d& xi : HardTangents()) {
     const SE3d x = SE3d::Exp(xi);
     const Eigen::MatrixXd jr_numeric = NumericJacobian(
-        [&](const Eigen::VectorXd& d) {
-          return Eigen::VectorXd((x.Inverse() * SE3d::Exp(xi + d)).Log());
-        },
+        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd((x.Inverse() * SE3d::Exp(xi + d)).Log()); },
         Vector6d::Zero());
     const Eigen::MatrixXd jl_numeric = NumericJacobian(
-        [&](const Eigen::VectorXd& d) {
-          return Eigen::VectorXd((SE3d::Exp(xi + d) * x.Inverse()).Log());
-        },
+        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd((SE3d::Exp(xi + d) * x.Inverse()).Log()); },
         Vector6d::Zero());
     EXPECT_LT((SE3d::RightJacobian(xi) - jr_numeric).norm(), 1e-6) << xi.transpose();
     EXPECT_LT((SE3d::LeftJacobian(xi) - jl_numeric).norm(), 1e-6) << xi.transpose();
@@ -92,10 +88,10 @@ TEST(SE3, RightAndLeftJacobiansMatchNumeric) {
 TEST(SE3, InverseJacobiansInvert) {
   for (const Vector6d& xi : HardTangents()) {
     using Matrix6d = Eigen::Matrix<double, 6, 6>;
-    EXPECT_LT((SE3d::LeftJacobianInverse(xi) * SE3d::LeftJacobian(xi) - Matrix6d::Identity())
-                  .norm(), 1e-9) << xi.transpose();
-    EXPECT_LT((SE3d::RightJacobianInverse(xi) * SE3d::RightJacobian(xi) - Matrix6d::Identity())
-                  .norm(), 1e-9) << xi.transpose();
+    EXPECT_LT((SE3d::LeftJacobianInverse(xi) * SE3d::LeftJacobian(xi) - Matrix6d::Identity()).norm(), 1e-9)
+        << xi.transpose();
+    EXPECT_LT((SE3d::RightJacobianInverse(xi) * SE3d::RightJacobian(xi) - Matrix6d::Identity()).norm(), 1e-9)
+        << xi.transpose();
   }
 }
 
@@ -104,8 +100,7 @@ TEST(SE3, LogJacobiansMatchNumeric) {
     if (xi.segment<3>(kRotationOffset).norm() > 3.0) continue;  // the cut of Log at pi
     const SE3d x = SE3d::Exp(xi);
     const Eigen::MatrixXd right = NumericJacobian(
-        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd((x * SE3d::Exp(d)).Log()); },
-        Vector6d::Zero());
+        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd((x * SE3d::Exp(d)).Log()); }, Vector6d::Zero());
     EXPECT_LT((SE3d::RightJacobianInverse(xi) - right).norm(), 1e-6) << xi.transpose();
   }
 }
@@ -115,8 +110,7 @@ TEST(SE3, ActionJacobianMatchesNumeric) {
   for (const Vector6d& xi : HardTangents()) {
     const SE3d x = SE3d::Exp(xi);
     const Eigen::MatrixXd numeric = NumericJacobian(
-        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd(x * SE3d::Exp(d) * p); },
-        Vector6d::Zero());
+        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd(x * SE3d::Exp(d) * p); }, Vector6d::Zero());
     EXPECT_LT((x.ActionJacobian(p) - numeric).norm(), 1e-6) << xi.transpose();
   }
 }

@@ -26,8 +26,8 @@ std::string Records(const std::vector<std::vector<float>>& rows) {
 }
 
 TEST_F(KittiBin, ReadsViewOfDelftLayout) {
-  const std::string path = WriteFile("00042.bin", Records({{10, 1, 0.5, -3, 2.5, 0.1, 0},
-                                                           {20, -2, 1.0, 7, -1.5, 0.0, 0}}));
+  const std::string path =
+      WriteFile("00042.bin", Records({{10, 1, 0.5, -3, 2.5, 0.1, 0}, {20, -2, 1.0, 7, -1.5, 0.0, 0}}));
   const RadarScan scan = ReadKittiBin(path, ParseBinLayout("vod"));
   ASSERT_EQ(scan.points.size(), 2u);
   EXPECT_EQ(scan.points[1].position, Eigen::Vector3d(20, -2, 1));
@@ -57,12 +57,11 @@ TEST_F(KittiBin, RejectsTruncatedFilesAndBadLayouts) {
 // R_body_x36d = R_body_xt32 R_x36d_xt32^T simplifies to R_x36d_xt32^T R_x36d_ars548.
 TEST(Extrinsic, SnailRadarPresetMatchesAlgebra) {
   Eigen::Matrix3d R_x36d_xt32;
-  R_x36d_xt32 << -0.001402106, -0.999967799, 0.007901562, 0.999997759, -0.001414596,
-      -0.001575345, 0.001586472, 0.007899336, 0.999967541;
+  R_x36d_xt32 << -0.001402106, -0.999967799, 0.007901562, 0.999997759, -0.001414596, -0.001575345, 0.001586472,
+      0.007899336, 0.999967541;
   Eigen::Matrix3d R_x36d_ars548;
-  R_x36d_ars548 << 0.99912647794293, 0.039117559886893, -0.0147002578838332, -0.0390210149947843,
-      0.999215265264576, 0.00679809171902766, 0.0149546468407877, -0.00621853445265288,
-      0.999868835581512;
+  R_x36d_ars548 << 0.99912647794293, 0.039117559886893, -0.0147002578838332, -0.0390210149947843, 0.999215265264576,
+      0.00679809171902766, 0.0149546468407877, -0.00621853445265288, 0.999868835581512;
   const SE3d extrinsic = SnailRadar20231213Extrinsic();
   EXPECT_LT((extrinsic.rotation().Matrix() - R_x36d_xt32.transpose() * R_x36d_ars548).norm(), 1e-5);
   EXPECT_LT((extrinsic.translation() - Eigen::Vector3d(0, 0, 0.07)).norm(), 1e-12);

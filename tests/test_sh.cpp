@@ -63,8 +63,7 @@ double ReferenceSh(int l, int m, const Eigen::Vector3d& d) {
   const double theta = std::acos(std::clamp(d.z(), -1.0, 1.0));
   const double phi = std::atan2(d.y(), d.x());
   const int am = std::abs(m);
-  const double k = std::sqrt((2.0 * l + 1.0) / (4.0 * M_PI) * std::tgamma(l - am + 1.0) /
-                             std::tgamma(l + am + 1.0));
+  const double k = std::sqrt((2.0 * l + 1.0) / (4.0 * M_PI) * std::tgamma(l - am + 1.0) / std::tgamma(l + am + 1.0));
   const double p = AssociatedLegendre(l, am, std::cos(theta));
   if (m == 0) return k * p;
   return std::sqrt(2.0) * k * p * (m > 0 ? std::cos(m * phi) : std::sin(am * phi));
@@ -88,8 +87,7 @@ TEST(SphericalHarmonics, OrthonormalByQuadrature) {
       gram += weights[i] * (2.0 * M_PI / n_phi) * y * y.transpose();
     }
   }
-  EXPECT_LT((gram - Eigen::Matrix<double, kCount, kCount>::Identity()).cwiseAbs().maxCoeff(), 1e-6)
-      << gram;
+  EXPECT_LT((gram - Eigen::Matrix<double, kCount, kCount>::Identity()).cwiseAbs().maxCoeff(), 1e-6) << gram;
 }
 
 TEST(SphericalHarmonics, MatchesAssociatedLegendreReference) {
@@ -99,8 +97,7 @@ TEST(SphericalHarmonics, MatchesAssociatedLegendreReference) {
     const auto y = ShBasis<kMaxShDegree>(d);
     for (int l = 0; l <= kMaxShDegree; ++l) {
       for (int m = -l; m <= l; ++m) {
-        ASSERT_NEAR(y[l * l + l + m], ReferenceSh(l, m, d), 1e-12)
-            << "l=" << l << " m=" << m << " d=" << d.transpose();
+        ASSERT_NEAR(y[l * l + l + m], ReferenceSh(l, m, d), 1e-12) << "l=" << l << " m=" << m << " d=" << d.transpose();
       }
     }
   }
@@ -148,10 +145,7 @@ TEST(SphericalHarmonics, JetDerivativesMatchNumeric) {
     Eigen::Matrix<double, kCount, 3> analytic;
     for (int i = 0; i < kCount; ++i) analytic.row(i) = y_jet[i].v.transpose();
     const Eigen::MatrixXd numeric = NumericJacobian(
-        [](const Eigen::VectorXd& x) {
-          return Eigen::VectorXd(ShBasis<kMaxShDegree>(Eigen::Vector3d(x)));
-        },
-        d);
+        [](const Eigen::VectorXd& x) { return Eigen::VectorXd(ShBasis<kMaxShDegree>(Eigen::Vector3d(x))); }, d);
     EXPECT_LT((analytic - numeric).norm(), 1e-8);
   }
 }

@@ -168,8 +168,8 @@ TEST_F(SimulatorFiles, RoundTripThroughSnailRadarLoader) {
 }
 
 TEST_F(SimulatorFiles, ConfigFileOverridesAndValidates) {
-  const SimulationConfig config = LoadSimulationConfig(
-      WriteFile("ok.yaml", "scans: 12\nspeed: 3.5\nmaterials:\n  wall: {specular: 8.0}\n"));
+  const SimulationConfig config =
+      LoadSimulationConfig(WriteFile("ok.yaml", "scans: 12\nspeed: 3.5\nmaterials:\n  wall: {specular: 8.0}\n"));
   EXPECT_EQ(config.scans, 12);
   EXPECT_EQ(config.speed, 3.5);
   EXPECT_EQ(config.materials.at("wall").specular, 8.0);

@@ -76,7 +76,8 @@ TEST(RadarSlam, ClosesTheYardsRevisitsWithoutAFalseLoop) {
                  (TruePosition(keyframes[q]) - TruePosition(keyframes[c])).norm() < 5.0;
     }
     revisits += revisit;
-    for (const LoopCandidate& loop : slam->candidates()) closed += revisit && loop.query == int(q) && loop.check.accepted;
+    for (const LoopCandidate& loop : slam->candidates())
+      closed += revisit && loop.query == int(q) && loop.check.accepted;
   }
   std::size_t accepted = 0;
   for (const LoopCandidate& loop : slam->candidates()) {
@@ -135,7 +136,7 @@ SimulatedSequence SecondRun(bool same_world) {
   config.seed = 7;
   config.world_seed = 1;  // the yard's objects
   config.start_offset = 70.0;
-  if (!same_world) {      // another yard: other walls, other objects
+  if (!same_world) {  // another yard: other walls, other objects
     config.loop_length = 90.0;
     config.loop_width = 45.0;
     config.world_seed = 99;

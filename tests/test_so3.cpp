@@ -29,8 +29,7 @@ TEST(SO3, ExpMatchesAngleAxis) {
   for (const Eigen::Vector3d& phi : HardTangents()) {
     const double angle = phi.norm();
     const Eigen::Matrix3d expected =
-        angle == 0.0 ? Eigen::Matrix3d::Identity()
-                     : Eigen::AngleAxisd(angle, phi / angle).toRotationMatrix();
+        angle == 0.0 ? Eigen::Matrix3d::Identity() : Eigen::AngleAxisd(angle, phi / angle).toRotationMatrix();
     EXPECT_LT((SO3d::Exp(phi).Matrix() - expected).norm(), 1e-14) << phi.transpose();
   }
 }
@@ -78,14 +77,10 @@ TEST(SO3, RightAndLeftJacobiansMatchNumeric) {
   for (const Eigen::Vector3d& phi : HardTangents()) {
     const SO3d r = SO3d::Exp(phi);
     const Eigen::MatrixXd jr_numeric = NumericJacobian(
-        [&](const Eigen::VectorXd& d) {
-          return Eigen::VectorXd((r.Inverse() * SO3d::Exp(phi + d)).Log());
-        },
+        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd((r.Inverse() * SO3d::Exp(phi + d)).Log()); },
         Eigen::Vector3d::Zero());
     const Eigen::MatrixXd jl_numeric = NumericJacobian(
-        [&](const Eigen::VectorXd& d) {
-          return Eigen::VectorXd((SO3d::Exp(phi + d) * r.Inverse()).Log());
-        },
+        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd((SO3d::Exp(phi + d) * r.Inverse()).Log()); },
         Eigen::Vector3d::Zero());
     EXPECT_LT((SO3d::RightJacobian(phi) - jr_numeric).norm(), 1e-6) << phi.transpose();
     EXPECT_LT((SO3d::LeftJacobian(phi) - jl_numeric).norm(), 1e-6) << phi.transpose();
@@ -94,10 +89,10 @@ TEST(SO3, RightAndLeftJacobiansMatchNumeric) {
 
 TEST(SO3, InverseJacobiansInvert) {
   for (const Eigen::Vector3d& phi : HardTangents()) {
-    EXPECT_LT((SO3d::RightJacobianInverse(phi) * SO3d::RightJacobian(phi) -
-               Eigen::Matrix3d::Identity()).norm(), 1e-9) << phi.transpose();
-    EXPECT_LT((SO3d::LeftJacobianInverse(phi) * SO3d::LeftJacobian(phi) -
-               Eigen::Matrix3d::Identity()).norm(), 1e-9) << phi.transpose();
+    EXPECT_LT((SO3d::RightJacobianInverse(phi) * SO3d::RightJacobian(phi) - Eigen::Matrix3d::Identity()).norm(), 1e-9)
+        << phi.transpose();
+    EXPECT_LT((SO3d::LeftJacobianInverse(phi) * SO3d::LeftJacobian(phi) - Eigen::Matrix3d::Identity()).norm(), 1e-9)
+        << phi.transpose();
   }
 }
 
@@ -108,11 +103,9 @@ TEST(SO3, LogJacobiansMatchNumeric) {
     if (phi.norm() > 3.0) continue;
     const SO3d r = SO3d::Exp(phi);
     const Eigen::MatrixXd right = NumericJacobian(
-        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd((r * SO3d::Exp(d)).Log()); },
-        Eigen::Vector3d::Zero());
+        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd((r * SO3d::Exp(d)).Log()); }, Eigen::Vector3d::Zero());
     const Eigen::MatrixXd left = NumericJacobian(
-        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd((SO3d::Exp(d) * r).Log()); },
-        Eigen::Vector3d::Zero());
+        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd((SO3d::Exp(d) * r).Log()); }, Eigen::Vector3d::Zero());
     EXPECT_LT((SO3d::RightJacobianInverse(phi) - right).norm(), 1e-6) << phi.transpose();
     EXPECT_LT((SO3d::LeftJacobianInverse(phi) - left).norm(), 1e-6) << phi.transpose();
   }
@@ -123,8 +116,7 @@ TEST(SO3, ActionJacobianMatchesNumeric) {
   for (const Eigen::Vector3d& phi : HardTangents()) {
     const SO3d r = SO3d::Exp(phi);
     const Eigen::MatrixXd numeric = NumericJacobian(
-        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd(r * SO3d::Exp(d) * p); },
-        Eigen::Vector3d::Zero());
+        [&](const Eigen::VectorXd& d) { return Eigen::VectorXd(r * SO3d::Exp(d) * p); }, Eigen::Vector3d::Zero());
     EXPECT_LT((r.ActionJacobianRotation(p) - numeric).norm(), 1e-6) << phi.transpose();
   }
 }
@@ -177,8 +169,7 @@ TEST(SO3, JetDerivativesThroughExpLogAreConsistent) {
     Eigen::Matrix<double, 4, 3> dq;
     for (int i = 0; i < 4; ++i) dq.row(i) = r.data()[i].v.transpose();
     const Eigen::MatrixXd numeric = NumericJacobian(
-        [](const Eigen::VectorXd& x) { return Eigen::VectorXd(SO3d::Exp(x).quaternion().coeffs()); },
-        phi_value);
+        [](const Eigen::VectorXd& x) { return Eigen::VectorXd(SO3d::Exp(x).quaternion().coeffs()); }, phi_value);
     EXPECT_LT((dq - numeric).norm(), 1e-8) << phi_value.transpose();
   }
 }

@@ -63,16 +63,16 @@ TEST_P(SolverTest, ConvergesFromTwoMetresFiveDegrees) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    EverySolver, SolverTest,
-    ::testing::Values(SolverCase{"gn", 0.0}, SolverCase{"gn", 0.25}, SolverCase{"gn-autodiff", 0.0},
-                      SolverCase{"gn-autodiff", 0.25}, SolverCase{"ceres", 0.0}, SolverCase{"ceres", 0.25},
-                      SolverCase{"mh-gn", 0.0}, SolverCase{"mh-gn", 0.25}),
-    [](const ::testing::TestParamInfo<SolverCase>& info) {
-      std::string name = info.param.name + "_w" + std::to_string(int(info.param.w_rcs * 100));
-      for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-      return name;
-    });
+INSTANTIATE_TEST_SUITE_P(EverySolver, SolverTest,
+                         ::testing::Values(SolverCase{"gn", 0.0}, SolverCase{"gn", 0.25},
+                                           SolverCase{"gn-autodiff", 0.0}, SolverCase{"gn-autodiff", 0.25},
+                                           SolverCase{"ceres", 0.0}, SolverCase{"ceres", 0.25},
+                                           SolverCase{"mh-gn", 0.0}, SolverCase{"mh-gn", 0.25}),
+                         [](const ::testing::TestParamInfo<SolverCase>& info) {
+                           std::string name = info.param.name + "_w" + std::to_string(int(info.param.w_rcs * 100));
+                           for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+                           return name;
+                         });
 
 // An RCS term holds the facing sign of its association's pose: there its
 // residual is the paper's, and as the point crosses its Gaussian's y-z plane
@@ -162,9 +162,8 @@ TEST(SolverAgreement, SameOptimumOnSameAssociation) {
     }
     double dt = 0.0, dr = 0.0;
     PoseErrors(gn.pose, lm.pose, dt, dr);
-    std::printf("w %.2f, %s incidence: GN cost %.10f (%d it), LM cost %.10f; pose difference %.2e m, %.2e rad\n",
-                w, ToString(map->incidence).c_str(), gn.final_cost, gn.iterations, lm.final_cost, dt,
-                dr * M_PI / 180.0);
+    std::printf("w %.2f, %s incidence: GN cost %.10f (%d it), LM cost %.10f; pose difference %.2e m, %.2e rad\n", w,
+                ToString(map->incidence).c_str(), gn.final_cost, gn.iterations, lm.final_cost, dt, dr * M_PI / 180.0);
     ASSERT_TRUE(gn.converged) << gn.reason;
     EXPECT_LT(dt, 1e-4) << "w " << w;
     EXPECT_LT(dr * M_PI / 180.0, 1e-4) << "w " << w;

@@ -21,8 +21,8 @@ class TrajectoryFiles : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("radargauss_traj_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+           ("radargauss_traj_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -42,8 +42,7 @@ class TrajectoryFiles : public ::testing::Test {
       FAIL() << "no error for:\n" << content;
     } catch (const DataError& e) {
       const std::string message = e.what();
-      EXPECT_NE(message.find(path + ":" + std::to_string(line) + ":"), std::string::npos)
-          << message;
+      EXPECT_NE(message.find(path + ":" + std::to_string(line) + ":"), std::string::npos) << message;
       EXPECT_NE(message.find(fault), std::string::npos) << message;
     }
   }
@@ -60,8 +59,8 @@ TEST_F(TrajectoryFiles, RoundTripIsExactToPrintedPrecision) {
   double time = 1702450000.0;
   for (int i = 0; i < 100; ++i) {
     time += 0.05 + 0.01 * std::abs(uniform(rng)) / 100.0;
-    original.Append(time, SE3d(SO3d::Exp(3.0 * RandomUnitVector(rng)),
-                               Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng))));
+    original.Append(
+        time, SE3d(SO3d::Exp(3.0 * RandomUnitVector(rng)), Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng))));
   }
   const std::string path = (dir_ / "round_trip.txt").string();
   WriteTum(path, original);
@@ -71,11 +70,12 @@ TEST_F(TrajectoryFiles, RoundTripIsExactToPrintedPrecision) {
     // 9 printed decimals: half a unit in the last place, plus the double's own
     // resolution at 1.7e9 s for the time stamp.
     EXPECT_NEAR(read[i].time, original[i].time, 5e-10 + 2.4e-7);
-    EXPECT_LT((read[i].pose.translation() - original[i].pose.translation()).cwiseAbs().maxCoeff(),
-              5e-10 + 1e-14);
+    EXPECT_LT((read[i].pose.translation() - original[i].pose.translation()).cwiseAbs().maxCoeff(), 5e-10 + 1e-14);
     // Normalisation after reading moves a component by at most ~1e-9.
-    EXPECT_LT((read[i].pose.rotation().quaternion().coeffs() -
-               original[i].pose.rotation().quaternion().coeffs()).cwiseAbs().maxCoeff(), 2e-9);
+    EXPECT_LT((read[i].pose.rotation().quaternion().coeffs() - original[i].pose.rotation().quaternion().coeffs())
+                  .cwiseAbs()
+                  .maxCoeff(),
+              2e-9);
   }
   // Writing what was read gives the same file again, up to the last digit of
   // the renormalised quaternion.
@@ -86,8 +86,8 @@ TEST_F(TrajectoryFiles, RoundTripIsExactToPrintedPrecision) {
 
 TEST_F(TrajectoryFiles, SkipsCommentsAndBlankLines) {
   const Trajectory t = ReadTum(Write("ok.txt", "# t x y z qx qy qz qw\n\n   \n" + std::string(kGood) +
-                                                    "1.5 1 2 3 0 0 0.7071067811865476 "
-                                                    "0.7071067811865476\r\n"));
+                                                   "1.5 1 2 3 0 0 0.7071067811865476 "
+                                                   "0.7071067811865476\r\n"));
   ASSERT_EQ(t.size(), 2u);
   EXPECT_EQ(t[1].time, 1.5);
   EXPECT_EQ(t[1].pose.translation(), Eigen::Vector3d(1, 2, 3));
@@ -106,9 +106,7 @@ TEST_F(TrajectoryFiles, MalformedLinesNameFileAndLine) {
   ExpectError(std::string(kGood) + "-1.0 0 0 0 0 0 0 1\n", 2, "time does not increase");
 }
 
-TEST_F(TrajectoryFiles, MissingFileIsAnError) {
-  EXPECT_THROW(ReadTum((dir_ / "absent.txt").string()), DataError);
-}
+TEST_F(TrajectoryFiles, MissingFileIsAnError) { EXPECT_THROW(ReadTum((dir_ / "absent.txt").string()), DataError); }
 
 TEST_F(TrajectoryFiles, FailedWriteLeavesNoFile) {
   const fs::path target = dir_ / "no_such_dir" / "out.txt";
@@ -133,9 +131,7 @@ TEST(Trajectory, InterpolationReproducesPlantedMotion) {
   const Eigen::Vector3d omega(0.05, 0.1, -0.4);  // rad/s, body frame
   const Eigen::Vector3d t0(1.0, 2.0, 3.0);
   const Eigen::Vector3d velocity(4.0, -1.0, 0.2);  // m/s, world frame
-  const auto truth = [&](double time) {
-    return SE3d(r0 * SO3d::Exp(time * omega), t0 + time * velocity);
-  };
+  const auto truth = [&](double time) { return SE3d(r0 * SO3d::Exp(time * omega), t0 + time * velocity); };
   Trajectory trajectory;
   for (int i = 0; i <= 10; ++i) trajectory.Append(0.5 * i, truth(0.5 * i));
   for (const double time : {0.0, 0.1, 0.37, 1.0, 2.49, 4.999, 5.0}) {
@@ -159,8 +155,7 @@ TEST(Trajectory, RightMultipliedAppliesExtrinsic) {
 
 // The NTU Eagle sample's recommended ground truth (see shared/data).
 TEST(TrajectoryRealData, ReadsNtuGroundTruth) {
-  const fs::path path =
-      fs::path(RADARGAUSS_SHARED_DATA_DIR) / "ntu4dradlm_loop1_eagle" / "gt_tum.txt";
+  const fs::path path = fs::path(RADARGAUSS_SHARED_DATA_DIR) / "ntu4dradlm_loop1_eagle" / "gt_tum.txt";
   if (!fs::exists(path)) GTEST_SKIP() << "shared data not found at " << path;
   const Trajectory t = ReadTum(path.string());
   EXPECT_EQ(t.size(), 497u);

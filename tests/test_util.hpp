@@ -19,9 +19,8 @@ inline const std::vector<double>& HardAngles() {
 }
 
 // Central differences of f: R^n -> R^m at x with step h.
-inline Eigen::MatrixXd NumericJacobian(
-    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f, const Eigen::VectorXd& x,
-    double h = 1e-6) {
+inline Eigen::MatrixXd NumericJacobian(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
+                                       const Eigen::VectorXd& x, double h = 1e-6) {
   const Eigen::VectorXd f0 = f(x);
   Eigen::MatrixXd J(f0.size(), x.size());
   for (int i = 0; i < x.size(); ++i) {

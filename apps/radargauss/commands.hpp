@@ -67,8 +67,8 @@ void AddMapBuildOptions(CLI::App* app, MapBuildSettings& settings);
 MapGeometry BuildGeometry(const Sequence& sequence, const MapBuildSettings& settings, bool verbose);
 // Its RCS models for one incidence model and degree; prints the fit's
 // summary when `verbose`.
-GaussianMap FitRcsModelsOf(const MapGeometry& geometry, const MapBuildSettings& settings,
-                           IncidenceModel incidence, int degree, bool verbose);
+GaussianMap FitRcsModelsOf(const MapGeometry& geometry, const MapBuildSettings& settings, IncidenceModel incidence,
+                           int degree, bool verbose);
 
 // reference.tum of a localisation experiment into `out`: the reference pose
 // of each matched scan (times in scan order; repeated times once).

@@ -36,10 +36,11 @@ int RunEvaluate(const EvaluateSettings& s) {
               evaluation.ate_translation.mean, evaluation.ate_translation.median, evaluation.ate_translation.max);
   std::printf("ATE rotation: RMSE %.3f deg, mean %.3f, median %.3f, max %.3f\n", evaluation.ate_rotation.rmse,
               evaluation.ate_rotation.mean, evaluation.ate_rotation.median, evaluation.ate_rotation.max);
-  std::printf("RPE over 10-50%% of the path: translation %.3f %%, horizontal %.3f %%, rotation %.5f deg/m (%zu "
-              "segments)\n",
-              evaluation.rpe_mean.translation, evaluation.rpe_mean.horizontal, evaluation.rpe_mean.rotation,
-              evaluation.rpe_mean.segments);
+  std::printf(
+      "RPE over 10-50%% of the path: translation %.3f %%, horizontal %.3f %%, rotation %.5f deg/m (%zu "
+      "segments)\n",
+      evaluation.rpe_mean.translation, evaluation.rpe_mean.horizontal, evaluation.rpe_mean.rotation,
+      evaluation.rpe_mean.segments);
   for (const SegmentDrift& d : evaluation.kitti) {
     std::printf("KITTI %4.0f m: translation %.3f %%, rotation %.5f deg/m (%zu segments)\n", d.length, d.translation,
                 d.rotation, d.segments);

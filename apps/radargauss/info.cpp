@@ -56,8 +56,8 @@ int RunInfo(const SequenceOptions& options) {
   std::printf("\npoints per scan: min %zu, median %.1f, max %zu\n", std::size_t(*fewest), Median(counts),
               std::size_t(*most));
   std::printf("fields: xyz%s%s%s\n", has_doppler ? " doppler" : "", has_rcs ? " rcs" : "", has_std ? " stds" : "");
-  std::printf("time span: %.9f .. %.9f (%.3f s)\n", sequence.scans.front().timestamp,
-              sequence.scans.back().timestamp, sequence.scans.back().timestamp - sequence.scans.front().timestamp);
+  std::printf("time span: %.9f .. %.9f (%.3f s)\n", sequence.scans.front().timestamp, sequence.scans.back().timestamp,
+              sequence.scans.back().timestamp - sequence.scans.front().timestamp);
   if (has_doppler) std::printf("doppler: %.3f .. %.3f m/s\n", doppler.min, doppler.max);
   if (has_rcs) std::printf("rcs: %.3f .. %.3f dBsm\n", rcs.min, rcs.max);
   if (!sequence.poses.empty()) {
@@ -65,8 +65,7 @@ int RunInfo(const SequenceOptions& options) {
     for (std::size_t i = 1; i < sequence.poses.size(); ++i) {
       length += (sequence.poses[i].translation() - sequence.poses[i - 1].translation()).norm();
     }
-    std::printf("trajectory: %zu poses, %.1f m driven over the matched scans\n", sequence.trajectory.size(),
-                length);
+    std::printf("trajectory: %zu poses, %.1f m driven over the matched scans\n", sequence.trajectory.size(), length);
   }
   return 0;
 }

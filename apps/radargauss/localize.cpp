@@ -118,11 +118,10 @@ std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const 
       for (const std::string& loss : s.losses) {
         for (const double w : s.w_rcs) {
           const auto matcher = MakeScanMatcher(s.Configuration(solver, w, loss));
-          const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" +
-                                   ToString(maps[m].incidence) + "-L" + std::to_string(degrees[m]);
+          const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" + ToString(maps[m].incidence) +
+                                   "-L" + std::to_string(degrees[m]);
           bar.Update("localize", done, total);
-          runs.push_back(
-              RunConfiguration(name, w, *matcher, matching, e.scans, e.references, e.errors, e.first_scan));
+          runs.push_back(RunConfiguration(name, w, *matcher, matching, e.scans, e.references, e.errors, e.first_scan));
           ++done;
         }
       }
@@ -165,13 +164,13 @@ std::string Hex(std::uint32_t value) {
 // spelling, so workers may mount the data elsewhere.
 ExperimentIdentity IdentityOf(const CLI::App& app, const Sequence& sequence, const std::vector<GaussianMap>& maps) {
   ExperimentIdentity identity;
-  const std::vector<std::string> skipped = {"--help", "--out",  "--shard",    "--sequence",
-                                            "--gt",   "--map", "--bag", "--extrinsic"};
+  const std::vector<std::string> skipped = {"--help", "--out", "--shard", "--sequence",
+                                            "--gt",   "--map", "--bag",   "--extrinsic"};
   for (const CLI::Option* option : app.get_options()) {
     const std::string name = option->get_name();
     if (std::find(skipped.begin(), skipped.end(), name) != skipped.end()) continue;
-    identity.emplace_back(name, option->count() > 0 ? CLI::detail::join(option->results(), ",")
-                                                    : option->get_default_str());
+    identity.emplace_back(name,
+                          option->count() > 0 ? CLI::detail::join(option->results(), ",") : option->get_default_str());
   }
   std::uint32_t scans = 0, poses = 0;
   for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
@@ -214,8 +213,7 @@ int RunLocalize(LocalizeSettings s, const CLI::App& app) {
   const std::string table = WriteExperimentResults(folder.path(), runs);
   WritePlotInputs(folder.path(), e, maps.front());
   if (!s.shard.empty()) {
-    WriteShard(folder.path(), ParseShard(s.shard), e.total_scans, IdentityOf(app, sequence, maps), runs,
-               e.references);
+    WriteShard(folder.path(), ParseShard(s.shard), e.total_scans, IdentityOf(app, sequence, maps), runs, e.references);
   }
   folder.Commit();
   double initial_t = 0.0;
@@ -223,9 +221,10 @@ int RunLocalize(LocalizeSettings s, const CLI::App& app) {
   std::printf("%zu scans, %zu configurations; initial errors: mean %.3f m (uniform in [0, %g] m, [0, %g] deg)\n\n%s\n",
               e.scans.size(), runs.size(), initial_t / std::max<std::size_t>(1, e.scans.size()), s.max_translation,
               s.max_rotation, table.c_str());
-  std::printf("results: %s (per_scan.csv, summary.json, table.md, trajectories/); plots: "
-              "scripts/plot_results.py %s --reference %s/reference.tum\n",
-              s.out.c_str(), s.out.c_str(), s.out.c_str());
+  std::printf(
+      "results: %s (per_scan.csv, summary.json, table.md, trajectories/); plots: "
+      "scripts/plot_results.py %s --reference %s/reference.tum\n",
+      s.out.c_str(), s.out.c_str(), s.out.c_str());
   return 0;
 }
 

@@ -40,8 +40,9 @@ void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
       ->check(InRange(0.0, 1.0))
       ->capture_default_str();
   app->add_option("--solver", s.solvers,
-                  "Solvers: " + Joined(ScanMatcherNames()) + " (and pcl-ndt, pcl-gicp when built "
-                  "with RADARGAUSS_WITH_PCL)")
+                  "Solvers: " + Joined(ScanMatcherNames()) +
+                      " (and pcl-ndt, pcl-gicp when built "
+                      "with RADARGAUSS_WITH_PCL)")
       ->delimiter(',')
       ->check(CLI::IsMember(SolverNames()).description("{" + Joined(ScanMatcherNames(), ",") + "[,pcl-ndt,pcl-gicp]}"))
       ->capture_default_str();

@@ -46,9 +46,9 @@ int main(int argc, char** argv) {
   using namespace radargauss::cli;
   CLI::App app{"radargauss: 4D radar Gaussian-RCS maps and scan matching"};
   app.require_subcommand(1);
-  const std::vector<Subcommand> subcommands = {AddInfo(app), AddSimulate(app), AddBuildMap(app), AddMapInfo(app),
-                                               AddLocalize(app), AddEvaluate(app), AddRefine(app),
-                                               AddOdometry(app), AddSlam(app), AddRelocalize(app), AddMerge(app)};
+  const std::vector<Subcommand> subcommands = {AddInfo(app),     AddSimulate(app),   AddBuildMap(app), AddMapInfo(app),
+                                               AddLocalize(app), AddEvaluate(app),   AddRefine(app),   AddOdometry(app),
+                                               AddSlam(app),     AddRelocalize(app), AddMerge(app)};
   std::vector<std::string> names;
   for (const Subcommand& command : subcommands) names.push_back(command.app->get_name());
   int threads = 0;
@@ -89,8 +89,8 @@ int main(int argc, char** argv) {
   }
   std::unique_ptr<tbb::global_control> thread_limit;
   if (threads > 0) {
-    thread_limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                         std::size_t(threads));
+    thread_limit =
+        std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
   }
   try {
     for (const Subcommand& command : subcommands) {

@@ -40,8 +40,7 @@ int RunMapInfo(const std::string& path) {
   for (int d = 0; d <= kMaxShDegree; ++d) std::printf(", %d: %zu", d, histogram[d]);
   std::printf("\nmean fit RMSE (normalised): %.4f\n", with_model ? rmse / double(with_model) : 0.0);
   if (n) {
-    std::printf("extent: x %.2f..%.2f, y %.2f..%.2f, z %.2f..%.2f m\n", lo.x(), hi.x(), lo.y(), hi.y(), lo.z(),
-                hi.z());
+    std::printf("extent: x %.2f..%.2f, y %.2f..%.2f, z %.2f..%.2f m\n", lo.x(), hi.x(), lo.y(), hi.y(), lo.z(), hi.z());
   }
   return 0;
 }

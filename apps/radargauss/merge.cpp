@@ -33,8 +33,7 @@ int RunMerge(const MergeSettings& s) {
   const fs::path means = fs::path(s.shards.front()) / "map_means.csv";
   if (fs::exists(means)) {
     const std::string bytes = ReadFileBytes(means.string(), "map means file");
-    WriteFileAtomically((fs::path(folder.path()) / "map_means.csv").string(),
-                        [&](std::ostream& out) { out << bytes; });
+    WriteFileAtomically((fs::path(folder.path()) / "map_means.csv").string(), [&](std::ostream& out) { out << bytes; });
   }
   folder.Commit();
   std::printf("%zu shards, %zu scans, %zu configurations\n\n%s\nresults: %s\n", s.shards.size(), references.size(),

@@ -18,12 +18,13 @@ namespace radargauss::cli {
 namespace {
 
 void PrintSummary(const OdometrySummary& summary) {
-  std::printf("odometry: %zu scans (%zu matched, %zu keyframes, %zu with predicted velocity, %zu standing, %zu "
-              "with predicted pose), path %.1f m; %.2f ms per scan (median, p90 %.2f); %zu Gaussians active, %zu "
-              "in the map\n",
-              summary.scans, summary.matched, summary.keyframes, summary.velocity_predicted, summary.standstill,
-              summary.pose_predicted, summary.path_length, summary.median_ms, summary.p90_ms,
-              summary.active_gaussians, summary.global_gaussians);
+  std::printf(
+      "odometry: %zu scans (%zu matched, %zu keyframes, %zu with predicted velocity, %zu standing, %zu "
+      "with predicted pose), path %.1f m; %.2f ms per scan (median, p90 %.2f); %zu Gaussians active, %zu "
+      "in the map\n",
+      summary.scans, summary.matched, summary.keyframes, summary.velocity_predicted, summary.standstill,
+      summary.pose_predicted, summary.path_length, summary.median_ms, summary.p90_ms, summary.active_gaussians,
+      summary.global_gaussians);
 }
 
 int RunOdometry(const OdometrySettings& s) {

@@ -229,7 +229,8 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
       ->needs(imu_topic)
       ->capture_default_str();
   app->add_option("--first-scan", s.first_scan, "Skip the scans before this one (0: none)")->capture_default_str();
-  app->add_option("--max-scans", s.max_scans, "Only the first N scans from --first-scan (0: all)")->capture_default_str();
+  app->add_option("--max-scans", s.max_scans, "Only the first N scans from --first-scan (0: all)")
+      ->capture_default_str();
 }
 
 PlaceRecognitionOptions PlaceRecognitionSettings::Resolved() const {
@@ -256,7 +257,8 @@ void AddPlaceRecognitionOptions(CLI::App* app, PlaceRecognitionSettings& s) {
                   "Places farther by Scan Context are not verified")
       ->check(InRange(0.0, 1.0))
       ->capture_default_str();
-  app->add_option("--max-radon-distance", o.max_radon_distance, "Places farther by the Radon descriptor are not verified")
+  app->add_option("--max-radon-distance", o.max_radon_distance,
+                  "Places farther by the Radon descriptor are not verified")
       ->check(InRange(0.0, 1.0))
       ->capture_default_str();
 }

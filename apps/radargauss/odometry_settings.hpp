@@ -32,9 +32,9 @@ struct OdometrySettings {
   std::string map_estimator = ToString(LocalMapOptions().estimator);
   std::string imu_topic;
   std::string imu_stamps = "header";
-  std::vector<double> imu_rotation = {0, 0, 0, 1};  // q_radar_imu (x y z w)
+  std::vector<double> imu_rotation = {0, 0, 0, 1};                                            // q_radar_imu (x y z w)
   std::vector<double> rotation_rate_std = ToVector(OdometryOptions().rotation_rate_std_deg);  // deg/s
-  std::vector<double> mounting = ToVector(OdometryOptions().mounting_deg);  // roll pitch yaw, deg
+  std::vector<double> mounting = ToVector(OdometryOptions().mounting_deg);                    // roll pitch yaw, deg
   std::size_t first_scan = 0;
   std::size_t max_scans = 0;
   std::string matcher = "gaussians";  // or a PCL peer

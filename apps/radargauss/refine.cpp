@@ -54,10 +54,11 @@ int RunRefine(const RefineSettings& s) {
   const Trajectory before = TrajectoryOf(sequence, sequence.poses), after = TrajectoryOf(sequence, result.poses);
   WriteTum((fs::path(folder.path()) / "refined.tum").string(), after);
   WriteMap((fs::path(folder.path()) / "refined.rgm").string(), result.map);
-  std::printf("refined %zu poses and %zu Gaussians' SH coefficients: cost %.6g -> %.6g in %d Ceres iterations "
-              "(%s), %.1f s\n",
-              result.poses.size(), result.map.gaussians.size(), result.initial_cost, result.final_cost,
-              result.iterations, result.converged ? "converged" : result.reason.c_str(), result.time_ms / 1000.0);
+  std::printf(
+      "refined %zu poses and %zu Gaussians' SH coefficients: cost %.6g -> %.6g in %d Ceres iterations "
+      "(%s), %.1f s\n",
+      result.poses.size(), result.map.gaussians.size(), result.initial_cost, result.final_cost, result.iterations,
+      result.converged ? "converged" : result.reason.c_str(), result.time_ms / 1000.0);
   if (!s.reference.empty()) {
     PrintEvaluation("before", before, s.reference, (fs::path(folder.path()) / "before").string());
     PrintEvaluation("after", after, s.reference, (fs::path(folder.path()) / "after").string());

@@ -86,10 +86,11 @@ int RunRelocalize(const RelocalizeSettings& s) {
   WriteFileAtomically((out / "per_scan.csv").string(), [&](std::ostream& o) { WritePerScan(o, relocalizer); });
   WriteFileAtomically((out / "candidates.csv").string(), [&](std::ostream& o) { WriteCandidates(o, relocalizer); });
   const std::optional<std::size_t> fix = relocalizer.first_fix();
-  nlohmann::json summary = {{"scans", sequence.scans.size()},
-                            {"fixed_scans", located.size()},
-                            {"matched_scans", matched},
-                            {"submaps_compared", relocalizer.candidates().empty() ? 0 : relocalizer.candidates().back().submap + 1}};
+  nlohmann::json summary = {
+      {"scans", sequence.scans.size()},
+      {"fixed_scans", located.size()},
+      {"matched_scans", matched},
+      {"submaps_compared", relocalizer.candidates().empty() ? 0 : relocalizer.candidates().back().submap + 1}};
   summary["first_fix_scan"] = fix ? nlohmann::json(*fix) : nlohmann::json(nullptr);
   summary["time_to_first_fix_s"] =
       fix ? nlohmann::json(sequence.scans[*fix].timestamp - sequence.scans.front().timestamp) : nlohmann::json(nullptr);
@@ -118,7 +119,8 @@ Subcommand AddRelocalize(CLI::App& parent) {
   auto s = std::make_shared<RelocalizeSettings>();
   CLI::App* app = parent.add_subcommand("relocalize", "Locate a sequence in a SLAM map without an initial pose");
   app->add_option("--map", s->map, "Map of radargauss slam (.rgm with places)")->required();
-  AddSequenceOptions(app, s->odometry.sequence, "--gt", "Reference trajectory (TUM, map frame), for the evaluation only");
+  AddSequenceOptions(app, s->odometry.sequence, "--gt",
+                     "Reference trajectory (TUM, map frame), for the evaluation only");
   app->add_option("--out", s->odometry.out, "Output folder")->required();
   AddOdometryOptions(app, s->odometry);
   app->add_option("--submap-distance", s->relocalization.submap_distance, "A submap every this many metres driven")

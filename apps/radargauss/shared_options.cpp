@@ -39,8 +39,8 @@ void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::stri
 }
 
 void CheckRcsWeights(const Sequence& sequence, const std::vector<double>& weights) {
-  const bool any_rcs = std::any_of(sequence.scans.begin(), sequence.scans.end(),
-                                   [](const RadarScan& scan) { return scan.has_rcs; });
+  const bool any_rcs =
+      std::any_of(sequence.scans.begin(), sequence.scans.end(), [](const RadarScan& scan) { return scan.has_rcs; });
   const auto rcs_weight = std::find_if(weights.begin(), weights.end(), [](double w) { return w > 0.0; });
   if (!any_rcs && rcs_weight != weights.end()) {
     throw DataError("--w-rcs " + FormatWeight(*rcs_weight) +
@@ -150,9 +150,9 @@ void AddMapBuildOptions(CLI::App* app, MapBuildSettings& s) {
 
 MapGeometry BuildGeometry(const Sequence& sequence, const MapBuildSettings& settings, bool verbose) {
   ProgressBar bar;
-  const MapGeometry geometry = BuildMapGeometry(
-      sequence.scans, sequence.poses, settings.Resolved(),
-      [&](const char* step, std::size_t done, std::size_t total) { bar.Update(step, done, total); });
+  const MapGeometry geometry =
+      BuildMapGeometry(sequence.scans, sequence.poses, settings.Resolved(),
+                       [&](const char* step, std::size_t done, std::size_t total) { bar.Update(step, done, total); });
   bar.Finish();
   if (verbose) {
     const MapCloudStats& stats = geometry.cloud_stats;
@@ -163,18 +163,19 @@ MapGeometry BuildGeometry(const Sequence& sequence, const MapBuildSettings& sett
   return geometry;
 }
 
-GaussianMap FitRcsModelsOf(const MapGeometry& geometry, const MapBuildSettings& settings,
-                           IncidenceModel incidence, int degree, bool verbose) {
+GaussianMap FitRcsModelsOf(const MapGeometry& geometry, const MapBuildSettings& settings, IncidenceModel incidence,
+                           int degree, bool verbose) {
   RcsFitOptions rcs = settings.Resolved().rcs;
   rcs.incidence = incidence;
   rcs.max_degree = degree;
   RcsFitStats stats;
   GaussianMap map = FitRcs(geometry, rcs, &stats);
   if (verbose) {
-    std::printf("rcs models (%s incidence, degree <= %d, %s): %zu with a model (%zu at a lowered "
-                "degree), %zu without; mean fit RMSE %.4f\n",
-                ToString(incidence).c_str(), degree, rcs.adaptive ? "adaptive" : "fixed", stats.with_model,
-                stats.lowered_degree, stats.no_model, stats.mean_fit_rmse);
+    std::printf(
+        "rcs models (%s incidence, degree <= %d, %s): %zu with a model (%zu at a lowered "
+        "degree), %zu without; mean fit RMSE %.4f\n",
+        ToString(incidence).c_str(), degree, rcs.adaptive ? "adaptive" : "fixed", stats.with_model,
+        stats.lowered_degree, stats.no_model, stats.mean_fit_rmse);
   }
   return map;
 }

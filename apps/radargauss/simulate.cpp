@@ -38,8 +38,8 @@ int RunSimulate(const SimulateSettings& s) {
   folder.Commit();
   std::size_t detections = 0;
   for (const RadarScan& scan : sequence.scans) detections += scan.points.size();
-  std::printf("simulated %zu scans, %zu detections (seed %u) into %s\n", sequence.scans.size(), detections,
-              config.seed, s.out.c_str());
+  std::printf("simulated %zu scans, %zu detections (seed %u) into %s\n", sequence.scans.size(), detections, config.seed,
+              s.out.c_str());
   std::printf("ground truth: %s/gt_radar_tum.txt (radar frame; use --extrinsic identity)\n", s.out.c_str());
   return 0;
 }

@@ -73,10 +73,11 @@ int RunSlam(const SlamSettings& s) {
   }
   folder.Commit();
   const SlamSummary summary = Summarise(slam);
-  std::printf("slam: %zu scans, %zu keyframes, %zu candidates compared, %zu verified, %zu loops (%zu false injected); place "
-              "recognition %.2f ms per keyframe (median); map of %zu Gaussians\n",
-              sequence.scans.size(), summary.keyframes, summary.compared, summary.verified, summary.loops, summary.injected,
-              summary.describe_ms + summary.search_ms, map.gaussians.size());
+  std::printf(
+      "slam: %zu scans, %zu keyframes, %zu candidates compared, %zu verified, %zu loops (%zu false injected); place "
+      "recognition %.2f ms per keyframe (median); map of %zu Gaussians\n",
+      sequence.scans.size(), summary.keyframes, summary.compared, summary.verified, summary.loops, summary.injected,
+      summary.describe_ms + summary.search_ms, map.gaussians.size());
   std::printf("%s", tables.c_str());
   std::printf("wrote %s (slam.tum, keyframes.csv, loops.csv, slam.json%s, odometry/%s)\n", s.odometry.out.c_str(),
               s.no_map ? "" : ", map.rgm, map.ply", reference ? ", evaluation.json, evaluation.md" : "");

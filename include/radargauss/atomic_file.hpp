@@ -18,9 +18,7 @@ namespace radargauss {
 // exception) propagates; `path` is untouched.
 // `path` must name a regular file or nothing: a device node, a FIFO or a
 // folder there is refused (DataError), never replaced.
-void WriteFileAtomically(const std::string& path,
-                         const std::function<void(std::ostream&)>& write,
-                         bool binary = false);
+void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write, bool binary = false);
 
 // Throws DataError naming `path` unless a file could be written there: its
 // folder exists and `path` names a regular file or nothing. Lets a command

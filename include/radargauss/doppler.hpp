@@ -18,14 +18,14 @@
 namespace radargauss {
 
 struct EgoVelocityOptions {
-  double min_range = 0.25;               // m, range gate
-  double max_range = 100.0;              // m
-  double outlier_probability = 0.4;      // RANSAC: expected outlier share
-  double success_probability = 0.9999;   // RANSAC: wanted chance of one clean draw
-  double inlier_threshold = 0.15;        // m/s, |v_d - H v|
-  double zero_velocity_threshold = 0.05; // m/s, 75th percentile of |v_d| below it: standing
-  double zero_velocity_sigma = 0.025;    // m/s, std reported when standing
-  std::uint32_t seed = 1;                // RANSAC draws are deterministic for a seed
+  double min_range = 0.25;                // m, range gate
+  double max_range = 100.0;               // m
+  double outlier_probability = 0.4;       // RANSAC: expected outlier share
+  double success_probability = 0.9999;    // RANSAC: wanted chance of one clean draw
+  double inlier_threshold = 0.15;         // m/s, |v_d - H v|
+  double zero_velocity_threshold = 0.05;  // m/s, 75th percentile of |v_d| below it: standing
+  double zero_velocity_sigma = 0.025;     // m/s, std reported when standing
+  std::uint32_t seed = 1;                 // RANSAC draws are deterministic for a seed
   // > 0 (m): draws take points of three distinct voxels of this edge and a
   // hypothesis's support is the number of voxels its inliers occupy, so that
   // a large close object (a car ahead) cannot outvote the wider static
@@ -35,11 +35,11 @@ struct EgoVelocityOptions {
 
 struct EgoVelocityResult {
   bool success = false;
-  std::string reason;                        // why it failed; empty on success
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // sensor velocity, radar frame, m/s
+  std::string reason;                                    // why it failed; empty on success
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();    // sensor velocity, radar frame, m/s
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // sigma^2 (H^T H)^-1
-  std::vector<bool> inlier;                  // per input point: static and in the range gate
-  bool zero_velocity = false;                // the zero-velocity branch decided
+  std::vector<bool> inlier;                              // per input point: static and in the range gate
+  bool zero_velocity = false;                            // the zero-velocity branch decided
   int ransac_iterations = 0;
 };
 

@@ -17,9 +17,7 @@ class DataError : public std::runtime_error {
 };
 
 // "<path>: <what>" and "<path>:<line>: <what>", the message forms of DataError.
-inline DataError FileError(const std::string& path, const std::string& what) {
-  return DataError(path + ": " + what);
-}
+inline DataError FileError(const std::string& path, const std::string& what) { return DataError(path + ": " + what); }
 inline DataError FileError(const std::string& path, std::size_t line, const std::string& what) {
   return DataError(path + ":" + std::to_string(line) + ": " + what);
 }

@@ -34,7 +34,7 @@ inline constexpr double kThinTrajectory = 0.01;
 struct EvaluationOptions {
   Alignment alignment = Alignment::kSe3;
   double time_tolerance = 0.02;  // s: an estimate pairs with the reference sample nearest in time within this
-  std::vector<double> segment_fractions = {0.1, 0.2, 0.3, 0.4, 0.5};  // of the reference's path length
+  std::vector<double> segment_fractions = {0.1, 0.2, 0.3, 0.4, 0.5};             // of the reference's path length
   std::vector<double> kitti_lengths = {100, 200, 300, 400, 500, 600, 700, 800};  // m, while shorter than the path
 };
 
@@ -43,11 +43,11 @@ struct EvaluationOptions {
 // translation |t_E| / d_ij, horizontal the x-y part of t_E (the frame at the
 // segment's end), rotation angle(E) / d_ij; means over the segments.
 struct SegmentDrift {
-  double length = 0.0;         // m
+  double length = 0.0;  // m
   std::size_t segments = 0;
-  double translation = 0.0;    // %
-  double horizontal = 0.0;     // %
-  double rotation = 0.0;       // deg/m
+  double translation = 0.0;  // %
+  double horizontal = 0.0;   // %
+  double rotation = 0.0;     // deg/m
 };
 
 struct Evaluation {

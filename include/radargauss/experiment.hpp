@@ -19,8 +19,7 @@
 namespace radargauss {
 
 // The seeded initial errors: one perturbation per scan, X_initial = X_ref * E.
-std::vector<SE3d> InitialErrors(std::size_t scans, double max_translation, double max_rotation_deg,
-                                std::uint32_t seed);
+std::vector<SE3d> InitialErrors(std::size_t scans, double max_translation, double max_rotation_deg, std::uint32_t seed);
 
 // Translation (m) and rotation (deg) error of an estimate.
 void PoseErrors(const SE3d& estimate, const SE3d& reference, double& translation, double& rotation_deg);
@@ -34,7 +33,6 @@ struct ScanOutcome {
   double rotation_error_deg = 0.0;
   ScanMatchingResult result;
 };
-
 
 struct ConfigurationRun {
   std::string name;  // e.g. gn-w0.25-trivial-offset-L3
@@ -72,9 +70,8 @@ using ExperimentIdentity = std::vector<std::pair<std::string, std::string>>;
 // range, and every outcome's numbers and poses exactly (doubles that read
 // back bit for bit), with the reference pose of each scan, so that merged
 // shards give the files one run writes.
-void WriteShard(const std::string& dir, const Shard& shard, std::size_t total_scans,
-                const ExperimentIdentity& identity, const std::vector<ConfigurationRun>& runs,
-                const std::vector<SE3d>& references);
+void WriteShard(const std::string& dir, const Shard& shard, std::size_t total_scans, const ExperimentIdentity& identity,
+                const std::vector<ConfigurationRun>& runs, const std::vector<SE3d>& references);
 // The runs of the whole experiment from the folders of all its shards (any
 // order), and the reference pose of every scan. Throws DataError naming the
 // folder (and the field) for a malformed shard.json, a missing, repeated or

@@ -25,11 +25,10 @@ constexpr int ShCoefficientCount(int degree) { return (degree + 1) * (degree + 1
 namespace sh_constants {
 inline constexpr double kC0 = 0.28209479177387814;
 inline constexpr double kC1 = 0.4886025119029199;
-inline constexpr double kC2[5] = {1.0925484305920792, -1.0925484305920792, 0.31539156525252005,
-                                  -1.0925484305920792, 0.5462742152960396};
-inline constexpr double kC3[7] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658,
-                                  0.3731763325901154,  -0.4570457994644658, 1.445305721320277,
-                                  -0.5900435899266435};
+inline constexpr double kC2[5] = {1.0925484305920792, -1.0925484305920792, 0.31539156525252005, -1.0925484305920792,
+                                  0.5462742152960396};
+inline constexpr double kC3[7] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658, 0.3731763325901154,
+                                  -0.4570457994644658, 1.445305721320277, -0.5900435899266435};
 }  // namespace sh_constants
 
 // Writes Y_0(d) .. Y_{(Degree+1)^2 - 1}(d) to `basis`.
@@ -92,9 +91,8 @@ T EvaluateSh(const CoefficientT* c, const Eigen::Matrix<T, 3, 1>& d) {
     value += T(kC1) * (T(c[2]) * z - T(c[1]) * y - T(c[3]) * x);  // Y_1..3 = -C1 y, C1 z, -C1 x
     if constexpr (Degree >= 2) {
       const T xx = x * x, yy = y * y, zz = z * z;
-      value += T(kC2[0] * c[4]) * (x * y) + T(kC2[1] * c[5]) * (y * z) +
-               T(kC2[2] * c[6]) * (T(2.0) * zz - xx - yy) + T(kC2[3] * c[7]) * (x * z) +
-               T(kC2[4] * c[8]) * (xx - yy);
+      value += T(kC2[0] * c[4]) * (x * y) + T(kC2[1] * c[5]) * (y * z) + T(kC2[2] * c[6]) * (T(2.0) * zz - xx - yy) +
+               T(kC2[3] * c[7]) * (x * z) + T(kC2[4] * c[8]) * (xx - yy);
       if constexpr (Degree >= 3) {
         value += T(kC3[0] * c[9]) * y * (T(3.0) * xx - yy) + T(kC3[1] * c[10]) * (x * y) * z +
                  T(kC3[2] * c[11]) * y * (T(4.0) * zz - xx - yy) +
@@ -123,8 +121,7 @@ double EvaluateShWithGradient(const double* c, const Eigen::Vector3d& d, Eigen::
     const double x = d.x(), y = d.y(), z = d.z();
     gradient += kC1 * Eigen::Vector3d(-c[3], -c[1], c[2]);  // Y_1..3 = -C1 y, C1 z, -C1 x
     if constexpr (Degree >= 2) {
-      const double b4 = kC2[0] * c[4], b5 = kC2[1] * c[5], b6 = kC2[2] * c[6], b7 = kC2[3] * c[7],
-                   b8 = kC2[4] * c[8];
+      const double b4 = kC2[0] * c[4], b5 = kC2[1] * c[5], b6 = kC2[2] * c[6], b7 = kC2[3] * c[7], b8 = kC2[4] * c[8];
       gradient += Eigen::Vector3d(b4 * y + b7 * z + 2.0 * (b8 - b6) * x, b4 * x + b5 * z - 2.0 * (b6 + b8) * y,
                                   b5 * y + b7 * x + 4.0 * b6 * z);
       if constexpr (Degree >= 3) {
@@ -133,12 +130,12 @@ double EvaluateShWithGradient(const double* c, const Eigen::Vector3d& d, Eigen::
         const double e9 = kC3[0] * c[9], e10 = kC3[1] * c[10], e11 = kC3[2] * c[11], e12 = kC3[3] * c[12],
                      e13 = kC3[4] * c[13], e14 = kC3[5] * c[14], e15 = kC3[6] * c[15];
         const double xx_yy = xx - yy, four_zz = 4.0 * zz;
-        gradient += Eigen::Vector3d(
-            (6.0 * e9 - 2.0 * e11) * xy + e10 * yz + (2.0 * e14 - 6.0 * e12) * xz + e13 * (four_zz - 3.0 * xx - yy) +
-                3.0 * e15 * xx_yy,
-            3.0 * e9 * xx_yy + e10 * xz + e11 * (four_zz - xx - 3.0 * yy) - 2.0 * (3.0 * e12 + e14) * yz -
-                2.0 * (e13 + 3.0 * e15) * xy,
-            e10 * xy + 8.0 * (e11 * yz + e13 * xz) + e12 * (6.0 * zz - 3.0 * (xx + yy)) + e14 * xx_yy);
+        gradient +=
+            Eigen::Vector3d((6.0 * e9 - 2.0 * e11) * xy + e10 * yz + (2.0 * e14 - 6.0 * e12) * xz +
+                                e13 * (four_zz - 3.0 * xx - yy) + 3.0 * e15 * xx_yy,
+                            3.0 * e9 * xx_yy + e10 * xz + e11 * (four_zz - xx - 3.0 * yy) -
+                                2.0 * (3.0 * e12 + e14) * yz - 2.0 * (e13 + 3.0 * e15) * xy,
+                            e10 * xy + 8.0 * (e11 * yz + e13 * xz) + e12 * (6.0 * zz - 3.0 * (xx + yy)) + e14 * xx_yy);
       }
     }
   }
@@ -150,10 +147,14 @@ double EvaluateShWithGradient(const double* c, const Eigen::Vector3d& d, Eigen::
 template <typename F>
 decltype(auto) WithShDegree(int degree, F&& f) {
   switch (degree) {
-    case 0: return f(std::integral_constant<int, 0>{});
-    case 1: return f(std::integral_constant<int, 1>{});
-    case 2: return f(std::integral_constant<int, 2>{});
-    case 3: return f(std::integral_constant<int, 3>{});
+    case 0:
+      return f(std::integral_constant<int, 0>{});
+    case 1:
+      return f(std::integral_constant<int, 1>{});
+    case 2:
+      return f(std::integral_constant<int, 2>{});
+    case 3:
+      return f(std::integral_constant<int, 3>{});
     default:
       throw std::invalid_argument("SH degree must be in 0..3, got " + std::to_string(degree));
   }
@@ -172,9 +173,8 @@ T EvaluateSh(int degree, const CoefficientT* coefficients, const Eigen::Matrix<T
 
 inline double EvaluateShWithGradient(int degree, const double* coefficients, const Eigen::Vector3d& d,
                                      Eigen::Vector3d& gradient, double* basis_out = nullptr) {
-  return WithShDegree(degree, [&](auto D) {
-    return EvaluateShWithGradient<decltype(D)::value>(coefficients, d, gradient, basis_out);
-  });
+  return WithShDegree(
+      degree, [&](auto D) { return EvaluateShWithGradient<decltype(D)::value>(coefficients, d, gradient, basis_out); });
 }
 
 }  // namespace radargauss

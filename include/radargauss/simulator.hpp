@@ -32,9 +32,9 @@
 namespace radargauss {
 
 struct Material {
-  double diffuse = 0.1;           // m^2
-  double specular = 0.0;          // m^2 at normal incidence
-  double lobe_width_deg = 15.0;   // width of the specular lobe
+  double diffuse = 0.1;          // m^2
+  double specular = 0.0;         // m^2 at normal incidence
+  double lobe_width_deg = 15.0;  // width of the specular lobe
 };
 
 // RCS in dBsm of a material at incidence angle theta (radians), noise-free
@@ -45,8 +45,8 @@ double MaterialRcs(const Material& material, double incidence_angle);
 // (configs/synthetic_world.yaml lists them all with these values).
 struct SimulationConfig {
   std::uint32_t seed = 1;
-  std::uint32_t world_seed = 0;      // the scene's objects; 0: drawn from seed (another seed, the same world)
-  double start_offset = 0.0;         // m along the loop where the drive starts
+  std::uint32_t world_seed = 0;  // the scene's objects; 0: drawn from seed (another seed, the same world)
+  double start_offset = 0.0;     // m along the loop where the drive starts
   // Drive.
   int scans = 300;
   double rate_hz = 10.0;
@@ -58,20 +58,20 @@ struct SimulationConfig {
   double sensor_height = 0.8;        // m above the ground
   double attitude_wobble_deg = 1.0;  // amplitude of roll/pitch oscillation
   // Sensor (ARS548-like).
-  double azimuth_fov_deg = 60.0;     // +/-
-  double elevation_fov_deg = 15.0;   // +/-
-  double min_range = 0.2;            // m
-  double max_range = 100.0;          // m
-  int min_detections = 150;          // per scan, drawn uniformly in [min, max]
+  double azimuth_fov_deg = 60.0;    // +/-
+  double elevation_fov_deg = 15.0;  // +/-
+  double min_range = 0.2;           // m
+  double max_range = 100.0;         // m
+  int min_detections = 150;         // per scan, drawn uniformly in [min, max]
   int max_detections = 800;
-  int max_rays = 60000;              // rays cast per scan at most
+  int max_rays = 60000;  // rays cast per scan at most
   double detection_threshold_db = -5.0;
-  double range_noise = 0.05;         // m (std)
+  double range_noise = 0.05;  // m (std)
   double azimuth_noise_deg = 0.2;
   double elevation_noise_deg = 0.3;
-  double doppler_noise = 0.03;       // m/s
+  double doppler_noise = 0.03;  // m/s
   double rcs_noise_db = 1.0;
-  double clutter_fraction = 0.05;    // share of detections that are clutter
+  double clutter_fraction = 0.05;      // share of detections that are clutter
   double rcs_outlier_fraction = 0.01;  // share with RCS + U(-25, 25) dB
   // The faults of real radars (docs/design.md, "The faults of real radars"),
   // all off by default.
@@ -80,25 +80,22 @@ struct SimulationConfig {
   double mounting_roll_deg = 0.0;       // the radar on the vehicle: T_vehicle_radar = Rz(yaw) Ry(pitch) Rx(roll)
   double mounting_pitch_deg = 0.0;      // positive: the x axis looking down (about the vehicle's y)
   double mounting_yaw_deg = 0.0;
-  int rcs_swerling = 0;                 // RCS fluctuation per detection: 0 none, 1 Swerling I, 3 Swerling III
-  double multipath_probability = 0.0;   // a ray that meets a wall or guardrail also returns a ghost
-  double multipath_loss_db = 6.0;       // the ghost's RCS below its target's
+  int rcs_swerling = 0;                // RCS fluctuation per detection: 0 none, 1 Swerling I, 3 Swerling III
+  double multipath_probability = 0.0;  // a ray that meets a wall or guardrail also returns a ghost
+  double multipath_loss_db = 6.0;      // the ghost's RCS below its target's
   // Scene: "town" (buildings, poles, parked and moving cars along the loop)
   // or "motorway" (guardrails, gantries, three lanes each way of traffic).
   std::string scene = "town";
-  double traffic_min_speed = 25.0;      // m/s: the motorway's cars, drawn uniformly
+  double traffic_min_speed = 25.0;  // m/s: the motorway's cars, drawn uniformly
   double traffic_max_speed = 40.0;
   int poles = 24;
   int parked_cars = 14;
   int moving_cars = 4;
-  double moving_car_speed = 7.0;     // m/s
+  double moving_car_speed = 7.0;  // m/s
   double object_rcs_spread_db = 2.0;
   std::map<std::string, Material> materials = {
-      {"ground", {0.02, 0.0, 10.0}},
-      {"wall", {0.5, 5.0, 15.0}},
-      {"pole", {1.0, 10.0, 20.0}},
-      {"car", {2.0, 30.0, 12.0}},
-      {"guardrail", {1.0, 20.0, 8.0}},
+      {"ground", {0.02, 0.0, 10.0}}, {"wall", {0.5, 5.0, 15.0}},      {"pole", {1.0, 10.0, 20.0}},
+      {"car", {2.0, 30.0, 12.0}},    {"guardrail", {1.0, 20.0, 8.0}},
   };
 };
 
@@ -116,9 +113,9 @@ enum class DetectionKind { kStatic, kDynamic, kClutter, kGhost };
 // What the simulator knows about a detection and a test may check.
 struct DetectionTruth {
   DetectionKind kind = DetectionKind::kStatic;
-  std::string material;                 // empty for clutter
-  double incidence_angle = 0.0;         // rad
-  double rcs_noise_free = 0.0;          // dBsm incl. object offset, before noise/outlier
+  std::string material;          // empty for clutter
+  double incidence_angle = 0.0;  // rad
+  double rcs_noise_free = 0.0;   // dBsm incl. object offset, before noise/outlier
   bool rcs_outlier = false;
   Eigen::Vector3d position_world = Eigen::Vector3d::Zero();  // noise-free hit (a ghost's: its target's)
   // A ghost's reflector: a point of its plane and the plane's normal (world).

@@ -53,8 +53,9 @@ Array PoseMatrices(const std::vector<SE3d>& poses) {
 }
 
 void BindScan(py::module_& m) {
-  py::class_<RadarScan>(m, "Scan", "One radar scan: points (N, 3) in the radar frame, Doppler (m/s, positive "
-                                   "receding) and RCS (dBsm), each a copy as a numpy array.")
+  py::class_<RadarScan>(m, "Scan",
+                        "One radar scan: points (N, 3) in the radar frame, Doppler (m/s, positive "
+                        "receding) and RCS (dBsm), each a copy as a numpy array.")
       .def(py::init([](const py::handle& points, const py::object& doppler, const py::object& rcs, double stamp) {
              return ScanFromArrays(points, doppler, rcs, stamp);
            }),
@@ -63,11 +64,14 @@ void BindScan(py::module_& m) {
       .def_readonly("has_doppler", &RadarScan::has_doppler)
       .def_readonly("has_rcs", &RadarScan::has_rcs)
       .def_property_readonly("points", &Positions)
-      .def_property_readonly("doppler", [](const RadarScan& s) { return Column(s, [](const RadarPoint& p) { return p.doppler; }); })
-      .def_property_readonly("rcs", [](const RadarScan& s) { return Column(s, [](const RadarPoint& p) { return p.rcs; }); })
+      .def_property_readonly(
+          "doppler", [](const RadarScan& s) { return Column(s, [](const RadarPoint& p) { return p.doppler; }); })
+      .def_property_readonly("rcs",
+                             [](const RadarScan& s) { return Column(s, [](const RadarPoint& p) { return p.rcs; }); })
       .def("__len__", [](const RadarScan& s) { return s.points.size(); })
       .def("__repr__", [](const RadarScan& s) {
-        return "<radargauss.Scan " + std::to_string(s.points.size()) + " points at " + std::to_string(s.timestamp) + ">";
+        return "<radargauss.Scan " + std::to_string(s.points.size()) + " points at " + std::to_string(s.timestamp) +
+               ">";
       });
 }
 
@@ -76,24 +80,29 @@ void BindSequence(py::module_& m) {
       .def_readonly("scans", &Sequence::scans)
       .def_readonly("layout", &Sequence::layout)
       .def_readonly("sources", &Sequence::scan_sources)
-      .def_property_readonly("poses", [](const Sequence& s) { return Poses(s.poses); },
-                             "T_world_radar of each scan as (N, 7) [x y z qx qy qz qw]; empty without ground truth")
-      .def_property_readonly("poses_matrix", [](const Sequence& s) { return PoseMatrices(s.poses); },
-                             "The same as (N, 4, 4) matrices, to compose with @")
-      .def_property_readonly("stamps", [](const Sequence& s) {
-        Array out = NewArray({py::ssize_t(s.scans.size())});
-        for (std::size_t i = 0; i < s.scans.size(); ++i) out.mutable_at(py::ssize_t(i)) = s.scans[i].timestamp;
-        return out;
-      })
+      .def_property_readonly(
+          "poses", [](const Sequence& s) { return Poses(s.poses); },
+          "T_world_radar of each scan as (N, 7) [x y z qx qy qz qw]; empty without ground truth")
+      .def_property_readonly(
+          "poses_matrix", [](const Sequence& s) { return PoseMatrices(s.poses); },
+          "The same as (N, 4, 4) matrices, to compose with @")
+      .def_property_readonly("stamps",
+                             [](const Sequence& s) {
+                               Array out = NewArray({py::ssize_t(s.scans.size())});
+                               for (std::size_t i = 0; i < s.scans.size(); ++i)
+                                 out.mutable_at(py::ssize_t(i)) = s.scans[i].timestamp;
+                               return out;
+                             })
       .def("__len__", [](const Sequence& s) { return s.scans.size(); });
   m.def(
-      "pose_matrix", [](const py::handle& pose) { return PoseToMatrix(PoseFromPython(pose, "pose")); },
-      py::arg("pose"), "A pose [x y z qx qy qz qw] (or 4x4) as its 4x4 matrix.");
+      "pose_matrix", [](const py::handle& pose) { return PoseToMatrix(PoseFromPython(pose, "pose")); }, py::arg("pose"),
+      "A pose [x y z qx qy qz qw] (or 4x4) as its 4x4 matrix.");
   m.def(
       "pose_matrices",
       [](const py::handle& poses) {
         std::vector<SE3d> out;
-        for (const py::handle row : py::iter(poses)) out.push_back(PoseFromPython(row, "poses[" + std::to_string(out.size()) + "]"));
+        for (const py::handle row : py::iter(poses))
+          out.push_back(PoseFromPython(row, "poses[" + std::to_string(out.size()) + "]"));
         return PoseMatrices(out);
       },
       py::arg("poses"), "Poses (N, 7) [x y z qx qy qz qw] (or (N, 4, 4)) as (N, 4, 4) matrices.");
@@ -115,12 +124,14 @@ void BindSequence(py::module_& m) {
         return LoadSequence(options);
       },
       py::arg("path") = "", py::arg("gt") = "", py::arg("extrinsic") = "auto", py::arg("bag") = "",
-      py::arg("topic") = "", py::arg("rcs_field") = "", py::arg("doppler_field") = "", py::arg("elevation_bias_deg") = 0.0,
+      py::arg("topic") = "", py::arg("rcs_field") = "", py::arg("doppler_field") = "",
+      py::arg("elevation_bias_deg") = 0.0,
       "Reads a sequence as `radargauss info` does: a Snail-Radar folder, a folder of .pcd or .bin scans "
       "(path), or a ROS1 bag (bag, topic); gt: a TUM file of reference poses, extrinsic T_gt_radar; "
       "elevation_bias_deg removed from every point.");
-  m.def("read_pcd", [](const std::string& path) { return ReadPcdScan(path); }, py::arg("path"),
-        "One PCD scan (ascii, binary or binary_compressed); the stamp from a <secs>.<nsecs>.pcd name.");
+  m.def(
+      "read_pcd", [](const std::string& path) { return ReadPcdScan(path); }, py::arg("path"),
+      "One PCD scan (ascii, binary or binary_compressed); the stamp from a <secs>.<nsecs>.pcd name.");
 }
 
 void BindTrajectories(py::module_& m) {

@@ -33,35 +33,60 @@ void BindMapClass(py::module_& m) {
                                             "stored one by one, not as columns).")
       .def("__len__", [](const PyMap& m) { return m.map().gaussians.size(); })
       .def_property_readonly("incidence", [](const PyMap& m) { return ToString(m.map().incidence); })
-      .def_property_readonly("means", [](const PyMap& m) {
-        return PerGaussian(m.map(), {3}, [](const Gaussian& g, double* p) { return std::copy(g.mean.data(), g.mean.data() + 3, p); });
-      })
-      .def_property_readonly("covariances", [](const PyMap& m) {
-        return PerGaussian(m.map(), {3, 3}, [](const Gaussian& g, double* p) {
-          for (int r = 0; r < 3; ++r) {
-            for (int c = 0; c < 3; ++c) *p++ = g.covariance(r, c);
-          }
-          return p;
-        });
-      })
-      .def_property_readonly("point_counts", [](const PyMap& m) {
-        return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) { *p = g.point_count; return p + 1; });
-      })
-      .def_property_readonly("rcs_degrees", [](const PyMap& m) {
-        return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) { *p = g.rcs.degree; return p + 1; });
-      }, "SH degree of each RCS model, -1 where a Gaussian has none")
-      .def_property_readonly("rcs_medians", [](const PyMap& m) {
-        return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) { *p = g.rcs.median; return p + 1; });
-      })
-      .def_property_readonly("rcs_scales", [](const PyMap& m) {
-        return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) { *p = g.rcs.scale; return p + 1; });
-      })
-      .def_property_readonly("rcs_coefficients", [](const PyMap& m) {
-        const py::ssize_t n = py::ssize_t(ShCoefficientCount(kMaxShDegree));
-        return PerGaussian(m.map(), {n}, [](const Gaussian& g, double* p) {
-          return std::copy(g.rcs.coefficients.begin(), g.rcs.coefficients.end(), p);
-        });
-      }, "(K, 16) real SH coefficients of the normalised RCS, zero beyond each model's degree");
+      .def_property_readonly("means",
+                             [](const PyMap& m) {
+                               return PerGaussian(m.map(), {3}, [](const Gaussian& g, double* p) {
+                                 return std::copy(g.mean.data(), g.mean.data() + 3, p);
+                               });
+                             })
+      .def_property_readonly("covariances",
+                             [](const PyMap& m) {
+                               return PerGaussian(m.map(), {3, 3}, [](const Gaussian& g, double* p) {
+                                 for (int r = 0; r < 3; ++r) {
+                                   for (int c = 0; c < 3; ++c) *p++ = g.covariance(r, c);
+                                 }
+                                 return p;
+                               });
+                             })
+      .def_property_readonly("point_counts",
+                             [](const PyMap& m) {
+                               return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
+                                 *p = g.point_count;
+                                 return p + 1;
+                               });
+                             })
+      .def_property_readonly(
+          "rcs_degrees",
+          [](const PyMap& m) {
+            return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
+              *p = g.rcs.degree;
+              return p + 1;
+            });
+          },
+          "SH degree of each RCS model, -1 where a Gaussian has none")
+      .def_property_readonly("rcs_medians",
+                             [](const PyMap& m) {
+                               return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
+                                 *p = g.rcs.median;
+                                 return p + 1;
+                               });
+                             })
+      .def_property_readonly("rcs_scales",
+                             [](const PyMap& m) {
+                               return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
+                                 *p = g.rcs.scale;
+                                 return p + 1;
+                               });
+                             })
+      .def_property_readonly(
+          "rcs_coefficients",
+          [](const PyMap& m) {
+            const py::ssize_t n = py::ssize_t(ShCoefficientCount(kMaxShDegree));
+            return PerGaussian(m.map(), {n}, [](const Gaussian& g, double* p) {
+              return std::copy(g.rcs.coefficients.begin(), g.rcs.coefficients.end(), p);
+            });
+          },
+          "(K, 16) real SH coefficients of the normalised RCS, zero beyond each model's degree");
 }
 
 MapOptions BuildOptions(const std::string& builder, double points_per_gaussian, double min_std,
@@ -109,10 +134,12 @@ void BindMap(py::module_& m) {
       py::arg("max_degree") = defaults.rcs.max_degree, py::arg("doppler_filter") = true,
       "The map of `radargauss build-map`: from a Sequence with poses, or from a list of Scans and their poses "
       "T_world_radar (4x4 or [x y z qx qy qz qw]). builder: kmeans or voxel; incidence: offset, view or none.");
-  m.def("read_map", [](const std::string& path) { return std::make_shared<PyMap>(ReadMap(path)); }, py::arg("path"),
-        "Reads a .rgm map file (validated: docs/design.md, \"Bounds on input\").");
-  m.def("write_map", [](const std::string& path, const PyMap& map) { WriteMap(path, map.map()); }, py::arg("path"),
-        py::arg("map"), "Writes a .rgm map file atomically.");
+  m.def(
+      "read_map", [](const std::string& path) { return std::make_shared<PyMap>(ReadMap(path)); }, py::arg("path"),
+      "Reads a .rgm map file (validated: docs/design.md, \"Bounds on input\").");
+  m.def(
+      "write_map", [](const std::string& path, const PyMap& map) { WriteMap(path, map.map()); }, py::arg("path"),
+      py::arg("map"), "Writes a .rgm map file atomically.");
 }
 
 }  // namespace radargauss::python

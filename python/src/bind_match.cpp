@@ -30,10 +30,11 @@ const char* MatchDoc() {
 
 void BindMatchResult(py::module_& m) {
   py::class_<ScanMatchingResult>(m, "MatchResult", "The outcome of one scan match.")
-      .def_property_readonly("pose", [](const ScanMatchingResult& r) { return PoseToMatrix(r.pose); },
-                             "T_world_radar at the end, 4x4")
-      .def_property_readonly("pose_tum", [](const ScanMatchingResult& r) { return PoseToTum(r.pose); },
-                             "the same as [x y z qx qy qz qw], exactly the numbers a TUM file gets")
+      .def_property_readonly(
+          "pose", [](const ScanMatchingResult& r) { return PoseToMatrix(r.pose); }, "T_world_radar at the end, 4x4")
+      .def_property_readonly(
+          "pose_tum", [](const ScanMatchingResult& r) { return PoseToTum(r.pose); },
+          "the same as [x y z qx qy qz qw], exactly the numbers a TUM file gets")
       .def_readonly("iterations", &ScanMatchingResult::iterations)
       .def_readonly("cost", &ScanMatchingResult::final_cost)
       .def_readonly("converged", &ScanMatchingResult::converged)
@@ -41,8 +42,9 @@ void BindMatchResult(py::module_& m) {
       .def_readonly("geometric_residuals", &ScanMatchingResult::n_geo)
       .def_readonly("rcs_residuals", &ScanMatchingResult::n_rcs)
       .def_readonly("time_ms", &ScanMatchingResult::time_ms)
-      .def_property_readonly("information", [](const ScanMatchingResult& r) { return MatrixToArray<6, 6>(r.information); },
-                             "6x6 Gauss-Newton matrix of eq. 2 over [dt (world); dphi (radar)]");
+      .def_property_readonly(
+          "information", [](const ScanMatchingResult& r) { return MatrixToArray<6, 6>(r.information); },
+          "6x6 Gauss-Newton matrix of eq. 2 over [dt (world); dphi (radar)]");
 }
 
 py::dict DriftToDict(const SegmentDrift& d) {
@@ -102,7 +104,9 @@ void BindMatch(py::module_& m) {
       "initial pose of scan i is compose(reference_i, E_i). (N, 7).");
   m.def(
       "compose",
-      [](const py::handle& a, const py::handle& b) { return PoseToTum(PoseFromPython(a, "a") * PoseFromPython(b, "b")); },
+      [](const py::handle& a, const py::handle& b) {
+        return PoseToTum(PoseFromPython(a, "a") * PoseFromPython(b, "b"));
+      },
       py::arg("a"), py::arg("b"), "The rigid transform a * b as [x y z qx qy qz qw].");
   m.def(
       "evaluate",

@@ -94,7 +94,8 @@ void BindOdometry(py::module_& m) {
       .def("__len__",
            [](LockedOdometry& odometry) { return odometry.With([](RadarOdometry& o) { return o.steps().size(); }); });
   m.def(
-      "odometry_options", [](const py::kwargs& kwargs) { return OptionsToDict(OdometryFields(), OdometryOptionsFrom(kwargs)); },
+      "odometry_options",
+      [](const py::kwargs& kwargs) { return OptionsToDict(OdometryFields(), OdometryOptionsFrom(kwargs)); },
       "Every option of RadarOdometry, the given keywords set (checked), as a dict.");
   m.def(
       "option_fields",

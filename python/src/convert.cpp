@@ -105,8 +105,7 @@ Array PoseToTum(const SE3d& pose) {
   return out;
 }
 
-RadarScan ScanFromArrays(const py::handle& points, const py::object& doppler, const py::object& rcs,
-                         double stamp) {
+RadarScan ScanFromArrays(const py::handle& points, const py::object& doppler, const py::object& rcs, double stamp) {
   if (!std::isfinite(stamp)) throw py::value_error("stamp must be finite");
   const Array xyz = CheckedArray(points, {-1, 3}, "points");
   const py::ssize_t n = xyz.shape(0);

@@ -32,8 +32,7 @@ Array PoseToMatrix(const SE3d& pose);
 Array PoseToTum(const SE3d& pose);  // [x y z qx qy qz qw], exactly the stored numbers
 
 // A scan from an (N, 3) position array and optional (N,) Doppler and RCS.
-RadarScan ScanFromArrays(const py::handle& points, const py::object& doppler, const py::object& rcs,
-                         double stamp);
+RadarScan ScanFromArrays(const py::handle& points, const py::object& doppler, const py::object& rcs, double stamp);
 
 template <int Rows, int Cols>
 Array MatrixToArray(const Eigen::Matrix<double, Rows, Cols>& m) {

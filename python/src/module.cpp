@@ -31,8 +31,8 @@ PYBIND11_MODULE(_radargauss, m) {
         if (threads < 0) throw py::value_error("threads must be >= 0 (0: all cores)");
         thread_limit.reset();
         if (threads > 0) {
-          thread_limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                               std::size_t(threads));
+          thread_limit =
+              std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
         }
       },
       py::arg("threads"), "Worker threads of the parallel stages (0: all cores), as the tool's --threads.");

@@ -105,9 +105,11 @@ OptionField<Options> MakeEnumField(const char* keyword, const char* path, Enum& 
 // A field by its C++ member path, stringified so that the table names the
 // member it sets.
 #define RADARGAUSS_FIELD(Options, keyword, path, doc) \
-  MakeField<Options>(keyword, #path, +[](Options& o) -> auto& { return o.path; }, doc)
+  MakeField<Options>(                                 \
+      keyword, #path, +[](Options & o) -> auto& { return o.path; }, doc)
 #define RADARGAUSS_ENUM(Options, keyword, path, from_string, names, doc) \
-  MakeEnumField<Options>(keyword, #path, +[](Options& o) -> auto& { return o.path; }, from_string, names(), doc)
+  MakeEnumField<Options>(                                                \
+      keyword, #path, +[](Options & o) -> auto& { return o.path; }, from_string, names(), doc)
 
 const std::vector<OptionField<MatchOptions>>& MatchFields() {
   using O = MatchOptions;
@@ -129,7 +131,8 @@ const std::vector<OptionField<MatchOptions>>& MatchFields() {
       RADARGAUSS_FIELD(O, "coarse_iterations", matching.coarse_iterations, "outer iterations per coarse level"),
       RADARGAUSS_FIELD(O, "coarse_voxel_per_sigma", matching.coarse_voxel_per_sigma,
                        "coarse levels match voxel centroids of this many sigma_k (0: the points)"),
-      RADARGAUSS_FIELD(O, "coarse_points", matching.coarse_points, "at most this many points per coarse level (0: all)"),
+      RADARGAUSS_FIELD(O, "coarse_points", matching.coarse_points,
+                       "at most this many points per coarse level (0: all)"),
       RADARGAUSS_FIELD(O, "geometric_first", matching.geometric_first,
                        "with 0 < w < 1, the geometric term alone first on the exact map"),
       RADARGAUSS_FIELD(O, "reassociate", matching.reassociate, "False: associate once at the initial pose"),
@@ -173,7 +176,8 @@ std::vector<OptionField<OdometryOptions>> OwnOdometryFields() {
   return {
       RADARGAUSS_FIELD(O, "ego_min_range", ego_velocity.min_range, "m: Doppler filter range gate"),
       RADARGAUSS_FIELD(O, "ego_max_range", ego_velocity.max_range, "m"),
-      RADARGAUSS_FIELD(O, "ego_outlier_probability", ego_velocity.outlier_probability, "RANSAC: expected outlier share"),
+      RADARGAUSS_FIELD(O, "ego_outlier_probability", ego_velocity.outlier_probability,
+                       "RANSAC: expected outlier share"),
       RADARGAUSS_FIELD(O, "ego_success_probability", ego_velocity.success_probability,
                        "RANSAC: wanted chance of one clean draw"),
       RADARGAUSS_FIELD(O, "ego_inlier_threshold", ego_velocity.inlier_threshold, "m/s: |v_d - H v| of an inlier"),
@@ -195,7 +199,8 @@ std::vector<OptionField<OdometryOptions>> OwnOdometryFields() {
       RADARGAUSS_FIELD(O, "rotation_rate_std_deg", rotation_rate_std_deg,
                        "deg/s about x, y, z: rate changes the rotation term allows"),
       RADARGAUSS_FIELD(O, "mounting_deg", mounting_deg, "roll, pitch, yaw of the radar on the vehicle (deg)"),
-      RADARGAUSS_FIELD(O, "estimate_elevation_bias", elevation_bias.estimate, "follow the Doppler velocity's elevation"),
+      RADARGAUSS_FIELD(O, "estimate_elevation_bias", elevation_bias.estimate,
+                       "follow the Doppler velocity's elevation"),
       RADARGAUSS_FIELD(O, "elevation_bias_window", elevation_bias.window, "scans the bias's median is over"),
       RADARGAUSS_FIELD(O, "elevation_bias_min_speed", elevation_bias.min_speed, "m/s: slower scans leave the bias"),
       RADARGAUSS_FIELD(O, "region", map.region, "m: edge of the local map's regions"),
@@ -206,7 +211,8 @@ std::vector<OptionField<OdometryOptions>> OwnOdometryFields() {
       RADARGAUSS_FIELD(O, "republish_kl", map.republish_kl, "nats: KL a Gaussian moves before it is republished"),
       RADARGAUSS_FIELD(O, "refit_growth", map.refit_growth, "refit once the new points reach this share"),
       RADARGAUSS_FIELD(O, "active_radius", map.active_radius, "m: regions farther from the radar leave"),
-      RADARGAUSS_FIELD(O, "azimuth_std_deg", map.azimuth_std_deg, "deg: Gaussians this angle x range wide horizontally"),
+      RADARGAUSS_FIELD(O, "azimuth_std_deg", map.azimuth_std_deg,
+                       "deg: Gaussians this angle x range wide horizontally"),
       RADARGAUSS_FIELD(O, "elevation_std_deg", map.elevation_std_deg, "deg: Gaussians this angle x range high"),
       RADARGAUSS_ENUM(O, "gaussians_builder", map.gaussians.builder, MapBuilderFromString, MapBuilderNames,
                       "region fit: k-means (build-map's) or voxel"),
@@ -217,7 +223,8 @@ std::vector<OptionField<OdometryOptions>> OwnOdometryFields() {
       RADARGAUSS_FIELD(O, "gaussians_min_std", map.gaussians.min_std, "m: smallest principal std"),
       RADARGAUSS_FIELD(O, "gaussians_seed", map.gaussians.seed, "k-means seed"),
       RADARGAUSS_FIELD(O, "gaussians_ndt_voxel", map.gaussians.ndt_voxel, "m: voxel builder's edge"),
-      RADARGAUSS_FIELD(O, "gaussians_ndt_min_points", map.gaussians.ndt_min_points, "voxel builder: points a voxel needs"),
+      RADARGAUSS_FIELD(O, "gaussians_ndt_min_points", map.gaussians.ndt_min_points,
+                       "voxel builder: points a voxel needs"),
       RADARGAUSS_FIELD(O, "gaussians_index_cell", map.gaussians.index_cell, "m: cell of the fit's index"),
       RADARGAUSS_FIELD(O, "gaussians_association_gate", map.gaussians.association_gate, "members' Mahalanobis gate"),
       RADARGAUSS_FIELD(O, "rcs_max_degree", map.rcs.max_degree, "SH degree of the RCS models (0..3)"),
@@ -233,7 +240,8 @@ std::vector<OptionField<OdometryOptions>> OwnOdometryFields() {
       RADARGAUSS_FIELD(O, "map_updatable", map.matching.updatable, "an updatable matching map"),
       RADARGAUSS_FIELD(O, "keyframe_distance", keyframe_distance, "m since the last keyframe: the scan enters the map"),
       RADARGAUSS_FIELD(O, "keyframe_angle_deg", keyframe_angle_deg, "deg: or turned this far"),
-      RADARGAUSS_FIELD(O, "min_matched_points", min_matched_points, "fewer associated points: the prediction stands in"),
+      RADARGAUSS_FIELD(O, "min_matched_points", min_matched_points,
+                       "fewer associated points: the prediction stands in"),
       RADARGAUSS_FIELD(O, "initial_pose", initial_pose, "T_world_radar of the first scan"),
   };
 }

@@ -8,8 +8,7 @@
 namespace radargauss {
 
 int ResolveField(const std::vector<std::string>& available, const std::string& requested,
-                 const std::vector<std::string>& defaults, const std::string& role,
-                 const std::string& source) {
+                 const std::vector<std::string>& defaults, const std::string& role, const std::string& source) {
   const auto index_of = [&](const std::string& name) {
     const auto it = std::find(available.begin(), available.end(), name);
     return it == available.end() ? -1 : static_cast<int>(it - available.begin());
@@ -27,8 +26,8 @@ int ResolveField(const std::vector<std::string>& available, const std::string& r
   return -1;
 }
 
-RadarFieldIndices ResolveRadarFields(const std::vector<std::string>& available,
-                                     const FieldMapping& mapping, const std::string& source) {
+RadarFieldIndices ResolveRadarFields(const std::vector<std::string>& available, const FieldMapping& mapping,
+                                     const std::string& source) {
   const auto required = [&](const char* name) {
     const int index = ResolveField(available, "", {name}, name, source);
     if (index < 0) throw FileError(source, std::string("no '") + name + "' field");

@@ -34,15 +34,14 @@ std::vector<std::string> ParseBinLayout(const std::string& layout) {
   return fields;
 }
 
-RadarScan ReadKittiBin(const std::string& path, const std::vector<std::string>& layout,
-                       const FieldMapping& mapping) {
+RadarScan ReadKittiBin(const std::string& path, const std::vector<std::string>& layout, const FieldMapping& mapping) {
   if (layout.empty()) throw std::invalid_argument("ReadKittiBin: the layout has no fields");
   const std::string bytes = ReadFileBytes(path, "scan file");
   const std::size_t record = layout.size() * sizeof(float);
   if (bytes.size() % record != 0) {
-    throw FileError(path, "truncated: " + std::to_string(bytes.size()) +
-                              " bytes is not a whole number of " + std::to_string(record) +
-                              "-byte records (" + std::to_string(layout.size()) + " float32 fields)");
+    throw FileError(path, "truncated: " + std::to_string(bytes.size()) + " bytes is not a whole number of " +
+                              std::to_string(record) + "-byte records (" + std::to_string(layout.size()) +
+                              " float32 fields)");
   }
   const RadarFieldIndices fields = ResolveRadarFields(layout, mapping, path);
   const int ix = fields.x, iy = fields.y, iz = fields.z, irc = fields.rcs, idop = fields.doppler;

@@ -51,21 +51,61 @@ void CheckSizeAgainstFile(const std::string& path, const std::string& bytes, con
 double DecodeValue(const char* p, char type, int size) {
   switch (type) {
     case 'F':
-      if (size == 4) { float v; std::memcpy(&v, p, 4); return v; }
-      { double v; std::memcpy(&v, p, 8); return v; }
+      if (size == 4) {
+        float v;
+        std::memcpy(&v, p, 4);
+        return v;
+      }
+      {
+        double v;
+        std::memcpy(&v, p, 8);
+        return v;
+      }
     case 'I':
       switch (size) {
-        case 1: { std::int8_t v; std::memcpy(&v, p, 1); return v; }
-        case 2: { std::int16_t v; std::memcpy(&v, p, 2); return v; }
-        case 4: { std::int32_t v; std::memcpy(&v, p, 4); return v; }
-        default: { std::int64_t v; std::memcpy(&v, p, 8); return static_cast<double>(v); }
+        case 1: {
+          std::int8_t v;
+          std::memcpy(&v, p, 1);
+          return v;
+        }
+        case 2: {
+          std::int16_t v;
+          std::memcpy(&v, p, 2);
+          return v;
+        }
+        case 4: {
+          std::int32_t v;
+          std::memcpy(&v, p, 4);
+          return v;
+        }
+        default: {
+          std::int64_t v;
+          std::memcpy(&v, p, 8);
+          return static_cast<double>(v);
+        }
       }
     default:
       switch (size) {
-        case 1: { std::uint8_t v; std::memcpy(&v, p, 1); return v; }
-        case 2: { std::uint16_t v; std::memcpy(&v, p, 2); return v; }
-        case 4: { std::uint32_t v; std::memcpy(&v, p, 4); return v; }
-        default: { std::uint64_t v; std::memcpy(&v, p, 8); return static_cast<double>(v); }
+        case 1: {
+          std::uint8_t v;
+          std::memcpy(&v, p, 1);
+          return v;
+        }
+        case 2: {
+          std::uint16_t v;
+          std::memcpy(&v, p, 2);
+          return v;
+        }
+        case 4: {
+          std::uint32_t v;
+          std::memcpy(&v, p, 4);
+          return v;
+        }
+        default: {
+          std::uint64_t v;
+          std::memcpy(&v, p, 8);
+          return static_cast<double>(v);
+        }
       }
   }
 }
@@ -82,9 +122,8 @@ void DecodeAscii(const std::string& path, const std::string& bytes, PcdCloud& cl
     if (words.empty()) continue;
     if (point >= h.points) throw FileError(path, "more data lines than POINTS");
     if (words.size() != tokens_per_point) {
-      throw FileError(path, "data line " + std::to_string(point + 1) + " has " +
-                                std::to_string(words.size()) + " values, expected " +
-                                std::to_string(tokens_per_point));
+      throw FileError(path, "data line " + std::to_string(point + 1) + " has " + std::to_string(words.size()) +
+                                " values, expected " + std::to_string(tokens_per_point));
     }
     std::size_t token = 0;
     for (std::size_t f = 0; f < h.fields.size(); ++f) {
@@ -92,8 +131,7 @@ void DecodeAscii(const std::string& path, const std::string& bytes, PcdCloud& cl
       char* end = nullptr;
       const double value = std::strtod(word.c_str(), &end);
       if (end != word.c_str() + word.size()) {
-        throw FileError(path, "data line " + std::to_string(point + 1) + ": not a number: '" +
-                                  word + "'");
+        throw FileError(path, "data line " + std::to_string(point + 1) + ": not a number: '" + word + "'");
       }
       // A float32 field holds the float nearest the decimal, as in the binary formats.
       const bool is_float32 = h.fields[f].type == 'F' && h.fields[f].size == 4;
@@ -103,8 +141,7 @@ void DecodeAscii(const std::string& path, const std::string& bytes, PcdCloud& cl
     ++point;
   }
   if (point != h.points) {
-    throw FileError(path, "truncated: " + std::to_string(point) + " data lines, POINTS is " +
-                              std::to_string(h.points));
+    throw FileError(path, "truncated: " + std::to_string(point) + " data lines, POINTS is " + std::to_string(h.points));
   }
 }
 
@@ -120,8 +157,7 @@ void DecodeBinary(const std::string& path, const std::string& bytes, PcdCloud& c
   for (std::size_t f = 0; f < h.fields.size(); ++f) {
     const PcdField& field = h.fields[f];
     for (std::size_t i = 0; i < h.points; ++i) {
-      cloud.values[f][i] = DecodeValue(data + i * h.point_step + field.offset, field.type,
-                                       field.size);
+      cloud.values[f][i] = DecodeValue(data + i * h.point_step + field.offset, field.type, field.size);
     }
   }
 }
@@ -142,13 +178,12 @@ void DecodeBinaryCompressed(const std::string& path, const std::string& bytes, P
                               " bytes, POINTS x point size is " + std::to_string(needed));
   }
   if (available - 8 < compressed_size) {
-    throw FileError(path, "truncated: compressed block of " + std::to_string(compressed_size) +
-                              " bytes, " + std::to_string(available - 8) + " present");
+    throw FileError(path, "truncated: compressed block of " + std::to_string(compressed_size) + " bytes, " +
+                              std::to_string(available - 8) + " present");
   }
   if (needed == 0) return;
   std::vector<char> raw(needed);
-  const unsigned int written =
-      lzf_decompress(bytes.data() + h.data_offset + 8, compressed_size, raw.data(), needed);
+  const unsigned int written = lzf_decompress(bytes.data() + h.data_offset + 8, compressed_size, raw.data(), needed);
   if (written != needed) throw FileError(path, "corrupt LZF data");
   for (std::size_t f = 0; f < h.fields.size(); ++f) {
     const PcdField& field = h.fields[f];
@@ -225,9 +260,9 @@ RadarScan ReadPcdScan(const std::string& path, const FieldMapping& mapping) {
     if (irc >= 0) p.rcs = cloud.values[irc][i];
     if (idop >= 0) p.doppler = mapping.doppler_sign * cloud.values[idop][i];
     if (has_std) {
-      p.std_dev = MeasurementStd{
-          static_cast<float>(cloud.values[istd[0]][i]), static_cast<float>(cloud.values[istd[1]][i]),
-          static_cast<float>(cloud.values[istd[2]][i]), static_cast<float>(cloud.values[istd[3]][i])};
+      p.std_dev =
+          MeasurementStd{static_cast<float>(cloud.values[istd[0]][i]), static_cast<float>(cloud.values[istd[1]][i]),
+                         static_cast<float>(cloud.values[istd[2]][i]), static_cast<float>(cloud.values[istd[3]][i])};
     }
   }
   ValidateScan(scan, path);
@@ -235,18 +270,21 @@ RadarScan ReadPcdScan(const std::string& path, const FieldMapping& mapping) {
 }
 
 void WritePcdScan(const std::string& path, const RadarScan& scan, PcdFormat format) {
-  const bool with_std = !scan.points.empty() &&
-                        std::all_of(scan.points.begin(), scan.points.end(),
-                                    [](const RadarPoint& p) { return p.std_dev.has_value(); });
+  const bool with_std = !scan.points.empty() && std::all_of(scan.points.begin(), scan.points.end(),
+                                                            [](const RadarPoint& p) { return p.std_dev.has_value(); });
   const int n_fields = with_std ? 9 : 5;
   const std::size_t n = scan.points.size();
   // Columns of float32, in field order.
   std::vector<std::vector<float>> columns(n_fields, std::vector<float>(n));
   for (std::size_t i = 0; i < n; ++i) {
     const RadarPoint& p = scan.points[i];
-    const float row[9] = {float(p.position.x()), float(p.position.y()), float(p.position.z()),
-                          float(p.doppler), float(p.rcs),
-                          with_std ? p.std_dev->range : 0.0f, with_std ? p.std_dev->azimuth : 0.0f,
+    const float row[9] = {float(p.position.x()),
+                          float(p.position.y()),
+                          float(p.position.z()),
+                          float(p.doppler),
+                          float(p.rcs),
+                          with_std ? p.std_dev->range : 0.0f,
+                          with_std ? p.std_dev->azimuth : 0.0f,
                           with_std ? p.std_dev->elevation : 0.0f,
                           with_std ? p.std_dev->doppler : 0.0f};
     for (int f = 0; f < n_fields; ++f) columns[f][i] = row[f];
@@ -263,8 +301,7 @@ void WritePcdScan(const std::string& path, const RadarScan& scan, PcdFormat form
                            "COUNT 1 1 1 1 1 1 1 1 1\n"
                          : "FIELDS x y z doppler intensity\nSIZE 4 4 4 4 4\nTYPE F F F F F\n"
                            "COUNT 1 1 1 1 1\n")
-            << "WIDTH " << n << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << n
-            << "\nDATA " << format_name << "\n";
+            << "WIDTH " << n << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << n << "\nDATA " << format_name << "\n";
         if (format == PcdFormat::kAscii) {
           out.precision(9);
           for (std::size_t i = 0; i < n; ++i) {
@@ -284,10 +321,9 @@ void WritePcdScan(const std::string& path, const RadarScan& scan, PcdFormat form
           const std::uint32_t raw_size = static_cast<std::uint32_t>(by_field.size() * sizeof(float));
           // LZF may expand incompressible data slightly; give it room.
           std::vector<char> compressed(raw_size + raw_size / 16 + 64);
-          std::uint32_t compressed_size =
-              raw_size == 0 ? 0
-                            : lzf_compress(by_field.data(), raw_size, compressed.data(),
-                                           static_cast<unsigned int>(compressed.size()));
+          std::uint32_t compressed_size = raw_size == 0 ? 0
+                                                        : lzf_compress(by_field.data(), raw_size, compressed.data(),
+                                                                       static_cast<unsigned int>(compressed.size()));
           if (raw_size != 0 && compressed_size == 0) throw FileError(path, "LZF compression failed");
           out.write(reinterpret_cast<const char*>(&compressed_size), 4);
           out.write(reinterpret_cast<const char*>(&raw_size), 4);

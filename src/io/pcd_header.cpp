@@ -25,7 +25,6 @@ namespace {
 constexpr std::size_t kMaxPcdFields = 256;
 constexpr std::size_t kMaxPcdValuesPerPoint = 1024;  // the sum of COUNT
 
-
 std::size_t ParseCount(const std::string& path, const std::string& key, const std::string& word) {
   std::size_t value = 0;
   const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
@@ -44,8 +43,7 @@ bool ValidTypeSize(char type, int size) {
 // Each field's type, size, count and offset from the SIZE, TYPE and COUNT
 // lines (as long as FIELDS), and the point step.
 void ResolveFields(const std::string& path, const std::vector<std::string>& sizes,
-                   const std::vector<std::string>& types, const std::vector<std::string>& counts,
-                   PcdHeader& header) {
+                   const std::vector<std::string>& types, const std::vector<std::string>& counts, PcdHeader& header) {
   std::size_t offset = 0;
   std::size_t values = 0;
   for (std::size_t i = 0; i < header.fields.size(); ++i) {
@@ -57,8 +55,7 @@ void ResolveFields(const std::string& path, const std::vector<std::string>& size
     if (count > kMaxPcdValuesPerPoint) throw FileError(path, "COUNT of field '" + field.name + "' is too large");
     field.count = static_cast<int>(count);
     if (!ValidTypeSize(field.type, field.size)) {
-      throw FileError(path, "unknown TYPE/SIZE " + types[i] + "/" + sizes[i] + " of field '" +
-                                field.name + "'");
+      throw FileError(path, "unknown TYPE/SIZE " + types[i] + "/" + sizes[i] + " of field '" + field.name + "'");
     }
     if (field.count < 1) throw FileError(path, "COUNT of field '" + field.name + "' is 0");
     values += static_cast<std::size_t>(field.count);
@@ -119,8 +116,7 @@ PcdHeader ParsePcdHeader(const std::string& path, const std::string& bytes) {
     } else if (key == "VIEWPOINT") {
       if (rest.size() != 7) throw FileError(path, "VIEWPOINT needs 7 values");
     } else if (key == "DATA") {
-      if (rest.size() != 1 ||
-          (rest[0] != "ascii" && rest[0] != "binary" && rest[0] != "binary_compressed")) {
+      if (rest.size() != 1 || (rest[0] != "ascii" && rest[0] != "binary" && rest[0] != "binary_compressed")) {
         throw FileError(path, "unknown DATA format (ascii, binary, binary_compressed)");
       }
       header.data = rest[0];

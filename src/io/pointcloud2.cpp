@@ -12,11 +12,20 @@ namespace {
 
 int DatatypeSize(std::uint8_t datatype) {
   switch (datatype) {
-    case 1: case 2: return 1;
-    case 3: case 4: return 2;
-    case 5: case 6: case 7: return 4;
-    case 8: return 8;
-    default: return 0;
+    case 1:
+    case 2:
+      return 1;
+    case 3:
+    case 4:
+      return 2;
+    case 5:
+    case 6:
+    case 7:
+      return 4;
+    case 8:
+      return 8;
+    default:
+      return 0;
   }
 }
 
@@ -25,26 +34,57 @@ double DecodeElement(const std::uint8_t* p, std::uint8_t datatype, bool big_endi
   const int size = DatatypeSize(datatype);
   for (int i = 0; i < size; ++i) bytes[i] = big_endian ? p[size - 1 - i] : p[i];
   switch (datatype) {
-    case 1: { std::int8_t v; std::memcpy(&v, bytes, 1); return v; }
-    case 2: { std::uint8_t v; std::memcpy(&v, bytes, 1); return v; }
-    case 3: { std::int16_t v; std::memcpy(&v, bytes, 2); return v; }
-    case 4: { std::uint16_t v; std::memcpy(&v, bytes, 2); return v; }
-    case 5: { std::int32_t v; std::memcpy(&v, bytes, 4); return v; }
-    case 6: { std::uint32_t v; std::memcpy(&v, bytes, 4); return v; }
-    case 7: { float v; std::memcpy(&v, bytes, 4); return v; }
-    default: { double v; std::memcpy(&v, bytes, 8); return v; }
+    case 1: {
+      std::int8_t v;
+      std::memcpy(&v, bytes, 1);
+      return v;
+    }
+    case 2: {
+      std::uint8_t v;
+      std::memcpy(&v, bytes, 1);
+      return v;
+    }
+    case 3: {
+      std::int16_t v;
+      std::memcpy(&v, bytes, 2);
+      return v;
+    }
+    case 4: {
+      std::uint16_t v;
+      std::memcpy(&v, bytes, 2);
+      return v;
+    }
+    case 5: {
+      std::int32_t v;
+      std::memcpy(&v, bytes, 4);
+      return v;
+    }
+    case 6: {
+      std::uint32_t v;
+      std::memcpy(&v, bytes, 4);
+      return v;
+    }
+    case 7: {
+      float v;
+      std::memcpy(&v, bytes, 4);
+      return v;
+    }
+    default: {
+      double v;
+      std::memcpy(&v, bytes, 8);
+      return v;
+    }
   }
 }
 
 }  // namespace
 
-RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp,
-                            const FieldMapping& mapping, const std::string& source) {
+RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp, const FieldMapping& mapping,
+                            const std::string& source) {
   std::vector<std::string> names;
   for (const PointCloud2Field& field : cloud.fields) {
     if (DatatypeSize(field.datatype) == 0) {
-      throw FileError(source, "field '" + field.name + "' has unknown datatype " +
-                                  std::to_string(field.datatype));
+      throw FileError(source, "field '" + field.name + "' has unknown datatype " + std::to_string(field.datatype));
     }
     if (std::size_t(field.offset) + DatatypeSize(field.datatype) > cloud.point_step) {
       throw FileError(source, "field '" + field.name + "' lies outside point_step");
@@ -58,8 +98,7 @@ RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp,
     throw FileError(source, "row_step is smaller than width x point_step");
   }
   if (std::size_t(cloud.row_step) * cloud.height > cloud.data.size()) {
-    throw FileError(source, "data holds " + std::to_string(cloud.data.size()) +
-                                " bytes, height x row_step needs " +
+    throw FileError(source, "data holds " + std::to_string(cloud.data.size()) + " bytes, height x row_step needs " +
                                 std::to_string(std::size_t(cloud.row_step) * cloud.height));
   }
   const RadarFieldIndices fields = ResolveRadarFields(names, mapping, source);

@@ -15,12 +15,18 @@ namespace fs = std::filesystem;
 
 const char* TypeName(fs::file_type type) {
   switch (type) {
-    case fs::file_type::directory: return "a directory";
-    case fs::file_type::character: return "a character device";
-    case fs::file_type::block: return "a block device";
-    case fs::file_type::fifo: return "a FIFO";
-    case fs::file_type::socket: return "a socket";
-    default: return "not a regular file";
+    case fs::file_type::directory:
+      return "a directory";
+    case fs::file_type::character:
+      return "a character device";
+    case fs::file_type::block:
+      return "a block device";
+    case fs::file_type::fifo:
+      return "a FIFO";
+    case fs::file_type::socket:
+      return "a socket";
+    default:
+      return "not a regular file";
   }
 }
 
@@ -30,7 +36,8 @@ void CheckRegularInputFile(const std::string& path, const std::string& what) {
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
   if (!fs::exists(status)) throw FileError(path, "cannot open " + what + " (no such file)");
-  if (!fs::is_regular_file(status)) throw FileError(path, std::string("is ") + TypeName(status.type()) + ", not a " + what);
+  if (!fs::is_regular_file(status))
+    throw FileError(path, std::string("is ") + TypeName(status.type()) + ", not a " + what);
 }
 
 std::string ReadFileBytes(const std::string& path, const std::string& what, std::size_t max_bytes) {

@@ -7,17 +7,19 @@ namespace radargauss {
 
 namespace {
 DataError Unavailable(const std::string& path) {
-  return FileError(path, "radargauss was built without ROS1 bag support "
-                         "(install librosbag-storage-dev libsensor-msgs-dev and reconfigure)");
+  return FileError(path,
+                   "radargauss was built without ROS1 bag support "
+                   "(install librosbag-storage-dev libsensor-msgs-dev and reconfigure)");
 }
 }  // namespace
 
 bool RosbagSupported() { return false; }
 std::vector<BagTopic> ListBagTopics(const std::string& bag_path) { throw Unavailable(bag_path); }
-std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string&,
-                                    const FieldMapping&) {
+std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string&, const FieldMapping&) {
   throw Unavailable(bag_path);
 }
-std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string&, bool) { throw Unavailable(bag_path); }
+std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string&, bool) {
+  throw Unavailable(bag_path);
+}
 
 }  // namespace radargauss

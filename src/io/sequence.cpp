@@ -21,7 +21,7 @@ SE3d SnailRadar20231213Extrinsic() {
   R_body_xt32 << 0, -1, 0, 1, 0, 0, 0, 0, 1;
   Eigen::Matrix3d R_x36d_xt32;
   R_x36d_xt32 << -0.001402106, -0.999967799, 0.007901562,  //
-      0.999997759, -0.001414596, -0.001575345,              //
+      0.999997759, -0.001414596, -0.001575345,             //
       0.001586472, 0.007899336, 0.999967541;
   Eigen::Matrix3d R_x36d_ars548;
   R_x36d_ars548 << 0.99912647794293, 0.039117559886893, -0.0147002578838332,  //
@@ -88,8 +88,7 @@ std::vector<std::string> ListScanFiles(const fs::path& dir, const std::string& e
   if (all_timed) {
     std::sort(files.begin(), files.end());
   } else {
-    std::sort(files.begin(), files.end(),
-              [](const auto& a, const auto& b) { return a.second < b.second; });
+    std::sort(files.begin(), files.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
   }
   std::vector<std::string> paths;
   for (auto& file : files) paths.push_back(std::move(file.second));

@@ -28,8 +28,9 @@ void CheckKeysAndDepth(const YAML::Node& node, const std::string& path, int dept
       if (entry.first.IsScalar()) {
         const auto [it, inserted] = lines.emplace(entry.first.Scalar(), LineOf(entry.first));
         if (!inserted) {
-          throw FileError(path, LineOf(entry.first), "key '" + entry.first.Scalar() + "' given twice (first on line " +
-                                                         std::to_string(it->second) + ")");
+          throw FileError(
+              path, LineOf(entry.first),
+              "key '" + entry.first.Scalar() + "' given twice (first on line " + std::to_string(it->second) + ")");
         }
       }
       CheckKeysAndDepth(entry.second, path, depth + 1);

@@ -29,8 +29,8 @@ std::vector<std::string> MapBuilderNames() { return NamesOf(kBuilderNames); }
 namespace {
 
 // Mean and (ML) covariance of the points listed by `members`, clamped.
-Gaussian FitGaussian(const std::vector<Eigen::Vector3d>& points,
-                     const std::vector<std::uint32_t>& members, double min_std) {
+Gaussian FitGaussian(const std::vector<Eigen::Vector3d>& points, const std::vector<std::uint32_t>& members,
+                     double min_std) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const std::uint32_t i : members) sum += points[i];
   Gaussian g;
@@ -60,8 +60,8 @@ void UpdateCluster(const std::vector<Eigen::Vector3d>& points, Cluster& cluster)
 
 // Splits `cluster` in two with 2-means (Lloyd) from two seeded members;
 // false if it cannot be split (all members at one position).
-bool Bisect(const std::vector<Eigen::Vector3d>& points, const Cluster& cluster, int iterations,
-            std::mt19937& rng, Cluster& left, Cluster& right) {
+bool Bisect(const std::vector<Eigen::Vector3d>& points, const Cluster& cluster, int iterations, std::mt19937& rng,
+            Cluster& left, Cluster& right) {
   const std::size_t n = cluster.members.size();
   if (n < 2 || cluster.sse <= 0.0) return false;
   std::uniform_int_distribution<std::size_t> pick(0, n - 1);
@@ -110,8 +110,7 @@ bool Bisect(const std::vector<Eigen::Vector3d>& points, const Cluster& cluster, 
 }
 
 // Bisecting k-means: split the cluster of largest SSE until there are k.
-std::vector<std::vector<std::uint32_t>> BisectingKMeans(const std::vector<Eigen::Vector3d>& points,
-                                                        std::size_t k,
+std::vector<std::vector<std::uint32_t>> BisectingKMeans(const std::vector<Eigen::Vector3d>& points, std::size_t k,
                                                         const GaussianMapOptions& options,
                                                         const ProgressCallback& progress) {
   std::mt19937 rng(options.seed);
@@ -143,8 +142,8 @@ std::vector<std::vector<std::uint32_t>> BisectingKMeans(const std::vector<Eigen:
 
 // Hard EM from an initial partition; returns the final Gaussians.
 std::vector<Gaussian> HardEm(const std::vector<Eigen::Vector3d>& points,
-                             std::vector<std::vector<std::uint32_t>> partition,
-                             const GaussianMapOptions& options, const ProgressCallback& progress) {
+                             std::vector<std::vector<std::uint32_t>> partition, const GaussianMapOptions& options,
+                             const ProgressCallback& progress) {
   std::vector<Gaussian> gaussians;
   std::vector<int> label(points.size(), -1);
   for (const auto& members : partition) {
@@ -195,8 +194,7 @@ std::vector<Gaussian> HardEm(const std::vector<Eigen::Vector3d>& points,
   return gaussians;
 }
 
-std::vector<Gaussian> VoxelGaussians(const std::vector<Eigen::Vector3d>& points,
-                                     const GaussianMapOptions& options) {
+std::vector<Gaussian> VoxelGaussians(const std::vector<Eigen::Vector3d>& points, const GaussianMapOptions& options) {
   std::vector<Gaussian> gaussians;
   for (const std::vector<std::uint32_t>& members : GroupByVoxel(points, options.ndt_voxel)) {
     if (int(members.size()) >= options.ndt_min_points) {
@@ -228,8 +226,7 @@ std::vector<std::vector<std::uint32_t>> KMeansPartition(const std::vector<Eigen:
   return BisectingKMeans(points, k, options, {});
 }
 
-std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points,
-                                 const GaussianIndex& index, double gate) {
+std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points, const GaussianIndex& index, double gate) {
   std::vector<int> association(points.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 4096), [&](const auto& range) {
     index.AssociateAll(points.data() + range.begin(), range.size(), gate * gate, association.data() + range.begin());
@@ -237,8 +234,7 @@ std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points,
   return association;
 }
 
-std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
-                                     const GaussianMapOptions& options,
+std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points, const GaussianMapOptions& options,
                                      const ProgressCallback& progress, std::vector<int>* association) {
   ValidateOptions(options);
   if (points.empty()) throw std::invalid_argument("cannot build a map from an empty cloud");
@@ -247,10 +243,9 @@ std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
     gaussians = VoxelGaussians(points, options);
   } else {
     const std::vector<Eigen::Vector3d> downsampled = VoxelDownsample(points, options.downsample_voxel);
-    const std::size_t k = std::max<std::size_t>(
-        1, std::size_t(std::llround(double(downsampled.size()) / options.points_per_gaussian)));
-    gaussians = HardEm(downsampled, BisectingKMeans(downsampled, k, options, progress), options,
-                       progress);
+    const std::size_t k =
+        std::max<std::size_t>(1, std::size_t(std::llround(double(downsampled.size()) / options.points_per_gaussian)));
+    gaussians = HardEm(downsampled, BisectingKMeans(downsampled, k, options, progress), options, progress);
   }
   // Members: every input point, associated by smallest Mahalanobis^2 within the gate.
   const GaussianIndex index(gaussians, options.index_cell);

@@ -31,8 +31,7 @@ IncidenceModel IncidenceModelFromString(const std::string& name) {
 }
 std::vector<std::string> IncidenceModelNames() { return NamesOf(kIncidenceNames); }
 
-void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs,
-                   Eigen::Matrix3d& axes) {
+void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs, Eigen::Matrix3d& axes) {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
   std_devs = solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
   axes = solver.eigenvectors();
@@ -131,7 +130,9 @@ class ColumnBound {
   double SmallestOverRectangle(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const {
     if (lo.x() <= 0.0 && hi.x() >= 0.0 && lo.y() <= 0.0 && hi.y() >= 0.0) return 0.0;
     const Eigen::Matrix2d& S = marginal_;
-    const auto value = [&S](double dx, double dy) { return S(0, 0) * dx * dx + 2.0 * S(0, 1) * dx * dy + S(1, 1) * dy * dy; };
+    const auto value = [&S](double dx, double dy) {
+      return S(0, 0) * dx * dx + 2.0 * S(0, 1) * dx * dy + S(1, 1) * dy * dy;
+    };
     double best = INFINITY;
     for (const double dx : {lo.x(), hi.x()}) {  // edges of fixed x: the best y, clamped
       best = std::min(best, value(dx, std::clamp(-S(0, 1) * dx / S(1, 1), lo.y(), hi.y())));
@@ -176,7 +177,6 @@ void SortListingsByKey(std::vector<std::pair<std::int64_t, std::uint32_t>>& list
 
 }  // namespace
 
-
 std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
   // A non-finite point has no voxel: the empty key finds an empty slot (no candidates).
   if (!p.allFinite()) return kEmptyCell;
@@ -197,8 +197,8 @@ std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vecto
   // size in doubles, which saturated corners cannot overflow.
   const VoxelKey lo = VoxelOf(g.mean - half, cell_size_);
   const VoxelKey hi = VoxelOf(g.mean + half, cell_size_);
-  const double box = (double(hi.x) - double(lo.x) + 1.0) * (double(hi.y) - double(lo.y) + 1.0) *
-                     (double(hi.z) - double(lo.z) + 1.0);
+  const double box =
+      (double(hi.x) - double(lo.x) + 1.0) * (double(hi.y) - double(lo.y) + 1.0) * (double(hi.z) - double(lo.z) + 1.0);
   if (!(box <= double(kMaxIndexCellsPerGaussian))) {
     throw DataError("Gaussian " + std::to_string(id) + " spans " + Brief(box) + " index cells of " + Brief(cell_size_) +
                     " m (at most " + std::to_string(kMaxIndexCellsPerGaussian) +
@@ -227,8 +227,7 @@ std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vecto
   return std::size_t(box);
 }
 
-GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size,
-                             double extent_sigmas)
+GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size, double extent_sigmas)
     : cell_size_(cell_size), extent_sigmas_(extent_sigmas) {
   if (!(cell_size > 0.0)) throw std::invalid_argument("index cell size must be > 0");
   if (!(extent_sigmas > 0.0)) throw std::invalid_argument("index extent must be > 0 standard deviations");
@@ -299,15 +298,14 @@ int GaussianIndex::Nearest(const Eigen::Vector3d& point, const std::uint32_t* ca
   return best;
 }
 
-int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq,
-                             double* mahalanobis_sq) const {
+int GaussianIndex::Associate(const Eigen::Vector3d& point, double gate_sq, double* mahalanobis_sq) const {
   std::size_t count = 0;
   const std::uint32_t* candidates = Candidates(point, count);
   return Nearest(point, candidates, count, GateBound(gate_sq), mahalanobis_sq);
 }
 
-void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t count, double gate_sq,
-                                 int* associations, double* mahalanobis_sq) const {
+void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t count, double gate_sq, int* associations,
+                                 double* mahalanobis_sq) const {
   if (cells_.empty()) {  // a default-constructed index
     std::fill(associations, associations + count, -1);
     return;
@@ -350,8 +348,7 @@ void GaussianIndex::AssociateAll(const Eigen::Vector3d* points, std::size_t coun
 std::size_t GaussianIndex::MemoryBytes() const {
   std::size_t listed = listed_cells_.size() * sizeof(std::vector<std::int64_t>);
   for (const std::vector<std::int64_t>& keys : listed_cells_) listed += keys.capacity() * sizeof(std::int64_t);
-  return gaussians_.size() * sizeof(IndexedGaussian) +
-         cell_entries_.size() * sizeof(std::uint32_t) +
+  return gaussians_.size() * sizeof(IndexedGaussian) + cell_entries_.size() * sizeof(std::uint32_t) +
          cells_.size() * sizeof(Cell) + listed;
 }
 

@@ -95,8 +95,9 @@ void WriteMap(const std::string& path, const GaussianMap& map) {
     }
   }
   Put<std::uint32_t>(bytes, Crc32(bytes.data(), bytes.size()));
-  WriteFileAtomically(path, [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); },
-                      /*binary=*/true);
+  WriteFileAtomically(
+      path, [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); },
+      /*binary=*/true);
 }
 
 namespace {
@@ -114,10 +115,9 @@ void ValidateGaussian(const Gaussian& g, const Fail& fail) {
     throw fail("covariance with principal stds outside [1e-4, 100] m (or not positive definite)");
   }
   if (g.rcs.degree < -1 || g.rcs.degree > kMaxShDegree) throw fail("SH degree out of range");
-  const bool rcs_finite = std::isfinite(g.rcs.median) && std::isfinite(g.rcs.scale) &&
-                          std::isfinite(g.rcs.fit_rmse) &&
-                          std::all_of(g.rcs.coefficients.begin(), g.rcs.coefficients.end(),
-                                      [](double c) { return std::isfinite(c); });
+  const bool rcs_finite =
+      std::isfinite(g.rcs.median) && std::isfinite(g.rcs.scale) && std::isfinite(g.rcs.fit_rmse) &&
+      std::all_of(g.rcs.coefficients.begin(), g.rcs.coefficients.end(), [](double c) { return std::isfinite(c); });
   if (!rcs_finite) throw fail("non-finite RCS model");
   if (g.rcs.degree >= 0 && !(g.rcs.scale > 0.0)) throw fail("RCS model with scale <= 0");
 }
@@ -187,8 +187,8 @@ GaussianMap ReadMap(const std::string& path) {
   if (count > (bytes.size() - kHeaderBytes) / kGaussianBytes ||
       (version == 1 && bytes.size() != kHeaderBytes + count * kGaussianBytes + 4) ||
       bytes.size() < kHeaderBytes + count * kGaussianBytes + places_bytes + 4) {
-    throw FileError(path, "truncated or oversized: " + std::to_string(bytes.size()) +
-                              " bytes for " + std::to_string(count) + " Gaussians");
+    throw FileError(path, "truncated or oversized: " + std::to_string(bytes.size()) + " bytes for " +
+                              std::to_string(count) + " Gaussians");
   }
   std::uint32_t stored_crc;
   std::memcpy(&stored_crc, bytes.data() + bytes.size() - 4, 4);
@@ -254,13 +254,11 @@ void ExportPly(const std::string& path, const GaussianMap& map) {
               rest[j - 1] = float(0.5 * g.rcs.coefficients[j]);
             }
           }
-          row.assign({float(g.mean.x()), float(g.mean.y()), float(g.mean.z()), 0.0f, 0.0f, 0.0f, dc,
-                      dc, dc});
+          row.assign({float(g.mean.x()), float(g.mean.y()), float(g.mean.z()), 0.0f, 0.0f, 0.0f, dc, dc, dc});
           for (int channel = 0; channel < 3; ++channel) row.insert(row.end(), rest, rest + 15);
           row.push_back(opacity_logit);
           for (int i = 0; i < 3; ++i) row.push_back(float(std::log(std::max(std_devs[i], 1e-9))));
-          row.insert(row.end(), {float(rotation.w()), float(rotation.x()), float(rotation.y()),
-                                 float(rotation.z())});
+          row.insert(row.end(), {float(rotation.w()), float(rotation.x()), float(rotation.y()), float(rotation.z())});
           out.write(reinterpret_cast<const char*>(row.data()), std::streamsize(row.size() * sizeof(float)));
         }
       },

@@ -19,8 +19,7 @@ MapGeometry BuildMapGeometry(MapCloud cloud, const MapOptions& options, const Pr
   if (cloud.points.empty()) throw DataError("no static points to build a map from");
   MapGeometry geometry;
   geometry.cloud = std::move(cloud);
-  geometry.map.gaussians = BuildGaussians(geometry.cloud.points, options.gaussians, progress,
-                                          &geometry.association);
+  geometry.map.gaussians = BuildGaussians(geometry.cloud.points, options.gaussians, progress, &geometry.association);
   return geometry;
 }
 

@@ -69,8 +69,8 @@ RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::
   return model;
 }
 
-RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud,
-                         const std::vector<int>& association, const RcsFitOptions& options) {
+RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud, const std::vector<int>& association,
+                         const RcsFitOptions& options) {
   map.incidence = options.incidence;
   const std::size_t n_gaussians = map.gaussians.size();
   // Members of each Gaussian, in point order (CSR).

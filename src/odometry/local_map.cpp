@@ -232,8 +232,8 @@ GaussianMap LocalMap::GlobalMap() const {
 }
 
 std::size_t LocalMap::MemoryBytes() const {
-  std::size_t bytes = matching_->MemoryBytes() + map_->gaussians.capacity() * sizeof(Gaussian) +
-                      poses_.capacity() * sizeof(SE3d);
+  std::size_t bytes =
+      matching_->MemoryBytes() + map_->gaussians.capacity() * sizeof(Gaussian) + poses_.capacity() * sizeof(SE3d);
   for (const auto& entry : regions_) {
     const Region& r = entry.second;
     bytes += 96 + r.points.capacity() * sizeof(Eigen::Vector3d) + r.rcs.capacity() * sizeof(double) +

@@ -76,7 +76,8 @@ void LocalMap::Join(Region& region, std::size_t i, std::int32_t c) {
   Component& component = region.components[c];
   const Eigen::Vector3d& point = region.points[i];
   const SE3d& pose = poses_[region.pose[i]];
-  if (component.rcs) region.direction[i] = IncidenceDirection(pose, point, component.points.mean, options_.rcs.incidence);
+  if (component.rcs)
+    region.direction[i] = IncidenceDirection(pose, point, component.points.mean, options_.rcs.incidence);
   component.points.Add(point);
   component.range_sum += (point - pose.translation()).norm();
   if (component.rcs && region.direction[i].squaredNorm() > 0.0) component.rcs->Add(region.direction[i], region.rcs[i]);
@@ -96,7 +97,8 @@ void LocalMap::Forget(Region& region, std::size_t i) {
   Component& component = region.components[c];
   component.points.Remove(point);
   component.range_sum -= (point - poses_[region.pose[i]].translation()).norm();
-  if (component.rcs && region.direction[i].squaredNorm() > 0.0) component.rcs->Remove(region.direction[i], region.rcs[i]);
+  if (component.rcs && region.direction[i].squaredNorm() > 0.0)
+    component.rcs->Remove(region.direction[i], region.rcs[i]);
   ++component.changes;
   region.member[i] = -1;
 }

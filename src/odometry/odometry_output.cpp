@@ -53,12 +53,12 @@ void WritePerScan(std::ostream& out, const std::vector<OdometryStep>& steps) {
     const Eigen::Vector3d velocity_std = s.velocity_covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
     std::string reason = s.reason;
     std::replace(reason.begin(), reason.end(), '"', '\'');
-    out << k << ',' << std::fixed << std::setprecision(9) << s.stamp << std::defaultfloat << std::setprecision(9)
-        << ',' << s.points << ',' << s.static_points << ',' << s.velocity_measured << ',' << s.velocity.x() << ','
+    out << k << ',' << std::fixed << std::setprecision(9) << s.stamp << std::defaultfloat << std::setprecision(9) << ','
+        << s.points << ',' << s.static_points << ',' << s.velocity_measured << ',' << s.velocity.x() << ','
         << s.velocity.y() << ',' << s.velocity.z() << ',' << velocity_std.x() << ',' << velocity_std.y() << ','
         << velocity_std.z() << ',' << s.standstill << ',' << s.gyro << ',' << s.matched << ',' << s.iterations << ','
-        << s.final_cost << ',' << s.converged << ",\"" << reason << "\"," << s.keyframe << ','
-        << s.active_gaussians << ',' << s.active_map_bytes << ',' << s.time_ms << '\n';
+        << s.final_cost << ',' << s.converged << ",\"" << reason << "\"," << s.keyframe << ',' << s.active_gaussians
+        << ',' << s.active_map_bytes << ',' << s.time_ms << '\n';
   }
 }
 
@@ -75,17 +75,17 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
                       [&](std::ostream& stream) { WritePerScan(stream, odometry.steps()); });
   const OdometrySummary s = Summarise(odometry);
   nlohmann::json summary = {{"scans", s.scans},
-                                  {"keyframes", s.keyframes},
-                                  {"matched", s.matched},
-                                  {"velocity_predicted", s.velocity_predicted},
-                                  {"standstill", s.standstill},
-                                  {"pose_predicted", s.pose_predicted},
-                                  {"path_length_m", s.path_length},
-                                  {"median_time_ms", s.median_ms},
-                                  {"p90_time_ms", s.p90_ms},
-                                  {"active_gaussians", s.active_gaussians},
-                                  {"global_gaussians", s.global_gaussians},
-                                  {"active_map_bytes", s.map_bytes}};
+                            {"keyframes", s.keyframes},
+                            {"matched", s.matched},
+                            {"velocity_predicted", s.velocity_predicted},
+                            {"standstill", s.standstill},
+                            {"pose_predicted", s.pose_predicted},
+                            {"path_length_m", s.path_length},
+                            {"median_time_ms", s.median_ms},
+                            {"p90_time_ms", s.p90_ms},
+                            {"active_gaussians", s.active_gaussians},
+                            {"global_gaussians", s.global_gaussians},
+                            {"active_map_bytes", s.map_bytes}};
   if (odometry.options().elevation_bias.estimate) {
     summary["elevation_bias_deg"] = odometry.elevation_bias_deg();
   }

@@ -88,8 +88,8 @@ void RadarOdometry::AddGyro(const std::vector<GyroSample>& samples) {
 
 std::optional<SO3d> RadarOdometry::GyroIncrement(double from, double to) const {
   // Rates held piecewise constant from each sample to the next, over [from, to].
-  auto it = std::upper_bound(gyro_.begin(), gyro_.end(), from,
-                             [](double t, const GyroSample& s) { return t < s.stamp; });
+  auto it =
+      std::upper_bound(gyro_.begin(), gyro_.end(), from, [](double t, const GyroSample& s) { return t < s.stamp; });
   if (it == gyro_.begin() || it == gyro_.end() || gyro_.back().stamp < to) return std::nullopt;
   --it;  // the sample in force at `from`
   SO3d increment;
@@ -159,10 +159,10 @@ RadarOdometry::Velocity RadarOdometry::MeasureVelocity(const RadarScan& scan,
     const auto& [measured_stamp, measured_covariance] = *state_->measured;
     const double dt = scan.timestamp - measured_stamp;
     const double spread = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(measured_covariance).eigenvalues().maxCoeff();
-    gate = VelocityGate{prediction->velocity,
-                        std::max(options_.min_gate, options_.gate_sigmas *
-                                                        std::sqrt(std::max(spread, 0.0) +
-                                                                  std::pow(options_.acceleration_std * dt, 2)))};
+    gate = VelocityGate{
+        prediction->velocity,
+        std::max(options_.min_gate, options_.gate_sigmas * std::sqrt(std::max(spread, 0.0) +
+                                                                     std::pow(options_.acceleration_std * dt, 2)))};
   }
   const EgoVelocityResult ego = EstimateEgoVelocity(scan, options_.ego_velocity, gate);
   for (std::size_t i = 0; i < ego.inlier.size(); ++i) {
@@ -248,8 +248,9 @@ RadarOdometry::PoseEstimate RadarOdometry::Match(const RadarScan& scan, const Pr
   const ScanMatchingResult& result = *estimate.match;
   const bool usable = result.pose.translation().allFinite() && result.n_geo >= options_.min_matched_points;
   if (!usable) {
-    estimate.reason = "matching: " + (result.reason.empty() ? std::string("too few points associated") : result.reason) +
-                      ": pose predicted";
+    estimate.reason =
+        "matching: " + (result.reason.empty() ? std::string("too few points associated") : result.reason) +
+        ": pose predicted";
     return estimate;
   }
   estimate.pose = result.pose;
@@ -264,8 +265,8 @@ ScanPriors RadarOdometry::PriorsOf(const Prediction& prediction, const Velocity&
     VelocityPrior prior;
     prior.previous = state_->pose;
     prior.displacement = Displacement(prediction, velocity.value);
-    const double vertical = options_.velocity_vertical_floor > 0.0 ? options_.velocity_vertical_floor
-                                                                     : options_.velocity_floor;
+    const double vertical =
+        options_.velocity_vertical_floor > 0.0 ? options_.velocity_vertical_floor : options_.velocity_floor;
     const Eigen::Vector3d floor(options_.velocity_floor, options_.velocity_floor, vertical);
     prior.sqrt_information =
         VelocitySqrtInformation(velocity.covariance, prediction.dt, floor.cwiseAbs2().asDiagonal());

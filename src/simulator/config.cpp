@@ -18,7 +18,6 @@
 
 namespace radargauss {
 
-
 // ---------------------------------------------------------------------------
 // Configuration file.
 
@@ -138,24 +137,20 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
   require(std::isfinite(c.start_time) && c.start_time >= 0.0, "start_time must be >= 0");
   require(c.speed >= 0.0, "speed must be >= 0");
   require(c.start_offset >= 0.0, "start_offset must be >= 0");
-  require(c.corner_radius > 0.0 && c.loop_length > 2.0 * c.corner_radius &&
-              c.loop_width > 2.0 * c.corner_radius,
+  require(c.corner_radius > 0.0 && c.loop_length > 2.0 * c.corner_radius && c.loop_width > 2.0 * c.corner_radius,
           "loop_length and loop_width must exceed 2 x corner_radius > 0");
   require(c.sensor_height > 0.0, "sensor_height must be > 0");
   require(c.azimuth_fov_deg > 0.0 && c.azimuth_fov_deg <= 90.0, "azimuth_fov_deg must be in (0, 90]");
-  require(c.elevation_fov_deg > 0.0 && c.elevation_fov_deg < 90.0,
-          "elevation_fov_deg must be in (0, 90)");
+  require(c.elevation_fov_deg > 0.0 && c.elevation_fov_deg < 90.0, "elevation_fov_deg must be in (0, 90)");
   require(c.min_range >= 0.0 && c.max_range > c.min_range, "need 0 <= min_range < max_range");
-  require(c.min_detections >= 1 && c.max_detections >= c.min_detections,
-          "need 1 <= min_detections <= max_detections");
+  require(c.min_detections >= 1 && c.max_detections >= c.min_detections, "need 1 <= min_detections <= max_detections");
   require(c.max_rays >= 1, "max_rays must be >= 1");
-  for (const double noise : {c.range_noise, c.azimuth_noise_deg, c.elevation_noise_deg,
-                             c.doppler_noise, c.rcs_noise_db, c.object_rcs_spread_db}) {
+  for (const double noise : {c.range_noise, c.azimuth_noise_deg, c.elevation_noise_deg, c.doppler_noise, c.rcs_noise_db,
+                             c.object_rcs_spread_db}) {
     require(noise >= 0.0 && std::isfinite(noise), "noise levels must be finite and >= 0");
   }
   require(c.clutter_fraction >= 0.0 && c.clutter_fraction < 1.0, "clutter_fraction must be in [0, 1)");
-  require(c.rcs_outlier_fraction >= 0.0 && c.rcs_outlier_fraction <= 1.0,
-          "rcs_outlier_fraction must be in [0, 1]");
+  require(c.rcs_outlier_fraction >= 0.0 && c.rcs_outlier_fraction <= 1.0, "rcs_outlier_fraction must be in [0, 1]");
   require(c.poles >= 0 && c.parked_cars >= 0 && c.moving_cars >= 0, "object counts must be >= 0");
   require(std::abs(c.elevation_bias_deg) < c.elevation_fov_deg, "elevation_bias_deg must be within the field of view");
   require(c.elevation_noise_growth >= 0.0, "elevation_noise_growth must be >= 0");
@@ -165,8 +160,7 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
     require(std::abs(angle) <= 45.0, std::string(key) + " must be within +/-45 deg");
   }
   require(c.rcs_swerling == 0 || c.rcs_swerling == 1 || c.rcs_swerling == 3, "rcs_swerling must be 0, 1 or 3");
-  require(c.multipath_probability >= 0.0 && c.multipath_probability <= 1.0,
-          "multipath_probability must be in [0, 1]");
+  require(c.multipath_probability >= 0.0 && c.multipath_probability <= 1.0, "multipath_probability must be in [0, 1]");
   require(c.multipath_loss_db >= 0.0, "multipath_loss_db must be >= 0");
   require(c.scene == "town" || c.scene == "motorway", "scene must be town or motorway");
   require(c.traffic_min_speed >= 0.0 && c.traffic_max_speed >= c.traffic_min_speed,
@@ -179,8 +173,7 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
             std::string("material '") + name + "' needs finite numbers");
     require(it->second.diffuse <= 1e6 && it->second.specular <= 1e6 && it->second.lobe_width_deg <= 180.0,
             std::string("material '") + name + "' needs diffuse, specular <= 1e6 m^2 and lobe_width_deg <= 180");
-    require(it->second.diffuse >= 0.0 && it->second.specular >= 0.0 &&
-                it->second.lobe_width_deg > 0.0 &&
+    require(it->second.diffuse >= 0.0 && it->second.specular >= 0.0 && it->second.lobe_width_deg > 0.0 &&
                 it->second.diffuse + it->second.specular > 0.0,
             std::string("material '") + name + "' needs diffuse, specular >= 0 (not both 0) and lobe_width_deg > 0");
   }
@@ -209,16 +202,19 @@ SimulationConfig LoadSimulationConfig(const std::string& path) {
           if (!material.second.IsMap()) throw FileError(path, "material '" + name + "' must be a map");
           for (const auto& property : material.second) {
             const std::string property_name = property.first.IsScalar() ? property.first.Scalar() : "";
-            if (property_name == "diffuse") m.diffuse = property.second.as<double>();
-            else if (property_name == "specular") m.specular = property.second.as<double>();
-            else if (property_name == "lobe_width_deg") m.lobe_width_deg = property.second.as<double>();
-            else throw FileError(path, "unknown material property '" + property_name + "'");
+            if (property_name == "diffuse")
+              m.diffuse = property.second.as<double>();
+            else if (property_name == "specular")
+              m.specular = property.second.as<double>();
+            else if (property_name == "lobe_width_deg")
+              m.lobe_width_deg = property.second.as<double>();
+            else
+              throw FileError(path, "unknown material property '" + property_name + "'");
           }
         }
         continue;
       }
-      const auto it = std::find_if(fields.begin(), fields.end(),
-                                   [&](const auto& field) { return field.first == key; });
+      const auto it = std::find_if(fields.begin(), fields.end(), [&](const auto& field) { return field.first == key; });
       if (it == fields.end()) throw FileError(path, "unknown parameter '" + key + "'");
       std::visit([&](auto* target) { *target = entry.second.as<std::remove_pointer_t<decltype(target)>>(); },
                  it->second);

@@ -26,8 +26,7 @@ bool MayHitBox(const Box& box, const Eigen::Vector3d& origin, const Eigen::Vecto
   return to_centre.squaredNorm() - along * along / squared_length <= radius * radius;
 }
 
-void IntersectBox(const Box& box, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                  Hit& hit) {
+void IntersectBox(const Box& box, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Hit& hit) {
   if (!MayHitBox(box, origin, direction, hit)) return;
   const Eigen::Matrix3d rotation = Eigen::AngleAxisd(box.yaw, Eigen::Vector3d::UnitZ()).matrix();
   const Eigen::Vector3d o = rotation.transpose() * (origin - box.centre);
@@ -160,9 +159,8 @@ Scene BuildTown(const SimulationConfig& config, const LoopPath& path, std::mt199
         const Eigen::Vector2d centre = p + side * (10.0 + 0.5 * depth) * LoopPath::Left(heading);
         const double height = draws.Uniform(6.0, 15.0);
         scene.static_boxes.push_back({Eigen::Vector3d(centre.x(), centre.y(), 0.5 * height),
-                                      Eigen::Vector3d(0.5 * building_length, 0.5 * depth,
-                                                      0.5 * height),
-                                      heading, "wall", draws.Offset()});
+                                      Eigen::Vector3d(0.5 * building_length, 0.5 * depth, 0.5 * height), heading,
+                                      "wall", draws.Offset()});
       }
       s += building_length + draws.Uniform(3.0, 8.0);
     }
@@ -176,9 +174,8 @@ Scene BuildTown(const SimulationConfig& config, const LoopPath& path, std::mt199
     path.At(draws.Uniform(0.0, path.Perimeter()), p, heading, straight);
     const double side = draws.Unit() < 0.5 ? -1.0 : 1.0;
     const Eigen::Vector2d centre = p + side * 3.3 * LoopPath::Left(heading);
-    scene.static_boxes.push_back({Eigen::Vector3d(centre.x(), centre.y(), kCarHalfExtent.z()),
-                                  kCarHalfExtent, heading + draws.Uniform(-0.1, 0.1), "car",
-                                  draws.Offset()});
+    scene.static_boxes.push_back({Eigen::Vector3d(centre.x(), centre.y(), kCarHalfExtent.z()), kCarHalfExtent,
+                                  heading + draws.Uniform(-0.1, 0.1), "car", draws.Offset()});
   }
   for (int i = 0; i < config.moving_cars; ++i) {
     // Alternate: oncoming in the left lane, or ahead in the ego lane.
@@ -207,16 +204,20 @@ Scene Nearby(const Scene& scene, const Eigen::Vector3d& position, double range) 
   return nearby;
 }
 
-Box MovingCarBox(const MovingCar& car, const LoopPath& path,
-                 double time) {
+Box MovingCarBox(const MovingCar& car, const LoopPath& path, double time) {
   Eigen::Vector2d p;
   double heading = 0.0;
   bool straight = false;
   path.At(car.s0 + car.direction * car.speed * time, p, heading, straight);
   const Eigen::Vector2d centre = p + car.lane_offset * LoopPath::Left(heading);
   const Eigen::Vector2d velocity = car.direction * car.speed * Eigen::Vector2d(std::cos(heading), std::sin(heading));
-  return {Eigen::Vector3d(centre.x(), centre.y(), kCarHalfExtent.z()), kCarHalfExtent, heading,
-          "car", car.rcs_offset, Eigen::Vector3d(velocity.x(), velocity.y(), 0.0), true};
+  return {Eigen::Vector3d(centre.x(), centre.y(), kCarHalfExtent.z()),
+          kCarHalfExtent,
+          heading,
+          "car",
+          car.rcs_offset,
+          Eigen::Vector3d(velocity.x(), velocity.y(), 0.0),
+          true};
 }
 
 // Sensor pose and world velocity at a time.
@@ -228,14 +229,13 @@ void SensorState(const SimulationConfig& config, const LoopPath& path, double ti
   path.At(5.0 + config.start_offset + config.speed * time, p, heading, straight);
   const double roll = config.attitude_wobble_deg * kDeg * std::sin(2.0 * M_PI * 0.5 * time);
   const double pitch = config.attitude_wobble_deg * kDeg * std::sin(2.0 * M_PI * 0.3 * time + 1.0);
-  const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ()) *
-                                    Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-                                    Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-                                       .matrix();
+  const Eigen::Matrix3d rotation =
+      (Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+          .matrix();
   pose = SE3d(SO3d::FromMatrix(rotation), Eigen::Vector3d(p.x(), p.y(), config.sensor_height));
   velocity_world = config.speed * Eigen::Vector3d(std::cos(heading), std::sin(heading), 0.0);
 }
-
 
 Hit CastRay(const Scene& scene, const std::vector<Box>& moving, const Eigen::Vector3d& origin,
             const Eigen::Vector3d& direction, double max_range) {

@@ -35,12 +35,10 @@ struct LoopPath {
     s = std::fmod(s, Perimeter());
     if (s < 0.0) s += Perimeter();
     const double straights[4] = {StraightX(), StraightY(), StraightX(), StraightY()};
-    const Eigen::Vector2d starts[4] = {{radius, 0.0}, {length, radius}, {length - radius, width},
-                                       {0.0, width - radius}};
-    const Eigen::Vector2d centres[4] = {{length - radius, radius},
-                                        {length - radius, width - radius},
-                                        {radius, width - radius},
-                                        {radius, radius}};
+    const Eigen::Vector2d starts[4] = {
+        {radius, 0.0}, {length, radius}, {length - radius, width}, {0.0, width - radius}};
+    const Eigen::Vector2d centres[4] = {
+        {length - radius, radius}, {length - radius, width - radius}, {radius, width - radius}, {radius, radius}};
     for (int side = 0; side < 4; ++side) {
       const double side_heading = side * 0.5 * M_PI;
       if (s <= straights[side]) {
@@ -61,9 +59,7 @@ struct LoopPath {
     }
   }
 
-  static Eigen::Vector2d Left(double heading) {
-    return Eigen::Vector2d(-std::sin(heading), std::cos(heading));
-  }
+  static Eigen::Vector2d Left(double heading) { return Eigen::Vector2d(-std::sin(heading), std::cos(heading)); }
 };
 
 struct Box {
@@ -84,11 +80,11 @@ struct Pole {
 };
 
 struct MovingCar {
-  double s0;          // arc length at t = 0
-  double lane_offset; // m to the left of the road centre line
-  double direction;   // +1 with the loop, -1 against it
+  double s0;           // arc length at t = 0
+  double lane_offset;  // m to the left of the road centre line
+  double direction;    // +1 with the loop, -1 against it
   double rcs_offset;
-  double speed;       // m/s
+  double speed;  // m/s
 };
 
 struct Hit {
@@ -105,7 +101,6 @@ struct Scene {
   std::vector<Pole> poles;
   std::vector<MovingCar> moving_cars;
 };
-
 
 // The scene of a run, drawn from `rng` (the same for a seed): the town or
 // the motorway of config.scene.

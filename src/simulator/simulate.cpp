@@ -66,13 +66,12 @@ struct ScanState {
 RadarPoint Measure(const SimulationConfig& config, const ScanState& state, double azimuth, double elevation,
                    const Eigen::Vector3d& direction_radar, double distance, const Eigen::Vector3d& velocity_world,
                    double rcs, Draws& draws, DetectionTruth& detection) {
-  const double growth =
-      1.0 + config.elevation_noise_growth * std::pow(azimuth / (config.azimuth_fov_deg * kDeg), 2);
+  const double growth = 1.0 + config.elevation_noise_growth * std::pow(azimuth / (config.azimuth_fov_deg * kDeg), 2);
   RadarPoint point;
   const double range = distance + config.range_noise * draws.Normal();
   const double az = azimuth + config.azimuth_noise_deg * kDeg * draws.Normal();
-  const double el = elevation + config.elevation_bias_deg * kDeg +
-                    config.elevation_noise_deg * growth * kDeg * draws.Normal();
+  const double el =
+      elevation + config.elevation_bias_deg * kDeg + config.elevation_noise_deg * growth * kDeg * draws.Normal();
   point.position = range * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
   point.doppler = direction_radar.dot(state.R.transpose() * velocity_world - state.velocity_radar) +
                   config.doppler_noise * draws.Normal();
@@ -100,8 +99,8 @@ bool Detected(const SimulationConfig& config, double rcs, double distance, Draws
 // the ray at the path's length (the target mirrored across the reflector),
 // with the mirrored target's velocity (docs/design.md, "The faults of real
 // radars"). Appends to `scan` and `truth`.
-void Detect(const SimulationConfig& config, const Scene& scene, const ScanState& state, Draws& draws,
-            RadarScan& scan, std::vector<DetectionTruth>& truth) {
+void Detect(const SimulationConfig& config, const Scene& scene, const ScanState& state, Draws& draws, RadarScan& scan,
+            std::vector<DetectionTruth>& truth) {
   const double azimuth = draws.Uniform(-config.azimuth_fov_deg, config.azimuth_fov_deg) * kDeg;
   const double elevation = draws.Uniform(-config.elevation_fov_deg, config.elevation_fov_deg) * kDeg;
   const Eigen::Vector3d direction_radar(std::cos(elevation) * std::cos(azimuth),
@@ -120,9 +119,8 @@ void Detect(const SimulationConfig& config, const Scene& scene, const ScanState&
     detection.incidence_angle = incidence;
     detection.position_world = origin + hit.distance * direction;
     detection.target_velocity = hit.velocity;
-    scan.points.push_back(
-        Measure(config, state, azimuth, elevation, direction_radar, hit.distance, hit.velocity, rcs_true, draws,
-                detection));
+    scan.points.push_back(Measure(config, state, azimuth, elevation, direction_radar, hit.distance, hit.velocity,
+                                  rcs_true, draws, detection));
     truth.push_back(detection);
   }
   const bool reflector = *hit.material == "wall" || *hit.material == "guardrail";
@@ -202,8 +200,8 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
   Draws draws(config.seed);
   std::mt19937 world_rng(config.world_seed);
   const Scene scene = BuildScene(config, path, config.world_seed == 0 ? draws.rng : world_rng);
-  const bool mounted = config.mounting_roll_deg != 0.0 || config.mounting_pitch_deg != 0.0 ||
-                       config.mounting_yaw_deg != 0.0;
+  const bool mounted =
+      config.mounting_roll_deg != 0.0 || config.mounting_pitch_deg != 0.0 || config.mounting_yaw_deg != 0.0;
   const SE3d mounting(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, config.mounting_yaw_deg * kDeg)) *
                           SO3d::Exp(Eigen::Vector3d(0.0, config.mounting_pitch_deg * kDeg, 0.0)) *
                           SO3d::Exp(Eigen::Vector3d(config.mounting_roll_deg * kDeg, 0.0, 0.0)),
@@ -229,8 +227,8 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
     scan.has_doppler = true;
     scan.has_rcs = true;
     std::vector<DetectionTruth> truth;
-    const int target = config.min_detections +
-                       static_cast<int>(draws.Unit() * (config.max_detections - config.min_detections + 1));
+    const int target =
+        config.min_detections + static_cast<int>(draws.Unit() * (config.max_detections - config.min_detections + 1));
     const int clutter = static_cast<int>(std::lround(target * config.clutter_fraction));
     const int surface = std::min(target, config.max_detections) - clutter;
     for (int ray = 0; ray < config.max_rays && static_cast<int>(scan.points.size()) < surface; ++ray) {

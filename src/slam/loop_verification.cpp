@@ -124,17 +124,22 @@ bool FillInformation(const ScanMatchingResult& match, const LoopVerificationOpti
   const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(information);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
   const Eigen::Matrix<double, 6, 6> covariance = ldlt.solve(Eigen::Matrix<double, 6, 6>::Identity());
-  check.translation_std = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
-                                                      covariance.topLeftCorner<3, 3>()).eigenvalues().maxCoeff()));
-  check.rotation_std_deg = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
-                                                       covariance.bottomRightCorner<3, 3>()).eigenvalues().maxCoeff())) *
-                           180.0 / M_PI;
+  check.translation_std = std::sqrt(std::max(
+      0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance.topLeftCorner<3, 3>()).eigenvalues().maxCoeff()));
+  check.rotation_std_deg =
+      std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance.bottomRightCorner<3, 3>())
+                                  .eigenvalues()
+                                  .maxCoeff())) *
+      180.0 / M_PI;
   Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Identity();
   J.topLeftCorner<3, 3>() = match.pose.rotation().Matrix().transpose();
   Eigen::Matrix<double, 6, 6> residual_covariance = J * covariance * J.transpose();
   const double rotation_floor = options.rotation_floor_std_deg * M_PI / 180.0;
-  residual_covariance.diagonal() += (Eigen::Matrix<double, 6, 1>() << Eigen::Vector3d::Constant(options.translation_floor_std),
-                                     Eigen::Vector3d::Constant(rotation_floor)).finished().cwiseAbs2();
+  residual_covariance.diagonal() +=
+      (Eigen::Matrix<double, 6, 1>() << Eigen::Vector3d::Constant(options.translation_floor_std),
+       Eigen::Vector3d::Constant(rotation_floor))
+          .finished()
+          .cwiseAbs2();
   const Eigen::Matrix<double, 6, 6> residual_information =
       residual_covariance.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
   check.sqrt_information = Eigen::LLT<Eigen::Matrix<double, 6, 6>>(residual_information).matrixU();

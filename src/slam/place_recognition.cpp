@@ -14,7 +14,7 @@ namespace radargauss {
 namespace {
 
 constexpr NamedValue<PlaceDescriptorKind> kDescriptorNames[] = {{PlaceDescriptorKind::kScanContext, "scan-context"},
-                                                                 {PlaceDescriptorKind::kRadon, "radon"}};
+                                                                {PlaceDescriptorKind::kRadon, "radon"}};
 
 }  // namespace
 
@@ -58,7 +58,7 @@ PlaceDescription Describe(const std::vector<RadarPoint>& submap, const PlaceReco
 
 const Eigen::VectorXd& KeyOf(const PlaceDescription& description, const PlaceRecognitionOptions& options) {
   return options.descriptor == PlaceDescriptorKind::kScanContext ? description.scan_context.ring_key
-                                                                  : description.radon.key;
+                                                                 : description.radon.key;
 }
 
 std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vector<PlaceDescription>& places,

@@ -9,7 +9,6 @@
 #include <queue>
 #include <stdexcept>
 
-
 namespace radargauss {
 
 namespace {
@@ -108,7 +107,8 @@ void RadarSlam::SearchLoops(int query) {
     eligible.push_back(c);
   }
   bool accepted = false;
-  for (const PlaceMatch& match : RankPlaces(descriptions_[query], descriptions_, eligible, options_.place_recognition)) {
+  for (const PlaceMatch& match :
+       RankPlaces(descriptions_[query], descriptions_, eligible, options_.place_recognition)) {
     LoopCandidate candidate;
     candidate.query = query;
     candidate.candidate = match.candidate;

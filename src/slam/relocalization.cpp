@@ -38,7 +38,8 @@ void ValidateOptions(const RelocalizationOptions& o) {
 
 Relocalizer::Relocalizer(GaussianMap map, const RelocalizationOptions& options) : options_(options) {
   ValidateOptions(options_);
-  if (map.places.empty()) throw DataError("the map has no places to relocalise against (build it with radargauss slam)");
+  if (map.places.empty())
+    throw DataError("the map has no places to relocalise against (build it with radargauss slam)");
   if (map.gaussians.empty()) throw DataError("the map has no Gaussians to match against");
   map_ = std::make_shared<const GaussianMap>(std::move(map));
   matching_ = std::make_shared<const MatchingMap>(map_);
@@ -123,8 +124,8 @@ void Relocalizer::Search() {
     } else {
       candidate.verified = true;
       for (const double yaw : match.yaws) {
-        LoopCheck check = VerifyLoop(points, map_->places[match.candidate].points, yaw, std::nullopt,
-                                     options_.verification);
+        LoopCheck check =
+            VerifyLoop(points, map_->places[match.candidate].points, yaw, std::nullopt, options_.verification);
         if (check.accepted || yaw == match.yaws.front() || check.associated > candidate.check.associated) {
           candidate.check = std::move(check);
           candidate.yaw = yaw;

@@ -86,7 +86,9 @@ ScanContextMatch CompareScanContexts(const ScanContext& query, const ScanContext
       case ScanContextChannel::kGeometric:
         distance = ShiftedDistance(query.geometric, candidate.geometric, shift);
         break;
-      case ScanContextChannel::kRcs: distance = ShiftedDistance(query.rcs, candidate.rcs, shift); break;
+      case ScanContextChannel::kRcs:
+        distance = ShiftedDistance(query.rcs, candidate.rcs, shift);
+        break;
       case ScanContextChannel::kBoth:
         distance = 0.5 * (ShiftedDistance(query.geometric, candidate.geometric, shift) +
                           ShiftedDistance(query.rcs, candidate.rcs, shift));

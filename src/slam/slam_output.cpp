@@ -23,10 +23,10 @@ void WriteKeyframes(std::ostream& out, const RadarSlam& slam) {
     const Keyframe& keyframe = slam.keyframes()[k];
     const SE3d& pose = slam.graph().poses()[k];
     const Eigen::Quaterniond& q = pose.rotation().quaternion();
-    out << k << ',' << keyframe.scan << ',' << std::fixed << keyframe.stamp << std::defaultfloat << ','
-        << keyframe.path << ',' << keyframe.points.size() << ',' << pose.translation().x() << ','
-        << pose.translation().y() << ',' << pose.translation().z() << ',' << q.x() << ',' << q.y() << ',' << q.z()
-        << ',' << q.w() << ',' << keyframe.describe_ms << ',' << keyframe.search_ms << '\n';
+    out << k << ',' << keyframe.scan << ',' << std::fixed << keyframe.stamp << std::defaultfloat << ',' << keyframe.path
+        << ',' << keyframe.points.size() << ',' << pose.translation().x() << ',' << pose.translation().y() << ','
+        << pose.translation().z() << ',' << q.x() << ',' << q.y() << ',' << q.z() << ',' << q.w() << ','
+        << keyframe.describe_ms << ',' << keyframe.search_ms << '\n';
   }
 }
 
@@ -36,10 +36,10 @@ void WriteLoops(std::ostream& out, const RadarSlam& slam) {
       << std::setprecision(6);
   for (const LoopCandidate& c : slam.candidates()) {
     const LoopCheck& check = c.check;
-    out << c.query << ',' << c.candidate << ',' << c.injected << ',' << c.distance << ',' << c.yaw * 180.0 / M_PI << ',' << c.verified
-        << ',' << check.overlap << ',' << check.associated << ',' << check.cost << ',' << check.translation_std << ','
-        << check.rotation_std_deg << ',' << check.correction << ',' << check.correction_deg << ',' << check.accepted
-        << ",\"" << check.reason << "\"\n";
+    out << c.query << ',' << c.candidate << ',' << c.injected << ',' << c.distance << ',' << c.yaw * 180.0 / M_PI << ','
+        << c.verified << ',' << check.overlap << ',' << check.associated << ',' << check.cost << ','
+        << check.translation_std << ',' << check.rotation_std_deg << ',' << check.correction << ','
+        << check.correction_deg << ',' << check.accepted << ",\"" << check.reason << "\"\n";
   }
 }
 
@@ -93,12 +93,9 @@ void WriteSlam(const std::string& dir, const RadarSlam& slam) {
   WriteFileAtomically((out / "keyframes.csv").string(), [&](std::ostream& s) { WriteKeyframes(s, slam); });
   WriteFileAtomically((out / "loops.csv").string(), [&](std::ostream& s) { WriteLoops(s, slam); });
   const SlamSummary s = Summarise(slam);
-  const nlohmann::json summary = {{"keyframes", s.keyframes},
-                                  {"candidates_compared", s.compared},
-                                  {"candidates_verified", s.verified},
-                                  {"loops", s.loops},
-                                  {"injected_false_loops", s.injected},
-                                  {"describe_time_ms", s.describe_ms},
+  const nlohmann::json summary = {{"keyframes", s.keyframes},           {"candidates_compared", s.compared},
+                                  {"candidates_verified", s.verified},  {"loops", s.loops},
+                                  {"injected_false_loops", s.injected}, {"describe_time_ms", s.describe_ms},
                                   {"search_time_ms", s.search_ms}};
   WriteFileAtomically((out / "slam.json").string(), [&](std::ostream& stream) { stream << summary.dump(2) << "\n"; });
 }

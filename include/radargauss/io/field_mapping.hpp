@@ -19,25 +19,22 @@ struct FieldMapping {
 };
 
 inline const std::vector<std::string> kRcsFieldNames = {"rcs", "RCS", "intensity", "power"};
-inline const std::vector<std::string> kDopplerFieldNames = {"doppler", "velocity", "v_r",
-                                                            "radial_velocity", "vel"};
+inline const std::vector<std::string> kDopplerFieldNames = {"doppler", "velocity", "v_r", "radial_velocity", "vel"};
 // The per-point standard deviations (Snail-Radar / ARS548); used when all four exist.
-inline const std::vector<std::string> kStdFieldNames = {"range_std", "azimuth_std",
-                                                        "elevation_std", "doppler_std"};
+inline const std::vector<std::string> kStdFieldNames = {"range_std", "azimuth_std", "elevation_std", "doppler_std"};
 
 // Resolves `requested` (see FieldMapping) against the available names: the
 // index of the field, or -1 for none. Throws DataError naming `source` when a
 // requested field is absent.
 int ResolveField(const std::vector<std::string>& available, const std::string& requested,
-                 const std::vector<std::string>& defaults, const std::string& role,
-                 const std::string& source);
+                 const std::vector<std::string>& defaults, const std::string& role, const std::string& source);
 
 // The radar fields of a record: x y z (required) and RCS / Doppler by the
 // mapping (-1 when absent or "none"). Throws DataError naming `source`.
 struct RadarFieldIndices {
   int x = -1, y = -1, z = -1, rcs = -1, doppler = -1;
 };
-RadarFieldIndices ResolveRadarFields(const std::vector<std::string>& available,
-                                     const FieldMapping& mapping, const std::string& source);
+RadarFieldIndices ResolveRadarFields(const std::vector<std::string>& available, const FieldMapping& mapping,
+                                     const std::string& source);
 
 }  // namespace radargauss

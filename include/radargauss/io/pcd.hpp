@@ -16,9 +16,9 @@ namespace radargauss {
 
 struct PcdField {
   std::string name;
-  char type = 'F';       // F (float), I (signed), U (unsigned)
-  int size = 4;          // bytes per element: F 4/8, I/U 1/2/4/8
-  int count = 1;         // elements per point; only the first is read
+  char type = 'F';         // F (float), I (signed), U (unsigned)
+  int size = 4;            // bytes per element: F 4/8, I/U 1/2/4/8
+  int count = 1;           // elements per point; only the first is read
   std::size_t offset = 0;  // byte offset within a point (binary layouts)
 };
 
@@ -27,9 +27,9 @@ struct PcdHeader {
   std::size_t width = 0;
   std::size_t height = 0;
   std::size_t points = 0;
-  std::string data;            // ascii, binary or binary_compressed
-  std::size_t point_step = 0;  // bytes per point
-  std::size_t data_offset = 0; // bytes from the file start to the data
+  std::string data;             // ascii, binary or binary_compressed
+  std::size_t point_step = 0;   // bytes per point
+  std::size_t data_offset = 0;  // bytes from the file start to the data
 };
 
 // A PCD file as columns: values[f][i] is the first element of field f of point i.
@@ -51,8 +51,7 @@ enum class PcdFormat { kAscii, kBinary, kBinaryCompressed };
 // Writes float32 fields x y z doppler intensity (intensity = RCS in dBsm, the
 // Snail-Radar layout) plus range_std azimuth_std elevation_std doppler_std
 // when every point has them; written atomically.
-void WritePcdScan(const std::string& path, const RadarScan& scan,
-                  PcdFormat format = PcdFormat::kBinary);
+void WritePcdScan(const std::string& path, const RadarScan& scan, PcdFormat format = PcdFormat::kBinary);
 
 // The scan time encoded in a file name "<secs>.<fraction>.pcd" (a leading
 // '-' for stamps before the clock's epoch; at most 12 + 18 digits), or false.

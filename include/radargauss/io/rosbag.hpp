@@ -47,8 +47,8 @@ struct PointCloud2Data {
 // Decodes x y z and the mapped RCS / Doppler fields by name and datatype,
 // honouring is_bigendian, point_step and row_step. Throws DataError naming
 // `source` for inconsistent sizes, unknown datatypes or non-finite points.
-RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp,
-                            const FieldMapping& mapping, const std::string& source);
+RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp, const FieldMapping& mapping,
+                            const std::string& source);
 
 // Every PointCloud2 message of `topic`, in bag order. The scan time is the
 // message header stamp, or the bag record time when the stamp is zero (the

@@ -21,10 +21,10 @@
 namespace radargauss {
 
 struct SequenceOptions {
-  std::string sequence_dir;      // (a) or (b)
-  std::string bag;               // (c), with topic
+  std::string sequence_dir;  // (a) or (b)
+  std::string bag;           // (c), with topic
   std::string topic;
-  std::string ground_truth;      // TUM file; empty: scans without poses
+  std::string ground_truth;  // TUM file; empty: scans without poses
   // "auto" (default): snail-20231213 when the ground-truth file name contains
   // "xt32" (Snail-Radar's utm50r_T_xt32.txt), else identity. Or a preset name
   // (identity, snail-20231213), or a file holding "x y z qx qy qz qw"

@@ -55,8 +55,7 @@ class SO3Manifold final : public ceres::Manifold {
 
   bool Minus(const double* y, const double* x, double* y_minus_x) const override {
     Eigen::Map<Eigen::Vector3d> out(y_minus_x);
-    out = internal::SignPreservingLog(
-        (SO3d::FromXyzw(x).Inverse() * SO3d::FromXyzw(y)).quaternion());
+    out = internal::SignPreservingLog((SO3d::FromXyzw(x).Inverse() * SO3d::FromXyzw(y)).quaternion());
     return true;
   }
 
@@ -77,8 +76,7 @@ class SE3Manifold final : public ceres::Manifold {
   int TangentSize() const override { return 6; }
 
   bool Plus(const double* x, const double* delta, double* x_plus_delta) const override {
-    const SE3d result =
-        SE3d::FromData(x) * SE3d::Exp(Eigen::Map<const Eigen::Matrix<double, 6, 1>>(delta));
+    const SE3d result = SE3d::FromData(x) * SE3d::Exp(Eigen::Map<const Eigen::Matrix<double, 6, 1>>(delta));
     Eigen::Map<Eigen::Vector4d> out_rotation(x_plus_delta);
     Eigen::Map<Eigen::Vector3d> out_translation(x_plus_delta + 4);
     out_rotation = result.rotation().quaternion().coeffs();

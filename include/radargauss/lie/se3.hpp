@@ -26,18 +26,14 @@ class SE3 {
   using Matrix3x6 = Eigen::Matrix<T, 3, 6>;
 
   SE3() : rotation_(), translation_(Vector3::Zero()) {}
-  SE3(const SO3<T>& rotation, const Vector3& translation)
-      : rotation_(rotation), translation_(translation) {}
+  SE3(const SO3<T>& rotation, const Vector3& translation) : rotation_(rotation), translation_(translation) {}
 
   // From memory laid out qx qy qz qw tx ty tz (the SE3Manifold block).
-  static SE3 FromData(const T* data) {
-    return SE3(SO3<T>::FromXyzw(data), Vector3(data[4], data[5], data[6]));
-  }
+  static SE3 FromData(const T* data) { return SE3(SO3<T>::FromXyzw(data), Vector3(data[4], data[5], data[6])); }
 
   // From a homogeneous 4x4 matrix whose top-left block is a rotation.
   static SE3 FromMatrix(const Matrix4& m) {
-    return SE3(SO3<T>::FromMatrix(m.template topLeftCorner<3, 3>()),
-               m.template topRightCorner<3, 1>());
+    return SE3(SO3<T>::FromMatrix(m.template topLeftCorner<3, 3>()), m.template topRightCorner<3, 1>());
   }
 
   static SE3 Exp(const Tangent& xi) {
@@ -49,8 +45,7 @@ class SE3 {
   Tangent Log() const {
     const Vector3 phi = rotation_.Log();
     Tangent xi;
-    xi.template segment<3>(kTranslationOffset) =
-        SO3<T>::LeftJacobianInverse(phi) * translation_;
+    xi.template segment<3>(kTranslationOffset) = SO3<T>::LeftJacobianInverse(phi) * translation_;
     xi.template segment<3>(kRotationOffset) = phi;
     return xi;
   }
@@ -106,9 +101,7 @@ class SE3 {
     return J;
   }
 
-  static Matrix6 RightJacobianInverse(const Tangent& xi) {
-    return LeftJacobianInverse(Tangent(-xi));
-  }
+  static Matrix6 RightJacobianInverse(const Tangent& xi) { return LeftJacobianInverse(Tangent(-xi)); }
 
   SE3 operator*(const SE3& other) const {
     return SE3(rotation_ * other.rotation_, rotation_ * other.translation_ + translation_);
@@ -180,8 +173,7 @@ class SE3 {
     const Matrix3 WV = W * V;
     const Matrix3 VW = V * W;
     const Matrix3 WVW = WV * W;
-    return T(0.5) * V + a * (WV + VW + WVW) + b * (W * WV + VW * W - T(3.0) * WVW) +
-           c * (WVW * W + W * WVW);
+    return T(0.5) * V + a * (WV + VW + WVW) + b * (W * WV + VW * W - T(3.0) * WVW) + c * (WVW * W + W * WVW);
   }
 
   SO3<T> rotation_;

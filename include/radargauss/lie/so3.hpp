@@ -33,9 +33,7 @@ class SO3 {
   explicit SO3(const Quaternion& q) : quaternion_(q) { quaternion_.normalize(); }
 
   // From memory laid out x y z w (Ceres parameter blocks).
-  static SO3 FromXyzw(const T* xyzw) {
-    return SO3(Quaternion(xyzw[3], xyzw[0], xyzw[1], xyzw[2]));
-  }
+  static SO3 FromXyzw(const T* xyzw) { return SO3(Quaternion(xyzw[3], xyzw[0], xyzw[1], xyzw[2])); }
 
   // A quaternion of unit norm kept as it is, without normalising again (which
   // may move the last bit): a stored rotation reads back bit for bit.
@@ -67,8 +65,7 @@ class SO3 {
       real_factor = cos(half_theta);
     }
     SO3 result;
-    result.quaternion_ = Quaternion(real_factor, imag_factor * phi.x(),
-                                    imag_factor * phi.y(), imag_factor * phi.z());
+    result.quaternion_ = Quaternion(real_factor, imag_factor * phi.x(), imag_factor * phi.y(), imag_factor * phi.z());
     return result;
   }
 
@@ -147,9 +144,7 @@ class SO3 {
     return Matrix3::Identity() - T(0.5) * W + c * W * W;
   }
 
-  static Matrix3 RightJacobianInverse(const Tangent& phi) {
-    return LeftJacobianInverse(Tangent(-phi));
-  }
+  static Matrix3 RightJacobianInverse(const Tangent& phi) { return LeftJacobianInverse(Tangent(-phi)); }
 
   SO3 operator*(const SO3& other) const {
     SO3 result;

@@ -29,16 +29,16 @@ std::vector<std::string> MapBuilderNames();
 
 struct GaussianMapOptions {
   MapBuilder builder = MapBuilder::kKMeans;
-  double downsample_voxel = 0.25;   // m (kKMeans)
-  double points_per_gaussian = 4.0; // about 4 for ARS548-like density, 16 for Oculii Eagle
-  int kmeans_iterations = 8;        // Lloyd iterations per bisection
-  int em_iterations = 10;           // hard-EM rounds
-  double min_std = 0.05;            // m, per principal axis
+  double downsample_voxel = 0.25;    // m (kKMeans)
+  double points_per_gaussian = 4.0;  // about 4 for ARS548-like density, 16 for Oculii Eagle
+  int kmeans_iterations = 8;         // Lloyd iterations per bisection
+  int em_iterations = 10;            // hard-EM rounds
+  double min_std = 0.05;             // m, per principal axis
   std::uint32_t seed = 1;
-  double ndt_voxel = 1.0;           // m (kVoxel)
-  int ndt_min_points = 5;           // (kVoxel)
-  double index_cell = 1.0;          // m, voxel hash of the spatial index
-  double association_gate = 3.0;    // tau: Mahalanobis distance gate for members
+  double ndt_voxel = 1.0;         // m (kVoxel)
+  int ndt_min_points = 5;         // (kVoxel)
+  double index_cell = 1.0;        // m, voxel hash of the spatial index
+  double association_gate = 3.0;  // tau: Mahalanobis distance gate for members
 };
 
 // Progress callback: (stage, done, total); may be empty.
@@ -49,10 +49,8 @@ using ProgressCallback = std::function<void(const char*, std::size_t, std::size_
 // when `association` is given it receives that association (the Gaussian of
 // each point or -1), so the RCS fit need not associate again.
 // Throws std::invalid_argument for bad options or an empty cloud.
-std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
-                                     const GaussianMapOptions& options,
-                                     const ProgressCallback& progress = {},
-                                     std::vector<int>* association = nullptr);
+std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points, const GaussianMapOptions& options,
+                                     const ProgressCallback& progress = {}, std::vector<int>* association = nullptr);
 
 // The seeding of kKMeans: `points` split by bisecting k-means (the cluster
 // of largest squared error first, options.seed) into at most k clusters, as
@@ -61,7 +59,6 @@ std::vector<std::vector<std::uint32_t>> KMeansPartition(const std::vector<Eigen:
                                                         const GaussianMapOptions& options);
 
 // For each point, the Gaussian it belongs to (-1: none within the gate).
-std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points,
-                                 const GaussianIndex& index, double gate);
+std::vector<int> AssociatePoints(const std::vector<Eigen::Vector3d>& points, const GaussianIndex& index, double gate);
 
 }  // namespace radargauss

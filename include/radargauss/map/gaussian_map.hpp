@@ -33,7 +33,7 @@ std::vector<std::string> IncidenceModelNames();
 // Per-Gaussian RCS model: y = (rcs - median) / scale in [-1, 1] is
 // predicted as c . Y(d) with real SH up to `degree` (sh.hpp).
 struct RcsModel {
-  int degree = -1;  // -1: no model (too few members or scale 0)
+  int degree = -1;      // -1: no model (too few members or scale 0)
   double median = 0.0;  // dBsm
   double scale = 0.0;   // dBsm
   std::array<double, ShCoefficientCount(kMaxShDegree)> coefficients{};
@@ -68,8 +68,7 @@ struct GaussianMap {
 
 // The ellipsoid of a covariance: std devs (ascending) and the rotation whose
 // columns are the principal axes (det +1). Sigma = R diag(std^2) R^T.
-void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs,
-                   Eigen::Matrix3d& axes);
+void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs, Eigen::Matrix3d& axes);
 
 // Clamps every principal std to at least `min_std` (docs/design.md, "Building the map").
 Eigen::Matrix3d ClampCovariance(const Eigen::Matrix3d& covariance, double min_std);
@@ -102,8 +101,7 @@ class GaussianIndex {
   GaussianIndex() = default;
   // Throws DataError when a Gaussian, or all of them, span more cells than
   // the bounds above.
-  GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size = 1.0,
-                double extent_sigmas = 3.0);
+  GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size = 1.0, double extent_sigmas = 3.0);
 
   // An empty index that Update can change (docs/design.md, "Odometry"): it
   // also keeps the cells each Gaussian is listed in.
@@ -179,8 +177,8 @@ class GaussianIndex {
   double extent_sigmas_ = 3.0;
   bool updatable_ = false;
   std::vector<std::vector<std::int64_t>> listed_cells_;  // updatable: the cells of each Gaussian
-  std::size_t cell_count_ = 0;     // occupied slots of cells_ (updatable)
-  std::size_t stale_entries_ = 0;  // entries of cell_entries_ no cell points to (updatable)
+  std::size_t cell_count_ = 0;                           // occupied slots of cells_ (updatable)
+  std::size_t stale_entries_ = 0;                        // entries of cell_entries_ no cell points to (updatable)
   // What a query reads per candidate, side by side in one entry; aligned so
   // that the mean and L^T a query scores fill two cache lines.
   struct alignas(64) IndexedGaussian {
@@ -200,7 +198,8 @@ class GaussianIndex {
   LinearProbingTable<Cell> cells_;
   // The slot holding `key`, or the empty slot where it would go.
   std::size_t Slot(std::int64_t key) const {
-    return cells_.Probe(std::uint64_t(key), [key](const Cell& cell) { return cell.key == key || cell.key == kEmptyCell; });
+    return cells_.Probe(std::uint64_t(key),
+                        [key](const Cell& cell) { return cell.key == key || cell.key == kEmptyCell; });
   }
   // The smallest Mahalanobis^2 a candidate must beat: one ulp above gate_sq.
   static double GateBound(double gate_sq);

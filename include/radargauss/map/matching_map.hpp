@@ -74,7 +74,7 @@ class MatchingMap {
   const GaussianMap& map() const { return *map_; }
   std::size_t levels() const { return levels_.size(); }
   const GaussianIndex& level(std::size_t k) const { return levels_[k]; }
-  const GaussianIndex& index() const { return levels_.back(); }  // the exact map
+  const GaussianIndex& index() const { return levels_.back(); }                        // the exact map
   double sigma(std::size_t k) const { return k < sigmas_.size() ? sigmas_[k] : 0.0; }  // level k's blur (m)
   double coarse_gate() const { return coarse_gate_; }
 

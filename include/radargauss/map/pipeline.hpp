@@ -16,9 +16,9 @@
 namespace radargauss {
 
 struct MapOptions {
-  MapCloudOptions cloud;          // Doppler filter
-  GaussianMapOptions gaussians;   // builder, density, EM
-  RcsFitOptions rcs;              // incidence model, SH degree
+  MapCloudOptions cloud;         // Doppler filter
+  GaussianMapOptions gaussians;  // builder, density, EM
+  RcsFitOptions rcs;             // incidence model, SH degree
 };
 
 // The geometric part of a map: the static cloud, its Gaussians (no RCS
@@ -38,7 +38,6 @@ MapGeometry BuildMapGeometry(const std::vector<RadarScan>& scans, const std::vec
 MapGeometry BuildMapGeometry(MapCloud cloud, const MapOptions& options = {}, const ProgressCallback& progress = {});
 
 // The geometry's map with the RCS model of every Gaussian fitted.
-GaussianMap FitRcs(const MapGeometry& geometry, const RcsFitOptions& options = {},
-                   RcsFitStats* stats = nullptr);
+GaussianMap FitRcs(const MapGeometry& geometry, const RcsFitOptions& options = {}, RcsFitStats* stats = nullptr);
 
 }  // namespace radargauss

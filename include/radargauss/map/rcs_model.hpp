@@ -72,7 +72,7 @@ struct RcsFitStats {
 // Fits the RCS model of every Gaussian of `map` from the cloud points
 // associated to it (`association[i]` = Gaussian of point i or -1); sets
 // map.incidence. Parallel over Gaussians; the same for any thread count.
-RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud,
-                         const std::vector<int>& association, const RcsFitOptions& options = {});
+RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud, const std::vector<int>& association,
+                         const RcsFitOptions& options = {});
 
 }  // namespace radargauss

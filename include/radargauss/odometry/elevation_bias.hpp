@@ -49,8 +49,8 @@ class ElevationBias {
  private:
   ElevationBiasOptions options_;
   SO3d vehicle_from_radar_;
-  double bias_ = 0.0;           // rad
-  std::deque<double> window_;   // raw elevations: residual + the bias then removed (rad)
+  double bias_ = 0.0;          // rad
+  std::deque<double> window_;  // raw elevations: residual + the bias then removed (rad)
 };
 
 }  // namespace radargauss

@@ -70,8 +70,8 @@ struct LocalMapOptions {
   // returns still gate into the map (docs/design.md, "Odometry").
   double azimuth_std_deg = 0.0;  // in [0, kMaxAngularNoiseDeg]
   double elevation_std_deg = 0.0;
-  GaussianMapOptions gaussians;       // the estimator of build-map
-  RcsFitOptions rcs;                  // incidence model and SH degree of the RCS models
+  GaussianMapOptions gaussians;                             // the estimator of build-map
+  RcsFitOptions rcs;                                        // incidence model and SH degree of the RCS models
   MatchingMapOptions matching = LocalMatchingMapOptions();  // coarse levels, index cells (always updatable)
 };
 
@@ -116,21 +116,21 @@ class LocalMap {
   // the matching map has of it.
   struct Component {
     PointStatistics points;
-    double range_sum = 0.0;               // members' ranges from the poses they were seen from
-    std::unique_ptr<RcsStatistics> rcs;   // when the region has RCS
-    std::uint32_t slot = kNoSlot;         // in map_, once published
+    double range_sum = 0.0;                                 // members' ranges from the poses they were seen from
+    std::unique_ptr<RcsStatistics> rcs;                     // when the region has RCS
+    std::uint32_t slot = kNoSlot;                           // in map_, once published
     Eigen::Matrix3d information = Eigen::Matrix3d::Zero();  // the published covariance's inverse
-    std::uint32_t changes = 0;            // members that came or left since the last KL check
-    bool reshaped = false;                // seeded or split: publish whatever the KL
+    std::uint32_t changes = 0;                              // members that came or left since the last KL check
+    bool reshaped = false;                                  // seeded or split: publish whatever the KL
   };
   struct Region {
     std::vector<Eigen::Vector3d> points;  // world frame, at most region_capacity (a ring once full)
     std::vector<double> rcs;
-    std::vector<std::uint32_t> pose;      // into poses_
-    std::size_t next = 0;                 // the ring's oldest point once full
-    std::size_t fitted = 0;               // points at the last fit
-    std::size_t added = 0;                // points since the last fit
-    std::vector<std::uint32_t> gaussians; // their slots in map_
+    std::vector<std::uint32_t> pose;       // into poses_
+    std::size_t next = 0;                  // the ring's oldest point once full
+    std::size_t fitted = 0;                // points at the last fit
+    std::size_t added = 0;                 // points since the last fit
+    std::vector<std::uint32_t> gaussians;  // their slots in map_
     bool has_rcs = false;
     // kIncremental: each point's component (-1: pending, in no Gaussian's
     // gate yet) and incidence direction, the components, and the points per
@@ -170,12 +170,12 @@ class LocalMap {
   void Recompute(Region& region, std::int32_t component);
 
   LocalMapOptions options_;
-  std::shared_ptr<GaussianMap> map_;        // slots; free ones are in no index
-  std::unique_ptr<MatchingMap> matching_;   // over map_
+  std::shared_ptr<GaussianMap> map_;       // slots; free ones are in no index
+  std::unique_ptr<MatchingMap> matching_;  // over map_
   std::vector<std::uint32_t> free_slots_;
   std::map<VoxelKey, Region> regions_;
-  std::vector<SE3d> poses_;                 // the poses points were inserted from
-  std::vector<Gaussian> evicted_;           // the global map's Gaussians that left
+  std::vector<SE3d> poses_;        // the poses points were inserted from
+  std::vector<Gaussian> evicted_;  // the global map's Gaussians that left
   std::size_t version_ = 0;
 };
 

@@ -20,9 +20,9 @@
 namespace radargauss {
 
 struct MountingOptions {
-  double min_speed = 5.0;            // m/s: slower scans say little about the direction
-  double max_yaw_rate_deg = 2.0;     // deg/s: turning adds the lever arm's lateral velocity
-  std::size_t min_scans = 10;        // straight scans at speed needed for an estimate
+  double min_speed = 5.0;         // m/s: slower scans say little about the direction
+  double max_yaw_rate_deg = 2.0;  // deg/s: turning adds the lever arm's lateral velocity
+  std::size_t min_scans = 10;     // straight scans at speed needed for an estimate
 };
 
 // Throws std::invalid_argument naming the bad option.
@@ -31,11 +31,11 @@ void ValidateOptions(const MountingOptions& options);
 // R_vehicle_radar = Rz(yaw) Ry(pitch) (roll unobserved, 0), the convention
 // of the simulator's mounting_* (z up: a positive pitch looks down).
 struct Mounting {
-  double pitch_deg = 0.0;  // the radar's x axis below the direction of travel
-  double yaw_deg = 0.0;    // the radar's x axis left of the direction of travel
+  double pitch_deg = 0.0;                               // the radar's x axis below the direction of travel
+  double yaw_deg = 0.0;                                 // the radar's x axis left of the direction of travel
   double pitch_spread_deg = 0.0, yaw_spread_deg = 0.0;  // 1.4826 x median absolute deviation
-  std::size_t pitch_scans = 0, yaw_scans = 0;  // scans the medians are over
-  SO3d vehicle_from_radar() const;  // R_vehicle_radar: the radar's axes in the levelled frame
+  std::size_t pitch_scans = 0, yaw_scans = 0;           // scans the medians are over
+  SO3d vehicle_from_radar() const;                      // R_vehicle_radar: the radar's axes in the levelled frame
 };
 
 // Medians over the scans whose velocity was measured, at least min_speed;

@@ -46,8 +46,8 @@ struct OdometryOptions {
   // gate_sigmas * sqrt(lambda_max(S) + (acceleration_std * dt)^2), at least
   // min_gate; dt counts from the last scan whose velocity was measured.
   double gate_sigmas = 3.0;
-  double acceleration_std = 3.0;  // m/s^2: process noise of the velocity
-  double min_gate = 0.5;          // m/s
+  double acceleration_std = 3.0;       // m/s^2: process noise of the velocity
+  double min_gate = 0.5;               // m/s
   std::size_t min_static_points = 10;  // fewer Doppler inliers: the prediction stands in
   double velocity_weight = 1.0;        // of the velocity term in eq. 2 (0: off)
   double velocity_floor = 0.05;        // m: std of the floor Q = diag(floor^2, floor^2, vertical^2) of the term
@@ -58,14 +58,14 @@ struct OdometryOptions {
   // The rotation term: the match's rotation against the predicted one, with
   // sigma = rotation_rate_std * dt about the radar's x, y, z (roll, pitch,
   // yaw); docs/design.md, "The rotation term".
-  double rotation_weight = 1.0;  // 0: off
+  double rotation_weight = 1.0;                           // 0: off
   Eigen::Vector3d rotation_rate_std_deg{1.0, 1.0, 90.0};  // deg/s: rate changes the prediction allows
-  MatchOptions match;                  // solver and eq. 2 (w_rcs, losses, incidence via map.rcs)
+  MatchOptions match;                                     // solver and eq. 2 (w_rcs, losses, incidence via map.rcs)
   LocalMapOptions map;
-  double keyframe_distance = 0.5;      // m since the last keyframe ...
-  double keyframe_angle_deg = 2.0;     // ... or deg: the scan enters the map
-  std::size_t min_matched_points = 10; // fewer associated points: the prediction stands in
-  SE3d initial_pose;                   // T_world_radar of the first scan
+  double keyframe_distance = 0.5;       // m since the last keyframe ...
+  double keyframe_angle_deg = 2.0;      // ... or deg: the scan enters the map
+  std::size_t min_matched_points = 10;  // fewer associated points: the prediction stands in
+  SE3d initial_pose;                    // T_world_radar of the first scan
   // The radar on the vehicle, roll / pitch / yaw in deg (VehicleFromRadar;
   // `radargauss odometry` prints an estimate): the prediction turns about
   // the vehicle's vertical and the rotation term's stds are about its axes.
@@ -85,19 +85,19 @@ void ValidateOptions(const OdometryOptions& options);
 // What happened to one scan.
 struct OdometryStep {
   double stamp = 0.0;
-  SE3d pose;                         // T_world_radar
+  SE3d pose;  // T_world_radar
   std::size_t points = 0;
-  std::size_t static_points = 0;     // Doppler inliers (all points without Doppler)
-  bool velocity_measured = false;    // false: the prediction's velocity
-  bool standstill = false;           // the zero-velocity branch held the pose
-  bool gyro = false;                 // the predicted rotation comes from gyro rates
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();      // m/s, radar frame
+  std::size_t static_points = 0;                                  // Doppler inliers (all points without Doppler)
+  bool velocity_measured = false;                                 // false: the prediction's velocity
+  bool standstill = false;                                        // the zero-velocity branch held the pose
+  bool gyro = false;                                              // the predicted rotation comes from gyro rates
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();             // m/s, radar frame
   Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();  // (m/s)^2: measured, or the prediction's
-  bool matched = false;              // the pose comes from scan matching
+  bool matched = false;                                           // the pose comes from scan matching
   int iterations = 0;
   double final_cost = 0.0;
   bool converged = false;
-  std::string reason;                // why a stage fell back or did not converge; empty when all went well
+  std::string reason;  // why a stage fell back or did not converge; empty when all went well
   bool keyframe = false;
   std::size_t active_gaussians = 0;  // after the map update
   std::size_t active_map_bytes = 0;  // LocalMap::MemoryBytes after the map update
@@ -167,16 +167,16 @@ class RadarOdometry {
     Eigen::Vector3d velocity;  // the last velocity, kept in the radar frame
     Eigen::Matrix3d velocity_covariance;
     double dt = 0.0;
-    bool gyro = false;         // the increment comes from gyro rates
+    bool gyro = false;  // the increment comes from gyro rates
   };
   // The scan's ego velocity: measured (gated by the prediction), or the prediction's.
   struct Velocity {
     bool measured = false;
-    bool standstill = false;             // the zero-velocity branch decided
+    bool standstill = false;  // the zero-velocity branch decided
     Eigen::Vector3d value = Eigen::Vector3d::Zero();
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
     std::vector<std::size_t> static_points;  // to match and to insert
-    std::string reason;                  // why the prediction stands in
+    std::string reason;                      // why the prediction stands in
   };
   // The scan's pose: matched, or the prediction's (with why).
   struct PoseEstimate {
@@ -221,7 +221,7 @@ class RadarOdometry {
   SE3d last_keyframe_;
   std::vector<std::size_t> last_static_points_;
   std::shared_ptr<const MatchingMap> fixed_map_;  // LocalizeIn's; null: the run's own map
-  std::size_t map_bytes_ = 0;  // LocalMap::MemoryBytes after the last keyframe
+  std::size_t map_bytes_ = 0;                     // LocalMap::MemoryBytes after the last keyframe
 };
 
 // Per-scan time (median, p90 in ms), scan and keyframe counts, fallbacks.

@@ -23,10 +23,10 @@ Eigen::Matrix3d VelocitySqrtInformation(const Eigen::Matrix3d& velocity_covarian
 
 // The velocity term as scan matching adds it to eq. 2: weight * |r_v|^2.
 struct VelocityPrior {
-  SE3d previous;                                              // (R_prev, t_prev)
-  Eigen::Vector3d displacement = Eigen::Vector3d::Zero();     // v dt, previous radar frame
+  SE3d previous;                                                   // (R_prev, t_prev)
+  Eigen::Vector3d displacement = Eigen::Vector3d::Zero();          // v dt, previous radar frame
   Eigen::Matrix3d sqrt_information = Eigen::Matrix3d::Identity();  // W
-  double weight = 1.0;                                        // 0: off
+  double weight = 1.0;                                             // 0: off
   Eigen::Matrix3d Jacobian() const { return sqrt_information * previous.rotation().Matrix().transpose(); }
   Eigen::Vector3d Residual(const Eigen::Vector3d& translation) const {
     return sqrt_information *

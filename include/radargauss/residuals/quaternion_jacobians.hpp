@@ -26,14 +26,13 @@ inline Eigen::Matrix<double, 3, 4> RotatePointJacobian(const double* xyzw, const
 // lambda^T d(R^T a)/d[x y z w], 1 x 4, without forming the 3 x 4 Jacobian
 // d(R^T a)/dv = 2 w [a]x + 2 (v a^T + (v . a) I - 2 a v^T),
 // d(R^T a)/dw = -2 v x a, and lambda^T [a]x = (lambda x a)^T.
-inline Eigen::Matrix<double, 1, 4> InverseRotatePointJacobianLeft(const Eigen::RowVector3d& lambda,
-                                                                 const double* xyzw, const Eigen::Vector3d& a) {
+inline Eigen::Matrix<double, 1, 4> InverseRotatePointJacobianLeft(const Eigen::RowVector3d& lambda, const double* xyzw,
+                                                                  const Eigen::Vector3d& a) {
   const Eigen::Map<const Eigen::Vector3d> v(xyzw);
   const double w = xyzw[3];
   const Eigen::Vector3d l = lambda.transpose();
   Eigen::Matrix<double, 1, 4> J;
-  J.leftCols<3>() =
-      (2.0 * w * l.cross(a) + 2.0 * (l.dot(v) * a + v.dot(a) * l - 2.0 * l.dot(a) * v)).transpose();
+  J.leftCols<3>() = (2.0 * w * l.cross(a) + 2.0 * (l.dot(v) * a + v.dot(a) * l - 2.0 * l.dot(a) * v)).transpose();
   J(3) = -2.0 * l.dot(v.cross(a));
   return J;
 }

@@ -46,8 +46,8 @@ struct RcsTerm {
   int degree = 0;
   std::array<double, ShCoefficientCount(kMaxShDegree)> coefficients{};
   IncidenceModel incidence = IncidenceModel::kOffset;
-  double facing = 1.0;          // s: FacingSign(u) at the association's pose
-  std::uint32_t gaussian = 0;   // index in the map (for joint refinement)
+  double facing = 1.0;         // s: FacingSign(u) at the association's pose
+  std::uint32_t gaussian = 0;  // index in the map (for joint refinement)
 };
 
 // d = s u / |u| for the Gaussian centre mu_r in the radar frame; writes |u|.
@@ -95,7 +95,7 @@ class RcsResidual {
   void Reset(const RcsTerm& term) { term_ = term; }
 
   using AutoDiff = ceres::AutoDiffCostFunction<RcsResidual, 1, 4, 3>;
-  static ceres::CostFunction* Create(const RcsTerm& term);  // residuals/autodiff_costs.cpp
+  static ceres::CostFunction* Create(const RcsTerm& term);                   // residuals/autodiff_costs.cpp
   static ceres::CostFunction* Create(std::unique_ptr<RcsResidual> functor);  // kept by the caller for Reset
 
  private:
@@ -141,8 +141,8 @@ struct RcsLinearisation {
 
 // With coefficients c from a parameter block (joint refinement), else the
 // term's; writes Y(d) = -dr/dc to `basis_out` when given.
-inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d& mean_radar,
-                                     const double* coefficients, double* basis_out = nullptr) {
+inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d& mean_radar, const double* coefficients,
+                                     double* basis_out = nullptr) {
   double norm = 0.0;
   RcsLinearisation out;
   const Eigen::Vector3d d = RcsDirection<double>(term, mean_radar, norm);
@@ -235,8 +235,9 @@ class RcsCoefficientResidual {
 
   template <typename T>
   bool operator()(T const* const* parameters, T* residual) const {
-    const Eigen::Matrix<T, 3, 1> t = full_ ? Eigen::Matrix<T, 3, 1>(parameters[2][0], parameters[2][1], parameters[2][2])
-                                           : Eigen::Matrix<T, 3, 1>(translation_.cast<T>());
+    const Eigen::Matrix<T, 3, 1> t = full_
+                                         ? Eigen::Matrix<T, 3, 1>(parameters[2][0], parameters[2][1], parameters[2][2])
+                                         : Eigen::Matrix<T, 3, 1>(translation_.cast<T>());
     residual[0] = RcsResidualValue<T, T>(term_, parameters[0], t, parameters[1]);
     return true;
   }
@@ -262,7 +263,8 @@ class RcsCoefficientCostFunction final : public ceres::CostFunction {
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const Eigen::Vector3d t = full_ ? Eigen::Vector3d(parameters[2][0], parameters[2][1], parameters[2][2]) : translation_;
+    const Eigen::Vector3d t =
+        full_ ? Eigen::Vector3d(parameters[2][0], parameters[2][1], parameters[2][2]) : translation_;
     return EvaluateRcsTerm(term_, parameters[0], t, parameters[1], residuals, jacobians != nullptr,
                            jacobians ? jacobians[0] : nullptr, jacobians ? jacobians[1] : nullptr,
                            full_ && jacobians ? jacobians[2] : nullptr);

@@ -43,8 +43,7 @@ class RelativePoseResidual {
 
   using AutoDiff = ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 4, 3, 4, 3>;
   // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
-  static ceres::CostFunction* Create(const SE3d& measured,
-                                     const Eigen::Matrix<double, 6, 6>& sqrt_information);
+  static ceres::CostFunction* Create(const SE3d& measured, const Eigen::Matrix<double, 6, 6>& sqrt_information);
 
  private:
   const SE3d measured_inverse_;

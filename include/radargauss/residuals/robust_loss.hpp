@@ -44,7 +44,7 @@ class DcsLoss final : public ceres::LossFunction {
     const double scale = 2.0 * phi_ / (s + phi_);  // DCS's, in (0, 1)
     rho[0] = phi_ * (3.0 - 2.0 * scale);           // Phi (3 s - Phi) / (s + Phi), without overflow
     rho[1] = scale * scale;
-    rho[2] = -rho[1] * scale / phi_;               // -2 rho' / (s + Phi)
+    rho[2] = -rho[1] * scale / phi_;  // -2 rho' / (s + Phi)
   }
 
  private:

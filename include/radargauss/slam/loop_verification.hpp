@@ -29,12 +29,12 @@ inline MatchOptions LoopMatchOptions() {
 }
 
 struct LoopVerificationOptions {
-  double bev_cell = 1.0;     // m: cells of the bird's-eye alignment
-  double bev_search = 12.0;  // m: translations tried around the keyframes' origins
+  double bev_cell = 1.0;                    // m: cells of the bird's-eye alignment
+  double bev_search = 12.0;                 // m: translations tried around the keyframes' origins
   MatchOptions match = LoopMatchOptions();  // geometric: w_rcs 0
   GaussianMapOptions gaussians;             // the candidate submap's Gaussians (build-map's estimator)
-  double min_associated = 0.5;  // share of the query's points within the gate
-  double max_cost = 6.0;        // eq. 2's f (mean squared Mahalanobis distance within the gate) at the end
+  double min_associated = 0.5;              // share of the query's points within the gate
+  double max_cost = 6.0;                    // eq. 2's f (mean squared Mahalanobis distance within the gate) at the end
   // The match's marginal stds (from N_geo times its information) may not exceed these.
   double max_translation_std = 0.2;  // m
   double max_rotation_std_deg = 1.0;
@@ -43,8 +43,8 @@ struct LoopVerificationOptions {
   // max(min_drift_deg, drift_deg * path) degrees, path the distance driven in
   // between along the graph (accepted loops crossed for free).
   double drift = 0.05;
-  double min_drift = 5.0;          // m
-  double drift_deg = 0.05;         // deg per m
+  double min_drift = 5.0;   // m
+  double drift_deg = 0.05;  // deg per m
   double min_drift_deg = 10.0;
   // Added to the match's covariance: what the submaps' own errors leave.
   double translation_floor_std = 0.1;  // m
@@ -56,13 +56,13 @@ void ValidateOptions(const LoopVerificationOptions& options);
 
 struct LoopCheck {
   bool accepted = false;
-  std::string reason;  // why not; empty when accepted
-  SE3d relative;       // the match: candidate frame from query frame
+  std::string reason;       // why not; empty when accepted
+  SE3d relative;            // the match: candidate frame from query frame
   double overlap = 0.0;     // share of the query's bird's-eye cells on the candidate's after the shift
   double associated = 0.0;  // share of the query's points
   double cost = 0.0;
   double translation_std = 0.0, rotation_std_deg = 0.0;
-  double correction = 0.0, correction_deg = 0.0;  // against the graph's estimate
+  double correction = 0.0, correction_deg = 0.0;                                       // against the graph's estimate
   Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Zero();  // of the relative-pose term
 };
 

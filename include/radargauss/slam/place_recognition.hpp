@@ -54,9 +54,9 @@ const Eigen::VectorXd& KeyOf(const PlaceDescription& description, const PlaceRec
 
 struct PlaceMatch {
   int candidate = 0;
-  double distance = 1.0;    // the descriptor's, 0 (same) .. 1
-  std::vector<double> yaws; // rad, the query's in the candidate's, to verify in order (Radon: yaw and yaw - pi)
-  bool close = false;       // distance within the descriptor's maximum
+  double distance = 1.0;     // the descriptor's, 0 (same) .. 1
+  std::vector<double> yaws;  // rad, the query's in the candidate's, to verify in order (Radon: yaw and yaw - pi)
+  bool close = false;        // distance within the descriptor's maximum
 };
 
 // The `candidates` descriptions nearest `query` by key among the `eligible`

@@ -38,7 +38,7 @@ struct SlamOptions {
   double odometry_translation_std = 0.05;  // m
   double odometry_drift = 0.02;            // m per m
   double odometry_rotation_std_deg = 0.1;
-  double odometry_drift_deg = 0.02;        // deg per m
+  double odometry_drift_deg = 0.02;  // deg per m
   // Robustness studies: after each keyframe's search, with this probability
   // a false loop to a keyframe chosen at random (at least min_loop_path
   // back) claiming the two coincide (identity, at the loop floors' weight)
@@ -53,9 +53,9 @@ void ValidateOptions(const SlamOptions& options);
 struct Keyframe {
   std::size_t scan = 0;  // the scan that opened it
   double stamp = 0.0;
-  SE3d odometry_pose;    // the odometry's T_world_radar at that scan
-  double path = 0.0;     // m driven to it
-  std::vector<RadarPoint> points;  // its submap, in its frame (closed keyframes)
+  SE3d odometry_pose;                         // the odometry's T_world_radar at that scan
+  double path = 0.0;                          // m driven to it
+  std::vector<RadarPoint> points;             // its submap, in its frame (closed keyframes)
   double describe_ms = 0.0, search_ms = 0.0;  // place recognition's time
 };
 
@@ -115,7 +115,7 @@ class RadarSlam {
 // the last solve's.
 struct SlamSummary {
   std::size_t keyframes = 0, compared = 0, verified = 0, loops = 0, injected = 0;  // loops: accepted, not injected
-  double describe_ms = 0.0, search_ms = 0.0;  // medians per keyframe
+  double describe_ms = 0.0, search_ms = 0.0;                                       // medians per keyframe
 };
 SlamSummary Summarise(const RadarSlam& slam);
 

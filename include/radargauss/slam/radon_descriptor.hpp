@@ -26,8 +26,9 @@ struct RadonOptions {
 void ValidateRadonOptions(const RadonOptions& options);
 
 struct RadonDescriptor {
-  Eigen::MatrixXd spectra;  // angles x offsets / 2: |DFT| of each projection (frequencies 1 .. offsets / 2) minus their mean
-  Eigen::VectorXd key;      // the rows' mean, unit norm (zero when empty): yaw-invariant
+  Eigen::MatrixXd
+      spectra;  // angles x offsets / 2: |DFT| of each projection (frequencies 1 .. offsets / 2) minus their mean
+  Eigen::VectorXd key;  // the rows' mean, unit norm (zero when empty): yaw-invariant
 };
 
 // Of points in the keyframe's frame (x forward, z up).

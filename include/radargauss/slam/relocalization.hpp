@@ -33,8 +33,8 @@
 namespace radargauss {
 
 struct RelocalizationOptions {
-  OdometryOptions odometry;        // the front end: submaps before the fix, tracking after
-  double submap_distance = 10.0;   // m driven per submap
+  OdometryOptions odometry;       // the front end: submaps before the fix, tracking after
+  double submap_distance = 10.0;  // m driven per submap
   PlaceRecognitionOptions place_recognition;
   LoopVerificationOptions verification;
   // A submap's places may confirm those of the confirm_window submaps before
@@ -68,8 +68,8 @@ struct PlaceCandidate {
   double distance = 1.0;  // the descriptor's
   double yaw = 0.0;       // rad
   bool verified = false;
-  LoopCheck check;      // check.accepted: verified
-  bool fixed = false;   // it confirmed the submap before's place: the fix
+  LoopCheck check;     // check.accepted: verified
+  bool fixed = false;  // it confirmed the submap before's place: the fix
 };
 
 class Relocalizer {
@@ -108,11 +108,11 @@ class Relocalizer {
   SE3d submap_origin_;              // the odometry's pose of that scan
   double submap_start_ = 0.0, path_ = 0.0;
   int submaps_ = 0;
-  std::optional<SE3d> fix_;         // T_map_odometry at the fix
+  std::optional<SE3d> fix_;                // T_map_odometry at the fix
   std::deque<std::vector<SE3d>> pending_;  // the last submaps' verified T_map_odometry, awaiting confirmation
   std::optional<std::size_t> first_fix_;
-  std::size_t fixes_ = 0;                 // how many fixes were made
-  int unmatched_ = 0;                     // scans in a row without a match since the fix
+  std::size_t fixes_ = 0;  // how many fixes were made
+  int unmatched_ = 0;      // scans in a row without a match since the fix
 };
 
 }  // namespace radargauss

@@ -22,8 +22,8 @@ class CeresScanProblem {
   // `rotation` (quaternion x y z w) and `translation` are the parameter
   // blocks; they must outlive the problem. `priors`: the scan's terms, in
   // every association. `threads`: square-root blocks per kind of term.
-  CeresScanProblem(const ScanMatchingOptions& options, const ScanPriors& priors, double* rotation,
-                   double* translation, CeresBlocks blocks = CeresBlocks::kSquareRoot, int threads = 1);
+  CeresScanProblem(const ScanMatchingOptions& options, const ScanPriors& priors, double* rotation, double* translation,
+                   CeresBlocks blocks = CeresBlocks::kSquareRoot, int threads = 1);
   ~CeresScanProblem();
   CeresScanProblem(const CeresScanProblem&) = delete;
   CeresScanProblem& operator=(const CeresScanProblem&) = delete;

@@ -209,9 +209,8 @@ class TermBlocks {
   // Eq. 2's weight of every term of this kind (for the next Truncate); the
   // robust loss is inside the shared blocks, else under the weight.
   void SetWeight(double weight) {
-    loss_.Reset(
-        new ceres::ScaledLoss(shared_ ? nullptr : robust_loss_.get(), weight, ceres::DO_NOT_TAKE_OWNERSHIP),
-        ceres::TAKE_OWNERSHIP);
+    loss_.Reset(new ceres::ScaledLoss(shared_ ? nullptr : robust_loss_.get(), weight, ceres::DO_NOT_TAKE_OWNERSHIP),
+                ceres::TAKE_OWNERSHIP);
   }
 
   // Term k is the one made from `args` (and, unless shared, its block is in the problem).
@@ -276,8 +275,8 @@ class TermBlocks {
 
   struct Block {
     std::unique_ptr<ceres::CostFunction> cost;
-    Functor* functor = nullptr;         // autodiff: the functor `cost` owns
-    AnalyticCost* analytic = nullptr;   // analytic: `cost` itself
+    Functor* functor = nullptr;           // autodiff: the functor `cost` owns
+    AnalyticCost* analytic = nullptr;     // analytic: `cost` itself
     ceres::ResidualBlockId id = nullptr;  // null while not in the problem (always when shared)
   };
   ceres::Problem& problem_;
@@ -285,7 +284,7 @@ class TermBlocks {
   bool shared_;
   bool square_root_;
   std::size_t threads_;
-  std::unique_ptr<ceres::LossFunction> robust_loss_;  // null: trivial
+  std::unique_ptr<ceres::LossFunction> robust_loss_;                 // null: trivial
   ceres::LossFunctionWrapper loss_{nullptr, ceres::TAKE_OWNERSHIP};  // the blocks' loss
   std::vector<double*> parameters_;
   std::vector<Block> blocks_;

@@ -26,8 +26,8 @@ namespace radargauss {
 // eq. 2 it is matched with, its iteration limit and step tolerances.
 struct Stage {
   std::size_t level = 0;
-  bool finest = false;       // on the exact map
-  bool full_cost = false;    // eq. 2 with the match's w: its last stage (else one that steers)
+  bool finest = false;          // on the exact map
+  bool full_cost = false;       // eq. 2 with the match's w: its last stage (else one that steers)
   ScanMatchingOptions options;  // the match's, with this stage's w_rcs
   int max_iterations = 0;
   double translation_tolerance = 0.0;  // m: a smaller step ends the stage ...
@@ -42,8 +42,8 @@ class CoarseToFine {
   // The stages: the coarse levels, the exact map with the geometric term
   // alone (geometric_first, when re-associating), the exact map with eq. 2;
   // with w = 1 the last alone.
-  CoarseToFine(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,
-               const ScanMatchingOptions& options, const ScanPriors& priors);
+  CoarseToFine(const RadarScan& scan, const MatchingMap& map, const SE3d& initial, const ScanMatchingOptions& options,
+               const ScanPriors& priors);
   // It keeps references: temporaries would not outlive it.
   CoarseToFine(const RadarScan&&, const MatchingMap&, const SE3d&, const ScanMatchingOptions&,
                const ScanPriors&) = delete;
@@ -99,8 +99,8 @@ class CoarseToFine {
   const ScanPriors& priors_;
   const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   std::vector<Stage> stages_;
-  bool geometric_first_ = false;         // the exact map's geometric stage before eq. 2's
-  bool reduce_ = false;                  // coarse levels match fewer points than the scan's
+  bool geometric_first_ = false;            // the exact map's geometric stage before eq. 2's
+  bool reduce_ = false;                     // coarse levels match fewer points than the scan's
   std::vector<Eigen::Vector3d> positions_;  // the scan's, when reduce_
   RadarScan coarse_scan_;
   const RadarScan* stage_scan_ = nullptr;  // the current stage's points

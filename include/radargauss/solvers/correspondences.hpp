@@ -39,8 +39,8 @@ std::vector<int> AssociateScan(const RadarScan& scan, const GaussianIndex& index
 // Associates every point at `pose` with the Gaussians of `level`
 // (smallest Mahalanobis^2 within the gate); RCS terms too when `with_rcs`
 // (and the scan has RCS).
-Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level,
-                                    const SE3d& pose, double gate, bool with_rcs);
+Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level, const SE3d& pose,
+                                    double gate, bool with_rcs);
 
 // Replaces the RCS terms of `correspondences` (made from `scan`) by those of
 // their geometric pairs, at the pose they were made at: what
@@ -69,8 +69,7 @@ bool CheckCorrespondences(const RadarScan& scan, const Correspondences& correspo
 // Whether two poses are bit for bit the same (the same association, the
 // same evaluated cost).
 inline bool SamePose(const SE3d& a, const SE3d& b) {
-  return a.translation() == b.translation() &&
-         a.rotation().quaternion().coeffs() == b.rotation().quaternion().coeffs();
+  return a.translation() == b.translation() && a.rotation().quaternion().coeffs() == b.rotation().quaternion().coeffs();
 }
 
 }  // namespace radargauss

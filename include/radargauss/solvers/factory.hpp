@@ -28,10 +28,10 @@ const std::vector<std::string>& ScanMatcherNames();        // every kind's name,
 // Everything a match is configured by: the solver and its options.
 struct MatchOptions {
   SolverKind solver = SolverKind::kGaussNewton;
-  ScanMatchingOptions matching;         // eq. 2, losses, association, stopping rules
-  GaussNewtonOptions gauss_newton;      // kGaussNewton, kGaussNewtonAutoDiff, kMultiHypothesis
-  CeresSolverOptions ceres;             // kCeres (kCeresDogleg sets dogleg)
-  MultiHypothesisOptions hypotheses;    // kMultiHypothesis
+  ScanMatchingOptions matching;       // eq. 2, losses, association, stopping rules
+  GaussNewtonOptions gauss_newton;    // kGaussNewton, kGaussNewtonAutoDiff, kMultiHypothesis
+  CeresSolverOptions ceres;           // kCeres (kCeresDogleg sets dogleg)
+  MultiHypothesisOptions hypotheses;  // kMultiHypothesis
 };
 
 // Throws std::invalid_argument for bad options.

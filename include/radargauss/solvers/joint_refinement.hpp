@@ -34,8 +34,8 @@ struct JointRefinementOptions {
 
 struct JointRefinementResult {
   std::vector<SE3d> poses;
-  GaussianMap map;                 // with the refined SH coefficients
-  double initial_cost = 0.0;       // Ceres cost before / after
+  GaussianMap map;            // with the refined SH coefficients
+  double initial_cost = 0.0;  // Ceres cost before / after
   double final_cost = 0.0;
   int iterations = 0;
   bool converged = false;
@@ -45,13 +45,12 @@ struct JointRefinementResult {
 
 // Throws std::invalid_argument for mismatched sizes or bad options, and
 // DataError when the map does not cover the scans (min_associated_share).
-JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans,
-                                    const std::vector<SE3d>& initial_poses, const GaussianMap& map,
-                                    const JointRefinementOptions& options);
+JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans, const std::vector<SE3d>& initial_poses,
+                                    const GaussianMap& map, const JointRefinementOptions& options);
 
 // RMS of the RCS residuals (normalised units) of the scans at `poses` against
 // `map`: the quality measure the refinement should lower.
-double RcsResidualRms(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
-                      const GaussianMap& map, double gate);
+double RcsResidualRms(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses, const GaussianMap& map,
+                      double gate);
 
 }  // namespace radargauss

@@ -26,8 +26,8 @@ enum class LoopRejection {
   kSwitchable,  // switchable constraints (Suenderhauf and Protzel 2012)
   kGraduated,   // graduated non-convexity to Geman-McClure of scale loop_loss.scale (Yang et al. 2020)
 };
-std::string ToString(LoopRejection rejection);                        // "loss", "switchable", "graduated"
-LoopRejection LoopRejectionFromString(const std::string& name);       // throws std::invalid_argument
+std::string ToString(LoopRejection rejection);                   // "loss", "switchable", "graduated"
+LoopRejection LoopRejectionFromString(const std::string& name);  // throws std::invalid_argument
 std::vector<std::string> LoopRejectionNames();
 
 // Where Levenberg-Marquardt starts.
@@ -39,7 +39,7 @@ enum class GraphInitialization {
   // every loop, so a false loop bends the start of any robust loss.
   kChordal,
 };
-std::string ToString(GraphInitialization initialization);                  // "current", "chordal"
+std::string ToString(GraphInitialization initialization);                    // "current", "chordal"
 GraphInitialization GraphInitializationFromString(const std::string& name);  // throws std::invalid_argument
 std::vector<std::string> GraphInitializationNames();
 
@@ -54,7 +54,7 @@ struct PoseGraphOptions {
   double graduation_factor = 1.4;  // kGraduated: mu's divisor per round
   GraphInitialization initialization = GraphInitialization::kCurrent;
   JacobianMode jacobians = JacobianMode::kAnalytic;
-  int max_iterations = 100;        // per solve
+  int max_iterations = 100;  // per solve
   int threads = 1;
 };
 
@@ -69,9 +69,9 @@ struct PoseGraphSummary {
 };
 
 struct PoseGraphEdge {
-  int from = 0;  // i
-  int to = 0;    // j
-  SE3d measured;  // Z_ij: frame i from frame j
+  int from = 0;                                                                            // i
+  int to = 0;                                                                              // j
+  SE3d measured;                                                                           // Z_ij: frame i from frame j
   Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Identity();  // W
   bool loop = false;
 };

@@ -26,13 +26,13 @@ namespace radargauss {
 
 // How the RCS term treats translation: the paper's rotation-only, or full.
 enum class RcsTranslation { kRotationOnly, kFull };
-std::string ToString(RcsTranslation mode);                                 // "rotation-only", "full"
-RcsTranslation RcsTranslationFromString(const std::string& name);          // throws std::invalid_argument
+std::string ToString(RcsTranslation mode);                         // "rotation-only", "full"
+RcsTranslation RcsTranslationFromString(const std::string& name);  // throws std::invalid_argument
 std::vector<std::string> RcsTranslationNames();
 // Which Jacobians a solver uses: closed form, or Jets through the functors.
 enum class JacobianMode { kAnalytic, kAutoDiff };
-std::string ToString(JacobianMode mode);                                   // "analytic", "autodiff"
-JacobianMode JacobianModeFromString(const std::string& name);              // throws std::invalid_argument
+std::string ToString(JacobianMode mode);                       // "analytic", "autodiff"
+JacobianMode JacobianModeFromString(const std::string& name);  // throws std::invalid_argument
 std::vector<std::string> JacobianModeNames();
 
 struct ScanMatchingOptions {
@@ -41,9 +41,9 @@ struct ScanMatchingOptions {
   LossConfig rcs_loss{LossType::kCauchy, 1.0};  // the paper: Cauchy
   RcsTranslation rcs_translation = RcsTranslation::kRotationOnly;
   JacobianMode jacobians = JacobianMode::kAnalytic;
-  double gate = 3.0;          // tau: association gate (Mahalanobis distance)
-  int max_iterations = 30;    // outer iterations (association + update) on the exact map
-  int coarse_iterations = 15; // outer iterations on each coarse level of the MatchingMap
+  double gate = 3.0;           // tau: association gate (Mahalanobis distance)
+  int max_iterations = 30;     // outer iterations (association + update) on the exact map
+  int coarse_iterations = 15;  // outer iterations on each coarse level of the MatchingMap
   // Coarse levels match the centroids of the scan's voxels of side
   // coarse_voxel_per_sigma * sigma_k (0: the points), then at most
   // coarse_points of them, evenly strided (0: all).
@@ -53,12 +53,12 @@ struct ScanMatchingOptions {
   // eq. 2 from there, so the RCS terms enter the last iterations only (the
   // same optimum); false: eq. 2 throughout.
   bool geometric_first = true;
-  bool reassociate = true;    // false: associate once at the initial pose
+  bool reassociate = true;  // false: associate once at the initial pose
   // Lazy re-association on the exact map: again only once the pose has moved
   // more than this since the last association (docs/design.md,
   // "Association"); 0 re-associates after every step.
-  double reassociation_translation = 0.01;  // m
-  double reassociation_rotation = 0.002;    // rad
+  double reassociation_translation = 0.01;     // m
+  double reassociation_rotation = 0.002;       // rad
   double translation_tolerance = 1e-3;         // m: stop when the update is smaller ...
   double rotation_tolerance = 1e-4;            // rad ... in both parts, on the exact map
   double coarse_translation_tolerance = 1e-2;  // m: the same on coarse levels, which
@@ -69,13 +69,13 @@ struct ScanMatchingOptions {
 void ValidateOptions(const ScanMatchingOptions& options);
 
 struct ScanMatchingResult {
-  SE3d pose;                // T_world_radar at the end
+  SE3d pose;  // T_world_radar at the end
   int iterations = 0;
   double final_cost = 0.0;  // f of eq. 2 at the final pose and association
   std::size_t n_geo = 0;
   std::size_t n_rcs = 0;
   bool converged = false;
-  std::string reason;       // why it did not converge; empty when it did
+  std::string reason;  // why it did not converge; empty when it did
   double time_ms = 0.0;
   // The Gauss-Newton matrix of eq. 2's f at the final pose and association,
   // over the solvers' tangent [dt (world); dphi (radar)] (conventions.hpp):

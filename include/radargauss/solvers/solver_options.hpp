@@ -29,13 +29,13 @@ enum class CeresBlocks {
   kShared,      // blocks of CeresScanProblem::kTermsPerBlock terms, each term's loss in its residual
   kSquareRoot,  // shared blocks, each handed to Ceres in its square-root form (default)
 };
-std::string ToString(CeresBlocks blocks);                     // "per-term", "shared", "square-root"
-CeresBlocks CeresBlocksFromString(const std::string& name);   // throws std::invalid_argument
+std::string ToString(CeresBlocks blocks);                    // "per-term", "shared", "square-root"
+CeresBlocks CeresBlocksFromString(const std::string& name);  // throws std::invalid_argument
 std::vector<std::string> CeresBlocksNames();
 
 // Ceres Levenberg-Marquardt or dogleg on the same residuals.
 struct CeresSolverOptions {
-  bool dogleg = false;           // Levenberg-Marquardt (default) or dogleg
+  bool dogleg = false;  // Levenberg-Marquardt (default) or dogleg
   // Iterations per solve (per association) in the stages that steer: few, as
   // the outer loop re-associates after each solve there.
   int max_inner_iterations = 2;
