@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/solvers/pose_graph_initialization.hpp"
 
-#include <Eigen/SVD>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -9,6 +8,7 @@
 #include <string>
 
 #include "radargauss/conventions.hpp"
+#include "radargauss/lie/nearest_rotation.hpp"
 
 namespace radargauss {
 
@@ -95,11 +95,7 @@ bool ChordalRotations(const std::vector<SE3d>& poses, const std::vector<PoseGrap
       rotations[k] = poses[k].rotation().Matrix();
       continue;
     }
-    const Eigen::Matrix3d M = X.middleRows<3>(3 * index[k]).transpose();
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-    D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
-    rotations[k] = svd.matrixU() * D * svd.matrixV().transpose();
+    rotations[k] = NearestRotation(X.middleRows<3>(3 * index[k]).transpose());
   }
   return true;
 }

@@ -10,10 +10,10 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/lie/nearest_rotation.hpp"
 #include "radargauss/names.hpp"
 
 namespace radargauss {
@@ -55,15 +55,12 @@ Eigen::Vector3d PrincipalSpread(const std::vector<Eigen::Vector3d>& points, Eige
   return solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
 }
 
-// The rotation closest to the mean of R_ref R_est^T over the pairs: the
+// The rotation nearest the mean of R_ref R_est^T over the pairs: the
 // alignment's rotation as the orientations give it (docs/design.md, "Evaluation").
 SO3d OrientationAlignment(const std::vector<SE3d>& est, const std::vector<SE3d>& ref) {
   Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
   for (std::size_t k = 0; k < est.size(); ++k) sum += (ref[k].rotation() * est[k].rotation().Inverse()).Matrix();
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d sign = Eigen::Matrix3d::Identity();
-  sign(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
-  return SO3d::FromMatrix(svd.matrixU() * sign * svd.matrixV().transpose());
+  return SO3d::FromMatrix(NearestRotation(sum));
 }
 
 // T_ref_est (and the scale) that the alignment applies to the estimate. The
