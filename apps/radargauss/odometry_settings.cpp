@@ -263,14 +263,9 @@ void AddPlaceRecognitionOptions(CLI::App* app, PlaceRecognitionSettings& s) {
       ->capture_default_str();
 }
 
-namespace {
-
-// The sequence as messages name it: its folder, or its bag and topic.
 std::string SequenceName(const SequenceOptions& sequence) {
   return sequence.bag.empty() ? sequence.sequence_dir : sequence.bag + " (topic " + sequence.topic + ")";
 }
-
-}  // namespace
 
 RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs) {
   SequenceOptions sequence_options = s.sequence;
@@ -299,10 +294,6 @@ RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs) {
   }
   return inputs;
 }
-
-}  // namespace radargauss::cli
-
-namespace radargauss::cli {
 
 StagedFolder RunFolder(const OdometrySettings& s, std::vector<std::string> outputs) {
   std::error_code error;

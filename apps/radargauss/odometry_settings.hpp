@@ -62,6 +62,9 @@ struct RunInputs {
 };
 RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs);
 
+// The sequence as messages name it: its folder, or its bag and topic.
+std::string SequenceName(const SequenceOptions& sequence);
+
 // The results folder --out of a run on the sequence: refused when it is the
 // sequence's own folder; `outputs` (the command's files) and the evaluation's
 // are never kept from an earlier run (StagedFolder).

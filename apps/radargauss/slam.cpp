@@ -55,7 +55,7 @@ int RunSlam(const SlamSettings& s) {
   try {
     if (!s.no_map) map = BuildPlaceMap(sequence.scans, slam);
   } catch (const DataError& e) {  // no static point in the whole run: known only now
-    throw DataError(std::string(e.what()) + " in " + s.odometry.sequence.sequence_dir + s.odometry.sequence.bag +
+    throw DataError(std::string(e.what()) + " in " + SequenceName(s.odometry.sequence) +
                     " (--no-map writes the trajectory without a map)");
   }
   const std::string out = folder.path();

@@ -10,7 +10,8 @@ namespace radargauss {
 MapCloud BuildMapCloud(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
                        const MapCloudOptions& options, MapCloudStats* stats) {
   if (poses.size() != scans.size()) {
-    throw DataError("building a map needs a ground truth (--gt) for every scan");
+    throw DataError("building a map needs one pose per scan: " + std::to_string(scans.size()) + " scans, " +
+                    std::to_string(poses.size()) + " poses");
   }
   const std::size_t n = scans.size();
   // Ego velocity per scan in parallel; results are per scan, so the merge
