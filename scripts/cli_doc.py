@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
 """docs/cli.md against the tool's --help: every block that follows a marker
-`<!-- help: SUBCOMMAND -->` must be that subcommand's --help output (the
+`<!-- help: SUBCOMMAND -->` must be that subcommand's --help-all output (the
 tool's path shown as `radargauss`), and every subcommand must have one.
   scripts/cli_doc.py TOOL DOC            check (exit 1 on a difference)
   scripts/cli_doc.py TOOL DOC --update   rewrite the blocks"""
@@ -13,7 +13,7 @@ MARKER = re.compile(r"<!-- help: ([\w-]*) -->\n```text\n(.*?)```\n", re.S)
 
 
 def help_text(tool, subcommand):
-    command = [tool] + ([subcommand] if subcommand != "radargauss" else []) + ["--help"]
+    command = [tool] + ([subcommand] if subcommand != "radargauss" else []) + ["--help-all"]
     output = subprocess.run(command, capture_output=True, text=True, check=True).stdout
     return output.replace(tool, "radargauss")
 
@@ -35,7 +35,7 @@ def main():
         name, block = match.group(1), match.group(2)
         current = help_text(tool, name)
         if current != block:
-            problems.append(f"{name}: {doc} differs from `radargauss {name} --help`")
+            problems.append(f"{name}: {doc} differs from `radargauss {name} --help-all`")
         return f"<!-- help: {name} -->\n```text\n{current}```\n"
 
     updated = MARKER.sub(replace, text)

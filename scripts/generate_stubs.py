@@ -1,15 +1,22 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
 """Writes the type stubs of radargauss._radargauss from the built module:
-the signatures pybind11 records, with **options expanded into the keywords
-of option_fields(). Run against the build tree's package:
+the signatures pybind11 records, with **options typed by one TypedDict per
+option table (option_fields(kind)), each holding what the table it extends
+lacks. Run against the build tree's package:
   PYTHONPATH=build/release/python scripts/generate_stubs.py > python/radargauss/_radargauss.pyi"""
 import re
 import sys
 
 import radargauss._radargauss as module
 
-OPTIONS_OF = {"match": "match", "RadarOdometry.__init__": "odometry"}
+# The options of each function, and the option tables as TypedDicts, each
+# extending the one whose keywords it holds too.
+OPTIONS_OF = {"match": "MatchOptions", "match_options": "MatchOptions", "RadarOdometry.__init__": "OdometryOptions",
+              "odometry_options": "OdometryOptions", "RadarSlam.__init__": "SlamOptions", "slam_options": "SlamOptions",
+              "Relocalizer.__init__": "RelocalizationOptions", "relocalization_options": "RelocalizationOptions"}
+TABLES = [("MatchOptions", "match", None), ("OdometryOptions", "odometry", "MatchOptions"),
+          ("SlamOptions", "slam", "OdometryOptions"), ("RelocalizationOptions", "relocalization", "OdometryOptions")]
 PY_TYPES = {"float": "float", "int": "int", "bool": "bool", "list of float": "list[float]",
             "sequence of 3 float": "Sequence[float]", "array (4, 4) or (7,)": "ArrayLike"}
 
@@ -23,14 +30,21 @@ def clean(signature):
     return signature
 
 
-def keywords(kind):
-    """The keyword-only parameters of an options table."""
-    out = []
-    for field in module.option_fields(kind):
-        kind_of = "str" if field["type"].startswith("{") else PY_TYPES[field["type"]]
-        default = "..." if field["type"].startswith("array") else repr(field["default"])
-        out.append(f"{field['keyword']}: {kind_of} = {default}")
-    return out
+def typed_dicts():
+    """A TypedDict per option table: its keywords the extended one lacks, each with its default."""
+    out, keywords_of = [], {}
+    for name, kind, base in TABLES:
+        fields = module.option_fields(kind)
+        keywords_of[name] = {field["keyword"] for field in fields}
+        lines = [f"class {name}({base or 'TypedDict'}, total=False):\n", f'    """option_fields("{kind}")"""\n']
+        for field in fields:
+            if base and field["keyword"] in keywords_of[base]:
+                continue
+            kind_of = "str" if field["type"].startswith("{") else PY_TYPES[field["type"]]
+            default = "identity" if field["type"].startswith("array") else repr(field["default"])
+            lines.append(f"    {field['keyword']}: {kind_of}  # {default}\n")
+        out.append("".join(lines) + "\n")
+    return "".join(out)
 
 
 def summary(doc):
@@ -44,9 +58,8 @@ def function_stub(qualified, function, indent):
     signature = clean(first)
     if not signature.startswith(function.__name__ + "("):
         return ""  # no signature of its own (object's __init__)
-    if qualified in OPTIONS_OF:  # one keyword per line
-        separator = ",\n" + indent + "    "
-        signature = signature.replace("**kwargs", "*" + separator + separator.join(keywords(OPTIONS_OF[qualified])))
+    if qualified in OPTIONS_OF:
+        signature = signature.replace("**kwargs", f"**options: Unpack[{OPTIONS_OF[qualified]}]")
     stub = f"{indent}def {signature}:\n"
     text = summary(doc)
     return stub + (f'{indent}    """{text}"""\n' if text else f"{indent}    ...\n")
@@ -67,7 +80,8 @@ def class_stub(name, cls):
 def main():
     parts = ["# SPDX-License-Identifier: BSD-3-Clause\n",
              "# Type stubs of radargauss._radargauss, written by scripts/generate_stubs.py.\n",
-             "from typing import Any, Sequence\n\nimport numpy\nfrom numpy.typing import ArrayLike\n\n"]
+             "from typing import Any, Sequence, TypedDict, Unpack\n\nimport numpy\nfrom numpy.typing import ArrayLike\n\n",
+             typed_dicts()]
     for name, value in sorted(vars(module).items()):
         if name.startswith("_"):
             continue

@@ -36,7 +36,54 @@ const std::vector<std::string>& ScanMatcherNames() {
   return names;
 }
 
+const OptionTable<MatchOptions>& MatchOptionTable() {
+  using O = MatchOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {RADARGAUSS_CHOICE(O, "solver", solver, ScanMatcherNames(), SolverKindFromString)
+                            .Sensor()
+                            .Help("gn (own Gauss-Newton), gn-autodiff, ceres, ceres-dogleg, mh-gn")};
+    AppendNested(t, ScanMatchingOptionTable(), +[](O& o) -> auto& { return o.matching; }, "matching");
+    for (Option<O> option : OptionTable<O>{
+             RADARGAUSS_OPTION(O, "gn_max_step_halvings", gauss_newton.max_step_halvings)
+                 .In(0, 64)
+                 .Help("Gauss-Newton: halvings of a step that raises eq. 2 (0: plain steps)"),
+             RADARGAUSS_OPTION(O, "gn_loss_curvature", gauss_newton.loss_curvature)
+                 .Help("Gauss-Newton: the losses' curvature in the Hessian (else IRLS)"),
+             RADARGAUSS_OPTION(O, "ceres_dogleg", ceres.dogleg).Help("Ceres: dogleg instead of Levenberg-Marquardt"),
+             RADARGAUSS_OPTION(O, "ceres_max_inner_iterations", ceres.max_inner_iterations)
+                 .AtLeast(1)
+                 .Help("Ceres: iterations per solve in the stages that steer"),
+             RADARGAUSS_OPTION(O, "ceres_max_exact_inner_iterations", ceres.max_exact_inner_iterations)
+                 .AtLeast(1)
+                 .Help("Ceres: iterations per solve in the last stage"),
+             RADARGAUSS_CHOICE(O, "ceres_blocks", ceres.blocks, CeresBlocksNames(), CeresBlocksFromString)
+                 .Help("Ceres: how analytic terms enter the problem"),
+             RADARGAUSS_OPTION(O, "ceres_threads", ceres.threads).In(1, 1024).Help("Ceres: threads"),
+             RADARGAUSS_OPTION(O, "ceres_function_tolerance", ceres.function_tolerance).Above(0.0).Help(
+                 "Ceres: per solve"),
+             RADARGAUSS_OPTION(O, "ceres_gradient_tolerance", ceres.gradient_tolerance).Above(0.0).Help(
+                 "Ceres: per solve"),
+             RADARGAUSS_OPTION(O, "ceres_parameter_tolerance", ceres.parameter_tolerance).Above(0.0).Help(
+                 "Ceres: per solve"),
+             RADARGAUSS_OPTION(O, "mh_starts", hypotheses.starts).In(1, 13).Help("multi-hypothesis: starts"),
+             RADARGAUSS_OPTION(O, "mh_xy_offset", hypotheses.xy_offset)
+                 .AtLeast(0.0)
+                 .Unit("m")
+                 .Help("multi-hypothesis: x/y offset of the starts"),
+             RADARGAUSS_OPTION(O, "mh_yaw_offset", hypotheses.yaw_offset)
+                 .AtLeast(0.0)
+                 .Unit("rad")
+                 .Help("multi-hypothesis: yaw offset of the starts"),
+         }) {
+      t.push_back(std::move(option));
+    }
+    return t;
+  }();
+  return table;
+}
+
 std::unique_ptr<ScanMatcher> MakeScanMatcher(const MatchOptions& options) {
+  CheckOptions(MatchOptionTable(), options);
   ScanMatchingOptions matching = options.matching;
   CeresSolverOptions ceres = options.ceres;
   switch (options.solver) {

@@ -105,19 +105,33 @@ ceres::Solver::Options SolverOptions(const PoseGraphOptions& options) {
   return solver_options;
 }
 
-void Validate(const PoseGraphOptions& options) {
-  if (options.max_iterations < 1) throw std::invalid_argument("pose graph: max_iterations must be >= 1");
-  if (options.threads < 1) throw std::invalid_argument("pose graph: threads must be >= 1");
-  if (!(options.switch_prior_std > 0.0)) throw std::invalid_argument("pose graph: switch_prior_std must be > 0");
-  if (!(options.loop_loss.scale > 0.0)) throw std::invalid_argument("pose graph: loop loss scale must be > 0");
-  if (!(options.graduation_factor > 1.0)) throw std::invalid_argument("pose graph: graduation_factor must be > 1");
-}
 
 bool Finite(const SE3d& pose) {
   return pose.translation().allFinite() && pose.rotation().quaternion().coeffs().allFinite();
 }
 
 }  // namespace
+
+const OptionTable<PoseGraphOptions>& PoseGraphOptionTable() {
+  using O = PoseGraphOptions;
+  static const OptionTable<O> table = {
+      RADARGAUSS_CHOICE(O, "loop_rejection", loop_rejection, LoopRejectionNames(), LoopRejectionFromString)
+          .Help("loop edges: loss, switchable or graduated"),
+      RADARGAUSS_CHOICE(O, "loop_loss", loop_loss.type, LossNames(), LossTypeFromString)
+          .Help("loss of the loop edges (loop rejection 'loss'; graduated: its scale)"),
+      RADARGAUSS_OPTION(O, "loop_loss_scale", loop_loss.scale).Above(0.0).Help("scale of the loop loss"),
+      RADARGAUSS_OPTION(O, "switch_prior_std", switch_prior_std).Above(0.0).Help("switchable: std of a switch's prior"),
+      RADARGAUSS_OPTION(O, "graduation_factor", graduation_factor).Above(1.0).Help("graduated: mu's divisor per round"),
+      RADARGAUSS_CHOICE(O, "graph_initialization", initialization, GraphInitializationNames(),
+                        GraphInitializationFromString)
+          .Help("where each solve starts: current (the last optimum and the odometry) or chordal (trusting every loop)"),
+      RADARGAUSS_CHOICE(O, "graph_jacobians", jacobians, JacobianModeNames(), JacobianModeFromString)
+          .Help("pose graph: closed-form Jacobians or Jets"),
+      RADARGAUSS_OPTION(O, "graph_max_iterations", max_iterations).AtLeast(1).Help("pose graph: iterations per solve"),
+      RADARGAUSS_OPTION(O, "graph_threads", threads).In(1, 1024).Help("pose graph: Ceres's threads"),
+  };
+  return table;
+}
 
 int PoseGraph::AddKeyframe(const SE3d& pose) {
   if (!Finite(pose)) {
@@ -247,7 +261,7 @@ void PoseGraph::Graduate(Problem& graph, const PoseGraphOptions& options, PoseGr
 }
 
 PoseGraphSummary PoseGraph::Optimize(const PoseGraphOptions& options) {
-  Validate(options);
+  CheckOptions(PoseGraphOptionTable(), options);
   const auto start = std::chrono::steady_clock::now();
   PoseGraphSummary summary;
   if (poses_.empty()) {

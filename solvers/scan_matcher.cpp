@@ -27,21 +27,55 @@ std::string ToString(JacobianMode mode) { return NameOf(kJacobianNames, mode); }
 JacobianMode JacobianModeFromString(const std::string& name) { return ValueNamed(kJacobianNames, name, "Jacobians"); }
 std::vector<std::string> JacobianModeNames() { return NamesOf(kJacobianNames); }
 
-void ValidateOptions(const ScanMatchingOptions& o) {
-  const auto require = [](bool ok, const char* what) {
-    if (!ok) throw std::invalid_argument(what);
+const OptionTable<ScanMatchingOptions>& ScanMatchingOptionTable() {
+  using O = ScanMatchingOptions;
+  static const OptionTable<O> table = {
+      RADARGAUSS_OPTION(O, "w_rcs", w_rcs).In(0.0, 1.0).Sensor().Help("eq. 2's RCS weight w"),
+      RADARGAUSS_CHOICE(O, "loss", geometric_loss.type, LossNames(), LossTypeFromString)
+          .Sensor()
+          .Help("robust loss of the geometric term"),
+      RADARGAUSS_OPTION(O, "loss_scale", geometric_loss.scale).Above(0.0).Help("its scale a"),
+      RADARGAUSS_CHOICE(O, "rcs_loss", rcs_loss.type, LossNames(), LossTypeFromString)
+          .Help("robust loss of the RCS term (the paper: cauchy)"),
+      RADARGAUSS_OPTION(O, "rcs_loss_scale", rcs_loss.scale).Above(0.0).Unit("dB").Help("its scale a"),
+      RADARGAUSS_CHOICE(O, "rcs_translation", rcs_translation, RcsTranslationNames(), RcsTranslationFromString)
+          .Help("the RCS term on the rotation alone (the paper) or on the full pose"),
+      RADARGAUSS_CHOICE(O, "jacobians", jacobians, JacobianModeNames(), JacobianModeFromString)
+          .Help("closed-form Jacobians or Jets through the Ceres functors"),
+      RADARGAUSS_OPTION(O, "gate", gate).Above(0.0).Help("association gate tau (Mahalanobis distance)"),
+      RADARGAUSS_OPTION(O, "max_iterations", max_iterations).AtLeast(1).Help("outer iterations on the exact map"),
+      RADARGAUSS_OPTION(O, "coarse_iterations", coarse_iterations).AtLeast(1).Help("outer iterations per coarse level"),
+      RADARGAUSS_OPTION(O, "coarse_voxel_per_sigma", coarse_voxel_per_sigma)
+          .AtLeast(0.0)
+          .Help("coarse levels match voxel centroids of this many sigma_k (0: the points)"),
+      RADARGAUSS_OPTION(O, "coarse_points", coarse_points).Help("at most this many points per coarse level (0: all)"),
+      RADARGAUSS_OPTION(O, "geometric_first", geometric_first)
+          .Help("with 0 < w < 1, the geometric term alone first on the exact map"),
+      RADARGAUSS_OPTION(O, "reassociate", reassociate).Help("false: associate once at the initial pose"),
+      RADARGAUSS_OPTION(O, "reassociation_translation", reassociation_translation)
+          .AtLeast(0.0)
+          .Unit("m")
+          .Help("re-associate on the exact map once the pose moved this far"),
+      RADARGAUSS_OPTION(O, "reassociation_rotation", reassociation_rotation).AtLeast(0.0).Unit("rad").Help(
+          "or turned this far"),
+      RADARGAUSS_OPTION(O, "translation_tolerance", translation_tolerance)
+          .Above(0.0)
+          .Unit("m")
+          .Help("converged when a step on the exact map is smaller"),
+      RADARGAUSS_OPTION(O, "rotation_tolerance", rotation_tolerance).Above(0.0).Unit("rad").Help(
+          "and its rotation smaller"),
+      RADARGAUSS_OPTION(O, "coarse_translation_tolerance", coarse_translation_tolerance)
+          .Above(0.0)
+          .Unit("m")
+          .Help("the same on coarse levels"),
+      RADARGAUSS_OPTION(O, "coarse_rotation_tolerance", coarse_rotation_tolerance)
+          .Above(0.0)
+          .Unit("rad")
+          .Help("the same on coarse levels"),
   };
-  require(o.w_rcs >= 0.0 && o.w_rcs <= 1.0, "w_rcs must be in [0, 1]");
-  require(o.geometric_loss.scale > 0.0 && o.rcs_loss.scale > 0.0, "loss scales must be > 0");
-  require(o.gate > 0.0, "association gate must be > 0");
-  require(o.max_iterations >= 1 && o.coarse_iterations >= 1, "iteration limits must be >= 1");
-  require(o.coarse_voxel_per_sigma >= 0.0 && std::isfinite(o.coarse_voxel_per_sigma),
-          "coarse voxel per sigma must be >= 0 and finite");
-  require(o.translation_tolerance > 0.0 && o.rotation_tolerance > 0.0 && o.coarse_translation_tolerance > 0.0 &&
-              o.coarse_rotation_tolerance > 0.0,
-          "tolerances must be > 0");
-  require(o.reassociation_translation >= 0.0 && o.reassociation_rotation >= 0.0,
-          "re-association thresholds must be >= 0");
+  return table;
 }
+
+void ValidateOptions(const ScanMatchingOptions& o) { CheckOptions(ScanMatchingOptionTable(), o); }
 
 }  // namespace radargauss

@@ -12,6 +12,42 @@
 
 namespace radargauss {
 
+const OptionTable<EgoVelocityOptions>& EgoVelocityOptionTable() {
+  using O = EgoVelocityOptions;
+  static const OptionTable<O> table = {
+      RADARGAUSS_OPTION(O, "ego_min_range", min_range).AtLeast(0.0).Unit("m").Help("Doppler filter's range gate"),
+      RADARGAUSS_OPTION(O, "ego_max_range", max_range)
+          .Above(0.0)
+          .Unit("m")
+          .NotBelow("ego_min_range")
+          .Help("and its far end"),
+      RADARGAUSS_OPTION(O, "ego_outlier_probability", outlier_probability)
+          .In(0.0, 0.9)
+          .Help("RANSAC: expected outlier share"),
+      RADARGAUSS_OPTION(O, "ego_success_probability", success_probability)
+          .In(0.5, 0.999999)
+          .Help("RANSAC: wanted chance of one clean draw"),
+      RADARGAUSS_OPTION(O, "ego_inlier_threshold", inlier_threshold)
+          .Above(0.0)
+          .Unit("m/s")
+          .Help("|v_d - H v| of an inlier"),
+      RADARGAUSS_OPTION(O, "ego_zero_velocity_threshold", zero_velocity_threshold)
+          .AtLeast(0.0)
+          .Unit("m/s")
+          .Help("75th percentile of |v_d| below it: standing"),
+      RADARGAUSS_OPTION(O, "ego_zero_velocity_sigma", zero_velocity_sigma)
+          .Above(0.0)
+          .Unit("m/s")
+          .Help("velocity std when standing"),
+      RADARGAUSS_OPTION(O, "seed", seed).Help("seed of the Doppler RANSAC"),
+      RADARGAUSS_OPTION(O, "ego_consensus_voxel", consensus_voxel)
+          .AtLeast(0.0)
+          .Unit("m")
+          .Help("support counted in voxels of this edge (0: points)"),
+  };
+  return table;
+}
+
 int RansacIterations(double outlier_probability, double success_probability) {
   const double clean_draw = std::pow(1.0 - outlier_probability, 3);
   if (clean_draw >= 1.0) return 1;  // no outliers expected: one draw suffices

@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
 """Documented ranges are the accepted ones (docs/design.md, "Bounds on
-input"): every numeric flag whose `--help` states a range, in every
+input"): every numeric flag whose `--help-all` states a range, in every
 subcommand that runs on a sequence, is tried at each end of that range (a
 closed end is accepted and the run ends, or is refused for what the value
 means on the data in one line naming the flag, within a time and memory bound),
 just outside it (refused in one line naming the flag), and, for an open
 end, at the end itself (refused) and just inside it (accepted or refused in
-one line naming the flag, never a crash, a hang or memory exhaustion).
+one line naming the flag, never a crash, a hang or memory exhaustion). A
+flag documented as "at least --other" is tried with --other at the same
+value.
 
     option_ranges_test.py <path to radargauss>
 """
@@ -38,14 +40,19 @@ def run(command, sanitized):
 
 
 def ranges(tool, command):
-    """(flag, type, low, high, low_closed, high_closed, values) of every ranged numeric flag."""
-    text = subprocess.run([tool, command, "--help"], capture_output=True, text=True, check=True).stdout
+    """(flag, type, low, high, low_closed, high_closed, values, companion) of every ranged numeric flag;
+    companion: the flag it may not fall below, or None."""
+    text = subprocess.run([tool, command, "--help-all"], capture_output=True, text=True, check=True).stdout
+    lines = text.splitlines()
     found = []
-    for line in text.splitlines():
+    for k, line in enumerate(lines):
         match = RANGE.match(line)
         if match:
             flag, kind, left, low, high, right, count = match.groups()
-            found.append((flag, kind, float(low), float(high), left == "[", right == "]", int(count or 1)))
+            described = " ".join(lines[k:k + 2])
+            companion = re.search(r"at least (--[a-z0-9-]+)", described)
+            found.append((flag, kind, float(low), float(high), left == "[", right == "]", int(count or 1),
+                          companion.group(1) if companion else None))
     return found
 
 
@@ -93,9 +100,10 @@ def main():
     }
     passed, failures = 0, []
 
-    def expect(command, flag, value, accepted, count):
+    def expect(command, flag, value, accepted, count, companion=None):
         nonlocal passed
-        status, error = run([tool, command] + commands[command] + [flag] + [text(value)] * count, sanitized)
+        extra = [companion, text(value)] if companion else []
+        status, error = run([tool, command] + commands[command] + [flag] + [text(value)] * count + extra, sanitized)
         lines = [line for line in error.splitlines() if line and not line.startswith("Run with --help")]
         one_line = len(lines) <= 1
         crashed = status is None or status < 0 or status > 125 or "out of memory" in error or "bad_alloc" in error
@@ -113,16 +121,17 @@ def main():
                                                                    error.replace("\n", " | ")[:300]))
 
     for command in commands:
-        for flag, kind, low, high, low_closed, high_closed, count in ranges(tool, command):
+        for flag, kind, low, high, low_closed, high_closed, count, companion in ranges(tool, command):
             for end, closed, direction in ((low, low_closed, -1), (high, high_closed, +1)):
                 if math.isinf(end):
                     continue
+                pair = companion if direction < 0 else None
                 if closed:
-                    expect(command, flag, int(end) if kind != "FLOAT" else end, True, count)
-                    expect(command, flag, outside(end, kind, direction), False, count)
+                    expect(command, flag, int(end) if kind != "FLOAT" else end, True, count, pair)
+                    expect(command, flag, outside(end, kind, direction), False, count, pair)
                 else:
-                    expect(command, flag, int(end) if kind != "FLOAT" else end, False, count)
-                    expect(command, flag, inside(end, kind, -direction), None, count)
+                    expect(command, flag, int(end) if kind != "FLOAT" else end, False, count, pair)
+                    expect(command, flag, inside(end, kind, -direction), None, count, pair)
     for failure in failures:
         print("FAIL:", failure)
     print("option ranges: %d passed, %d failed" % (passed, len(failures)))

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "option_flags.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/read_file.hpp"
 #include "yaml_config.hpp"
@@ -40,10 +41,25 @@ std::string ConfigPath(int argc, char** argv) {
   return {};
 }
 
+// --help-all is --help with every option group shown (option_flags.hpp).
+std::vector<char*> HelpAllAsHelp(int argc, char** argv) {
+  static char help[] = "--help";
+  std::vector<char*> args(argv, argv + argc);
+  for (char*& arg : args) {
+    if (std::string(arg) == "--help-all") {
+      radargauss::cli::ShowEveryOption(true);
+      arg = help;
+    }
+  }
+  return args;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace radargauss::cli;
+  std::vector<char*> args = HelpAllAsHelp(argc, argv);
+  argv = args.data();
   CLI::App app{"radargauss: 4D radar Gaussian-RCS maps and scan matching"};
   app.require_subcommand(1);
   const std::vector<Subcommand> subcommands = {AddInfo(app),     AddSimulate(app),   AddBuildMap(app), AddMapInfo(app),

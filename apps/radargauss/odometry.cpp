@@ -28,7 +28,7 @@ void PrintSummary(const OdometrySummary& summary) {
 }
 
 int RunOdometry(const OdometrySettings& s) {
-  const OdometryOptions options = Resolved(s);
+  const OdometryOptions& options = s.odometry;
   ValidateOptions(options);
   ImuRotation(s.imu_rotation);
   RunInputs inputs = LoadRunInputs(s, options.match.matching.w_rcs);

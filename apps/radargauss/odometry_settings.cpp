@@ -18,61 +18,6 @@
 
 namespace radargauss::cli {
 
-namespace {
-
-// The local map's flags (docs/design.md, "Odometry").
-void AddLocalMapOptions(CLI::App* app, OdometrySettings& s) {
-  OdometryOptions& o = s.odometry;
-  app->add_option("--active-radius", o.map.active_radius, "Radius of the active map around the radar (m)")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--azimuth-std", o.map.azimuth_std_deg,
-                  "Radar's azimuth noise (deg): map Gaussians at least this angle x range wide")
-      ->check(InRange(0.0, kMaxAngularNoiseDeg))
-      ->capture_default_str();
-  app->add_option("--elevation-std", o.map.elevation_std_deg,
-                  "Radar's elevation noise (deg): map Gaussians at least this angle x range high")
-      ->check(InRange(0.0, kMaxAngularNoiseDeg))
-      ->capture_default_str();
-  app->add_option("--region", o.map.region, "Edge of the map regions fitted together (m)")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--region-capacity", o.map.region_capacity,
-                  "Points a region keeps (the newest); at least the points a region's first fit needs")
-      ->check(InRange(o.map.min_points, std::size_t(1000000)))
-      ->capture_default_str();
-  app->add_option("--map-estimator", s.map_estimator,
-                  "How region Gaussians follow their points: refit (k-means + EM) or incremental")
-      ->check(CLI::IsMember(MapEstimatorNames()))
-      ->capture_default_str();
-  app->add_option("--republish-kl", o.map.republish_kl,
-                  "Incremental map: KL (nats) a Gaussian moves before the matching map gets it again")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app->add_option("--refit-growth", o.map.refit_growth, "Refit a region once its new points reach this share")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--points-per-gaussian", o.map.gaussians.points_per_gaussian, "K = round(N_downsampled / this)")
-      ->check(InRange(1.0, 1e6))
-      ->capture_default_str();
-  app->add_option("--min-std", o.map.gaussians.min_std, "Minimum principal std of a Gaussian (m)")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--coarse-levels", s.coarse_levels, "Coarse levels: merged or inflated")
-      ->check(CLI::IsMember(CoarseLevelsNames()))
-      ->capture_default_str();
-  app->add_option("--coarse-sigmas", o.map.matching.inflation,
-                  "Blur sigma_k of the coarse levels (m), coarse first; 0: the exact map alone")
-      ->expected(1, 8)
-      ->check(InRange(0.0, kMaxCoarseSigma))
-      ->capture_default_str();
-  app->add_option("--index-cell", o.map.matching.index_cell, "Cell of the active map's spatial index (m)")
-      ->check(InRange(kMinIndexCell, kMaxIndexCell))
-      ->capture_default_str();
-}
-
-}  // namespace
-
 // The matcher of a map version: the Gaussian solvers, or a PCL peer over the
 // active map's points (RadarOdometry makes one per map version).
 MatcherFactory MatcherOf(const std::string& matcher) {
@@ -89,19 +34,6 @@ MatcherFactory MatcherOf(const std::string& matcher) {
 #else
   throw DataError("--matcher " + matcher + " needs radargauss built with RADARGAUSS_WITH_PCL");
 #endif
-}
-
-OdometryOptions Resolved(const OdometrySettings& s) {
-  OdometryOptions o = s.odometry;
-  o.match.solver = SolverKindFromString(s.solver);
-  o.match.matching.geometric_loss.type = LossTypeFromString(s.loss);
-  o.map.rcs.incidence = IncidenceModelFromString(s.incidence);
-  o.map.matching.coarse = CoarseLevelsFromString(s.coarse_levels);
-  o.map.estimator = MapEstimatorFromString(s.map_estimator);
-  o.rotation_rate_std_deg = Eigen::Vector3d(s.rotation_rate_std[0], s.rotation_rate_std[1], s.rotation_rate_std[2]);
-  o.mounting_deg = Eigen::Vector3d(s.mounting[0], s.mounting[1], s.mounting[2]);
-  if (o.map.matching.inflation == std::vector<double>{0.0}) o.map.matching.inflation.clear();  // the exact map alone
-  return o;
 }
 
 // R_radar_imu from --imu-rotation, checked whether or not an IMU is read.
@@ -154,70 +86,16 @@ void CheckReferenceCovers(const Trajectory& reference, const Sequence& sequence,
 }
 
 void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
-  OdometryOptions& o = s.odometry;
-  app->add_option("--solver", s.solver, "Scan matcher: gn (own Gauss-Newton), gn-autodiff, ceres, ceres-dogleg, mh-gn")
-      ->check(CLI::IsMember(ScanMatcherNames()))
-      ->capture_default_str();
   app->add_option("--matcher", s.matcher,
                   "gaussians (the Gaussian-RCS map and --solver), or pcl-ndt / pcl-gicp on the active map's points "
                   "(no w_rcs, no velocity term; needs PCL)")
       ->check(CLI::IsMember({"gaussians", "pcl-ndt", "pcl-gicp"}))
       ->capture_default_str();
-  app->add_option("--w-rcs", o.match.matching.w_rcs, "Weight w_rcs of eq. 2 (0..1)")
-      ->check(InRange(0.0, 1.0))
-      ->capture_default_str();
-  app->add_option("--loss", s.loss, "Geometric robust loss")->check(CLI::IsMember(LossNames()))->capture_default_str();
-  app->add_option("--loss-scale", o.match.matching.geometric_loss.scale, "Scale of the geometric loss")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--incidence", s.incidence, "Incidence vector of the RCS models: offset or view")
-      ->check(CLI::IsMember(IncidenceModelNames()))
-      ->capture_default_str();
-  app->add_option("--degree", o.map.rcs.max_degree, "SH degree of the RCS models (0..3)")
-      ->check(InRange(0, kMaxShDegree))
-      ->capture_default_str();
-  app->add_option("--velocity-weight", o.velocity_weight, "Weight of the Doppler velocity term (0: off)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  app->add_option("--velocity-floor", o.velocity_floor, "Std of the velocity term's floor Q (m)")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--velocity-vertical-floor", o.velocity_vertical_floor,
-                  "Its floor along the radar's z (m; 0: --velocity-floor); larger leaves the vertical to the map")
-      ->check(NonNegative())
-      ->capture_default_str();
-  app->add_option("--rotation-weight", o.rotation_weight, "Weight of the rotation term (0: off)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  app->add_option("--mounting", s.mounting,
-                  "The radar on the vehicle: roll pitch yaw (deg; positive pitch looks down; odometry prints an "
-                  "estimate)")
-      ->expected(3)
-      ->check(InRange(-45.0, 45.0))
-      ->capture_default_str();
-  app->add_flag("--estimate-elevation-bias", o.elevation_bias.estimate,
-                "Estimate the elevation bias (beyond --elevation-bias) from the Doppler velocity (needs --mounting)");
-  app->add_option("--rotation-rate-std", s.rotation_rate_std,
-                  "Rotation term: change of the rate between scans about x y z (roll pitch yaw, deg/s)")
-      ->expected(3)
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--gate-sigmas", o.gate_sigmas, "Doppler gate around the predicted velocity (sigmas)")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--acceleration-std", o.acceleration_std, "Process noise of the velocity (m/s^2)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  app->add_option("--min-gate", o.min_gate, "Smallest Doppler gate (m/s)")->check(Positive())->capture_default_str();
-  app->add_option("--keyframe-distance", o.keyframe_distance, "A scan enters the map after this distance (m) ...")
-      ->check(NonNegative())
-      ->capture_default_str();
-  app->add_option("--keyframe-angle", o.keyframe_angle_deg, "... or this rotation (deg) since the last keyframe")
-      ->check(NonNegative())
-      ->capture_default_str();
-  AddLocalMapOptions(app, s);
-  app->add_option("--seed", o.ego_velocity.seed, "Seed of the Doppler RANSAC")->capture_default_str();
-  CLI::Option* imu_topic =
+  AddTableOptions(app, OdometryOptionTable(), s.odometry);
+  AddRunOptions(app, s);
+}
+
+void AddRunOptions(CLI::App* app, OdometrySettings& s) {  CLI::Option* imu_topic =
       app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
   // The IMU's settings without its topic would be read by nothing: refused.
   app->add_option("--imu-stamps", s.imu_stamps, "Stamp the IMU by its header or by the bag's record time")
@@ -230,36 +108,6 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
       ->capture_default_str();
   app->add_option("--first-scan", s.first_scan, "Skip the scans before this one (0: none)")->capture_default_str();
   app->add_option("--max-scans", s.max_scans, "Only the first N scans from --first-scan (0: all)")
-      ->capture_default_str();
-}
-
-PlaceRecognitionOptions PlaceRecognitionSettings::Resolved() const {
-  PlaceRecognitionOptions o = options;
-  o.descriptor = PlaceDescriptorKindFromString(descriptor);
-  o.scan_context.channel = channel == "geometric" ? ScanContextChannel::kGeometric
-                           : channel == "rcs"     ? ScanContextChannel::kRcs
-                                                  : ScanContextChannel::kBoth;
-  return o;
-}
-
-void AddPlaceRecognitionOptions(CLI::App* app, PlaceRecognitionSettings& s) {
-  PlaceRecognitionOptions& o = s.options;
-  app->add_option("--descriptor", s.descriptor, "Place descriptor: scan-context or radon")
-      ->check(CLI::IsMember(PlaceDescriptorKindNames()))
-      ->capture_default_str();
-  app->add_option("--channel", s.channel, "Scan Context channels: geometric, rcs or both")
-      ->check(CLI::IsMember({"geometric", "rcs", "both"}))
-      ->capture_default_str();
-  app->add_option("--candidates", o.candidates, "Places compared per submap (nearest keys)")
-      ->check(InRange(1, 100000))
-      ->capture_default_str();
-  app->add_option("--max-scan-context-distance", o.max_scan_context_distance,
-                  "Places farther by Scan Context are not verified")
-      ->check(InRange(0.0, 1.0))
-      ->capture_default_str();
-  app->add_option("--max-radon-distance", o.max_radon_distance,
-                  "Places farther by the Radon descriptor are not verified")
-      ->check(InRange(0.0, 1.0))
       ->capture_default_str();
 }
 

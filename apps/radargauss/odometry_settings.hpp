@@ -10,31 +10,22 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "option_flags.hpp"
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/progress.hpp"
-#include "radargauss/slam/place_recognition.hpp"
 #include "radargauss/trajectory.hpp"
 
 namespace radargauss::cli {
-
-inline std::vector<double> ToVector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 struct OdometrySettings {
   SequenceOptions sequence;  // ground_truth: the reference, for evaluation only
   OdometryOptions odometry;
   std::string out;
-  std::string solver = "gn";
-  std::string loss = "trivial";
-  std::string incidence = "offset";
-  std::string coarse_levels = ToString(MatchingMapOptions().coarse);
-  std::string map_estimator = ToString(LocalMapOptions().estimator);
   std::string imu_topic;
   std::string imu_stamps = "header";
-  std::vector<double> imu_rotation = {0, 0, 0, 1};                                            // q_radar_imu (x y z w)
-  std::vector<double> rotation_rate_std = ToVector(OdometryOptions().rotation_rate_std_deg);  // deg/s
-  std::vector<double> mounting = ToVector(OdometryOptions().mounting_deg);                    // roll pitch yaw, deg
+  std::vector<double> imu_rotation = {0, 0, 0, 1};  // q_radar_imu (x y z w)
   std::size_t first_scan = 0;
   std::size_t max_scans = 0;
   std::string matcher = "gaussians";  // or a PCL peer
@@ -42,7 +33,6 @@ struct OdometrySettings {
 
 // The matcher of a map version: the Gaussian solvers, or a PCL peer.
 MatcherFactory MatcherOf(const std::string& matcher);
-OdometryOptions Resolved(const OdometrySettings& s);
 // R_radar_imu from --imu-rotation, checked whether or not an IMU is read.
 Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw);
 // The bag's gyro rates turned into the radar frame by q_radar_imu.
@@ -86,16 +76,10 @@ void RegisterScans(const Sequence& sequence, const char* stage, RegisterScan&& r
   bar.Update(stage, sequence.scans.size(), sequence.scans.size());
   bar.Finish();
 }
-// Every flag of OdometrySettings.
+// Every flag of OdometrySettings: the odometry's from its option table.
 void AddOdometryOptions(CLI::App* app, OdometrySettings& s);
-
-// The place-recognition flags of slam and relocalize.
-struct PlaceRecognitionSettings {
-  PlaceRecognitionOptions options;
-  std::string descriptor = ToString(PlaceRecognitionOptions().descriptor);
-  std::string channel = "both";
-  PlaceRecognitionOptions Resolved() const;
-};
-void AddPlaceRecognitionOptions(CLI::App* app, PlaceRecognitionSettings& s);
+// The run's own: the IMU, the scans to run on (slam and relocalize take the
+// odometry's options from their own tables).
+void AddRunOptions(CLI::App* app, OdometrySettings& s);
 
 }  // namespace radargauss::cli

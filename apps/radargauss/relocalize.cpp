@@ -27,7 +27,6 @@ struct RelocalizeSettings {
   OdometrySettings odometry;
   std::string map;
   RelocalizationOptions relocalization;
-  PlaceRecognitionSettings place_recognition;
 };
 
 void WritePerScan(std::ostream& out, const Relocalizer& relocalizer) {
@@ -59,10 +58,7 @@ void WriteCandidates(std::ostream& out, const Relocalizer& relocalizer) {
 }
 
 int RunRelocalize(const RelocalizeSettings& s) {
-  RelocalizationOptions options = s.relocalization;
-  if (s.odometry.matcher != "gaussians") throw DataError("relocalize: --matcher must be gaussians");
-  options.odometry = Resolved(s.odometry);
-  options.place_recognition = s.place_recognition.Resolved();
+  const RelocalizationOptions& options = s.relocalization;
   ValidateOptions(options);
   GaussianMap map = ReadMap(s.map);
   if (map.places.empty()) {
@@ -122,11 +118,8 @@ Subcommand AddRelocalize(CLI::App& parent) {
   AddSequenceOptions(app, s->odometry.sequence, "--gt",
                      "Reference trajectory (TUM, map frame), for the evaluation only");
   app->add_option("--out", s->odometry.out, "Output folder")->required();
-  AddOdometryOptions(app, s->odometry);
-  app->add_option("--submap-distance", s->relocalization.submap_distance, "A submap every this many metres driven")
-      ->check(Positive())
-      ->capture_default_str();
-  AddPlaceRecognitionOptions(app, s->place_recognition);
+  AddTableOptions(app, RelocalizationOptionTable(), s->relocalization);
+  AddRunOptions(app, s->odometry);
   return {app, [s] { return RunRelocalize(*s); }};
 }
 

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "radargauss/options.hpp"
 #include "radargauss/types.hpp"
 
 namespace radargauss {
@@ -32,6 +33,9 @@ struct EgoVelocityOptions {
   // world; 0: points drawn uniformly, support = the number of inliers.
   double consensus_voxel = 0.0;
 };
+
+// Its options (options.hpp), as odometry names them (ego_*, seed).
+const OptionTable<EgoVelocityOptions>& EgoVelocityOptionTable();
 
 struct EgoVelocityResult {
   bool success = false;

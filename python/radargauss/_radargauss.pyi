@@ -1,9 +1,267 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Type stubs of radargauss._radargauss, written by scripts/generate_stubs.py.
-from typing import Any, Sequence
+from typing import Any, Sequence, TypedDict, Unpack
 
 import numpy
 from numpy.typing import ArrayLike
+
+class MatchOptions(TypedDict, total=False):
+    """option_fields("match")"""
+    solver: str  # 'gn'
+    w_rcs: float  # 0.0
+    loss: str  # 'trivial'
+    loss_scale: float  # 1.0
+    rcs_loss: str  # 'cauchy'
+    rcs_loss_scale: float  # 1.0
+    rcs_translation: str  # 'rotation-only'
+    jacobians: str  # 'analytic'
+    gate: float  # 3.0
+    max_iterations: int  # 30
+    coarse_iterations: int  # 15
+    coarse_voxel_per_sigma: float  # 2.0
+    coarse_points: int  # 0
+    geometric_first: bool  # True
+    reassociate: bool  # True
+    reassociation_translation: float  # 0.01
+    reassociation_rotation: float  # 0.002
+    translation_tolerance: float  # 0.001
+    rotation_tolerance: float  # 0.0001
+    coarse_translation_tolerance: float  # 0.01
+    coarse_rotation_tolerance: float  # 0.001
+    gn_max_step_halvings: int  # 8
+    gn_loss_curvature: bool  # False
+    ceres_dogleg: bool  # False
+    ceres_max_inner_iterations: int  # 2
+    ceres_max_exact_inner_iterations: int  # 8
+    ceres_blocks: str  # 'square-root'
+    ceres_threads: int  # 1
+    ceres_function_tolerance: float  # 1e-06
+    ceres_gradient_tolerance: float  # 1e-10
+    ceres_parameter_tolerance: float  # 1e-08
+    mh_starts: int  # 8
+    mh_xy_offset: float  # 1.0
+    mh_yaw_offset: float  # 0.05
+
+class OdometryOptions(MatchOptions, total=False):
+    """option_fields("odometry")"""
+    mounting: Sequence[float]  # [0.0, 0.0, 0.0]
+    velocity_weight: float  # 1.0
+    velocity_floor: float  # 0.05
+    velocity_vertical_floor: float  # 0.0
+    rotation_weight: float  # 1.0
+    rotation_rate_std: Sequence[float]  # [1.0, 1.0, 90.0]
+    gate_sigmas: float  # 3.0
+    acceleration_std: float  # 3.0
+    min_gate: float  # 0.5
+    min_static_points: int  # 10
+    keyframe_distance: float  # 0.5
+    keyframe_angle: float  # 2.0
+    min_matched_points: int  # 10
+    initial_pose: ArrayLike  # identity
+    ego_min_range: float  # 0.25
+    ego_max_range: float  # 100.0
+    ego_outlier_probability: float  # 0.4
+    ego_success_probability: float  # 0.9999
+    ego_inlier_threshold: float  # 0.15
+    ego_zero_velocity_threshold: float  # 0.05
+    ego_zero_velocity_sigma: float  # 0.025
+    seed: int  # 1
+    ego_consensus_voxel: float  # 1.0
+    azimuth_std: float  # 0.0
+    elevation_std: float  # 0.0
+    active_radius: float  # 100.0
+    region: float  # 4.0
+    region_capacity: int  # 256
+    region_min_points: int  # 8
+    map_estimator: str  # 'refit'
+    republish_kl: float  # 2.0
+    refit_growth: float  # 0.5
+    builder: str  # 'kmeans'
+    downsample: float  # 0.25
+    points_per_gaussian: float  # 4.0
+    kmeans_iterations: int  # 8
+    em_iterations: int  # 10
+    min_std: float  # 0.05
+    map_seed: int  # 1
+    ndt_voxel: float  # 1.0
+    ndt_min_points: int  # 5
+    fit_index_cell: float  # 1.0
+    association_gate: float  # 3.0
+    degree: int  # 3
+    rcs_adaptive: bool  # True
+    incidence: str  # 'offset'
+    rcs_rank_threshold: float  # 0.01
+    coarse_levels: str  # 'merged'
+    coarse_sigmas: list[float]  # [0.25]
+    index_cell: float  # 1.0
+    coarse_gate: float  # 3.0
+    estimate_elevation_bias: bool  # False
+    elevation_bias_window: int  # 100
+    elevation_bias_min_speed: float  # 5.0
+
+class SlamOptions(OdometryOptions, total=False):
+    """option_fields("slam")"""
+    submap_distance: float  # 10.0
+    min_loop_path: float  # 150.0
+    odometry_translation_std: float  # 0.05
+    odometry_drift: float  # 0.02
+    odometry_rotation_std: float  # 0.1
+    odometry_drift_deg: float  # 0.02
+    false_loop_rate: float  # 0.0
+    false_loop_seed: int  # 1
+    descriptor: str  # 'scan-context'
+    candidates: int  # 20
+    max_scan_context_distance: float  # 0.4
+    max_radon_distance: float  # 0.15
+    submap_voxel: float  # 0.25
+    channel: str  # 'both'
+    scan_context_rings: int  # 20
+    scan_context_sectors: int  # 60
+    scan_context_max_range: float  # 80.0
+    scan_context_rcs_floor: float  # -30.0
+    radon_angles: int  # 60
+    radon_offsets: int  # 64
+    radon_cell: float  # 1.0
+    radon_max_range: float  # 80.0
+    verify_bev_cell: float  # 1.0
+    verify_bev_search: float  # 12.0
+    verify_min_associated: float  # 0.5
+    verify_max_cost: float  # 6.0
+    verify_max_translation_std: float  # 0.2
+    verify_max_rotation_std: float  # 1.0
+    verify_drift: float  # 0.05
+    verify_min_drift: float  # 5.0
+    verify_drift_deg: float  # 0.05
+    verify_min_drift_deg: float  # 10.0
+    verify_translation_floor_std: float  # 0.1
+    verify_rotation_floor_std: float  # 0.5
+    verify_solver: str  # 'mh-gn'
+    verify_loss: str  # 'trivial'
+    verify_loss_scale: float  # 1.0
+    verify_jacobians: str  # 'analytic'
+    verify_gate: float  # 3.0
+    verify_max_iterations: int  # 30
+    verify_coarse_iterations: int  # 15
+    verify_coarse_voxel_per_sigma: float  # 2.0
+    verify_coarse_points: int  # 0
+    verify_geometric_first: bool  # True
+    verify_reassociate: bool  # True
+    verify_reassociation_translation: float  # 0.01
+    verify_reassociation_rotation: float  # 0.002
+    verify_translation_tolerance: float  # 0.001
+    verify_rotation_tolerance: float  # 0.0001
+    verify_coarse_translation_tolerance: float  # 0.01
+    verify_coarse_rotation_tolerance: float  # 0.001
+    verify_gn_max_step_halvings: int  # 8
+    verify_gn_loss_curvature: bool  # False
+    verify_ceres_dogleg: bool  # False
+    verify_ceres_max_inner_iterations: int  # 2
+    verify_ceres_max_exact_inner_iterations: int  # 8
+    verify_ceres_blocks: str  # 'square-root'
+    verify_ceres_threads: int  # 1
+    verify_ceres_function_tolerance: float  # 1e-06
+    verify_ceres_gradient_tolerance: float  # 1e-10
+    verify_ceres_parameter_tolerance: float  # 1e-08
+    verify_mh_starts: int  # 13
+    verify_mh_xy_offset: float  # 2.0
+    verify_mh_yaw_offset: float  # 0.1
+    verify_builder: str  # 'kmeans'
+    verify_downsample: float  # 0.25
+    verify_points_per_gaussian: float  # 4.0
+    verify_kmeans_iterations: int  # 8
+    verify_em_iterations: int  # 10
+    verify_min_std: float  # 0.05
+    verify_map_seed: int  # 1
+    verify_ndt_voxel: float  # 1.0
+    verify_ndt_min_points: int  # 5
+    verify_fit_index_cell: float  # 1.0
+    verify_association_gate: float  # 3.0
+    loop_rejection: str  # 'graduated'
+    loop_loss: str  # 'geman-mcclure'
+    loop_loss_scale: float  # 3.0
+    switch_prior_std: float  # 0.1
+    graduation_factor: float  # 1.4
+    graph_initialization: str  # 'current'
+    graph_jacobians: str  # 'analytic'
+    graph_max_iterations: int  # 100
+    graph_threads: int  # 1
+
+class RelocalizationOptions(OdometryOptions, total=False):
+    """option_fields("relocalization")"""
+    submap_distance: float  # 10.0
+    confirm_window: int  # 3
+    confirm_translation: float  # 1.0
+    confirm_rotation: float  # 2.0
+    ambiguous_translation: float  # 5.0
+    ambiguous_rotation: float  # 5.0
+    max_unmatched_scans: int  # 10
+    descriptor: str  # 'scan-context'
+    candidates: int  # 20
+    max_scan_context_distance: float  # 0.4
+    max_radon_distance: float  # 0.15
+    submap_voxel: float  # 0.25
+    channel: str  # 'both'
+    scan_context_rings: int  # 20
+    scan_context_sectors: int  # 60
+    scan_context_max_range: float  # 80.0
+    scan_context_rcs_floor: float  # -30.0
+    radon_angles: int  # 60
+    radon_offsets: int  # 64
+    radon_cell: float  # 1.0
+    radon_max_range: float  # 80.0
+    verify_bev_cell: float  # 1.0
+    verify_bev_search: float  # 12.0
+    verify_min_associated: float  # 0.5
+    verify_max_cost: float  # 6.0
+    verify_max_translation_std: float  # 0.2
+    verify_max_rotation_std: float  # 1.0
+    verify_drift: float  # 0.05
+    verify_min_drift: float  # 5.0
+    verify_drift_deg: float  # 0.05
+    verify_min_drift_deg: float  # 10.0
+    verify_translation_floor_std: float  # 0.1
+    verify_rotation_floor_std: float  # 0.5
+    verify_solver: str  # 'mh-gn'
+    verify_loss: str  # 'trivial'
+    verify_loss_scale: float  # 1.0
+    verify_jacobians: str  # 'analytic'
+    verify_gate: float  # 3.0
+    verify_max_iterations: int  # 30
+    verify_coarse_iterations: int  # 15
+    verify_coarse_voxel_per_sigma: float  # 2.0
+    verify_coarse_points: int  # 0
+    verify_geometric_first: bool  # True
+    verify_reassociate: bool  # True
+    verify_reassociation_translation: float  # 0.01
+    verify_reassociation_rotation: float  # 0.002
+    verify_translation_tolerance: float  # 0.001
+    verify_rotation_tolerance: float  # 0.0001
+    verify_coarse_translation_tolerance: float  # 0.01
+    verify_coarse_rotation_tolerance: float  # 0.001
+    verify_gn_max_step_halvings: int  # 8
+    verify_gn_loss_curvature: bool  # False
+    verify_ceres_dogleg: bool  # False
+    verify_ceres_max_inner_iterations: int  # 2
+    verify_ceres_max_exact_inner_iterations: int  # 8
+    verify_ceres_blocks: str  # 'square-root'
+    verify_ceres_threads: int  # 1
+    verify_ceres_function_tolerance: float  # 1e-06
+    verify_ceres_gradient_tolerance: float  # 1e-10
+    verify_ceres_parameter_tolerance: float  # 1e-08
+    verify_mh_starts: int  # 13
+    verify_mh_xy_offset: float  # 2.0
+    verify_mh_yaw_offset: float  # 0.1
+    verify_builder: str  # 'kmeans'
+    verify_downsample: float  # 0.25
+    verify_points_per_gaussian: float  # 4.0
+    verify_kmeans_iterations: int  # 8
+    verify_em_iterations: int  # 10
+    verify_min_std: float  # 0.05
+    verify_map_seed: int  # 1
+    verify_ndt_voxel: float  # 1.0
+    verify_ndt_min_points: int  # 5
+    verify_fit_index_cell: float  # 1.0
+    verify_association_gate: float  # 3.0
 
 class DataError(ValueError): ...
 
@@ -53,96 +311,7 @@ class MatchResult:
 
 class RadarOdometry:
     """Radar odometry on a map it builds as it goes (docs/design.md, "Odometry"): register scans in time order. Threads may share one: its calls take turns."""
-    def __init__(self: RadarOdometry, *,
-        ego_min_range: float = 0.25,
-        ego_max_range: float = 100.0,
-        ego_outlier_probability: float = 0.4,
-        ego_success_probability: float = 0.9999,
-        ego_inlier_threshold: float = 0.15,
-        ego_zero_velocity_threshold: float = 0.05,
-        ego_zero_velocity_sigma: float = 0.025,
-        ego_seed: int = 1,
-        ego_consensus_voxel: float = 1.0,
-        gate_sigmas: float = 3.0,
-        acceleration_std: float = 3.0,
-        min_gate: float = 0.5,
-        min_static_points: int = 10,
-        velocity_weight: float = 1.0,
-        velocity_floor: float = 0.05,
-        velocity_vertical_floor: float = 0.0,
-        rotation_weight: float = 1.0,
-        rotation_rate_std_deg: Sequence[float] = [1.0, 1.0, 90.0],
-        mounting_deg: Sequence[float] = [0.0, 0.0, 0.0],
-        estimate_elevation_bias: bool = False,
-        elevation_bias_window: int = 100,
-        elevation_bias_min_speed: float = 5.0,
-        region: float = 4.0,
-        region_capacity: int = 256,
-        region_min_points: int = 8,
-        map_estimator: str = 'refit',
-        republish_kl: float = 2.0,
-        refit_growth: float = 0.5,
-        active_radius: float = 100.0,
-        azimuth_std_deg: float = 0.0,
-        elevation_std_deg: float = 0.0,
-        gaussians_builder: str = 'kmeans',
-        gaussians_downsample_voxel: float = 0.25,
-        gaussians_points_per_gaussian: float = 4.0,
-        gaussians_kmeans_iterations: int = 8,
-        gaussians_em_iterations: int = 10,
-        gaussians_min_std: float = 0.05,
-        gaussians_seed: int = 1,
-        gaussians_ndt_voxel: float = 1.0,
-        gaussians_ndt_min_points: int = 5,
-        gaussians_index_cell: float = 1.0,
-        gaussians_association_gate: float = 3.0,
-        rcs_max_degree: int = 3,
-        rcs_adaptive: bool = True,
-        rcs_incidence: str = 'offset',
-        rcs_rank_threshold: float = 0.01,
-        map_inflation: list[float] = [0.25],
-        map_index_cell: float = 1.0,
-        map_coarse: str = 'merged',
-        map_coarse_gate: float = 3.0,
-        map_updatable: bool = False,
-        keyframe_distance: float = 0.5,
-        keyframe_angle_deg: float = 2.0,
-        min_matched_points: int = 10,
-        initial_pose: ArrayLike = ...,
-        solver: str = 'gn',
-        w_rcs: float = 0.0,
-        loss: str = 'trivial',
-        loss_scale: float = 1.0,
-        rcs_loss: str = 'cauchy',
-        rcs_loss_scale: float = 1.0,
-        rcs_translation: str = 'rotation-only',
-        jacobians: str = 'analytic',
-        gate: float = 3.0,
-        max_iterations: int = 30,
-        coarse_iterations: int = 15,
-        coarse_voxel_per_sigma: float = 2.0,
-        coarse_points: int = 0,
-        geometric_first: bool = True,
-        reassociate: bool = True,
-        reassociation_translation: float = 0.01,
-        reassociation_rotation: float = 0.002,
-        translation_tolerance: float = 0.001,
-        rotation_tolerance: float = 0.0001,
-        coarse_translation_tolerance: float = 0.01,
-        coarse_rotation_tolerance: float = 0.001,
-        gn_max_step_halvings: int = 8,
-        gn_loss_curvature: bool = False,
-        ceres_dogleg: bool = False,
-        ceres_max_inner_iterations: int = 2,
-        ceres_max_exact_inner_iterations: int = 8,
-        ceres_blocks: str = 'square-root',
-        ceres_threads: int = 1,
-        ceres_function_tolerance: float = 1e-06,
-        ceres_gradient_tolerance: float = 1e-10,
-        ceres_parameter_tolerance: float = 1e-08,
-        mh_starts: int = 8,
-        mh_xy_offset: float = 1.0,
-        mh_yaw_offset: float = 0.05) -> None:
+    def __init__(self: RadarOdometry, **options: Unpack[OdometryOptions]) -> None:
         ...
     def __len__(self: RadarOdometry) -> int:
         ...
@@ -158,8 +327,8 @@ class RadarOdometry:
         """(stamps (N,), poses (N, 7)) so far"""
 
 class RadarSlam:
-    """Radar SLAM (docs/design.md, "SLAM"): odometry, keyframes with submaps, place recognition, verified loops on a pose graph. Keywords: descriptor ('scan-context' or 'radon'), submap_distance, min_loop_path, candidates, loop_rejection ('loss', 'switchable', 'graduated'), graph_initialization ('current', 'chordal'), and any keyword of RadarOdometry. Threads may share one: its calls take turns."""
-    def __init__(self: RadarSlam, descriptor: str = 'scan-context', submap_distance: float = 10.0, min_loop_path: float = 150.0, candidates: int = 20, loop_rejection: str = 'graduated', graph_initialization: str = 'current', **kwargs) -> None:
+    """Radar SLAM (docs/design.md, "SLAM"): odometry, keyframes with submaps, place recognition, verified loops on a pose graph. Threads may share one: its calls take turns."""
+    def __init__(self: RadarSlam, **options: Unpack[SlamOptions]) -> None:
         ...
     def finish(self: RadarSlam) -> None:
         """Closes the last keyframe (described and searched): call after the last scan."""
@@ -177,8 +346,8 @@ class RadarSlam:
         """(stamps (N,), poses (N, 7)): every scan at its keyframe's optimised pose"""
 
 class Relocalizer:
-    """Relocalisation in a map of RadarSlam without an initial pose (docs/design.md, "Relocalisation"). Keywords: descriptor, submap_distance, candidates, and any keyword of RadarOdometry. Threads may share one: its calls take turns."""
-    def __init__(self: Relocalizer, map: GaussianMap, descriptor: str = 'scan-context', submap_distance: float = 10.0, candidates: int = 20, **kwargs) -> None:
+    """Relocalisation in a map of RadarSlam without an initial pose (docs/design.md, "Relocalisation"). Threads may share one: its calls take turns."""
+    def __init__(self: Relocalizer, map: GaussianMap, **options: Unpack[RelocalizationOptions]) -> None:
         ...
     @property
     def first_fix(self) -> Any: ...
@@ -235,51 +404,17 @@ def evaluate(estimate: tuple, reference: tuple, align: str = 'se3') -> dict:
 def initial_errors(scans: int, max_translation: float = 2.0, max_rotation_deg: float = 5.0, seed: int = 42) -> numpy.ndarray:
     """The seeded errors E of `radargauss localize` (its --max-translation, --max-rotation, --seed): the initial pose of scan i is compose(reference_i, E_i). (N, 7)."""
 
-def match(scan: Scan, map: GaussianMap, initial: Any, *,
-    solver: str = 'gn',
-    w_rcs: float = 0.0,
-    loss: str = 'trivial',
-    loss_scale: float = 1.0,
-    rcs_loss: str = 'cauchy',
-    rcs_loss_scale: float = 1.0,
-    rcs_translation: str = 'rotation-only',
-    jacobians: str = 'analytic',
-    gate: float = 3.0,
-    max_iterations: int = 30,
-    coarse_iterations: int = 15,
-    coarse_voxel_per_sigma: float = 2.0,
-    coarse_points: int = 0,
-    geometric_first: bool = True,
-    reassociate: bool = True,
-    reassociation_translation: float = 0.01,
-    reassociation_rotation: float = 0.002,
-    translation_tolerance: float = 0.001,
-    rotation_tolerance: float = 0.0001,
-    coarse_translation_tolerance: float = 0.01,
-    coarse_rotation_tolerance: float = 0.001,
-    gn_max_step_halvings: int = 8,
-    gn_loss_curvature: bool = False,
-    ceres_dogleg: bool = False,
-    ceres_max_inner_iterations: int = 2,
-    ceres_max_exact_inner_iterations: int = 8,
-    ceres_blocks: str = 'square-root',
-    ceres_threads: int = 1,
-    ceres_function_tolerance: float = 1e-06,
-    ceres_gradient_tolerance: float = 1e-10,
-    ceres_parameter_tolerance: float = 1e-08,
-    mh_starts: int = 8,
-    mh_xy_offset: float = 1.0,
-    mh_yaw_offset: float = 0.05) -> MatchResult:
+def match(scan: Scan, map: GaussianMap, initial: Any, **options: Unpack[MatchOptions]) -> MatchResult:
     """Matches a Scan against a GaussianMap, minimising eq. 2 coarse to fine as `radargauss localize` does."""
 
-def match_options(**kwargs) -> dict:
+def match_options(**options: Unpack[MatchOptions]) -> dict:
     """Every option of match, the given keywords set (checked as match checks them), as a dict."""
 
-def odometry_options(**kwargs) -> dict:
+def odometry_options(**options: Unpack[OdometryOptions]) -> dict:
     """Every option of RadarOdometry, the given keywords set (checked), as a dict."""
 
 def option_fields(kind: str) -> list:
-    """The keywords of match ('match') or RadarOdometry ('odometry'): one dict per option with its keyword, the C++ member it sets (path), type, doc and default."""
+    """The keywords of match, RadarOdometry, RadarSlam or Relocalizer ('match', 'odometry', 'slam', 'relocalization'): one dict per option with its keyword, the C++ member it sets (path), type, doc, default, group, unit and range."""
 
 def pose_matrices(poses: Any) -> numpy.ndarray:
     """Poses (N, 7) [x y z qx qy qz qw] (or (N, 4, 4)) as (N, 4, 4) matrices."""
@@ -299,11 +434,17 @@ def read_sequence(path: str = '', gt: str = '', extrinsic: str = 'auto', bag: st
 def read_tum(path: str) -> tuple:
     """A TUM file as (stamps (N,), poses (N, 7) [x y z qx qy qz qw])."""
 
+def relocalization_options(**options: Unpack[RelocalizationOptions]) -> dict:
+    """Every option of Relocalizer, the given keywords set (checked), as a dict."""
+
 def set_threads(threads: int) -> None:
     """Worker threads of the parallel stages (0: all cores), as the tool's --threads."""
 
 def simulate(seed: int = 1, scans: int = 0, config: str = '') -> Sequence:
     """The synthetic 4D radar drive of `radargauss simulate` (configs/synthetic_world.yaml) as a Sequence with its ground-truth poses; scans > 0 overrides the config's count."""
+
+def slam_options(**options: Unpack[SlamOptions]) -> dict:
+    """Every option of RadarSlam, the given keywords set (checked), as a dict."""
 
 def write_map(path: str, map: GaussianMap) -> None:
     """Writes a .rgm map file atomically."""

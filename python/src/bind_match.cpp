@@ -24,7 +24,7 @@ const char* MatchDoc() {
       "map : GaussianMap\n    the map (its coarse-to-fine levels are built on first use)\n"
       "initial : array (4, 4) or (7,)\n    T_world_radar to start from\n"
       "**options\n    any of the keywords below (match_options() gives them all with their values)\n" +
-      ParametersDoc(MatchFields()) + "\nReturns\n-------\nMatchResult\n";
+      ParametersDoc(MatchOptionTable()) + "\nReturns\n-------\nMatchResult\n";
   return doc.c_str();
 }
 
@@ -74,7 +74,7 @@ void BindMatch(py::module_& m) {
       "match",
       [](const RadarScan& scan, const PyMap& map, const py::handle& initial, const py::kwargs& kwargs) {
         const SE3d start = PoseFromPython(initial, "initial");
-        const MatchOptions options = OptionsFrom(MatchFields(), kwargs);
+        const MatchOptions options = OptionsFrom(MatchOptionTable(), kwargs);
         const MatchingMap& matching = map.matching();
         py::gil_scoped_release release;
         return Match(scan, matching, start, options);
@@ -83,9 +83,9 @@ void BindMatch(py::module_& m) {
   m.def(
       "match_options",
       [](const py::kwargs& kwargs) {
-        const MatchOptions options = OptionsFrom(MatchFields(), kwargs);
+        const MatchOptions options = OptionsFrom(MatchOptionTable(), kwargs);
         MakeScanMatcher(options);  // validates: std::invalid_argument is a ValueError
-        return OptionsToDict(MatchFields(), options);
+        return OptionsToDict(MatchOptionTable(), options);
       },
       "Every option of match, the given keywords set (checked as match checks them), as a dict.");
   m.def(

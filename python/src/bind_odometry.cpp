@@ -7,6 +7,8 @@
 #include "bindings.hpp"
 #include "option_fields.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/slam/radar_slam.hpp"
+#include "radargauss/slam/relocalization.hpp"
 
 namespace radargauss::python {
 
@@ -43,12 +45,12 @@ const char* OdometryDoc() {
       "Radar odometry on a map it builds as it goes (docs/design.md, \"Odometry\"): register scans in time "
       "order. Threads may share one: its calls take turns.\n\nParameters\n----------\n"
       "**options\n    any of the keywords below (odometry_options() gives them all with their values)\n" +
-      ParametersDoc(OdometryFields());
+      ParametersDoc(OdometryOptionTable());
   return doc.c_str();
 }
 
 OdometryOptions OdometryOptionsFrom(const py::kwargs& kwargs) {
-  const OdometryOptions options = OptionsFrom(OdometryFields(), kwargs);
+  const OdometryOptions options = OptionsFrom(OdometryOptionTable(), kwargs);
   ValidateOptions(options);  // std::invalid_argument: ValueError
   return options;
 }
@@ -84,7 +86,7 @@ void BindOdometry(py::module_& m) {
       .def(
           "options",
           [](LockedOdometry& odometry) {
-            return OptionsToDict(OdometryFields(), odometry.With([](RadarOdometry& o) { return o.options(); }));
+            return OptionsToDict(OdometryOptionTable(), odometry.With([](RadarOdometry& o) { return o.options(); }));
           },
           "Every option by keyword, as odometry_options gives them")
       .def_property_readonly(
@@ -95,18 +97,38 @@ void BindOdometry(py::module_& m) {
            [](LockedOdometry& odometry) { return odometry.With([](RadarOdometry& o) { return o.steps().size(); }); });
   m.def(
       "odometry_options",
-      [](const py::kwargs& kwargs) { return OptionsToDict(OdometryFields(), OdometryOptionsFrom(kwargs)); },
+      [](const py::kwargs& kwargs) { return OptionsToDict(OdometryOptionTable(), OdometryOptionsFrom(kwargs)); },
       "Every option of RadarOdometry, the given keywords set (checked), as a dict.");
+  m.def(
+      "slam_options",
+      [](const py::kwargs& kwargs) {
+        const SlamOptions options = OptionsFrom(SlamOptionTable(), kwargs);
+        ValidateOptions(options);  // std::invalid_argument: ValueError
+        return OptionsToDict(SlamOptionTable(), options);
+      },
+      "Every option of RadarSlam, the given keywords set (checked), as a dict.");
+  m.def(
+      "relocalization_options",
+      [](const py::kwargs& kwargs) {
+        const RelocalizationOptions options = OptionsFrom(RelocalizationOptionTable(), kwargs);
+        ValidateOptions(options);  // std::invalid_argument: ValueError
+        return OptionsToDict(RelocalizationOptionTable(), options);
+      },
+      "Every option of Relocalizer, the given keywords set (checked), as a dict.");
   m.def(
       "option_fields",
       [](const std::string& kind) {
-        if (kind == "match") return FieldsToList(MatchFields());
-        if (kind == "odometry") return FieldsToList(OdometryFields());
-        throw py::value_error("option_fields takes 'match' or 'odometry', not '" + kind + "'");
+        if (kind == "match") return FieldsToList(MatchOptionTable());
+        if (kind == "odometry") return FieldsToList(OdometryOptionTable());
+        if (kind == "slam") return FieldsToList(SlamOptionTable());
+        if (kind == "relocalization") return FieldsToList(RelocalizationOptionTable());
+        throw py::value_error("option_fields takes 'match', 'odometry', 'slam' or 'relocalization', not '" + kind +
+                              "'");
       },
       py::arg("kind"),
-      "The keywords of match ('match') or RadarOdometry ('odometry'): one dict per option with its keyword, the "
-      "C++ member it sets (path), type, doc and default.");
+      "The keywords of match, RadarOdometry, RadarSlam or Relocalizer ('match', 'odometry', 'slam', "
+      "'relocalization'): one dict per option with its keyword, the C++ member it sets (path), type, doc, default, "
+      "group, unit and range.");
 }
 
 }  // namespace radargauss::python

@@ -13,14 +13,6 @@ namespace radargauss::python {
 
 namespace {
 
-// Place recognition's keywords, shared by RadarSlam and Relocalizer.
-PlaceRecognitionOptions PlaceRecognitionFrom(const std::string& descriptor, int candidates) {
-  PlaceRecognitionOptions options;
-  options.descriptor = PlaceDescriptorKindFromString(descriptor);  // std::invalid_argument: ValueError
-  options.candidates = candidates;
-  return options;
-}
-
 py::dict LoopToDict(const LoopCandidate& c) {
   py::dict d;
   d["query"] = c.query;
@@ -38,40 +30,39 @@ py::dict LoopToDict(const LoopCandidate& c) {
 using LockedSlam = Locked<RadarSlam>;
 using LockedRelocalizer = Locked<Relocalizer>;
 
-std::unique_ptr<LockedSlam> MakeSlam(const std::string& descriptor, double submap_distance, double min_loop_path,
-                                     int candidates, const std::string& loop_rejection,
-                                     const std::string& graph_initialization, const py::kwargs& kwargs) {
-  SlamOptions options;
-  options.odometry = OptionsFrom(OdometryFields(), kwargs);
-  options.place_recognition = PlaceRecognitionFrom(descriptor, candidates);
-  options.submap_distance = submap_distance;
-  options.min_loop_path = min_loop_path;
-  options.graph.loop_rejection = LoopRejectionFromString(loop_rejection);
-  options.graph.initialization = GraphInitializationFromString(graph_initialization);
+std::unique_ptr<LockedSlam> MakeSlam(const py::kwargs& kwargs) {
+  const SlamOptions options = OptionsFrom(SlamOptionTable(), kwargs);
   return std::make_unique<LockedSlam>(std::make_unique<RadarSlam>(options));  // validates
 }
 
-std::unique_ptr<LockedRelocalizer> MakeRelocalizer(const PyMap& map, const std::string& descriptor,
-                                                   double submap_distance, int candidates, const py::kwargs& kwargs) {
-  RelocalizationOptions options;
-  options.odometry = OptionsFrom(OdometryFields(), kwargs);
-  options.place_recognition = PlaceRecognitionFrom(descriptor, candidates);
-  options.submap_distance = submap_distance;
+std::unique_ptr<LockedRelocalizer> MakeRelocalizer(const PyMap& map, const py::kwargs& kwargs) {
+  const RelocalizationOptions options = OptionsFrom(RelocalizationOptionTable(), kwargs);
   return std::make_unique<LockedRelocalizer>(std::make_unique<Relocalizer>(map.map(), options));
+}
+
+const char* SlamDoc() {
+  static const std::string doc =
+      "Radar SLAM (docs/design.md, \"SLAM\"): odometry, keyframes with submaps, place recognition, verified loops "
+      "on a pose graph. Threads may share one: its calls take turns.\n\nParameters\n----------\n"
+      "**options\n    any of the keywords below (option_fields('slam') lists them)\n" +
+      ParametersDoc(SlamOptionTable());
+  return doc.c_str();
+}
+
+const char* RelocalizerDoc() {
+  static const std::string doc =
+      "Relocalisation in a map of RadarSlam without an initial pose (docs/design.md, \"Relocalisation\"). Threads "
+      "may share one: its calls take turns.\n\nParameters\n----------\nmap : Map\n    a map of RadarSlam, with "
+      "places\n**options\n    any of the keywords below (option_fields('relocalization') lists them)\n" +
+      ParametersDoc(RelocalizationOptionTable());
+  return doc.c_str();
 }
 
 }  // namespace
 
 void BindSlam(py::module_& m) {
-  py::class_<LockedSlam>(m, "RadarSlam",
-                         "Radar SLAM (docs/design.md, \"SLAM\"): odometry, keyframes with submaps, place recognition, "
-                         "verified loops on a pose graph. Keywords: descriptor ('scan-context' or 'radon'), "
-                         "submap_distance, min_loop_path, candidates, loop_rejection ('loss', 'switchable', "
-                         "'graduated'), graph_initialization ('current', 'chordal'), and any keyword of "
-                         "RadarOdometry. Threads may share one: its calls take turns.")
-      .def(py::init(&MakeSlam), py::arg("descriptor") = "scan-context", py::arg("submap_distance") = 10.0,
-           py::arg("min_loop_path") = 150.0, py::arg("candidates") = PlaceRecognitionOptions().candidates,
-           py::arg("loop_rejection") = "graduated", py::arg("graph_initialization") = "current")
+  py::class_<LockedSlam>(m, "RadarSlam", SlamDoc())
+      .def(py::init(&MakeSlam))
       .def(
           "register",
           [](LockedSlam& slam, const RadarScan& scan) { slam.With([&](RadarSlam& s) { s.Register(scan); }); },
@@ -107,12 +98,8 @@ void BindSlam(py::module_& m) {
             return std::make_shared<PyMap>(slam.With([&](RadarSlam& s) { return BuildPlaceMap(scans, s); }));
           },
           py::arg("scans"), "The map of the place from the registered scans (in order), with the keyframes as places");
-  py::class_<LockedRelocalizer>(m, "Relocalizer",
-                                "Relocalisation in a map of RadarSlam without an initial pose (docs/design.md, "
-                                "\"Relocalisation\"). Keywords: descriptor, submap_distance, candidates, and any "
-                                "keyword of RadarOdometry. Threads may share one: its calls take turns.")
-      .def(py::init(&MakeRelocalizer), py::arg("map"), py::arg("descriptor") = "scan-context",
-           py::arg("submap_distance") = 10.0, py::arg("candidates") = PlaceRecognitionOptions().candidates)
+  py::class_<LockedRelocalizer>(m, "Relocalizer", RelocalizerDoc())
+      .def(py::init(&MakeRelocalizer), py::arg("map"))
       .def(
           "register",
           [](LockedRelocalizer& relocalizer, const RadarScan& scan) {

@@ -1,85 +1,74 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The options of `match` and `RadarOdometry` as Python keywords, from one
-// table per options struct (option_fields.cpp): the keywords, the values
-// they set, the docstrings' Parameters and the dicts read back all come from
-// it. Each entry names the C++ member it sets (`path`, as written in C++).
-//
-// Keywords: a ScanMatchingOptions field by its own name (losses as loss,
-// loss_scale, rcs_loss, rcs_loss_scale); the solvers' own options as gn_*,
-// ceres_*, mh_*; odometry's own by name, its Doppler filter as ego_*, its
-// map as region*, refit_growth, active_radius, gaussians_*, rcs_*, map_*.
+// Python keywords from the option tables (radargauss/options.hpp): the
+// keywords, the values they set, the docstrings' Parameters and the dicts
+// read back all come from the table of the options struct, as the command
+// line's flags do.
 #pragma once
 
-#include <functional>
 #include <string>
-#include <vector>
 
 #include "convert.hpp"
-#include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/options.hpp"
 
 namespace radargauss::python {
 
-template <typename Options>
-struct OptionField {
-  std::string keyword;  // the Python keyword
-  std::string path;     // the C++ member it sets, e.g. "matching.gate"
-  std::string type;     // numpydoc type: float, int, bool, str, ...
-  std::string doc;
-  std::function<void(Options&, const py::handle&)> set;  // TypeError or ValueError for a bad value
-  std::function<py::object(const Options&)> get;
-};
-
-const std::vector<OptionField<MatchOptions>>& MatchFields();
-// Odometry's own fields, then every match field (paths under match.).
-const std::vector<OptionField<OdometryOptions>>& OdometryFields();
+// A Python value as `option` takes it, strictly: a bool is not a number, a
+// float is finite, an integer fits; a pose is a (4, 4) matrix or 7 numbers.
+// TypeError for the wrong type, ValueError for a value out of range.
+OptionValue ValueFromPython(const OptionSpec& option, const py::handle& value);
+py::object ValueToPython(const OptionSpec& option, const OptionValue& value);
+std::string TypeDoc(const OptionSpec& option);  // numpydoc type: "float", "int", "{'gn', 'ceres'}", ...
 
 // `options` with each keyword of `kwargs` set; a TypeError names an unknown keyword.
 template <typename Options>
-Options OptionsFrom(const std::vector<OptionField<Options>>& fields, const py::kwargs& kwargs, Options options = {}) {
+Options OptionsFrom(const OptionTable<Options>& table, const py::kwargs& kwargs, Options options = {}) {
   for (const auto& [key, value] : kwargs) {
     const std::string keyword = py::str(key);
-    const OptionField<Options>* field = nullptr;
-    for (const OptionField<Options>& f : fields) {
-      if (f.keyword == keyword) field = &f;
-    }
-    if (!field) throw py::type_error("unknown keyword '" + keyword + "' (option_fields() lists them)");
-    field->set(options, value);
+    const Option<Options>* option = FindOption(table, keyword);
+    if (!option) throw py::type_error("unknown keyword '" + keyword + "' (option_fields() lists them)");
+    option->set(options, ValueFromPython(*option, value));
   }
   return options;
 }
 
-// Every field of `options` by keyword.
+// Every option of `options` by keyword.
 template <typename Options>
-py::dict OptionsToDict(const std::vector<OptionField<Options>>& fields, const Options& options) {
+py::dict OptionsToDict(const OptionTable<Options>& table, const Options& options) {
   py::dict out;
-  for (const OptionField<Options>& f : fields) out[py::str(f.keyword)] = f.get(options);
+  for (const Option<Options>& option : table) out[py::str(option.name)] = ValueToPython(option, option.get(options));
   return out;
 }
 
-// numpydoc Parameters lines: "name : type, default <value>" and the doc, indented.
+// numpydoc Parameters lines: "name : type, default <value>" and the help, indented.
 template <typename Options>
-std::string ParametersDoc(const std::vector<OptionField<Options>>& fields) {
+std::string ParametersDoc(const OptionTable<Options>& table) {
   std::string doc;
   const Options defaults{};
-  for (const OptionField<Options>& f : fields) {
-    doc += f.keyword + " : " + f.type + ", default " + py::repr(f.get(defaults)).template cast<std::string>() +
-           "\n    " + f.doc + "\n";
+  for (const Option<Options>& option : table) {
+    const std::string unit = option.unit.empty() ? "" : " (" + option.unit + ")";
+    doc += option.name + " : " + TypeDoc(option) + ", default " +
+           py::repr(ValueToPython(option, option.get(defaults))).template cast<std::string>() + "\n    " +
+           option.help + unit + "\n";
   }
   return doc;
 }
 
-// The table as Python sees it: one dict per field (keyword, path, type, doc, default).
+// The table as Python sees it: one dict per option (keyword, path, type,
+// doc, default, group, unit, range).
 template <typename Options>
-py::list FieldsToList(const std::vector<OptionField<Options>>& fields) {
+py::list FieldsToList(const OptionTable<Options>& table) {
   py::list out;
   const Options defaults{};
-  for (const OptionField<Options>& f : fields) {
+  for (const Option<Options>& option : table) {
     py::dict d;
-    d["keyword"] = f.keyword;
-    d["path"] = f.path;
-    d["type"] = f.type;
-    d["doc"] = f.doc;
-    d["default"] = f.get(defaults);
+    d["keyword"] = option.name;
+    d["path"] = option.path;
+    d["type"] = TypeDoc(option);
+    d["doc"] = option.help;
+    d["default"] = ValueToPython(option, option.get(defaults));
+    d["group"] = ToString(option.group);
+    d["unit"] = option.unit;
+    d["range"] = option.RangeText();
     out.append(d);
   }
   return out;

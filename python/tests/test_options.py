@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""The option keywords of match and RadarOdometry against the C++ headers
-(every field of the options structs is a keyword and round-trips), the
+"""The option keywords of match, RadarOdometry, RadarSlam and Relocalizer
+against the C++ headers (every field of the options structs is a keyword,
+but those the code sets, and round-trips), the
 docstrings' name lists against the library's name tables, pose matrices
 against quaternions by hand, and the stubs against the module."""
 import ast
@@ -38,30 +39,53 @@ def leaf_paths(structs, name, prefix=""):
             yield prefix + field
 
 
-@pytest.mark.parametrize("kind, struct", [("match", "MatchOptions"), ("odometry", "OdometryOptions")])
-def test_every_field_of_the_cpp_options_is_a_keyword(kind, struct):
+# Members the code sets, not the user: the local map's matching map is
+# always updatable, and the loop's match is geometric.
+SET_BY_THE_CODE = {"map.matching.updatable", "verification.match.matching.w_rcs",
+                   "verification.match.matching.rcs_loss.type", "verification.match.matching.rcs_loss.scale",
+                   "verification.match.matching.rcs_translation"}
+KINDS = [("match", "MatchOptions", rg.match_options), ("odometry", "OdometryOptions", rg.odometry_options),
+         ("slam", "SlamOptions", rg.slam_options), ("relocalization", "RelocalizationOptions", rg.relocalization_options)]
+
+
+@pytest.mark.parametrize("kind, struct, read_back", KINDS)
+def test_every_field_of_the_cpp_options_is_a_keyword(kind, struct, read_back):
     structs = cpp_structs()
     expected = set(leaf_paths(structs, struct))
     fields = rg.option_fields(kind)
     assert len(expected) > (30 if kind == "match" else 70)
-    assert {f["path"] for f in fields} == expected
+    assert {f["path"] for f in fields} == expected - {p for p in expected if p.removeprefix("odometry.") in
+                                                       SET_BY_THE_CODE}
     keywords = [f["keyword"] for f in fields]
     assert len(set(keywords)) == len(keywords)
+    assert set(read_back()) == set(keywords)
+
+
+def in_range(field, value):
+    low, high = (float(x) for x in field["range"][1:-1].split(", "))
+    return (value > low if field["range"][0] == "(" else value >= low) and value <= high
+
+
+def test_the_members_the_code_sets_exist():
+    structs = cpp_structs()
+    members = set(leaf_paths(structs, "SlamOptions")) | set(leaf_paths(structs, "RelocalizationOptions"))
+    assert {"odometry." + p if p.startswith("map.") else p for p in SET_BY_THE_CODE} <= members
 
 
 def other_value(field):
-    """A valid value that differs from the default."""
-    default, kind, keyword = field["default"], field["type"], field["keyword"]
+    """A valid value that differs from the default, inside the option's range."""
+    default, kind = field["default"], field["type"]
     if kind.startswith("{"):
         return next(choice for choice in re.findall(r"'([^']+)'", kind) if choice != default)
-    if keyword == "rcs_max_degree":
-        return default - 1
     if kind == "bool":
         return not default
     if kind == "int":
-        return default + 1
+        return default + 1 if in_range(field, default + 1) else default - 1
     if kind == "float":
-        return default / 2 if default else 0.25
+        high = float(field["range"].split(", ")[1][:-1])
+        for value in (default / 2 if default else 0.25, (default + high) / 2, default * 2):
+            if value != default and np.isfinite(value) and in_range(field, value):
+                return value
     if kind == "list of float":
         return [0.5]
     if kind == "sequence of 3 float":
@@ -71,8 +95,8 @@ def other_value(field):
     return pose
 
 
-@pytest.mark.parametrize("kind, read_back", [("match", rg.match_options), ("odometry", rg.odometry_options)])
-def test_every_keyword_round_trips(kind, read_back):
+@pytest.mark.parametrize("kind, struct, read_back", KINDS)
+def test_every_keyword_round_trips(kind, struct, read_back):
     defaults = read_back()
     for field in rg.option_fields(kind):
         value = other_value(field)
@@ -99,10 +123,13 @@ def test_keywords_reach_match_and_odometry_and_bad_ones_are_refused():
         rg.match_options(max_iterations=2.5)
     with pytest.raises(TypeError, match="reassociate must be a bool"):
         rg.match_options(reassociate=1)
-    with pytest.raises(ValueError, match="gate must be finite"):
+    with pytest.raises(ValueError, match="gate = inf is not a finite number"):
         rg.match_options(gate=float("inf"))
-    with pytest.raises(ValueError, match="iteration limits must be >= 1"):
+    with pytest.raises(ValueError, match=r"max_iterations = 0 is not in \[1, "):
         rg.match_options(max_iterations=0)
+    with pytest.raises(ValueError, match=r"region_capacity \(6\) must be at least region_min_points \(8\)"):
+        rg.odometry_options(region_capacity=6)
+    assert rg.odometry_options(region_capacity=6, region_min_points=6)["region_capacity"] == 6
 
 
 def names_in_doc(doc, keyword):
@@ -112,10 +139,10 @@ def names_in_doc(doc, keyword):
 def test_docstring_names_are_the_librarys_names():
     """The solver and loss lists of match's docstring against the names the
     library's own message lists when it refuses an unknown one."""
-    for keyword, what in (("solver", "solver"), ("loss", "loss"), ("ceres_blocks", "Ceres blocks")):
+    for keyword in ("solver", "loss", "ceres_blocks"):
         with pytest.raises(ValueError) as refused:
             rg.match_options(**{keyword: "no-such-name"})
-        library = str(refused.value).split("(", 1)[1].rstrip(")").split(", ")
+        library = str(refused.value).split("{", 1)[1].rstrip("}").split(",")
         assert names_in_doc(rg.match.__doc__, keyword) == library, keyword
     assert "mh-gn" in names_in_doc(rg.match.__doc__, "solver")
 

@@ -12,6 +12,7 @@
 
 #include <Eigen/LU>
 
+#include "radargauss/map/matching_map.hpp"
 #include "radargauss/names.hpp"
 
 namespace radargauss {
@@ -204,20 +205,35 @@ std::vector<Gaussian> VoxelGaussians(const std::vector<Eigen::Vector3d>& points,
   return gaussians;
 }
 
-void ValidateOptions(const GaussianMapOptions& o) {
-  const auto require = [](bool ok, const char* what) {
-    if (!ok) throw std::invalid_argument(what);
+}  // namespace
+
+const OptionTable<GaussianMapOptions>& GaussianMapOptionTable() {
+  using O = GaussianMapOptions;
+  static const OptionTable<O> table = {
+      RADARGAUSS_CHOICE(O, "builder", builder, MapBuilderNames(), MapBuilderFromString)
+          .Help("kmeans (RA-L default) or voxel (NDT-style baseline)"),
+      RADARGAUSS_OPTION(O, "downsample", downsample_voxel).Above(0.0).Unit("m").Help("voxel downsample edge"),
+      RADARGAUSS_OPTION(O, "points_per_gaussian", points_per_gaussian)
+          .In(1.0, 1e6)
+          .Help("K = round(N_downsampled / this) (about 4 for ARS548, 16 for Oculii Eagle)"),
+      RADARGAUSS_OPTION(O, "kmeans_iterations", kmeans_iterations).AtLeast(1).Help("Lloyd iterations per bisection"),
+      RADARGAUSS_OPTION(O, "em_iterations", em_iterations).AtLeast(0).Help("hard-EM rounds"),
+      RADARGAUSS_OPTION(O, "min_std", min_std).Above(0.0).Unit("m").Help("minimum principal std of a Gaussian"),
+      RADARGAUSS_OPTION(O, "map_seed", seed).Help("seed of the bisecting k-means"),
+      RADARGAUSS_OPTION(O, "ndt_voxel", ndt_voxel).Above(0.0).Unit("m").Help("voxel edge of the voxel builder"),
+      RADARGAUSS_OPTION(O, "ndt_min_points", ndt_min_points).AtLeast(1).Help("points a voxel of the voxel builder needs"),
+      RADARGAUSS_OPTION(O, "fit_index_cell", index_cell)
+          .In(kMinIndexCell, kMaxIndexCell)
+          .Unit("m")
+          .Help("cell of the fit's spatial index"),
+      RADARGAUSS_OPTION(O, "association_gate", association_gate)
+          .Above(0.0)
+          .Help("members' association gate tau (Mahalanobis distance)"),
   };
-  require(o.downsample_voxel > 0.0, "downsample voxel must be > 0");
-  require(o.points_per_gaussian >= 1.0, "points per Gaussian must be >= 1");
-  require(o.kmeans_iterations >= 1 && o.em_iterations >= 0, "iteration counts must be >= 1 (EM >= 0)");
-  require(o.min_std > 0.0, "min std must be > 0");
-  require(o.ndt_voxel > 0.0 && o.ndt_min_points >= 1, "NDT voxel must be > 0 and min points >= 1");
-  require(o.index_cell > 0.0, "index cell must be > 0");
-  require(o.association_gate > 0.0, "association gate must be > 0");
+  return table;
 }
 
-}  // namespace
+void ValidateOptions(const GaussianMapOptions& o) { CheckOptions(GaussianMapOptionTable(), o); }
 
 std::vector<std::vector<std::uint32_t>> KMeansPartition(const std::vector<Eigen::Vector3d>& points, std::size_t k,
                                                         const GaussianMapOptions& options) {

@@ -55,6 +55,33 @@ std::string ToString(CoarseLevels coarse) { return NameOf(kCoarseNames, coarse);
 CoarseLevels CoarseLevelsFromString(const std::string& name) { return ValueNamed(kCoarseNames, name, "coarse levels"); }
 std::vector<std::string> CoarseLevelsNames() { return NamesOf(kCoarseNames); }
 
+const OptionTable<MatchingMapOptions>& MatchingMapOptionTable() {
+  using O = MatchingMapOptions;
+  static const OptionTable<O> table = [] {
+    Option<O> sigmas = RADARGAUSS_OPTION(O, "coarse_sigmas", inflation)
+                           .Count(1, 8)
+                           .In(0.0, kMaxCoarseSigma)
+                           .Unit("m")
+                           .Help("blur sigma_k of the coarse levels, coarse first; 0: the exact map alone");
+    sigmas.get = [](const O& o) { return OptionValue(o.inflation.empty() ? std::vector<double>{0.0} : o.inflation); };
+    sigmas.set = [](O& o, const OptionValue& v) {
+      o.inflation = std::get<std::vector<double>>(v);
+      if (o.inflation == std::vector<double>{0.0}) o.inflation.clear();
+    };
+    return OptionTable<O>{
+        RADARGAUSS_CHOICE(O, "coarse_levels", coarse, CoarseLevelsNames(), CoarseLevelsFromString)
+            .Help("coarse levels: merged or inflated"),
+        std::move(sigmas),
+        RADARGAUSS_OPTION(O, "index_cell", index_cell)
+            .In(kMinIndexCell, kMaxIndexCell)
+            .Unit("m")
+            .Help("cell of the exact level's spatial index"),
+        RADARGAUSS_OPTION(O, "coarse_gate", coarse_gate).Above(0.0).Help("tau on the coarse levels"),
+    };
+  }();
+  return table;
+}
+
 MatchingMap::MatchingMap(GaussianMap map, const MatchingMapOptions& options)
     : MatchingMap(std::make_shared<const GaussianMap>(std::move(map)), options) {}
 
@@ -62,15 +89,9 @@ MatchingMap::MatchingMap(std::shared_ptr<const GaussianMap> shared, const Matchi
     : map_(std::move(shared)), coarse_gate_(options.coarse_gate), coarse_(options.coarse) {
   if (!map_) throw std::invalid_argument("MatchingMap needs a map");
   const GaussianMap& map = *map_;
-  if (!(options.index_cell >= kMinIndexCell && options.index_cell <= kMaxIndexCell)) {
-    throw std::invalid_argument("index_cell must be in [0.1, " + std::to_string(int(kMaxIndexCell)) + "] m");
-  }
-  if (!(options.coarse_gate > 0.0)) throw std::invalid_argument("coarse gate must be > 0");
+  CheckOptions(MatchingMapOptionTable(), options);
   for (const double sigma : options.inflation) {
-    if (!(sigma > 0.0 && sigma <= kMaxCoarseSigma)) {
-      throw std::invalid_argument("coarse-to-fine inflation must be in (0, " + std::to_string(int(kMaxCoarseSigma)) +
-                                  "] m");
-    }
+    if (!(sigma > 0.0)) throw std::invalid_argument("coarse_sigmas: a coarse level's sigma must be > 0 m");
     sigmas_.push_back(sigma);
     const double cell = std::max(options.index_cell, CoarseIndexCell(options.coarse, sigma));
     if (options.updatable) {

@@ -12,6 +12,21 @@
 
 namespace radargauss {
 
+const OptionTable<RcsFitOptions>& RcsFitOptionTable() {
+  using O = RcsFitOptions;
+  static const OptionTable<O> table = {
+      RADARGAUSS_OPTION(O, "degree", max_degree).In(0, kMaxShDegree).Help("SH degree of the RCS models"),
+      RADARGAUSS_OPTION(O, "rcs_adaptive", adaptive).Help("lower the degree when members are too few (else no model)"),
+      RADARGAUSS_CHOICE(O, "incidence", incidence, IncidenceModelNames(), IncidenceModelFromString)
+          .Help("incidence vector of the RCS models: offset (the paper) or view"),
+      RADARGAUSS_OPTION(O, "rcs_rank_threshold", rank_threshold)
+          .In(0.0, 1.0)
+          .Above(0.0)
+          .Help("relative pivot threshold of the fit"),
+  };
+  return table;
+}
+
 RcsNormalisation NormaliseRcs(std::vector<double> rcs) {
   RcsNormalisation result;
   if (rcs.size() < 2) return result;

@@ -9,12 +9,22 @@
 
 namespace radargauss {
 
-void ValidateOptions(const ElevationBiasOptions& o) {
-  if (o.window < 1) throw std::invalid_argument("elevation bias window must be >= 1 scan");
-  if (!(o.min_speed > 0.0) || !std::isfinite(o.min_speed)) {
-    throw std::invalid_argument("elevation bias minimum speed must be positive");
-  }
+const OptionTable<ElevationBiasOptions>& ElevationBiasOptionTable() {
+  using O = ElevationBiasOptions;
+  static const OptionTable<O> table = {
+      RADARGAUSS_OPTION(O, "estimate_elevation_bias", estimate)
+          .Sensor()
+          .Help("estimate the elevation bias (beyond the sequence's) from the Doppler velocity (needs the mounting)"),
+      RADARGAUSS_OPTION(O, "elevation_bias_window", window).In(1, 1e6).Help("scans the bias's median is over"),
+      RADARGAUSS_OPTION(O, "elevation_bias_min_speed", min_speed)
+          .Above(0.0)
+          .Unit("m/s")
+          .Help("slower scans leave the bias"),
+  };
+  return table;
 }
+
+void ValidateOptions(const ElevationBiasOptions& o) { CheckOptions(ElevationBiasOptionTable(), o); }
 
 ElevationBias::ElevationBias(const ElevationBiasOptions& options, const SO3d& vehicle_from_radar)
     : options_(options), vehicle_from_radar_(vehicle_from_radar) {

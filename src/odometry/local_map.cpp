@@ -24,25 +24,49 @@ MapEstimator MapEstimatorFromString(const std::string& name) {
 }
 std::vector<std::string> MapEstimatorNames() { return NamesOf(kEstimatorNames); }
 
-void ValidateOptions(const LocalMapOptions& o) {
-  const auto require = [](bool ok, const char* what) {
-    if (!ok) throw std::invalid_argument(what);
-  };
-  require(o.region > 0.0 && std::isfinite(o.region), "map region must be > 0 m and finite");
-  require(o.region_capacity >= 4, "map region capacity must be >= 4 points");
-  if (!(o.min_points >= 1 && o.min_points <= o.region_capacity)) {
-    throw std::invalid_argument("map region_capacity (" + std::to_string(o.region_capacity) +
-                                ", --region-capacity) must be >= min_points (" + std::to_string(o.min_points) +
-                                "), the points a region's first fit needs, and min_points >= 1");
-  }
-  require(o.refit_growth > 0.0 && std::isfinite(o.refit_growth), "map refit growth must be > 0 and finite");
-  require(o.active_radius > 0.0, "active map radius must be > 0 m");
-  require(o.republish_kl >= 0.0 && std::isfinite(o.republish_kl), "map republish KL must be >= 0 and finite");
-  require(o.azimuth_std_deg >= 0.0 && o.azimuth_std_deg <= kMaxAngularNoiseDeg && o.elevation_std_deg >= 0.0 &&
-              o.elevation_std_deg <= kMaxAngularNoiseDeg,
-          "map azimuth_std_deg and elevation_std_deg must be in [0, 5] deg");
-  require(o.gaussians.min_std > 0.0, "minimum std must be > 0 m");
+const OptionTable<LocalMapOptions>& LocalMapOptionTable() {
+  using O = LocalMapOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {
+        RADARGAUSS_OPTION(O, "azimuth_std", azimuth_std_deg)
+            .In(0.0, kMaxAngularNoiseDeg)
+            .Unit("deg")
+            .Sensor()
+            .Help("the radar's azimuth noise: map Gaussians at least this angle x range wide"),
+        RADARGAUSS_OPTION(O, "elevation_std", elevation_std_deg)
+            .In(0.0, kMaxAngularNoiseDeg)
+            .Unit("deg")
+            .Sensor()
+            .Help("the radar's elevation noise: map Gaussians at least this angle x range high"),
+        RADARGAUSS_OPTION(O, "active_radius", active_radius)
+            .Above(0.0)
+            .Unit("m")
+            .Help("radius of the active map around the radar"),
+        RADARGAUSS_OPTION(O, "region", region).Above(0.0).Unit("m").Help("edge of the map regions fitted together"),
+        RADARGAUSS_OPTION(O, "region_capacity", region_capacity)
+            .In(4, 1e6)
+            .NotBelow("region_min_points")
+            .Help("points a region keeps (the newest)"),
+        RADARGAUSS_OPTION(O, "region_min_points", min_points).In(1, 1e6).Help("points a region's first fit needs"),
+        RADARGAUSS_CHOICE(O, "map_estimator", estimator, MapEstimatorNames(), MapEstimatorFromString)
+            .Help("how region Gaussians follow their points: refit (k-means + EM) or incremental"),
+        RADARGAUSS_OPTION(O, "republish_kl", republish_kl)
+            .AtLeast(0.0)
+            .Unit("nats")
+            .Help("incremental map: KL a Gaussian moves before the matching map gets it again"),
+        RADARGAUSS_OPTION(O, "refit_growth", refit_growth)
+            .Above(0.0)
+            .Help("refit a region once its new points reach this share"),
+    };
+    AppendNested(t, GaussianMapOptionTable(), +[](O& o) -> auto& { return o.gaussians; }, "gaussians");
+    AppendNested(t, RcsFitOptionTable(), +[](O& o) -> auto& { return o.rcs; }, "rcs");
+    AppendNested(t, MatchingMapOptionTable(), +[](O& o) -> auto& { return o.matching; }, "matching");
+    return t;
+  }();
+  return table;
 }
+
+void ValidateOptions(const LocalMapOptions& o) { CheckOptions(LocalMapOptionTable(), o); }
 
 LocalMap::LocalMap(const LocalMapOptions& options) : options_(options), map_(std::make_shared<GaussianMap>()) {
   ValidateOptions(options_);

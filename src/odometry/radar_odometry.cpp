@@ -13,30 +13,57 @@
 
 namespace radargauss {
 
-void ValidateOptions(const OdometryOptions& o) {
-  const auto require = [](bool ok, const char* what) {
-    if (!ok) throw std::invalid_argument(what);
-  };
-  const auto finite_non_negative = [](double x) { return std::isfinite(x) && x >= 0.0; };
-  require(finite_non_negative(o.gate_sigmas) && o.gate_sigmas > 0.0, "velocity gate sigmas must be > 0 and finite");
-  require(finite_non_negative(o.acceleration_std), "acceleration std must be >= 0 and finite");
-  require(finite_non_negative(o.min_gate) && o.min_gate > 0.0, "minimum velocity gate must be > 0 m/s and finite");
-  require(o.min_static_points >= 3, "minimum static points must be >= 3");
-  require(finite_non_negative(o.velocity_weight), "velocity weight must be >= 0 and finite");
-  require(finite_non_negative(o.velocity_floor) && o.velocity_floor > 0.0, "velocity floor must be > 0 m and finite");
-  require(finite_non_negative(o.velocity_vertical_floor), "velocity vertical floor must be >= 0 m and finite");
-  require(finite_non_negative(o.rotation_weight), "rotation weight must be >= 0 and finite");
-  require(o.mounting_deg.allFinite() && o.mounting_deg.cwiseAbs().maxCoeff() <= 45.0,
-          "mounting angles must be within +/-45 deg");
-  ValidateOptions(o.elevation_bias);
-  require(o.rotation_rate_std_deg.allFinite() && (o.rotation_rate_std_deg.array() > 0.0).all(),
-          "rotation rate stds must be > 0 deg/s and finite");
-  require(finite_non_negative(o.keyframe_distance), "keyframe distance must be >= 0 m and finite");
-  require(finite_non_negative(o.keyframe_angle_deg), "keyframe angle must be >= 0 deg and finite");
-  require(o.min_matched_points >= 3, "minimum matched points must be >= 3");
-  ValidateOptions(o.match.matching);
-  ValidateOptions(o.map);
+const OptionTable<OdometryOptions>& OdometryOptionTable() {
+  using O = OdometryOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {
+        RADARGAUSS_OPTION(O, "mounting", mounting_deg)
+            .In(-45.0, 45.0)
+            .Unit("deg")
+            .Sensor()
+            .Help("the radar on the vehicle: roll pitch yaw (positive pitch looks down; odometry prints an estimate)"),
+        RADARGAUSS_OPTION(O, "velocity_weight", velocity_weight)
+            .AtLeast(0.0)
+            .Help("weight of the Doppler velocity term (0: off)"),
+        RADARGAUSS_OPTION(O, "velocity_floor", velocity_floor).Above(0.0).Unit("m").Help("std of the velocity term's floor Q"),
+        RADARGAUSS_OPTION(O, "velocity_vertical_floor", velocity_vertical_floor)
+            .AtLeast(0.0)
+            .Unit("m")
+            .Help("its floor along the radar's z (0: velocity_floor); larger leaves the vertical to the map"),
+        RADARGAUSS_OPTION(O, "rotation_weight", rotation_weight).AtLeast(0.0).Help("weight of the rotation term (0: off)"),
+        RADARGAUSS_OPTION(O, "rotation_rate_std", rotation_rate_std_deg)
+            .Above(0.0)
+            .Unit("deg/s")
+            .Help("rotation term: change of the rate between scans about x y z (roll pitch yaw)"),
+        RADARGAUSS_OPTION(O, "gate_sigmas", gate_sigmas).Above(0.0).Help("Doppler gate around the predicted velocity (sigmas)"),
+        RADARGAUSS_OPTION(O, "acceleration_std", acceleration_std)
+            .AtLeast(0.0)
+            .Unit("m/s^2")
+            .Help("process noise of the velocity"),
+        RADARGAUSS_OPTION(O, "min_gate", min_gate).Above(0.0).Unit("m/s").Help("smallest Doppler gate"),
+        RADARGAUSS_OPTION(O, "min_static_points", min_static_points)
+            .AtLeast(3)
+            .Help("fewer Doppler inliers: the prediction stands in"),
+        RADARGAUSS_OPTION(O, "keyframe_distance", keyframe_distance)
+            .AtLeast(0.0)
+            .Unit("m")
+            .Help("a scan enters the map after this distance since the last keyframe ..."),
+        RADARGAUSS_OPTION(O, "keyframe_angle", keyframe_angle_deg).AtLeast(0.0).Unit("deg").Help("... or this rotation"),
+        RADARGAUSS_OPTION(O, "min_matched_points", min_matched_points)
+            .AtLeast(3)
+            .Help("fewer associated points: the prediction stands in"),
+        RADARGAUSS_OPTION(O, "initial_pose", initial_pose).Help("T_world_radar of the first scan: x y z qx qy qz qw"),
+    };
+    AppendNested(t, EgoVelocityOptionTable(), +[](O& o) -> auto& { return o.ego_velocity; }, "ego_velocity");
+    AppendNested(t, MatchOptionTable(), +[](O& o) -> auto& { return o.match; }, "match");
+    AppendNested(t, LocalMapOptionTable(), +[](O& o) -> auto& { return o.map; }, "map");
+    AppendNested(t, ElevationBiasOptionTable(), +[](O& o) -> auto& { return o.elevation_bias; }, "elevation_bias");
+    return t;
+  }();
+  return table;
 }
+
+void ValidateOptions(const OdometryOptions& o) { CheckOptions(OdometryOptionTable(), o); }
 
 RadarOdometry::RadarOdometry(const OdometryOptions& options)
     : RadarOdometry(options, [](const LocalMap&, const MatchOptions& match) {

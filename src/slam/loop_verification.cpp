@@ -15,19 +15,50 @@
 
 namespace radargauss {
 
+const OptionTable<LoopVerificationOptions>& LoopVerificationOptionTable() {
+  using O = LoopVerificationOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {
+        // At most 1000 cells searched each way: 100 m over cells of 0.1 m.
+        RADARGAUSS_OPTION(O, "bev_cell", bev_cell).In(0.1, 10.0).Unit("m").Help("cells of the bird's-eye alignment"),
+        RADARGAUSS_OPTION(O, "bev_search", bev_search)
+            .In(0.0, 100.0)
+            .Unit("m")
+            .Help("translations tried around the keyframes' origins"),
+        RADARGAUSS_OPTION(O, "min_associated", min_associated)
+            .In(0.0, 1.0)
+            .Help("share of the query's points within the gate"),
+        RADARGAUSS_OPTION(O, "max_cost", max_cost).Above(0.0).Help("eq. 2's f at the end of the match"),
+        RADARGAUSS_OPTION(O, "max_translation_std", max_translation_std)
+            .Above(0.0)
+            .Unit("m")
+            .Help("the match's marginal translation std"),
+        RADARGAUSS_OPTION(O, "max_rotation_std", max_rotation_std_deg)
+            .Above(0.0)
+            .Unit("deg")
+            .Help("the match's marginal rotation std"),
+        RADARGAUSS_OPTION(O, "drift", drift).AtLeast(0.0).Unit("m per m").Help("the loop may move the query this much"),
+        RADARGAUSS_OPTION(O, "min_drift", min_drift).AtLeast(0.0).Unit("m").Help("and at least this"),
+        RADARGAUSS_OPTION(O, "drift_deg", drift_deg).AtLeast(0.0).Unit("deg per m").Help("and turn it this much"),
+        RADARGAUSS_OPTION(O, "min_drift_deg", min_drift_deg).AtLeast(0.0).Unit("deg").Help("and at least this"),
+        RADARGAUSS_OPTION(O, "translation_floor_std", translation_floor_std)
+            .Above(0.0)
+            .Unit("m")
+            .Help("added to the match's covariance: what the submaps' own errors leave"),
+        RADARGAUSS_OPTION(O, "rotation_floor_std", rotation_floor_std_deg).Above(0.0).Unit("deg").Help("the same"),
+    };
+    // The loop's match is geometric: its RCS rows are not options.
+    AppendNested(t, MatchOptionTable(), +[](O& o) -> auto& { return o.match; }, "match", "",
+                 {"w_rcs", "rcs_loss", "rcs_loss_scale", "rcs_translation"});
+    AppendNested(t, GaussianMapOptionTable(), +[](O& o) -> auto& { return o.gaussians; }, "gaussians");
+    return t;
+  }();
+  return table;
+}
+
 void ValidateOptions(const LoopVerificationOptions& o) {
-  const auto require = [](bool ok, const char* what) {
-    if (!ok) throw std::invalid_argument(std::string("loop verification: ") + what);
-  };
-  require(o.bev_cell > 0.0 && std::isfinite(o.bev_cell), "bev_cell must be positive and finite");
-  require(o.bev_search >= 0.0 && o.bev_search <= 1000.0 * o.bev_cell, "bev_search must be in [0, 1000 cells]");
-  require(o.min_associated >= 0.0 && o.min_associated <= 1.0, "min_associated must be in [0, 1]");
-  require(o.max_cost > 0.0, "max_cost must be positive");
-  require(o.max_translation_std > 0.0 && o.max_rotation_std_deg > 0.0, "the maximum stds must be positive");
-  require(o.drift >= 0.0 && o.min_drift >= 0.0 && o.drift_deg >= 0.0 && o.min_drift_deg >= 0.0,
-          "the drift bounds must be >= 0");
-  require(o.translation_floor_std > 0.0 && o.rotation_floor_std_deg > 0.0, "the floor stds must be positive");
-  require(o.match.matching.w_rcs == 0.0, "the match is geometric (w_rcs 0)");
+  CheckOptions(LoopVerificationOptionTable(), o);
+  if (o.match.matching.w_rcs != 0.0) throw std::invalid_argument("w_rcs: the loop's match is geometric (w_rcs 0)");
 }
 
 namespace {

@@ -19,18 +19,52 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
+const OptionTable<SlamOptions>& SlamOptionTable() {
+  using O = SlamOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {
+        RADARGAUSS_OPTION(O, "submap_distance", submap_distance)
+            .Above(0.0)
+            .Unit("m")
+            .Sensor()
+            .Help("a keyframe every this many metres driven"),
+        RADARGAUSS_OPTION(O, "min_loop_path", min_loop_path)
+            .AtLeast(0.0)
+            .Unit("m")
+            .Help("metres driven between a loop's keyframes at least"),
+        RADARGAUSS_OPTION(O, "odometry_translation_std", odometry_translation_std)
+            .Above(0.0)
+            .Unit("m")
+            .Help("odometry edges: translation std"),
+        RADARGAUSS_OPTION(O, "odometry_drift", odometry_drift).AtLeast(0.0).Unit("m per m").Help("and its growth"),
+        RADARGAUSS_OPTION(O, "odometry_rotation_std", odometry_rotation_std_deg)
+            .Above(0.0)
+            .Unit("deg")
+            .Help("odometry edges: rotation std"),
+        RADARGAUSS_OPTION(O, "odometry_drift_deg", odometry_drift_deg)
+            .AtLeast(0.0)
+            .Unit("deg per m")
+            .Help("and its growth"),
+        RADARGAUSS_OPTION(O, "false_loop_rate", false_loop_rate)
+            .In(0.0, 1.0)
+            .Study()
+            .Help("robustness studies: the share of keyframes given an injected false loop (0: none)"),
+        RADARGAUSS_OPTION(O, "false_loop_seed", false_loop_seed).Study().Help("seed of the injected false loops"),
+    };
+    AppendNested(t, OdometryOptionTable(), +[](O& o) -> auto& { return o.odometry; }, "odometry");
+    AppendNested(t, PlaceRecognitionOptionTable(), +[](O& o) -> auto& { return o.place_recognition; },
+                 "place_recognition");
+    AppendNested(t, LoopVerificationOptionTable(), +[](O& o) -> auto& { return o.verification; }, "verification",
+                 "verify_");
+    AppendNested(t, PoseGraphOptionTable(), +[](O& o) -> auto& { return o.graph; }, "graph");
+    return t;
+  }();
+  return table;
+}
+
 void ValidateOptions(const SlamOptions& o) {
-  const auto require = [](bool ok, const char* what) {
-    if (!ok) throw std::invalid_argument(std::string("slam: ") + what);
-  };
-  ValidateOptions(o.odometry);
+  CheckOptions(SlamOptionTable(), o);
   ValidateOptions(o.verification);
-  ValidateOptions(o.place_recognition);
-  require(o.submap_distance > 0.0 && std::isfinite(o.submap_distance), "submap_distance must be positive");
-  require(o.min_loop_path >= 0.0, "min_loop_path must be >= 0");
-  require(o.false_loop_rate >= 0.0 && o.false_loop_rate <= 1.0, "false_loop_rate must be in [0, 1]");
-  require(o.odometry_translation_std > 0.0 && o.odometry_rotation_std_deg > 0.0, "odometry stds must be positive");
-  require(o.odometry_drift >= 0.0 && o.odometry_drift_deg >= 0.0, "odometry drifts must be >= 0");
 }
 
 RadarSlam::RadarSlam(const SlamOptions& options)

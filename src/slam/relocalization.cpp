@@ -21,19 +21,45 @@ bool Agree(const SE3d& a, const SE3d& b, double translation, double rotation_deg
 
 }  // namespace
 
+const OptionTable<RelocalizationOptions>& RelocalizationOptionTable() {
+  using O = RelocalizationOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {
+        RADARGAUSS_OPTION(O, "submap_distance", submap_distance)
+            .Above(0.0)
+            .Unit("m")
+            .Sensor()
+            .Help("a submap every this many metres driven"),
+        RADARGAUSS_OPTION(O, "confirm_window", confirm_window)
+            .In(1, 1000)
+            .Help("a submap's places may confirm those of this many submaps before it"),
+        RADARGAUSS_OPTION(O, "confirm_translation", confirm_translation)
+            .Above(0.0)
+            .Unit("m")
+            .Help("the two poses of the odometry in the map may disagree this much"),
+        RADARGAUSS_OPTION(O, "confirm_rotation", confirm_rotation_deg).Above(0.0).Unit("deg").Help("and this much"),
+        RADARGAUSS_OPTION(O, "ambiguous_translation", ambiguous_translation)
+            .Above(0.0)
+            .Unit("m")
+            .Help("agreeing places further apart alias: no fix from them"),
+        RADARGAUSS_OPTION(O, "ambiguous_rotation", ambiguous_rotation_deg).Above(0.0).Unit("deg").Help("or turned"),
+        RADARGAUSS_OPTION(O, "max_unmatched_scans", max_unmatched_scans)
+            .AtLeast(1)
+            .Help("scans in a row without a match that drop the fix"),
+    };
+    AppendNested(t, OdometryOptionTable(), +[](O& o) -> auto& { return o.odometry; }, "odometry");
+    AppendNested(t, PlaceRecognitionOptionTable(), +[](O& o) -> auto& { return o.place_recognition; },
+                 "place_recognition");
+    AppendNested(t, LoopVerificationOptionTable(), +[](O& o) -> auto& { return o.verification; }, "verification",
+                 "verify_");
+    return t;
+  }();
+  return table;
+}
+
 void ValidateOptions(const RelocalizationOptions& o) {
-  ValidateOptions(o.odometry);
-  ValidateOptions(o.place_recognition);
+  CheckOptions(RelocalizationOptionTable(), o);
   ValidateOptions(o.verification);
-  if (!(o.submap_distance > 0.0) || !std::isfinite(o.submap_distance)) {
-    throw std::invalid_argument("relocalization: submap_distance must be positive");
-  }
-  if (!(o.confirm_translation > 0.0) || !(o.confirm_rotation_deg > 0.0) || !(o.ambiguous_translation > 0.0) ||
-      !(o.ambiguous_rotation_deg > 0.0)) {
-    throw std::invalid_argument("relocalization: the confirmation and ambiguity tolerances must be positive");
-  }
-  if (o.confirm_window < 1) throw std::invalid_argument("relocalization: confirm_window must be >= 1");
-  if (o.max_unmatched_scans < 1) throw std::invalid_argument("relocalization: max_unmatched_scans must be >= 1");
 }
 
 Relocalizer::Relocalizer(GaussianMap map, const RelocalizationOptions& options) : options_(options) {

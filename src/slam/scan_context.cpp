@@ -6,7 +6,20 @@
 #include <limits>
 #include <stdexcept>
 
+#include "radargauss/names.hpp"
+
 namespace radargauss {
+
+namespace {
+constexpr NamedValue<ScanContextChannel> kChannelNames[] = {
+    {ScanContextChannel::kGeometric, "geometric"}, {ScanContextChannel::kRcs, "rcs"}, {ScanContextChannel::kBoth, "both"}};
+}  // namespace
+
+std::string ToString(ScanContextChannel channel) { return NameOf(kChannelNames, channel); }
+ScanContextChannel ScanContextChannelFromString(const std::string& name) {
+  return ValueNamed(kChannelNames, name, "Scan Context channel");
+}
+std::vector<std::string> ScanContextChannelNames() { return NamesOf(kChannelNames); }
 
 void ValidateScanContextOptions(const ScanContextOptions& options) {
   if (options.rings < 1 || options.sectors < 1) {

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 
 #include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/options.hpp"
 #include "radargauss/voxel_grid.hpp"
 
 namespace radargauss {
@@ -40,6 +41,10 @@ struct GaussianMapOptions {
   double index_cell = 1.0;        // m, voxel hash of the spatial index
   double association_gate = 3.0;  // tau: Mahalanobis distance gate for members
 };
+
+// Its options (options.hpp); ValidateOptions throws std::invalid_argument naming the bad one.
+const OptionTable<GaussianMapOptions>& GaussianMapOptionTable();
+void ValidateOptions(const GaussianMapOptions& options);
 
 // Progress callback: (stage, done, total); may be empty.
 using ProgressCallback = std::function<void(const char*, std::size_t, std::size_t)>;

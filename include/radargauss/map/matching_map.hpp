@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/options.hpp"
 
 namespace radargauss {
 
@@ -58,6 +59,10 @@ struct MatchingMapOptions {
   // An updatable map (MatchingMap::Update), as odometry's local map needs.
   bool updatable = false;
 };
+// Its options (options.hpp) but `updatable`, which the code that needs an
+// updatable map sets; coarse_sigmas [0] stands for no coarse level.
+const OptionTable<MatchingMapOptions>& MatchingMapOptionTable();
+
 // The exact map alone: one level, no coarse-to-fine.
 inline MatchingMapOptions ExactMapOnly() {
   MatchingMapOptions options;

@@ -21,6 +21,7 @@
 
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/map/map_cloud.hpp"
+#include "radargauss/options.hpp"
 
 namespace radargauss {
 
@@ -55,6 +56,8 @@ struct RcsFitOptions {
   // fitting huge coefficients that explode off the sampled directions.
   double rank_threshold = 1e-2;
 };
+// Its options (options.hpp).
+const OptionTable<RcsFitOptions>& RcsFitOptionTable();
 
 // Fits one model from the members' incidence directions and raw RCS.
 RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::vector<double>& rcs,

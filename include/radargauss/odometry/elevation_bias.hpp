@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include "radargauss/lie/so3.hpp"
+#include "radargauss/options.hpp"
 #include "radargauss/types.hpp"
 
 namespace radargauss {
@@ -30,7 +31,8 @@ struct ElevationBiasOptions {
   double min_speed = 5.0;    // m/s: slower scans are left out
 };
 
-// Throws std::invalid_argument naming the bad option.
+// Its options (options.hpp); ValidateOptions throws std::invalid_argument naming the bad one.
+const OptionTable<ElevationBiasOptions>& ElevationBiasOptionTable();
 void ValidateOptions(const ElevationBiasOptions& options);
 
 class ElevationBias {

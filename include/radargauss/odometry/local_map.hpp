@@ -75,7 +75,8 @@ struct LocalMapOptions {
   MatchingMapOptions matching = LocalMatchingMapOptions();  // coarse levels, index cells (always updatable)
 };
 
-// Throws std::invalid_argument naming the bad option.
+// Its options (options.hpp); ValidateOptions throws std::invalid_argument naming the bad one.
+const OptionTable<LocalMapOptions>& LocalMapOptionTable();
 void ValidateOptions(const LocalMapOptions& options);
 
 // `covariance` widened to the radar's angular noise at `range` (m) and at

@@ -79,7 +79,10 @@ struct OdometryOptions {
 // down: docs/design.md, "Mounting").
 SO3d VehicleFromRadar(const Eigen::Vector3d& roll_pitch_yaw_deg);
 
-// Throws std::invalid_argument naming the bad option.
+// Its options (options.hpp): its own, then the Doppler filter's, the
+// match's, the local map's and the elevation bias's; ValidateOptions throws
+// std::invalid_argument naming the bad one.
+const OptionTable<OdometryOptions>& OdometryOptionTable();
 void ValidateOptions(const OdometryOptions& options);
 
 // What happened to one scan.

@@ -51,7 +51,9 @@ struct LoopVerificationOptions {
   double rotation_floor_std_deg = 0.5;
 };
 
-// Throws std::invalid_argument naming the bad option.
+// Its options (options.hpp), the match's and the submaps' Gaussians' among
+// them; ValidateOptions throws std::invalid_argument naming the bad one.
+const OptionTable<LoopVerificationOptions>& LoopVerificationOptionTable();
 void ValidateOptions(const LoopVerificationOptions& options);
 
 struct LoopCheck {

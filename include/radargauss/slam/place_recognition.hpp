@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "radargauss/options.hpp"
 #include "radargauss/slam/radon_descriptor.hpp"
 #include "radargauss/slam/scan_context.hpp"
 #include "radargauss/types.hpp"
@@ -37,7 +38,8 @@ struct PlaceRecognitionOptions {
   double max_radon_distance = 0.15;
 };
 
-// Throws std::invalid_argument naming the bad option.
+// Its options (options.hpp); ValidateOptions throws std::invalid_argument naming the bad one.
+const OptionTable<PlaceRecognitionOptions>& PlaceRecognitionOptionTable();
 void ValidateOptions(const PlaceRecognitionOptions& options);
 
 // The first point of each voxel of edge `voxel`, in arrival order.

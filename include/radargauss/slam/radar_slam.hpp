@@ -48,6 +48,9 @@ struct SlamOptions {
 };
 
 // Throws std::invalid_argument naming the bad option.
+// Its options (options.hpp): its own, the odometry's, place recognition's,
+// the loop verification's (verify_*) and the pose graph's.
+const OptionTable<SlamOptions>& SlamOptionTable();
 void ValidateOptions(const SlamOptions& options);
 
 struct Keyframe {

@@ -51,7 +51,10 @@ struct RelocalizationOptions {
   int max_unmatched_scans = 10;
 };
 
-// Throws std::invalid_argument naming the bad option.
+// Its options (options.hpp): its own, the odometry's, place recognition's
+// and the verification's (verify_*); ValidateOptions throws
+// std::invalid_argument naming the bad one.
+const OptionTable<RelocalizationOptions>& RelocalizationOptionTable();
 void ValidateOptions(const RelocalizationOptions& options);
 
 struct RelocalizationStep {

@@ -34,6 +34,9 @@ struct MatchOptions {
   MultiHypothesisOptions hypotheses;  // kMultiHypothesis
 };
 
+// Its options (options.hpp): the solver, eq. 2's and the solvers' own (gn_*, ceres_*, mh_*).
+const OptionTable<MatchOptions>& MatchOptionTable();
+
 // Throws std::invalid_argument for bad options.
 std::unique_ptr<ScanMatcher> MakeScanMatcher(const MatchOptions& options);
 // The same from a name of ScanMatcherNames() (throws for an unknown one).

@@ -58,6 +58,9 @@ struct PoseGraphOptions {
   int threads = 1;
 };
 
+// Its options (options.hpp).
+const OptionTable<PoseGraphOptions>& PoseGraphOptionTable();
+
 struct PoseGraphSummary {
   bool converged = false;
   int iterations = 0;  // Levenberg-Marquardt's, over every solve

@@ -18,6 +18,7 @@
 
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/map/matching_map.hpp"
+#include "radargauss/options.hpp"
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/residuals/priors.hpp"
 #include "radargauss/types.hpp"
@@ -65,7 +66,8 @@ struct ScanMatchingOptions {
   double coarse_rotation_tolerance = 1e-3;     // rad only steer into the exact map's basin
 };
 
-// Throws std::invalid_argument naming the bad option.
+// Its options (options.hpp); ValidateOptions throws std::invalid_argument naming the bad one.
+const OptionTable<ScanMatchingOptions>& ScanMatchingOptionTable();
 void ValidateOptions(const ScanMatchingOptions& options);
 
 struct ScanMatchingResult {

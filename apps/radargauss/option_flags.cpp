@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "option_flags.hpp"
+
+#include <cctype>
+
+namespace radargauss::cli {
+
+namespace {
+bool show_every_option = false;
+}  // namespace
+
+void ShowEveryOption(bool show) { show_every_option = show; }
+bool ShowingEveryOption() { return show_every_option; }
+
+std::string HelpGroup(OptionGroup group) {
+  switch (group) {
+    case OptionGroup::kSensor:
+      return "Sensor and method";
+    case OptionGroup::kTuning:
+      return "Tuning";
+    case OptionGroup::kStudy:
+      return "Study";
+  }
+  return "Tuning";
+}
+
+std::string GroupedHelp::make_group(std::string group, bool is_positional,
+                                    std::vector<const CLI::Option*> opts) const {
+  if (!show_every_option && (group == HelpGroup(OptionGroup::kTuning) || group == HelpGroup(OptionGroup::kStudy))) {
+    return {};
+  }
+  return CLI::Formatter::make_group(std::move(group), is_positional, std::move(opts));
+}
+
+std::string HelpText(const OptionSpec& option) {
+  std::string text = option.help;
+  if (!text.empty()) text[0] = char(std::toupper(static_cast<unsigned char>(text[0])));
+  if (!option.unit.empty()) text += " (" + option.unit + ")";
+  if (!option.at_least.empty()) {
+    OptionSpec other;
+    other.name = option.at_least;
+    text += "; at least " + other.Flag();
+  }
+  return text;
+}
+
+}  // namespace radargauss::cli
