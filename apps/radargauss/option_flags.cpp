@@ -2,12 +2,28 @@
 #include "option_flags.hpp"
 
 #include <cctype>
+#include <map>
+#include <utility>
 
 namespace radargauss::cli {
 
 namespace {
 bool show_every_option = false;
 }  // namespace
+
+void CheckAfterParse(CLI::App* app, std::function<void()> check) {
+  static std::map<CLI::App*, std::vector<std::function<void()>>> checks;
+  std::vector<std::function<void()>>& of_app = checks[app];
+  of_app.push_back(std::move(check));
+  if (of_app.size() > 1) return;  // the callback below runs them all
+  app->final_callback([&of_app] {
+    try {
+      for (const std::function<void()>& run : of_app) run();
+    } catch (const std::invalid_argument& e) {
+      throw CLI::ValidationError(e.what());
+    }
+  });
+}
 
 void ShowEveryOption(bool show) { show_every_option = show; }
 bool ShowingEveryOption() { return show_every_option; }

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -30,6 +31,10 @@ class GroupedHelp : public CLI::Formatter {
  public:
   std::string make_group(std::string group, bool is_positional, std::vector<const CLI::Option*> opts) const override;
 };
+// Runs `check` once `app`'s flags are all read (every check added to it, in
+// order); a std::invalid_argument becomes a ValidationError.
+void CheckAfterParse(CLI::App* app, std::function<void()> check);
+
 // "Std of the velocity term's floor Q (m); at least --x".
 std::string HelpText(const OptionSpec& option);
 
@@ -65,13 +70,7 @@ void AddTableOptions(CLI::App* app, const OptionTable<Options>& table, Options& 
     flag->group(HelpGroup(option->group));
   }
   // What no single flag decides (an option below another) is checked once all are read.
-  app->final_callback([&table, &options] {
-    try {
-      CheckOptions(table, options, true);
-    } catch (const std::invalid_argument& e) {
-      throw CLI::ValidationError(e.what());
-    }
-  });
+  CheckAfterParse(app, [&table, &options] { CheckOptions(table, options, true); });
   if (!ShowingEveryOption()) app->footer("--help-all lists every option (the tuning and study groups too)");
   app->formatter(std::make_shared<GroupedHelp>());
 }

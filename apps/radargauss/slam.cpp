@@ -23,6 +23,7 @@ namespace {
 struct SlamSettings {
   OdometrySettings odometry;  // the run's inputs; the odometry's options are slam.odometry
   SlamOptions slam;
+  FalseLoopStudy study;
   bool no_map = false;
 };
 
@@ -33,7 +34,7 @@ int RunSlam(const SlamSettings& s) {
   const Sequence& sequence = inputs.sequence;
   const std::optional<Trajectory>& reference = inputs.reference;
   StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "odometry", "map.rgm", "map.ply"});
-  RadarSlam slam(options);
+  RadarSlam slam(options, s.study);
   RegisterScans(sequence, "slam", [&](const RadarScan& scan) { slam.Register(scan); });
   slam.Finish();
   GaussianMap map;
@@ -78,6 +79,7 @@ Subcommand AddSlam(CLI::App& parent) {
   AddSequenceOptions(app, s->odometry.sequence, "--gt", "Reference trajectory (TUM), for the evaluation only");
   app->add_option("--out", s->odometry.out, "Output folder")->required();
   AddTableOptions(app, SlamOptionTable(), s->slam);
+  AddTableOptions(app, FalseLoopStudyOptionTable(), s->study);
   AddRunOptions(app, s->odometry);
   app->add_flag("--no-map", s->no_map, "Write no map of the place (trajectories and loops only)");
   return {app, [s] { return RunSlam(*s); }};

@@ -107,8 +107,6 @@ class SlamOptions(OdometryOptions, total=False):
     odometry_drift: float  # 0.02
     odometry_rotation_std: float  # 0.1
     odometry_drift_deg: float  # 0.02
-    false_loop_rate: float  # 0.0
-    false_loop_seed: int  # 1
     descriptor: str  # 'scan-context'
     candidates: int  # 20
     max_scan_context_distance: float  # 0.4

@@ -16,7 +16,8 @@ FLAG = re.compile(r"^\s+(--[a-z0-9-]+)(?: ([A-Z]+:(?:\{[^}]*\}|[\[(][^\])]*[\])]
 RUN_FLAGS = {"--help", "--sequence", "--gt", "--extrinsic", "--bag", "--topic", "--bin-layout", "--rcs-field",
              "--doppler-field", "--doppler-sign", "--elevation-bias", "--out", "--imu-topic", "--imu-stamps",
              "--imu-rotation", "--first-scan", "--max-scans"}
-COMMANDS = [("odometry", "odometry", {"--matcher"}), ("slam", "slam", {"--no-map"}),
+COMMANDS = [("odometry", "odometry", {"--matcher"}),
+            ("slam", "slam", {"--no-map", "--false-loop-rate", "--false-loop-seed"}),  # and the study's
             ("relocalize", "relocalization", {"--map"})]
 
 pytestmark = pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool")

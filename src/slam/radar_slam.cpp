@@ -45,11 +45,6 @@ const OptionTable<SlamOptions>& SlamOptionTable() {
             .AtLeast(0.0)
             .Unit("deg per m")
             .Help("and its growth"),
-        RADARGAUSS_OPTION(O, "false_loop_rate", false_loop_rate)
-            .In(0.0, 1.0)
-            .Study()
-            .Help("robustness studies: the share of keyframes given an injected false loop (0: none)"),
-        RADARGAUSS_OPTION(O, "false_loop_seed", false_loop_seed).Study().Help("seed of the injected false loops"),
     };
     AppendNested(t, OdometryOptionTable(), +[](O& o) -> auto& { return o.odometry; }, "odometry");
     AppendNested(t, PlaceRecognitionOptionTable(), +[](O& o) -> auto& { return o.place_recognition; },
@@ -62,14 +57,27 @@ const OptionTable<SlamOptions>& SlamOptionTable() {
   return table;
 }
 
+const OptionTable<FalseLoopStudy>& FalseLoopStudyOptionTable() {
+  using O = FalseLoopStudy;
+  static const OptionTable<O> table = {
+      RADARGAUSS_OPTION(O, "false_loop_rate", rate)
+          .In(0.0, 1.0)
+          .Study()
+          .Help("robustness studies: the share of keyframes given an injected false loop (0: none)"),
+      RADARGAUSS_OPTION(O, "false_loop_seed", seed).Study().Help("seed of the injected false loops"),
+  };
+  return table;
+}
+
 void ValidateOptions(const SlamOptions& o) {
   CheckOptions(SlamOptionTable(), o);
   ValidateOptions(o.verification);
 }
 
-RadarSlam::RadarSlam(const SlamOptions& options)
-    : options_(options), odometry_(options.odometry), false_loops_(options.false_loop_seed) {
+RadarSlam::RadarSlam(const SlamOptions& options, const FalseLoopStudy& study)
+    : options_(options), study_(study), odometry_(options.odometry), false_loops_(study.seed) {
   ValidateOptions(options_);
+  CheckOptions(FalseLoopStudyOptionTable(), study_);
 }
 
 const OdometryStep& RadarSlam::Register(const RadarScan& scan) {
@@ -165,11 +173,11 @@ void RadarSlam::SearchLoops(int query) {
     candidates_.push_back(candidate);
   }
   keyframes_[query].search_ms = MillisecondsSince(start);
-  if (options_.false_loop_rate > 0.0 && !eligible.empty()) InjectFalseLoop(query, eligible);
+  if (study_.rate > 0.0 && !eligible.empty()) InjectFalseLoop(query, eligible);
 }
 
 void RadarSlam::InjectFalseLoop(int query, const std::vector<int>& eligible) {
-  if (std::uniform_real_distribution<double>(0.0, 1.0)(false_loops_) >= options_.false_loop_rate) return;
+  if (std::uniform_real_distribution<double>(0.0, 1.0)(false_loops_) >= study_.rate) return;
   LoopCandidate loop;
   loop.query = query;
   loop.candidate = eligible[std::uniform_int_distribution<std::size_t>(0, eligible.size() - 1)(false_loops_)];

@@ -39,13 +39,18 @@ struct SlamOptions {
   double odometry_drift = 0.02;            // m per m
   double odometry_rotation_std_deg = 0.1;
   double odometry_drift_deg = 0.02;  // deg per m
-  // Robustness studies: after each keyframe's search, with this probability
-  // a false loop to a keyframe chosen at random (at least min_loop_path
-  // back) claiming the two coincide (identity, at the loop floors' weight)
-  // goes into the graph, recorded in candidates() as injected. 0: none.
-  double false_loop_rate = 0.0;
-  std::uint32_t false_loop_seed = 1;
 };
+
+// Robustness studies, apart from what a user sets: after each keyframe's
+// search, with probability `rate` a false loop to a keyframe chosen at
+// random (at least min_loop_path back) claiming the two coincide (identity,
+// at the loop floors' weight) goes into the graph, recorded in candidates()
+// as injected. 0: none.
+struct FalseLoopStudy {
+  double rate = 0.0;
+  std::uint32_t seed = 1;
+};
+const OptionTable<FalseLoopStudy>& FalseLoopStudyOptionTable();
 
 // Throws std::invalid_argument naming the bad option.
 // Its options (options.hpp): its own, the odometry's, place recognition's,
@@ -68,13 +73,13 @@ struct LoopCandidate {
   double distance = 1.0;         // the descriptor's
   double yaw = 0.0;              // rad: the descriptor's, of the query in the candidate
   bool verified = false;         // passed to verification
-  bool injected = false;         // a false loop of false_loop_rate, not a candidate
+  bool injected = false;         // a false loop of FalseLoopStudy, not a candidate
   LoopCheck check;               // check.accepted: in the graph
 };
 
 class RadarSlam {
  public:
-  explicit RadarSlam(const SlamOptions& options = {});
+  explicit RadarSlam(const SlamOptions& options = {}, const FalseLoopStudy& study = {});
 
   // As RadarOdometry::Register; a keyframe that closes is described and searched.
   const OdometryStep& Register(const RadarScan& scan);
@@ -102,6 +107,7 @@ class RadarSlam {
   double PathThroughGraph(int from, int to) const;
 
   SlamOptions options_;
+  FalseLoopStudy study_;
   RadarOdometry odometry_;
   PoseGraph graph_;
   std::vector<Keyframe> keyframes_;
