@@ -88,10 +88,11 @@ void MapPlaces(const std::uint8_t* data, std::size_t size) {
   Expecting([&] {
     const GaussianMap map = ReadMap(path);
     PlaceRecognitionOptions options;
-    for (const PlaceDescriptorKind kind : {PlaceDescriptorKind::kScanContext, PlaceDescriptorKind::kRadon}) {
-      options.descriptor = kind;
+    for (const char* descriptor : {"scan-context", "radon"}) {
+      options.descriptor = descriptor;
+      PlaceDatabase places(options, [](int) -> std::shared_ptr<const PlaceDescription> { return nullptr; });
       for (const MapPlace& place : map.places) {
-        KeyOnly(Describe(DownsampleSubmap(place.points, options.submap_voxel), options));
+        places.Add(places.Describe(DownsampleSubmap(place.points, options.submap_voxel)));
       }
     }
   });

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The inputs radargauss reads, one entry point per format, as the fuzz
 // targets (fuzz/target.cpp) and the replay of their findings
-// (tests/test_fuzz_regressions.cpp) call them. Each feeds the bytes to the
+// (tests/hostile/test_fuzz_regressions.cpp) call them. Each feeds the bytes to the
 // library's real reader; the reader's own errors (DataError, and for the
 // CLI's YAML CLI11's ConversionError) are the expected outcome and are
 // caught. Anything else escapes: a crash, a leak, UB or a hang is a finding.

@@ -94,33 +94,29 @@ ScanMatchingResult CeresSolver::Match(const RadarScan& scan, const MatchingMap& 
   exact_options.callbacks.push_back(&stop);
   // Per stage: associate, solve the association's problem, stop once the pose settles.
   CoarseToFine match(scan, map, initial, options_, priors);
-  bool converged = false;
-  for (const Stage& stage : match.stages()) {
-    converged = false;
-    for (int iteration = 1; iteration <= stage.max_iterations && !converged; ++iteration) {
-      if (!match.Associate(stage, iteration)) return match.Failed();
-      const Correspondences& c = match.correspondences();
-      problem.Update(c, stage.options.w_rcs);
-      const SE3d before = match.pose();
-      stop.Start(c.pose);
-      ceres::Solver::Summary summary;
-      ceres::Solve(stage.full_cost ? exact_options : solver_options, &problem.problem(), &summary);
-      if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
-        match.SetReason("Ceres: " + summary.message);
-        return match.Failed();
-      }
-      match.pose() = PoseOfBlocks(rotation.data(), translation.data());
-      const SE3d step = before.Inverse() * match.pose();
-      // Converged when the pose settled, or when Ceres converged (or took a
-      // step below the tolerances) on an association the outer loop keeps:
-      // the next solve would be the same problem from its own solution.
-      // (stop.small_step: only the last stage's solves carry the callback)
-      const bool settled = summary.termination_type == ceres::CONVERGENCE || stop.small_step;
-      converged = stage.SmallStep(step.translation().norm(), step.rotation().Log().norm()) ||
-                  (KeepsAssociation(stage.finest, c.pose, match.pose(), options_) && settled);
+  return match.Run([&](const Stage& stage, int) {
+    const Correspondences& c = match.correspondences();
+    problem.Update(c, stage.options.w_rcs);
+    const SE3d before = match.pose();
+    stop.Start(c.pose);
+    ceres::Solver::Summary summary;
+    ceres::Solve(stage.full_cost ? exact_options : solver_options, &problem.problem(), &summary);
+    if (!summary.IsSolutionUsable() || !rotation.allFinite() || !translation.allFinite()) {
+      match.SetReason("Ceres: " + summary.message);
+      return StepResult::kFailed;
     }
-  }
-  return match.Finish(converged);
+    match.pose() = PoseOfBlocks(rotation.data(), translation.data());
+    const SE3d step = before.Inverse() * match.pose();
+    // Converged when the pose settled, or when Ceres converged (or took a
+    // step below the tolerances) on an association the outer loop keeps:
+    // the next solve would be the same problem from its own solution.
+    // (stop.small_step: only the last stage's solves carry the callback)
+    const bool settled = summary.termination_type == ceres::CONVERGENCE || stop.small_step;
+    return stage.SmallStep(step.translation().norm(), step.rotation().Log().norm()) ||
+                   (KeepsAssociation(stage.finest, c.pose, match.pose(), options_) && settled)
+               ? StepResult::kConverged
+               : StepResult::kContinue;
+  });
 }
 
 }  // namespace radargauss

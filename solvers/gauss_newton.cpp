@@ -128,38 +128,34 @@ ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const Matchin
   CoarseToFine match(scan, map, initial, options_, priors);
   const int max_halvings = gauss_newton_.max_step_halvings;
   StepCheck check;
-  bool converged = false;
-  for (const Stage& stage : match.stages()) {
-    converged = false;
-    for (int iteration = 1; iteration <= stage.max_iterations && !converged; ++iteration) {
-      if (!match.Associate(stage, iteration)) return match.Failed();
-      const Correspondences& c = match.correspondences();
-      // H = (1-w)/N_geo H_geo + w/N_rcs H_rcs plus the priors', likewise g (eq. 2).
-      const CombinedSystem system =
-          BuildCombinedSystem(c, match.pose(), stage.options, priors, gauss_newton_.loss_curvature);
-      const bool same_association = check.On(c);
-      const std::optional<StepCheck::Waiting> waiting = std::exchange(check.waiting, std::nullopt);
-      Vector6 dx;
-      if (waiting && same_association && system.cost > waiting->cost) {  // the last step raised eq. 2
-        check.taken_back = true;
-        dx = Backtrack(match, stage, waiting->from, waiting->dx, waiting->cost, 0.5, 1, max_halvings);
-      } else {
-        std::string reason;
-        if (!SolveStep(system, gauss_newton_.loss_curvature, dx, reason)) {
-          match.SetReason(reason);
-          return match.Failed();
-        }
-        if (!stage.finest || max_halvings == 0) {  // plain steps: coarse levels only steer
-          match.pose() = Step(match.pose(), dx);
-        } else {
-          dx = TakeChecked(match, stage, check, same_association, dx, system.cost, iteration == stage.max_iterations,
-                           max_halvings);
-        }
+  return match.Run([&](const Stage& stage, int iteration) {
+    const Correspondences& c = match.correspondences();
+    // H = (1-w)/N_geo H_geo + w/N_rcs H_rcs plus the priors', likewise g (eq. 2).
+    const CombinedSystem system =
+        BuildCombinedSystem(c, match.pose(), stage.options, priors, gauss_newton_.loss_curvature);
+    const bool same_association = check.On(c);
+    const std::optional<StepCheck::Waiting> waiting = std::exchange(check.waiting, std::nullopt);
+    Vector6 dx;
+    if (waiting && same_association && system.cost > waiting->cost) {  // the last step raised eq. 2
+      check.taken_back = true;
+      dx = Backtrack(match, stage, waiting->from, waiting->dx, waiting->cost, 0.5, 1, max_halvings);
+    } else {
+      std::string reason;
+      if (!SolveStep(system, gauss_newton_.loss_curvature, dx, reason)) {
+        match.SetReason(reason);
+        return StepResult::kFailed;
       }
-      converged = stage.SmallStep(dx.segment<3>(kTranslationOffset).norm(), dx.segment<3>(kRotationOffset).norm());
+      if (!stage.finest || max_halvings == 0) {  // plain steps: coarse levels only steer
+        match.pose() = Step(match.pose(), dx);
+      } else {
+        dx = TakeChecked(match, stage, check, same_association, dx, system.cost, iteration == stage.max_iterations,
+                         max_halvings);
+      }
     }
-  }
-  return match.Finish(converged);
+    return stage.SmallStep(dx.segment<3>(kTranslationOffset).norm(), dx.segment<3>(kRotationOffset).norm())
+               ? StepResult::kConverged
+               : StepResult::kContinue;
+  });
 }
 
 }  // namespace radargauss

@@ -77,6 +77,7 @@ struct Option : OptionSpec {
   Option Sensor() && { return group = OptionGroup::kSensor, std::move(*this); }
   Option Study() && { return group = OptionGroup::kStudy, std::move(*this); }
   Option NotBelow(std::string other) && { return at_least = std::move(other), std::move(*this); }
+  Option Choices(std::vector<std::string> names) && { return choices = std::move(names), std::move(*this); }
 };
 
 template <typename Options>
@@ -126,7 +127,7 @@ OptionValue ToValue(const T& value) {
   } else if constexpr (std::is_same_v<T, SE3d>) {
     return PoseWords(value);
   } else {
-    return value;  // std::vector<double>
+    return value;  // std::vector<double>, std::string
   }
 }
 
@@ -143,6 +144,8 @@ T FromValue(const OptionValue& value) {
     return Eigen::Vector3d(v[0], v[1], v[2]);
   } else if constexpr (std::is_same_v<T, SE3d>) {
     return PoseFromWords(std::get<std::vector<double>>(value));
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    return std::get<std::string>(value);
   } else {
     return std::get<std::vector<double>>(value);
   }
@@ -152,7 +155,8 @@ T FromValue(const OptionValue& value) {
 
 // An option of `Options` for the member `member` returns, its kind and
 // range from the member's type: bool a flag, an integer within its type,
-// Eigen::Vector3d three reals, SE3d a pose of seven.
+// Eigen::Vector3d three reals, SE3d a pose of seven, a string a choice
+// (its names by Choices).
 template <typename Options, typename T>
 Option<Options> MakeOption(std::string name, std::string path, T& (*member)(Options&)) {
   Option<Options> option;
@@ -167,6 +171,8 @@ Option<Options> MakeOption(std::string name, std::string path, T& (*member)(Opti
     option.max = std::min(double(std::numeric_limits<T>::max()), kLargest);
   } else if constexpr (std::is_floating_point_v<T>) {
     option.kind = OptionKind::kReal;
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    option.kind = OptionKind::kChoice;
   } else {
     option.kind = OptionKind::kReals;
     if constexpr (std::is_same_v<T, Eigen::Vector3d>) option.min_count = option.max_count = 3;

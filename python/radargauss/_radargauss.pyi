@@ -133,6 +133,7 @@ class SlamOptions(OdometryOptions, total=False):
     verify_min_drift_deg: float  # 10.0
     verify_translation_floor_std: float  # 0.1
     verify_rotation_floor_std: float  # 0.5
+    verify_kept_targets: int  # 64
     verify_solver: str  # 'mh-gn'
     verify_loss: str  # 'trivial'
     verify_loss_scale: float  # 1.0
@@ -219,6 +220,7 @@ class RelocalizationOptions(OdometryOptions, total=False):
     verify_min_drift_deg: float  # 10.0
     verify_translation_floor_std: float  # 0.1
     verify_rotation_floor_std: float  # 0.5
+    verify_kept_targets: int  # 64
     verify_solver: str  # 'mh-gn'
     verify_loss: str  # 'trivial'
     verify_loss_scale: float  # 1.0

@@ -46,6 +46,9 @@ const OptionTable<LoopVerificationOptions>& LoopVerificationOptionTable() {
             .Unit("m")
             .Help("added to the match's covariance: what the submaps' own errors leave"),
         RADARGAUSS_OPTION(O, "rotation_floor_std", rotation_floor_std_deg).Above(0.0).Unit("deg").Help("the same"),
+        RADARGAUSS_OPTION(O, "kept_targets", kept_targets)
+            .In(1, 100000)
+            .Help("candidates' verification maps kept, the last verified (each built once while kept)"),
     };
     // The loop's match is geometric: its RCS rows are not options.
     AppendNested(t, MatchOptionTable(), +[](O& o) -> auto& { return o.match; }, "match", "",
@@ -60,6 +63,13 @@ void ValidateOptions(const LoopVerificationOptions& o) {
   CheckOptions(LoopVerificationOptionTable(), o);
   if (o.match.matching.w_rcs != 0.0) throw std::invalid_argument("w_rcs: the loop's match is geometric (w_rcs 0)");
 }
+
+namespace {
+
+// Fewer points in the query or the candidate: "submap too small".
+constexpr std::size_t kMinSubmapPoints = 10;
+
+}  // namespace
 
 namespace {
 
@@ -179,26 +189,51 @@ bool FillInformation(const ScanMatchingResult& match, const LoopVerificationOpti
 
 }  // namespace
 
+VerificationTarget::VerificationTarget(const std::vector<RadarPoint>& candidate, const LoopVerificationOptions& options)
+    : points_(Positions(candidate)), matcher_(MakeScanMatcher(options.match)) {
+  ValidateOptions(options);
+  if (points_.size() >= kMinSubmapPoints) {
+    map_ = std::make_unique<const MatchingMap>(GaussianMap{BuildGaussians(points_, options.gaussians), {}});
+  }
+}
+
+std::shared_ptr<const VerificationTarget> VerificationTargets::Get(int index, const std::vector<RadarPoint>& points,
+                                                                   const LoopVerificationOptions& options) {
+  for (auto kept = kept_.begin(); kept != kept_.end(); ++kept) {
+    if (kept->first != index) continue;
+    kept_.splice(kept_.begin(), kept_, kept);  // the most recent first
+    return kept_.front().second;
+  }
+  auto target = std::make_shared<const VerificationTarget>(points, options);
+  ++built_;
+  kept_.emplace_front(index, target);
+  if (kept_.size() > capacity_) kept_.pop_back();
+  return target;
+}
+
 LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate, double yaw,
+                     const std::optional<GraphPrior>& prior, const LoopVerificationOptions& options) {
+  return VerifyLoop(query, VerificationTarget(candidate, options), yaw, prior, options);
+}
+
+LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const VerificationTarget& candidate, double yaw,
                      const std::optional<GraphPrior>& prior, const LoopVerificationOptions& options) {
   ValidateOptions(options);
   LoopCheck check;
-  if (query.size() < 10 || candidate.size() < 10) {
+  if (query.size() < kMinSubmapPoints || !candidate.map()) {
     check.reason = "submap too small";
     return check;
   }
   const SO3d rotation(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
   std::vector<Eigen::Vector3d> turned = Positions(query);
   for (Eigen::Vector3d& p : turned) p = rotation * p;
-  const std::vector<Eigen::Vector3d> candidate_points = Positions(candidate);
-  const auto [shift, overlap] = AlignBirdsEye(turned, candidate_points, options.bev_cell, options.bev_search);
+  const auto [shift, overlap] = AlignBirdsEye(turned, candidate.points(), options.bev_cell, options.bev_search);
   check.overlap = overlap;
   const SE3d initial(rotation, Eigen::Vector3d(shift.x(), shift.y(), 0.0));
 
-  const MatchingMap map(GaussianMap{BuildGaussians(candidate_points, options.gaussians), {}});
   RadarScan scan;
   scan.points = query;
-  const ScanMatchingResult match = MakeScanMatcher(options.match)->Match(scan, map, initial);
+  const ScanMatchingResult match = candidate.matcher().Match(scan, *candidate.map(), initial);
   check.relative = match.pose;
   check.associated = double(match.n_geo) / query.size();
   check.cost = match.final_cost;

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <map>
 #include <unordered_set>
+#include <utility>
 
 #include "radargauss/names.hpp"
 #include "radargauss/voxel_grid.hpp"
@@ -13,21 +15,56 @@ namespace radargauss {
 
 namespace {
 
-constexpr NamedValue<PlaceDescriptorKind> kDescriptorNames[] = {{PlaceDescriptorKind::kScanContext, "scan-context"},
-                                                                {PlaceDescriptorKind::kRadon, "radon"}};
+// The built-in descriptors are registered here, where the registry starts:
+// a static library's file that only registers would not be linked.
+std::map<std::string, PlaceDescriptorFactory>& Registry() {
+  static std::map<std::string, PlaceDescriptorFactory> registry = {
+      {"scan-context",
+       [](const PlaceRecognitionOptions& o) {
+         return std::make_unique<ScanContextDescriptor>(o.scan_context, o.max_scan_context_distance);
+       }},
+      {"radon",
+       [](const PlaceRecognitionOptions& o) {
+         return std::make_unique<RadonPlaceDescriptor>(o.radon, o.max_radon_distance);
+       }},
+  };
+  return registry;
+}
 
 }  // namespace
 
-std::string ToString(PlaceDescriptorKind kind) { return NameOf(kDescriptorNames, kind); }
-PlaceDescriptorKind PlaceDescriptorKindFromString(const std::string& name) {
-  return ValueNamed(kDescriptorNames, name, "place descriptor");
+bool RegisterPlaceDescriptor(const std::string& name, PlaceDescriptorFactory factory) {
+  if (name.empty() || !factory) throw std::invalid_argument("a place descriptor needs a name and a factory");
+  if (!Registry().emplace(name, std::move(factory)).second) {
+    throw std::invalid_argument("place descriptor '" + name + "' is registered already");
+  }
+  return true;
 }
-std::vector<std::string> PlaceDescriptorKindNames() { return NamesOf(kDescriptorNames); }
+
+std::vector<std::string> PlaceDescriptorNames() {
+  std::vector<std::string> names = {"scan-context", "radon"};  // the built-ins first, as the docs list them
+  for (const auto& entry : Registry()) {
+    if (entry.first != "scan-context" && entry.first != "radon") names.push_back(entry.first);
+  }
+  return names;
+}
+
+std::unique_ptr<PlaceDescriptor> MakePlaceDescriptor(const PlaceRecognitionOptions& options) {
+  const auto found = Registry().find(options.descriptor);
+  if (found == Registry().end()) {
+    throw std::invalid_argument("unknown place descriptor '" + options.descriptor + "' (" +
+                                Joined(PlaceDescriptorNames()) + ")");
+  }
+  std::unique_ptr<PlaceDescriptor> descriptor = found->second(options);
+  if (!descriptor) throw std::invalid_argument("place descriptor '" + options.descriptor + "' made nothing");
+  return descriptor;
+}
 
 const OptionTable<PlaceRecognitionOptions>& PlaceRecognitionOptionTable() {
   using O = PlaceRecognitionOptions;
   static const OptionTable<O> table = {
-      RADARGAUSS_CHOICE(O, "descriptor", descriptor, PlaceDescriptorKindNames(), PlaceDescriptorKindFromString)
+      RADARGAUSS_OPTION(O, "descriptor", descriptor)
+          .Choices(PlaceDescriptorNames())
           .Sensor()
           .Help("place descriptor: scan-context or radon"),
       RADARGAUSS_OPTION(O, "candidates", candidates).In(1, 100000).Help("places compared per submap (nearest keys)"),
@@ -74,65 +111,41 @@ std::vector<RadarPoint> DownsampleSubmap(const std::vector<RadarPoint>& points, 
   return kept;
 }
 
-PlaceDescription Describe(const std::vector<RadarPoint>& submap, const PlaceRecognitionOptions& options) {
-  PlaceDescription description;
-  if (options.descriptor == PlaceDescriptorKind::kScanContext) {
-    description.scan_context = MakeScanContext(submap, options.scan_context);
-  } else {
-    description.radon = MakeRadonDescriptor(submap, options.radon);
+PlaceDatabase::PlaceDatabase(const PlaceRecognitionOptions& options, Redescribe describe)
+    : descriptor_(MakePlaceDescriptor(options)), candidates_(options.candidates), describe_(std::move(describe)) {
+  ValidateOptions(options);
+}
+
+void PlaceDatabase::Add(std::shared_ptr<const PlaceDescription> description) {
+  if (!description) throw std::invalid_argument("PlaceDatabase::Add: no description");
+  if (describe_) {  // the key alone
+    auto key = std::make_shared<PlaceDescription>();
+    key->key = description->key;
+    description = std::move(key);
   }
-  return description;
+  places_.push_back(std::move(description));
 }
 
-const Eigen::VectorXd& KeyOf(const PlaceDescription& description, const PlaceRecognitionOptions& options) {
-  return options.descriptor == PlaceDescriptorKind::kScanContext ? description.scan_context.ring_key
-                                                                 : description.radon.key;
-}
-
-std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vector<PlaceDescription>& places,
-                                   const std::vector<int>& eligible, const PlaceRecognitionOptions& options) {
-  return RankPlaces(query, places, eligible, options, nullptr);
-}
-
-std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vector<PlaceDescription>& keys,
-                                   const std::vector<int>& eligible, const PlaceRecognitionOptions& options,
-                                   const std::function<PlaceDescription(int)>& describe) {
-  const Eigen::VectorXd& query_key = KeyOf(query, options);
+std::vector<PlaceMatch> PlaceDatabase::Rank(const PlaceDescription& query, const std::vector<int>& eligible) const {
   std::vector<std::pair<double, int>> nearest;
-  for (const int c : eligible) nearest.emplace_back((query_key - KeyOf(keys[c], options)).norm(), c);
-  const std::size_t kept = std::min<std::size_t>(nearest.size(), std::size_t(options.candidates));
+  for (const int c : eligible) nearest.emplace_back((query.key - places_.at(std::size_t(c))->key).norm(), c);
+  const std::size_t kept = std::min<std::size_t>(nearest.size(), std::size_t(candidates_));
   std::partial_sort(nearest.begin(), nearest.begin() + kept, nearest.end());
   nearest.resize(kept);
   std::vector<PlaceMatch> matches;
-  PlaceDescription described;
   for (const auto& [key_distance, c] : nearest) {
-    if (describe) described = describe(c);
-    const PlaceDescription& candidate = describe ? described : keys[c];
+    const std::shared_ptr<const PlaceDescription> candidate = describe_ ? describe_(c) : places_[std::size_t(c)];
+    const PlaceComparison comparison = descriptor_->Compare(query, *candidate);
     PlaceMatch match;
     match.candidate = c;
-    if (options.descriptor == PlaceDescriptorKind::kScanContext) {
-      const ScanContextMatch m = CompareScanContexts(query.scan_context, candidate.scan_context, options.scan_context);
-      match.distance = m.distance;
-      match.yaws = {m.yaw};
-      match.close = m.distance <= options.max_scan_context_distance;
-    } else {
-      const RadonMatch m = CompareRadonDescriptors(query.radon, candidate.radon, options.radon);
-      match.distance = m.distance;
-      match.yaws = {m.yaw, m.yaw - M_PI};  // known up to pi
-      match.close = m.distance <= options.max_radon_distance;
-    }
+    match.distance = comparison.distance;
+    match.yaws = comparison.yaws.empty() ? std::vector<double>{0.0} : comparison.yaws;  // no yaw known: 0
+    match.close = comparison.distance <= descriptor_->MaxDistance();
     matches.push_back(std::move(match));
   }
   std::stable_sort(matches.begin(), matches.end(),
                    [](const PlaceMatch& a, const PlaceMatch& b) { return a.distance < b.distance; });
   return matches;
-}
-
-PlaceDescription KeyOnly(PlaceDescription description) {
-  description.scan_context.geometric.resize(0, 0);
-  description.scan_context.rcs.resize(0, 0);
-  description.radon.spectra.resize(0, 0);
-  return description;
 }
 
 }  // namespace radargauss

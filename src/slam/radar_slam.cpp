@@ -75,7 +75,12 @@ void ValidateOptions(const SlamOptions& o) {
 }
 
 RadarSlam::RadarSlam(const SlamOptions& options, const FalseLoopStudy& study)
-    : options_(options), study_(study), odometry_(options.odometry), false_loops_(study.seed) {
+    : options_(options),
+      study_(study),
+      odometry_(options.odometry),
+      places_(options.place_recognition),
+      targets_(options.verification.kept_targets),
+      false_loops_(study.seed) {
   ValidateOptions(options_);
   CheckOptions(FalseLoopStudyOptionTable(), study_);
 }
@@ -136,7 +141,7 @@ void RadarSlam::CloseKeyframe() {
   Keyframe& keyframe = keyframes_.back();
   keyframe.points = DownsampleSubmap(open_points_, options_.place_recognition.submap_voxel);
   open_points_.clear();
-  descriptions_.push_back(Describe(keyframe.points, options_.place_recognition));
+  places_.Add(places_.Describe(keyframe.points));
   keyframe.describe_ms = MillisecondsSince(start);
   open_ = false;
   SearchLoops(int(keyframes_.size()) - 1);
@@ -149,8 +154,7 @@ void RadarSlam::SearchLoops(int query) {
     eligible.push_back(c);
   }
   bool accepted = false;
-  for (const PlaceMatch& match :
-       RankPlaces(descriptions_[query], descriptions_, eligible, options_.place_recognition)) {
+  for (const PlaceMatch& match : places_.Rank(places_.place(std::size_t(query)), eligible)) {
     LoopCandidate candidate;
     candidate.query = query;
     candidate.candidate = match.candidate;
@@ -193,7 +197,7 @@ void RadarSlam::InjectFalseLoop(int query, const std::vector<int>& eligible) {
   candidates_.push_back(loop);
 }
 
-LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match) const {
+LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match) {
   LoopCandidate result;
   result.query = query;
   result.candidate = match.candidate;
@@ -201,9 +205,11 @@ LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match) const {
   result.verified = true;
   const SE3d expected = graph_.poses()[match.candidate].Inverse() * graph_.poses()[query];
   const double path = PathThroughGraph(match.candidate, query);
+  const std::shared_ptr<const VerificationTarget> target =
+      targets_.Get(match.candidate, keyframes_[match.candidate].points, options_.verification);
   for (const double yaw : match.yaws) {
-    LoopCheck check = VerifyLoop(keyframes_[query].points, keyframes_[match.candidate].points, yaw,
-                                 GraphPrior{expected, path}, options_.verification);
+    LoopCheck check =
+        VerifyLoop(keyframes_[query].points, *target, yaw, GraphPrior{expected, path}, options_.verification);
     if (check.accepted || yaw == match.yaws.front() || check.associated > result.check.associated) {
       result.check = std::move(check);
       result.yaw = yaw;

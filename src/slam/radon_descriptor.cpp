@@ -102,4 +102,31 @@ RadonMatch CompareRadonDescriptors(const RadonDescriptor& query, const RadonDesc
   return best;
 }
 
+namespace {
+
+struct RadonDescription final : PlaceDescription {
+  RadonDescriptor descriptor;
+};
+
+}  // namespace
+
+RadonPlaceDescriptor::RadonPlaceDescriptor(const RadonOptions& options, double max_distance)
+    : options_(options), max_distance_(max_distance) {
+  ValidateRadonOptions(options_);
+}
+
+std::shared_ptr<const PlaceDescription> RadonPlaceDescriptor::Describe(const std::vector<RadarPoint>& submap) const {
+  auto description = std::make_shared<RadonDescription>();
+  description->descriptor = MakeRadonDescriptor(submap, options_);
+  description->key = description->descriptor.key;
+  return description;
+}
+
+PlaceComparison RadonPlaceDescriptor::Compare(const PlaceDescription& query, const PlaceDescription& candidate) const {
+  const RadonMatch match = CompareRadonDescriptors(dynamic_cast<const RadonDescription&>(query).descriptor,
+                                                   dynamic_cast<const RadonDescription&>(candidate).descriptor,
+                                                   options_);
+  return {match.distance, {match.yaw, match.yaw - M_PI}};  // known up to pi
+}
+
 }  // namespace radargauss

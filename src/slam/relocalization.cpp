@@ -70,8 +70,11 @@ Relocalizer::Relocalizer(GaussianMap map, const RelocalizationOptions& options) 
   map_ = std::make_shared<const GaussianMap>(std::move(map));
   matching_ = std::make_shared<const MatchingMap>(map_);
   // Keys only: a place's full descriptor is made again when it is compared.
-  for (const MapPlace& place : map_->places)
-    places_.push_back(KeyOnly(Describe(place.points, options_.place_recognition)));
+  places_ = std::make_unique<PlaceDatabase>(options_.place_recognition, [this](int place) {
+    return places_->Describe(map_->places[std::size_t(place)].points);
+  });
+  for (const MapPlace& place : map_->places) places_->Add(places_->Describe(place.points));
+  targets_ = std::make_unique<VerificationTargets>(options_.verification.kept_targets);
   Restart();
 }
 
@@ -132,12 +135,11 @@ const RelocalizationStep& Relocalizer::Register(const RadarScan& scan) {
 void Relocalizer::Search() {
   const int submap = submaps_++;
   const std::vector<RadarPoint> points = DownsampleSubmap(submap_, options_.place_recognition.submap_voxel);
-  const PlaceDescription description = Describe(points, options_.place_recognition);
-  std::vector<int> every(places_.size());
-  for (std::size_t p = 0; p < places_.size(); ++p) every[p] = int(p);
+  const std::shared_ptr<const PlaceDescription> description = places_->Describe(points);
+  std::vector<int> every(places_->size());
+  for (std::size_t p = 0; p < places_->size(); ++p) every[p] = int(p);
   std::vector<std::pair<SE3d, std::size_t>> found;  // T_map_odometry of each verified place, its candidate
-  const auto describe = [&](int place) { return Describe(map_->places[place].points, options_.place_recognition); };
-  for (const PlaceMatch& match : RankPlaces(description, places_, every, options_.place_recognition, describe)) {
+  for (const PlaceMatch& match : places_->Rank(*description, every)) {
     PlaceCandidate candidate;
     candidate.submap = submap;
     candidate.place = match.candidate;
@@ -149,9 +151,10 @@ void Relocalizer::Search() {
       candidate.check.reason = reason;
     } else {
       candidate.verified = true;
+      const std::shared_ptr<const VerificationTarget> target =
+          targets_->Get(match.candidate, map_->places[std::size_t(match.candidate)].points, options_.verification);
       for (const double yaw : match.yaws) {
-        LoopCheck check =
-            VerifyLoop(points, map_->places[match.candidate].points, yaw, std::nullopt, options_.verification);
+        LoopCheck check = VerifyLoop(points, *target, yaw, std::nullopt, options_.verification);
         if (check.accepted || yaw == match.yaws.front() || check.associated > candidate.check.associated) {
           candidate.check = std::move(check);
           candidate.yaw = yaw;

@@ -118,4 +118,31 @@ ScanContextMatch CompareScanContexts(const ScanContext& query, const ScanContext
   return best;
 }
 
+namespace {
+
+struct ScanContextDescription final : PlaceDescription {
+  ScanContext context;
+};
+
+}  // namespace
+
+ScanContextDescriptor::ScanContextDescriptor(const ScanContextOptions& options, double max_distance)
+    : options_(options), max_distance_(max_distance) {
+  ValidateScanContextOptions(options_);
+}
+
+std::shared_ptr<const PlaceDescription> ScanContextDescriptor::Describe(const std::vector<RadarPoint>& submap) const {
+  auto description = std::make_shared<ScanContextDescription>();
+  description->context = MakeScanContext(submap, options_);
+  description->key = description->context.ring_key;
+  return description;
+}
+
+PlaceComparison ScanContextDescriptor::Compare(const PlaceDescription& query, const PlaceDescription& candidate) const {
+  const ScanContextMatch match = CompareScanContexts(dynamic_cast<const ScanContextDescription&>(query).context,
+                                                     dynamic_cast<const ScanContextDescription&>(candidate).context,
+                                                     options_);
+  return {match.distance, {match.yaw}};
+}
+
 }  // namespace radargauss

@@ -6,6 +6,8 @@
 // fitness, on the information matrix and on consistency with the graph.
 #pragma once
 
+#include <list>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +16,7 @@
 
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/map/builder.hpp"
+#include "radargauss/map/matching_map.hpp"
 #include "radargauss/solvers/factory.hpp"
 #include "radargauss/types.hpp"
 
@@ -49,6 +52,9 @@ struct LoopVerificationOptions {
   // Added to the match's covariance: what the submaps' own errors leave.
   double translation_floor_std = 0.1;  // m
   double rotation_floor_std_deg = 0.5;
+  // Candidates made ready for verification (VerificationTarget) that a
+  // search keeps, the last verified: each is built once while it stays.
+  std::size_t kept_targets = 64;
 };
 
 // Its options (options.hpp), the match's and the submaps' Gaussians' among
@@ -83,9 +89,44 @@ struct GraphPrior {
   double path = 0.0;
 };
 
+// A candidate submap made ready for verification once: its points, the
+// matching map of its Gaussians (none for a submap too small to verify) and
+// the matcher, reused for every yaw and every query it is verified against.
+class VerificationTarget {
+ public:
+  VerificationTarget(const std::vector<RadarPoint>& candidate, const LoopVerificationOptions& options);
+  const std::vector<Eigen::Vector3d>& points() const { return points_; }
+  const MatchingMap* map() const { return map_.get(); }
+  const ScanMatcher& matcher() const { return *matcher_; }
+
+ private:
+  std::vector<Eigen::Vector3d> points_;
+  std::unique_ptr<const MatchingMap> map_;
+  std::unique_ptr<const ScanMatcher> matcher_;
+};
+
+// The targets of the last `capacity` candidates verified, by their index
+// (keyframe or map place): each built once while it stays.
+class VerificationTargets {
+ public:
+  explicit VerificationTargets(std::size_t capacity) : capacity_(capacity) {}
+  // The target of candidate `index`, built from `points` when not kept.
+  std::shared_ptr<const VerificationTarget> Get(int index, const std::vector<RadarPoint>& points,
+                                                const LoopVerificationOptions& options);
+  std::size_t built() const { return built_; }
+
+ private:
+  std::size_t capacity_;
+  std::list<std::pair<int, std::shared_ptr<const VerificationTarget>>> kept_;  // most recent first
+  std::size_t built_ = 0;
+};
+
 // Checks the loop from `query` (points in its keyframe's frame) to
 // `candidate` at the descriptor's `yaw`; without a prior (relocalisation)
 // there is no consistency check.
+LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const VerificationTarget& candidate, double yaw,
+                     const std::optional<GraphPrior>& prior, const LoopVerificationOptions& options);
+// The same, the target made for this check alone.
 LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate, double yaw,
                      const std::optional<GraphPrior>& prior, const LoopVerificationOptions& options);
 

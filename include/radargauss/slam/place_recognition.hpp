@@ -1,31 +1,32 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Place recognition over submaps (docs/design.md, "Place recognition"): a
-// submap's description by the selected descriptor, the candidates nearest by
-// its yaw-invariant key, and the full comparison that gives a distance and
-// the yaws to verify. SLAM searches its own keyframes with it,
-// relocalisation a map's places.
+// Place recognition over submaps (docs/design.md, "Place recognition"): the
+// selected descriptor (place_descriptor.hpp) describes a submap; a
+// PlaceDatabase holds the places, ranks the candidates nearest a query by
+// key and compares them in full, which gives a distance and the yaws to
+// verify. SLAM searches its own keyframes with it, relocalisation a map's places.
+//
+//   PlaceDatabase places(options);
+//   places.Add(places.Describe(submap));
+//   for (const PlaceMatch& match : places.Rank(*places.Describe(query), eligible)) ...
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "radargauss/options.hpp"
+#include "radargauss/slam/place_descriptor.hpp"
 #include "radargauss/slam/radon_descriptor.hpp"
 #include "radargauss/slam/scan_context.hpp"
 #include "radargauss/types.hpp"
 
 namespace radargauss {
 
-enum class PlaceDescriptorKind { kScanContext, kRadon };
-std::string ToString(PlaceDescriptorKind kind);                              // "scan-context", "radon"
-PlaceDescriptorKind PlaceDescriptorKindFromString(const std::string& name);  // throws std::invalid_argument
-std::vector<std::string> PlaceDescriptorKindNames();
-
 struct PlaceRecognitionOptions {
-  PlaceDescriptorKind descriptor = PlaceDescriptorKind::kScanContext;
+  std::string descriptor = "scan-context";  // a name of PlaceDescriptorNames()
   ScanContextOptions scan_context;
   RadonOptions radon;
   double submap_voxel = 0.25;  // m: a submap keeps the first point of each voxel
@@ -38,21 +39,21 @@ struct PlaceRecognitionOptions {
   double max_radon_distance = 0.15;
 };
 
+// The descriptors by name: "scan-context" and "radon", and any registered.
+using PlaceDescriptorFactory = std::function<std::unique_ptr<PlaceDescriptor>(const PlaceRecognitionOptions&)>;
+// Adds `factory` under `name`; throws std::invalid_argument for a name taken.
+// Returns true, so that a file can register one at its static initialisation.
+bool RegisterPlaceDescriptor(const std::string& name, PlaceDescriptorFactory factory);
+std::vector<std::string> PlaceDescriptorNames();
+// Throws std::invalid_argument for an unknown name.
+std::unique_ptr<PlaceDescriptor> MakePlaceDescriptor(const PlaceRecognitionOptions& options);
+
 // Its options (options.hpp); ValidateOptions throws std::invalid_argument naming the bad one.
 const OptionTable<PlaceRecognitionOptions>& PlaceRecognitionOptionTable();
 void ValidateOptions(const PlaceRecognitionOptions& options);
 
 // The first point of each voxel of edge `voxel`, in arrival order.
 std::vector<RadarPoint> DownsampleSubmap(const std::vector<RadarPoint>& points, double voxel);
-
-// The selected descriptor of a submap (the other is left empty).
-struct PlaceDescription {
-  ScanContext scan_context;
-  RadonDescriptor radon;
-};
-PlaceDescription Describe(const std::vector<RadarPoint>& submap, const PlaceRecognitionOptions& options);
-// The yaw-invariant key: Scan Context's ring key or the Radon key.
-const Eigen::VectorXd& KeyOf(const PlaceDescription& description, const PlaceRecognitionOptions& options);
 
 struct PlaceMatch {
   int candidate = 0;
@@ -61,17 +62,32 @@ struct PlaceMatch {
   bool close = false;        // distance within the descriptor's maximum
 };
 
-// The `candidates` descriptions nearest `query` by key among the `eligible`
-// indices of `places`, compared in full, nearest first.
-std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vector<PlaceDescription>& places,
-                                   const std::vector<int>& eligible, const PlaceRecognitionOptions& options);
-// The same for a database that keeps only the keys of its places (a few
-// hundred bytes a place, not the descriptor's kilobytes): the compared
-// candidates' full descriptions are made by describe(index).
-std::vector<PlaceMatch> RankPlaces(const PlaceDescription& query, const std::vector<PlaceDescription>& keys,
-                                   const std::vector<int>& eligible, const PlaceRecognitionOptions& options,
-                                   const std::function<PlaceDescription(int)>& describe);
-// The description with its key alone (what the second RankPlaces needs of a place).
-PlaceDescription KeyOnly(PlaceDescription description);
+// The places a search ranks, by one descriptor: each whole, or its key alone
+// (a few hundred bytes a place, not the descriptor's kilobytes) with
+// `describe(place)` to make it whole again when it is compared.
+class PlaceDatabase {
+ public:
+  using Redescribe = std::function<std::shared_ptr<const PlaceDescription>(int place)>;
+  explicit PlaceDatabase(const PlaceRecognitionOptions& options, Redescribe describe = nullptr);
+
+  std::shared_ptr<const PlaceDescription> Describe(const std::vector<RadarPoint>& submap) const {
+    return descriptor_->Describe(submap);
+  }
+  // Adds the next place (index size()).
+  void Add(std::shared_ptr<const PlaceDescription> description);
+  // The `candidates` places nearest `query` by key among `eligible`,
+  // compared in full, nearest first.
+  std::vector<PlaceMatch> Rank(const PlaceDescription& query, const std::vector<int>& eligible) const;
+  std::size_t size() const { return places_.size(); }
+  // A place as kept: whole, or its key alone when the database re-describes.
+  const PlaceDescription& place(std::size_t index) const { return *places_.at(index); }
+  const PlaceDescriptor& descriptor() const { return *descriptor_; }
+
+ private:
+  std::unique_ptr<PlaceDescriptor> descriptor_;
+  int candidates_;
+  Redescribe describe_;
+  std::vector<std::shared_ptr<const PlaceDescription>> places_;
+};
 
 }  // namespace radargauss

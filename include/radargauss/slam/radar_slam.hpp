@@ -101,7 +101,7 @@ class RadarSlam {
   void CloseKeyframe();
   void SearchLoops(int query);
   void InjectFalseLoop(int query, const std::vector<int>& eligible);
-  LoopCandidate Verify(int query, const PlaceMatch& match) const;
+  LoopCandidate Verify(int query, const PlaceMatch& match);
   // The metres driven between two keyframes along the graph's odometry edges,
   // loop edges crossed for free: how far the graph's estimate may have drifted.
   double PathThroughGraph(int from, int to) const;
@@ -111,7 +111,8 @@ class RadarSlam {
   RadarOdometry odometry_;
   PoseGraph graph_;
   std::vector<Keyframe> keyframes_;
-  std::vector<PlaceDescription> descriptions_;  // per closed keyframe
+  PlaceDatabase places_;           // a place per closed keyframe
+  VerificationTargets targets_;  // the last verified keyframes' verification maps
   std::vector<LoopCandidate> candidates_;
   std::vector<std::size_t> scan_keyframe_;  // per scan
   std::vector<RadarPoint> open_points_;     // the open keyframe's submap so far

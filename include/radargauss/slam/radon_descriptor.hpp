@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "radargauss/slam/place_descriptor.hpp"
 #include "radargauss/types.hpp"
 
 namespace radargauss {
@@ -43,5 +44,19 @@ struct RadonMatch {
 // The best row shift of `query` against `candidate`; distance 1 when either is empty.
 RadonMatch CompareRadonDescriptors(const RadonDescriptor& query, const RadonDescriptor& candidate,
                                    const RadonOptions& options);
+
+// The Radon descriptor as a place descriptor: its key, the best row shift's
+// yaw and that yaw - pi (a projection is known up to pi).
+class RadonPlaceDescriptor final : public PlaceDescriptor {
+ public:
+  RadonPlaceDescriptor(const RadonOptions& options, double max_distance);
+  std::shared_ptr<const PlaceDescription> Describe(const std::vector<RadarPoint>& submap) const override;
+  PlaceComparison Compare(const PlaceDescription& query, const PlaceDescription& candidate) const override;
+  double MaxDistance() const override { return max_distance_; }
+
+ private:
+  RadonOptions options_;
+  double max_distance_;
+};
 
 }  // namespace radargauss

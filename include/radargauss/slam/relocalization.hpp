@@ -103,7 +103,8 @@ class Relocalizer {
   RelocalizationOptions options_;
   std::shared_ptr<const GaussianMap> map_;
   std::shared_ptr<const MatchingMap> matching_;
-  std::vector<PlaceDescription> places_;  // each place's key (KeyOnly)
+  std::unique_ptr<PlaceDatabase> places_;  // the map's places by key, described again when compared
+  std::unique_ptr<VerificationTargets> targets_;  // the last verified places' verification maps
   std::unique_ptr<RadarOdometry> odometry_;
   std::vector<RelocalizationStep> steps_;
   std::vector<PlaceCandidate> candidates_;

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "radargauss/slam/place_descriptor.hpp"
 #include "radargauss/types.hpp"
 
 namespace radargauss {
@@ -54,5 +55,18 @@ struct ScanContextMatch {
 // `options`; distance 1 when either is empty.
 ScanContextMatch CompareScanContexts(const ScanContext& query, const ScanContext& candidate,
                                      const ScanContextOptions& options);
+
+// Scan Context as a place descriptor: the ring key, the best column shift's yaw.
+class ScanContextDescriptor final : public PlaceDescriptor {
+ public:
+  ScanContextDescriptor(const ScanContextOptions& options, double max_distance);
+  std::shared_ptr<const PlaceDescription> Describe(const std::vector<RadarPoint>& submap) const override;
+  PlaceComparison Compare(const PlaceDescription& query, const PlaceDescription& candidate) const override;
+  double MaxDistance() const override { return max_distance_; }
+
+ private:
+  ScanContextOptions options_;
+  double max_distance_;
+};
 
 }  // namespace radargauss

@@ -1,17 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The association side of every single-scan solver's loop (docs/design.md,
-// "Coarse to fine" and "Association"): the stages of a match, the
-// correspondences of each iteration, and the end of the match. A solver
-// writes its own loop around it:
+// The loop every single-scan solver shares (docs/design.md, "Coarse to
+// fine" and "Association"): the stages of a match, the correspondences of
+// each iteration, and the end of the match. A solver gives the step alone:
 //
 //   CoarseToFine match(scan, map, initial, options, priors);
-//   for (const Stage& stage : match.stages()) {
-//     for (int iteration = 1; iteration <= stage.max_iterations; ++iteration) {
-//       if (!match.Associate(stage, iteration)) return match.Failed();
-//       ... linearise, solve, update match.pose(), check ...
-//     }
-//   }
-//   return match.Finish();
+//   return match.Run([&](const Stage& stage, int iteration) {
+//     ... linearise match.correspondences() at match.pose(), solve, update match.pose() ...
+//     return small_step ? StepResult::kConverged : StepResult::kContinue;
+//   });
 #pragma once
 
 #include <chrono>
@@ -37,6 +33,10 @@ struct Stage {
   }
 };
 
+// What a solver's step made of an iteration: go on, the stage converged, or
+// the match failed (its reason set).
+enum class StepResult { kContinue, kConverged, kFailed };
+
 class CoarseToFine {
  public:
   // The stages: the coarse levels, the exact map with the geometric term
@@ -53,6 +53,23 @@ class CoarseToFine {
                const ScanPriors&&) = delete;
 
   const std::vector<Stage>& stages() const { return stages_; }
+  // The loop: per stage, per iteration, Associate and `step(stage,
+  // iteration)`; a stage ends when its step converges or at its iteration
+  // limit; the match ends converged when its last stage did.
+  template <typename TakeStep>
+  ScanMatchingResult Run(TakeStep&& step) {
+    bool converged = false;
+    for (const Stage& stage : stages_) {
+      converged = false;
+      for (int iteration = 1; iteration <= stage.max_iterations && !converged; ++iteration) {
+        if (!Associate(stage, iteration)) return Failed();
+        const StepResult result = step(stage, iteration);
+        if (result == StepResult::kFailed) return Failed();
+        converged = result == StepResult::kConverged;
+      }
+    }
+    return Finish(converged);
+  }
   // Iteration `iteration` of `stage` at pose(): its correspondences are made
   // at the first (the exact map's eq. 2 stage takes the geometric stage's
   // last ones with their RCS terms, if still within the re-association

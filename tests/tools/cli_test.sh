@@ -1,0 +1,212 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
+# End-to-end checks of the radargauss command-line tool: good runs work, bad
+# input gives a one-line error on stderr and a non-zero exit.
+#   cli_test.sh <path to radargauss> [pcl|bag]
+set -u
+tool=$1
+source "$(dirname "${BASH_SOURCE[0]}")/cli_expect.sh"
+
+# The cases on optional parts run as tests of their own: "pcl" (the PCL
+# peers) and "bag" (the ROS1 bag reader and the TI bag of ../shared); each
+# exits with 77 (ctest: skipped) when its part is absent.
+skipped=0
+finish_section() {
+  echo "cli, $1: $passed passed, $failed failed, $skipped skipped"
+  [ "$failed" -eq 0 ] || exit 1
+  [ "$skipped" -eq 0 ] || exit 77
+  exit 0
+}
+if [ "${2:-}" = pcl ]; then
+  "$tool" simulate --out "$work/seq10" --scans 10 >/dev/null
+  if "$tool" odometry --sequence "$work/seq10" --matcher pcl-gicp --max-scans 2 --out "$work/odometry_probe" \
+       2>&1 | grep -q "RADARGAUSS_WITH_PCL"; then
+    echo "skipped: radargauss built without PCL"; skipped=$((skipped + 1))
+  else
+    expect_ok "odometry with PCL GICP as the loop's matcher" "wrote $work/odometry_gicp" -- \
+      "$tool" odometry --sequence "$work/seq10" --matcher pcl-gicp --out "$work/odometry_gicp"
+  fi
+  finish_section pcl
+fi
+if [ "${2:-}" = bag ]; then
+  ti_bag="$(cd "$(dirname "$0")/../.." && pwd)/../shared/data/ti_mmwave_demo/demo_ti_mmwave_rospkg_format.bag"
+  if [[ -f "$ti_bag" ]] && "$tool" info --bag "$ti_bag" >/dev/null 2>&1; then
+    expect_ok "odometry on the TI bag with its IMU" "wrote $work/ti" -- \
+      "$tool" odometry --bag "$ti_bag" --topic /ti_mmwave/radar_scan_pcl --rcs-field none --max-scans 60 \
+      --imu-topic /sensor_platform/imu --imu-stamps record --out "$work/ti"
+    expect_fail "odometry on a bag without the topic" "no messages on topic" -- \
+      "$tool" odometry --bag "$ti_bag" --topic /absent --out "$work/ti_absent"
+    expect_fail "odometry with an IMU topic of the wrong type" "not sensor_msgs/Imu" -- \
+      "$tool" odometry --bag "$ti_bag" --topic /ti_mmwave/radar_scan_pcl --rcs-field none \
+      --imu-topic /sensor_platform/baro --out "$work/ti_baro"
+    expect_fail "odometry with IMU stamps on another clock" "do not overlap" -- \
+      "$tool" odometry --bag "$ti_bag" --topic /ti_mmwave/radar_scan_pcl --rcs-field none \
+      --imu-topic /sensor_platform/imu --out "$work/ti_clock"
+    [[ ! -e "$work/ti_clock" ]] || { echo "FAIL: a failed odometry left its output folder"; failed=$((failed + 1)); }
+  else
+    echo "skipped: the TI mmWave bag or ROS1 bag support is absent"; skipped=$((skipped + 1))
+  fi
+  finish_section bag
+fi
+
+expect_fail "no subcommand" "subcommand" -- "$tool"
+expect_fail "unknown flag" "bogus" -- "$tool" info --bogus
+expect_fail "missing sequence" "radargauss: error:" -- "$tool" info --sequence "$work/absent"
+expect_fail "no sequence at all" "radargauss: error: no sequence" -- "$tool" info
+expect_fail "simulate without --out" "out" -- "$tool" simulate
+expect_fail "bad scan count" "scans" -- "$tool" simulate --out "$work/s" --scans -3
+expect_ok "simulate" "simulated 6 scans" -- "$tool" simulate --out "$work/seq" --scans 6 --seed 3
+expect_ok "info on the simulation" "scans: 6 read, 6 matched" -- \
+  "$tool" info --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt"
+expect_fail "simulate over an existing sequence" "already holds" -- \
+  "$tool" simulate --out "$work/seq" --scans 2
+expect_ok "simulate --force" "simulated 2 scans" -- "$tool" simulate --out "$work/seq" --scans 2 --force
+expect_ok "build-map" "wrote $work/seq.rgm" -- \
+  "$tool" build-map --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --out "$work/seq.rgm"
+expect_ok "map-info" "rcs coverage" -- "$tool" map-info "$work/seq.rgm"
+expect_fail "build-map without gt" "needs --gt" -- "$tool" build-map --sequence "$work/seq" --out "$work/x.rgm"
+expect_fail "bad incidence" "incidence" -- \
+  "$tool" build-map --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --out "$work/x.rgm" --incidence side
+head -c 100 "$work/seq.rgm" > "$work/cut.rgm"
+expect_fail "truncated map" "radargauss: error:" -- "$tool" map-info "$work/cut.rgm"
+expect_ok "localize" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0,0.25 --solver gn,ceres --out "$work/results"
+for f in per_scan.csv summary.json table.md reference.tum trajectories/gn-w0-trivial-offset-L3.tum; do
+  if [ -s "$work/results/$f" ]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: missing $f"; fi
+done
+expect_ok "localize with merged coarse levels" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0 --coarse-levels merged --coarse-points 100 --coarse-gate 2 --out "$work/results_merged"
+expect_ok "localize with the losses' curvature" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0.25 --solver gn --loss-curvature --out "$work/results_curvature"
+expect_fail "localize with unknown coarse levels" "coarse-levels" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --coarse-levels blurred --out "$work/r5"
+expect_fail "localize with a zero coarse gate" "coarse-gate" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --coarse-gate 0 --out "$work/r6"
+expect_ok "localize with the scan's points on the coarse levels" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0 --coarse-voxel 0 --out "$work/results_points"
+expect_ok "localize with eq. 2 throughout on the exact map" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0.25 --no-geometric-first --out "$work/results_throughout"
+expect_fail "localize with a value for the geometric-first flag" "geometric-first" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --no-geometric-first=maybe --out "$work/r8"
+expect_fail "localize with a negative coarse voxel" "coarse-voxel" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --coarse-voxel -1 --out "$work/r7"
+expect_fail "localize with RCS weights on a sequence without RCS" "has no RCS field" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --rcs-field none \
+  --w-rcs 0,0.25 --out "$work/r9"
+mkdir -p "$work/dataset" && cp -r "$work/seq/ars548/points" "$work/dataset/points"
+expect_fail "a data set's root as the sequence" "did you mean $work/dataset/points" -- \
+  "$tool" info --sequence "$work/dataset"
+expect_fail "localize with a bad weight" "w-rcs" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --w-rcs 1.5 --out "$work/r2"
+expect_fail "localize with a map of another version" "map version 3" -- \
+  bash -c "cp '$work/seq.rgm' '$work/v3.rgm' && printf '\\x03' | dd of='$work/v3.rgm' bs=1 seek=8 conv=notrunc 2>/dev/null && '$tool' localize --sequence '$work/seq' --gt '$work/seq/gt_radar_tum.txt' --map '$work/v3.rgm' --out '$work/r3'"
+expect_fail "localize --map with --degrees" "drop --map" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" --degrees 1 --out "$work/r4"
+"$tool" simulate --out "$work/seq10" --scans 10 >/dev/null
+expect_ok "evaluate a trajectory against itself" "ATE translation: RMSE 0.000 m" -- \
+  "$tool" evaluate --est "$work/seq10/gt_radar_tum.txt" --ref "$work/seq10/gt_radar_tum.txt" \
+  --align first --out "$work/evaluation"
+if [ -s "$work/evaluation/evaluation.json" ]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: evaluation.json"; fi
+"$tool" build-map --sequence "$work/seq10" --gt "$work/seq10/gt_radar_tum.txt" --out "$work/seq10.rgm" >/dev/null
+expect_ok "refine a trajectory and its map" "wrote $work/refined/refined.tum" -- \
+  "$tool" refine --sequence "$work/seq10" --poses "$work/seq10/gt_radar_tum.txt" --gt "$work/seq10/gt_radar_tum.txt" \
+  --map "$work/seq10.rgm" --rounds 1 --iterations 5 --out "$work/refined"
+expect_fail "refine without --poses" "poses" -- \
+  "$tool" refine --sequence "$work/seq10" --map "$work/seq10.rgm" --out "$work/refined2"
+expect_ok "odometry with its evaluation" "wrote $work/odometry" -- \
+  "$tool" odometry --sequence "$work/seq10" --gt "$work/seq10/gt_radar_tum.txt" --out "$work/odometry"
+for file in odometry.tum per_scan.csv summary.json map.rgm map.ply evaluation.json; do
+  [[ -s "$work/odometry/$file" ]] || { echo "FAIL: odometry wrote no $file"; failed=1; }
+done
+cp -r "$work/seq10" "$work/backwards"
+second=$(ls "$work/backwards/ars548/points" | grep pcd | sed -n 2p)
+cp "$work/backwards/ars548/points/$second" "$work/backwards/ars548/points/${second%%.*}.1.pcd"
+expect_ok "slam with its evaluation" "wrote $work/slam" -- \
+  "$tool" slam --sequence "$work/seq10" --gt "$work/seq10/gt_radar_tum.txt" --submap-distance 2 --out "$work/slam"
+for file in slam.tum keyframes.csv loops.csv slam.json map.rgm map.ply evaluation.json odometry/odometry.tum \
+  odometry/evaluation.json; do
+  [[ -s "$work/slam/$file" ]] || { echo "FAIL: slam wrote no $file"; failed=1; }
+done
+expect_ok "map-info counts the places" "places (SLAM keyframes for relocalize): [1-9]" -- \
+  "$tool" map-info "$work/slam/map.rgm"
+expect_ok "relocalize says when nothing verifies" "relocalize: no fix" -- \
+  "$tool" relocalize --map "$work/slam/map.rgm" --sequence "$work/seq10" --submap-distance 2 \
+  --max-scan-context-distance 0 --out "$work/relocalized"
+[[ -s "$work/relocalized/per_scan.csv" && ! -s "$work/relocalized/relocalization.tum" ]] ||
+  { echo "FAIL: relocalize without a fix wrote no per_scan.csv or a pose"; failed=1; }
+# The evaluation in memory (odometry --gt) and from the files (evaluate) agree
+# field by field, here on the straight drive whose positions lie on a line.
+"$tool" simulate --out "$work/straight" --scans 120 --seed 3 >/dev/null
+"$tool" odometry --sequence "$work/straight" --gt "$work/straight/gt_radar_tum.txt" --out "$work/straight_odometry" \
+  >/dev/null
+"$tool" evaluate --est "$work/straight_odometry/odometry.tum" --ref "$work/straight/gt_radar_tum.txt" \
+  --out "$work/straight_evaluate" >/dev/null
+if /usr/bin/python3 - "$work/straight_odometry/evaluation.json" "$work/straight_evaluate/evaluation.json" <<'PY'
+import json, math, sys
+def flat(value, prefix=""):
+    if isinstance(value, dict):
+        return {k: v for key in value for k, v in flat(value[key], prefix + key + ".").items()}
+    if isinstance(value, list):
+        return {k: v for i, item in enumerate(value) for k, v in flat(item, prefix + str(i) + ".").items()}
+    return {prefix: value}
+memory, files = (flat(json.load(open(path))) for path in sys.argv[1:])
+assert memory.keys() == files.keys(), set(memory) ^ set(files)
+for key, value in memory.items():
+    other = files[key]
+    same = value == other if isinstance(value, str) else math.isclose(value, other, rel_tol=1e-6, abs_tol=1e-9)
+    assert same, "%s: %r in memory, %r from the files" % (key, value, other)
+assert memory["alignment_note."].startswith("rotation from the orientations"), memory["alignment_note."]
+assert memory["ate_rotation_deg.max."] < 5.0, memory["ate_rotation_deg.max."]
+PY
+then
+  passed=$((passed + 1))
+else
+  echo "FAIL: odometry's evaluation and evaluate's differ"; failed=$((failed + 1))
+fi
+expect_fail "odometry on a scan folder with a repeated stamp" "does not increase" -- \
+  "$tool" odometry --sequence "$work/backwards" --out "$work/odometry_backwards"
+[[ ! -e "$work/odometry_backwards/odometry.tum" ]] || { echo "FAIL: a failed odometry left outputs"; failed=1; }
+expect_fail "odometry with a missing reference" "cannot open" -- \
+  "$tool" odometry --sequence "$work/seq10" --gt "$work/absent.tum" --out "$work/odometry_nogt"
+[[ ! -e "$work/odometry_nogt" ]] || { echo "FAIL: odometry with a bad reference left its output folder"; failed=1; }
+expect_fail "odometry with RCS weights on a sequence without RCS" "has no RCS field" -- \
+  "$tool" odometry --sequence "$work/seq10" --rcs-field none --w-rcs 0.25 --out "$work/odometry_rcs"
+expect_fail "odometry with a NaN velocity weight" "velocity-weight" -- \
+  "$tool" odometry --sequence "$work/seq10" --velocity-weight nan --out "$work/odometry_nan"
+expect_fail "odometry with a zero rotation rate std" "rotation-rate-std" -- \
+  "$tool" odometry --sequence "$work/seq10" --rotation-rate-std 1 0 90 --out "$work/odometry_tilt"
+expect_fail "odometry with two rotation rate stds" "rotation-rate-std" -- \
+  "$tool" odometry --sequence "$work/seq10" --rotation-rate-std 1 1 --out "$work/odometry_tilt2"
+expect_fail "odometry with an IMU topic but no bag" "needs --bag" -- \
+  "$tool" odometry --sequence "$work/seq10" --imu-topic /imu --out "$work/odometry_imu"
+expect_fail "evaluate with a missing reference" "cannot open" -- \
+  "$tool" evaluate --est "$work/results/reference.tum" --ref "$work/absent.tum"
+expect_fail "evaluate with an unknown alignment" "align" -- \
+  "$tool" evaluate --est "$work/results/reference.tum" --ref "$work/results/reference.tum" --align umeyama
+printf 'w-rcs: [0, 1]\nstride: 1\n' > "$work/loc.yaml"
+expect_ok "localize --config" "2 configurations" -- \
+  "$tool" localize --config "$work/loc.yaml" --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" --out "$work/r5"
+printf 'bogus-key: 1\n' > "$work/bad_loc.yaml"
+expect_fail "localize --config with an unknown key" "bogus-key" -- \
+  "$tool" localize --config "$work/bad_loc.yaml" --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --out "$work/r6"
+expect_fail "bad doppler sign" "doppler-sign" -- \
+  "$tool" info --sequence "$work/seq" --doppler-sign 2
+printf 'scans: lots\n' >"$work/bad.yaml"
+expect_fail "bad config" "wrong type" -- "$tool" simulate --out "$work/s2" --config "$work/bad.yaml"
+expect_fail "bad ground truth" "expected 8 columns" -- \
+  bash -c "printf '0 1 2\n' > '$work/gt.txt'; '$tool' info --sequence '$work/seq' --gt '$work/gt.txt'"
+first=$(ls "$work/seq/ars548/points/"*.pcd | head -1)
+head -c 300 "$first" >"$work/cut" && mv "$work/cut" "$first"
+expect_fail "truncated scan" "truncated" -- "$tool" info --sequence "$work/seq"
+
+echo "cli: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
