@@ -42,7 +42,8 @@ const OptionTable<MatchOptions>& MatchOptionTable() {
     OptionTable<O> t = {RADARGAUSS_CHOICE(O, "solver", solver, ScanMatcherNames(), SolverKindFromString)
                             .Sensor()
                             .Help("gn (own Gauss-Newton), gn-autodiff, ceres, ceres-dogleg, mh-gn")};
-    AppendNested(t, ScanMatchingOptionTable(), +[](O& o) -> auto& { return o.matching; }, "matching");
+    AppendNested(
+        t, ScanMatchingOptionTable(), +[](O & o) -> auto& { return o.matching; }, "matching");
     for (Option<O> option : OptionTable<O>{
              RADARGAUSS_OPTION(O, "gn_max_step_halvings", gauss_newton.max_step_halvings)
                  .In(0, 64)
@@ -59,12 +60,15 @@ const OptionTable<MatchOptions>& MatchOptionTable() {
              RADARGAUSS_CHOICE(O, "ceres_blocks", ceres.blocks, CeresBlocksNames(), CeresBlocksFromString)
                  .Help("Ceres: how analytic terms enter the problem"),
              RADARGAUSS_OPTION(O, "ceres_threads", ceres.threads).In(1, 1024).Help("Ceres: threads"),
-             RADARGAUSS_OPTION(O, "ceres_function_tolerance", ceres.function_tolerance).Above(0.0).Help(
-                 "Ceres: per solve"),
-             RADARGAUSS_OPTION(O, "ceres_gradient_tolerance", ceres.gradient_tolerance).Above(0.0).Help(
-                 "Ceres: per solve"),
-             RADARGAUSS_OPTION(O, "ceres_parameter_tolerance", ceres.parameter_tolerance).Above(0.0).Help(
-                 "Ceres: per solve"),
+             RADARGAUSS_OPTION(O, "ceres_function_tolerance", ceres.function_tolerance)
+                 .Above(0.0)
+                 .Help("Ceres: per solve"),
+             RADARGAUSS_OPTION(O, "ceres_gradient_tolerance", ceres.gradient_tolerance)
+                 .Above(0.0)
+                 .Help("Ceres: per solve"),
+             RADARGAUSS_OPTION(O, "ceres_parameter_tolerance", ceres.parameter_tolerance)
+                 .Above(0.0)
+                 .Help("Ceres: per solve"),
              RADARGAUSS_OPTION(O, "mh_starts", hypotheses.starts).In(1, 13).Help("multi-hypothesis: starts"),
              RADARGAUSS_OPTION(O, "mh_xy_offset", hypotheses.xy_offset)
                  .AtLeast(0.0)

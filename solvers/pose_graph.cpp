@@ -105,7 +105,6 @@ ceres::Solver::Options SolverOptions(const PoseGraphOptions& options) {
   return solver_options;
 }
 
-
 bool Finite(const SE3d& pose) {
   return pose.translation().allFinite() && pose.rotation().quaternion().coeffs().allFinite();
 }
@@ -124,7 +123,8 @@ const OptionTable<PoseGraphOptions>& PoseGraphOptionTable() {
       RADARGAUSS_OPTION(O, "graduation_factor", graduation_factor).Above(1.0).Help("graduated: mu's divisor per round"),
       RADARGAUSS_CHOICE(O, "graph_initialization", initialization, GraphInitializationNames(),
                         GraphInitializationFromString)
-          .Help("where each solve starts: current (the last optimum and the odometry) or chordal (trusting every loop)"),
+          .Help(
+              "where each solve starts: current (the last optimum and the odometry) or chordal (trusting every loop)"),
       RADARGAUSS_CHOICE(O, "graph_jacobians", jacobians, JacobianModeNames(), JacobianModeFromString)
           .Help("pose graph: closed-form Jacobians or Jets"),
       RADARGAUSS_OPTION(O, "graph_max_iterations", max_iterations).AtLeast(1).Help("pose graph: iterations per solve"),

@@ -56,14 +56,18 @@ const OptionTable<ScanMatchingOptions>& ScanMatchingOptionTable() {
           .AtLeast(0.0)
           .Unit("m")
           .Help("re-associate on the exact map once the pose moved this far"),
-      RADARGAUSS_OPTION(O, "reassociation_rotation", reassociation_rotation).AtLeast(0.0).Unit("rad").Help(
-          "or turned this far"),
+      RADARGAUSS_OPTION(O, "reassociation_rotation", reassociation_rotation)
+          .AtLeast(0.0)
+          .Unit("rad")
+          .Help("or turned this far"),
       RADARGAUSS_OPTION(O, "translation_tolerance", translation_tolerance)
           .Above(0.0)
           .Unit("m")
           .Help("converged when a step on the exact map is smaller"),
-      RADARGAUSS_OPTION(O, "rotation_tolerance", rotation_tolerance).Above(0.0).Unit("rad").Help(
-          "and its rotation smaller"),
+      RADARGAUSS_OPTION(O, "rotation_tolerance", rotation_tolerance)
+          .Above(0.0)
+          .Unit("rad")
+          .Help("and its rotation smaller"),
       RADARGAUSS_OPTION(O, "coarse_translation_tolerance", coarse_translation_tolerance)
           .Above(0.0)
           .Unit("m")

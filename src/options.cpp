@@ -108,9 +108,9 @@ std::string OptionSpec::Check(const OptionValue& value) const {
       const std::vector<double>* list = std::get_if<std::vector<double>>(&value);
       if (!list) return "is not a list of numbers";
       if (list->size() < min_count || list->size() > max_count) {
-        return min_count == max_count ? "does not hold " + std::to_string(min_count) + " numbers"
-                                      : "does not hold " + std::to_string(min_count) + " to " +
-                                            std::to_string(max_count) + " numbers";
+        return min_count == max_count
+                   ? "does not hold " + std::to_string(min_count) + " numbers"
+                   : "does not hold " + std::to_string(min_count) + " to " + std::to_string(max_count) + " numbers";
       }
       for (const double x : *list) {
         const std::string why = CheckNumber(*this, x);
@@ -118,7 +118,8 @@ std::string OptionSpec::Check(const OptionValue& value) const {
       }
       if (unit_quaternion) {
         const Eigen::Map<const Eigen::Vector4d> q(list->data() + list->size() - 4);
-        if (!(std::abs(q.norm() - 1.0) < 1e-3)) return "ends in no unit quaternion (its norm is " + Shortest(q.norm()) + ")";
+        if (!(std::abs(q.norm() - 1.0) < 1e-3))
+          return "ends in no unit quaternion (its norm is " + Shortest(q.norm()) + ")";
       }
       return {};
     }

@@ -26,7 +26,7 @@ int RunBuildMap(const BuildMapSettings& s) {
   const Sequence sequence = LoadSequence(s.sequence);
   const MapGeometry geometry = BuildGeometry(sequence, s.build, true);
   const GaussianMap map =
-      FitRcsModelsOf(geometry, s.build, IncidenceModelFromString(s.build.incidence), s.build.map.rcs.max_degree, true);
+      FitRcsModelsOf(geometry, s.build, s.build.map.rcs.incidence, s.build.map.rcs.max_degree, true);
   WriteMap(s.out, map);
   if (!s.ply.empty()) ExportPly(s.ply, map);
   std::printf("wrote %s%s%s\n", s.out.c_str(), s.ply.empty() ? "" : " and ", s.ply.c_str());

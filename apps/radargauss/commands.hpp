@@ -50,15 +50,9 @@ CLI::Validator NonNegative();
 // Adds FiniteNumber to every floating-point flag of `app` and its subcommands.
 void CheckEveryNumberIsFinite(CLI::App& app);
 
-// The map-building flags of build-map and localize.
+// The map-building flags of build-map and localize: MapOptionTable's.
 struct MapBuildSettings {
   MapOptions map;
-  std::string builder = "kmeans";
-  std::string incidence = "offset";
-  bool no_adaptive = false;
-  bool no_doppler_filter = false;
-  // The options the flags describe (builder, incidence, filter, adaptivity).
-  MapOptions Resolved() const;
 };
 void AddMapBuildOptions(CLI::App* app, MapBuildSettings& settings);
 

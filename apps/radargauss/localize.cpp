@@ -37,7 +37,7 @@ std::vector<GaussianMap> MapsToMatch(const Sequence& sequence, LocalizeSettings&
     degrees = {s.build.map.rcs.max_degree};
     return maps;
   }
-  if (s.incidences.empty()) s.incidences = {s.build.incidence};
+  if (s.incidences.empty()) s.incidences = {ToString(s.build.map.rcs.incidence)};
   if (s.degrees.empty()) s.degrees = {s.build.map.rcs.max_degree};
   const MapGeometry geometry = BuildGeometry(sequence, s.build, false);
   std::printf("map: %zu Gaussians from %zu static points\n", geometry.map.gaussians.size(),

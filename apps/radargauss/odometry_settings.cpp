@@ -95,7 +95,8 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   AddRunOptions(app, s);
 }
 
-void AddRunOptions(CLI::App* app, OdometrySettings& s) {  CLI::Option* imu_topic =
+void AddRunOptions(CLI::App* app, OdometrySettings& s) {
+  CLI::Option* imu_topic =
       app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
   // The IMU's settings without its topic would be read by nothing: refused.
   app->add_option("--imu-stamps", s.imu_stamps, "Stamp the IMU by its header or by the bag's record time")

@@ -40,12 +40,19 @@ std::string HelpGroup(OptionGroup group) {
   return "Tuning";
 }
 
-std::string GroupedHelp::make_group(std::string group, bool is_positional,
-                                    std::vector<const CLI::Option*> opts) const {
+std::string GroupedHelp::make_group(std::string group, bool is_positional, std::vector<const CLI::Option*> opts) const {
   if (!show_every_option && (group == HelpGroup(OptionGroup::kTuning) || group == HelpGroup(OptionGroup::kStudy))) {
     return {};
   }
   return CLI::Formatter::make_group(std::move(group), is_positional, std::move(opts));
+}
+
+std::string GroupedHelp::make_help(const CLI::App* app, std::string name, CLI::AppFormatMode mode) const {
+  std::string help = CLI::Formatter::make_help(app, std::move(name), mode);
+  for (std::size_t blank = help.find("\n\n\n"); blank != std::string::npos; blank = help.find("\n\n\n", blank)) {
+    help.erase(blank, 1);
+  }
+  return help;
 }
 
 std::string HelpText(const OptionSpec& option) {

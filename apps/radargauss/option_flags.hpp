@@ -30,6 +30,8 @@ std::string HelpGroup(OptionGroup group);
 class GroupedHelp : public CLI::Formatter {
  public:
   std::string make_group(std::string group, bool is_positional, std::vector<const CLI::Option*> opts) const override;
+  // CLI11's help without the blank lines the left-out groups leave.
+  std::string make_help(const CLI::App* app, std::string name, CLI::AppFormatMode mode) const override;
 };
 // Runs `check` once `app`'s flags are all read (every check added to it, in
 // order); a std::invalid_argument becomes a ValidationError.

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "commands.hpp"
+#include "option_flags.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/progress.hpp"
 
@@ -103,69 +104,37 @@ void CheckEveryNumberIsFinite(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands({})) CheckEveryNumberIsFinite(*sub);
 }
 
-MapOptions MapBuildSettings::Resolved() const {
-  MapOptions options = map;
-  options.gaussians.builder = MapBuilderFromString(builder);
-  options.cloud.doppler_filter = !no_doppler_filter;
-  options.rcs.incidence = IncidenceModelFromString(incidence);
-  options.rcs.adaptive = !no_adaptive;
-  return options;
-}
-
-void AddMapBuildOptions(CLI::App* app, MapBuildSettings& s) {
-  GaussianMapOptions& gaussians = s.map.gaussians;
-  app->add_option("--builder", s.builder, "kmeans (RA-L default) or voxel (NDT-style baseline)")
-      ->check(CLI::IsMember(MapBuilderNames()))
-      ->capture_default_str();
-  app->add_option("--points-per-gaussian", gaussians.points_per_gaussian,
-                  "K = round(N_downsampled / this) (about 4 for ARS548, 16 for Oculii Eagle)")
-      ->check(InRange(1.0, 1e6))
-      ->capture_default_str();
-  app->add_option("--downsample", gaussians.downsample_voxel, "Voxel downsample edge (m)")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--em-iterations", gaussians.em_iterations, "Hard-EM rounds")
-      ->check(NonNegative())
-      ->capture_default_str();
-  app->add_option("--min-std", gaussians.min_std, "Minimum principal std of a Gaussian (m)")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--ndt-voxel", gaussians.ndt_voxel, "Voxel edge of the voxel builder (m)")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--gate", gaussians.association_gate, "Association gate tau (Mahalanobis distance)")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--map-seed", gaussians.seed, "Seed of the bisecting k-means")->capture_default_str();
-  app->add_option("--degree", s.map.rcs.max_degree, "SH degree of the RCS models (0..3)")
-      ->check(InRange(0, kMaxShDegree))
-      ->capture_default_str();
-  app->add_option("--incidence", s.incidence, "Incidence vector: offset (paper) or view")
-      ->check(CLI::IsMember(IncidenceModelNames()))
-      ->capture_default_str();
-  app->add_flag("--no-adaptive", s.no_adaptive,
-                "Give no model instead of lowering the degree when members are too few");
-  app->add_flag("--no-doppler-filter", s.no_doppler_filter, "Keep dynamic points too");
-}
+void AddMapBuildOptions(CLI::App* app, MapBuildSettings& s) { AddTableOptions(app, MapOptionTable(), s.map); }
 
 MapGeometry BuildGeometry(const Sequence& sequence, const MapBuildSettings& settings, bool verbose) {
   ProgressBar bar;
-  const MapGeometry geometry =
-      BuildMapGeometry(sequence.scans, sequence.poses, settings.Resolved(),
-                       [&](const char* step, std::size_t done, std::size_t total) { bar.Update(step, done, total); });
+  MapGeometry geometry;
+  try {
+    geometry =
+        BuildMapGeometry(sequence.scans, sequence.poses, settings.map,
+                         [&](const char* step, std::size_t done, std::size_t total) { bar.Update(step, done, total); });
+  } catch (const DataError& e) {  // no static point: say which flags decide what is static
+    if (std::string(e.what()).rfind("no static points", 0) == 0 && settings.map.cloud.doppler_filter) {
+      throw DataError(std::string(e.what()) +
+                      " (static: Doppler inliers within --cloud-ego-min-range to "
+                      "--cloud-ego-max-range; --doppler-filter false keeps every point)");
+    }
+    throw;
+  }
   bar.Finish();
   if (verbose) {
     const MapCloudStats& stats = geometry.cloud_stats;
     std::printf("map cloud: %zu scans (%zu without ego velocity), %zu of %zu points static\n", stats.scans,
                 stats.scans_without_ego_velocity, stats.points_static, stats.points_in);
-    std::printf("gaussians: %zu (%s builder)\n", geometry.map.gaussians.size(), settings.builder.c_str());
+    std::printf("gaussians: %zu (%s builder)\n", geometry.map.gaussians.size(),
+                ToString(settings.map.gaussians.builder).c_str());
   }
   return geometry;
 }
 
 GaussianMap FitRcsModelsOf(const MapGeometry& geometry, const MapBuildSettings& settings, IncidenceModel incidence,
                            int degree, bool verbose) {
-  RcsFitOptions rcs = settings.Resolved().rcs;
+  RcsFitOptions rcs = settings.map.rcs;
   rcs.incidence = incidence;
   rcs.max_degree = degree;
   RcsFitStats stats;

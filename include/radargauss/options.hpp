@@ -55,9 +55,9 @@ struct OptionSpec {
   std::string at_least;                      // another option of the table this one may not be below
   bool unit_quaternion = false;              // the list's last four numbers: a unit quaternion (a pose)
 
-  std::string Flag() const;                  // "--region-capacity"
-  std::string RangeText() const;             // "[0, 1]", "(0, inf)", "{gn, ceres}"; empty for a flag
-  std::string TypeText() const;              // "FLOAT", "INT", "TEXT", "FLAG"
+  std::string Flag() const;                           // "--region-capacity"
+  std::string RangeText() const;                      // "[0, 1]", "(0, inf)", "{gn, ceres}"; empty for a flag
+  std::string TypeText() const;                       // "FLOAT", "INT", "TEXT", "FLAG"
   std::string Check(const OptionValue& value) const;  // why `value` is refused; empty when it is fine
   // The value of the words a command line or YAML gave; std::invalid_argument saying why not.
   OptionValue Parse(const std::vector<std::string>& words) const;
@@ -110,8 +110,8 @@ void AppendNested(OptionTable<Outer>& outer, const OptionTable<Inner>& inner, In
 namespace option_detail {
 
 void RequireUniqueNames(const std::vector<std::string>& names);
-double AsNumber(const OptionValue& value);  // an integer's or a real's; throws std::logic_error for others
-std::vector<double> PoseWords(const SE3d& pose);                    // x y z qx qy qz qw
+double AsNumber(const OptionValue& value);        // an integer's or a real's; throws std::logic_error for others
+std::vector<double> PoseWords(const SE3d& pose);  // x y z qx qy qz qw
 SE3d PoseFromWords(const std::vector<double>& words);
 
 template <typename T>
@@ -194,15 +194,19 @@ Option<Options> MakeChoice(std::string name, std::string path, Enum& (*member)(O
   option.kind = OptionKind::kChoice;
   option.choices = std::move(names);
   option.get = [member](const Options& o) { return OptionValue(ToString(member(const_cast<Options&>(o)))); };
-  option.set = [member, from_name](Options& o, const OptionValue& v) { member(o) = from_name(std::get<std::string>(v)); };
+  option.set = [member, from_name](Options& o, const OptionValue& v) {
+    member(o) = from_name(std::get<std::string>(v));
+  };
   return option;
 }
 
 // The member as a function pointer with its path spelled out once.
 #define RADARGAUSS_OPTION(Options, name, member) \
-  ::radargauss::MakeOption<Options>(name, #member, +[](Options & o) -> auto& { return o.member; })
+  ::radargauss::MakeOption<Options>(             \
+      name, #member, +[](Options & o) -> auto& { return o.member; })
 #define RADARGAUSS_CHOICE(Options, name, member, names, from_name) \
-  ::radargauss::MakeChoice<Options>(name, #member, +[](Options & o) -> auto& { return o.member; }, names, from_name)
+  ::radargauss::MakeChoice<Options>(                               \
+      name, #member, +[](Options & o) -> auto& { return o.member; }, names, from_name)
 
 template <typename Options>
 void CheckOptions(const OptionTable<Options>& table, const Options& options, bool as_flags) {

@@ -13,8 +13,8 @@ namespace radargauss::python {
 namespace {
 
 double NumberFromPython(const py::handle& value, const std::string& keyword) {
-  if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value) ||
-                                             py::hasattr(value, "__float__"))) {
+  if (py::isinstance<py::bool_>(value) ||
+      !(py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value) || py::hasattr(value, "__float__"))) {
     throw py::type_error(keyword + " must be a number");
   }
   return value.cast<double>();

@@ -47,8 +47,8 @@ std::string ParametersDoc(const OptionTable<Options>& table) {
   for (const Option<Options>& option : table) {
     const std::string unit = option.unit.empty() ? "" : " (" + option.unit + ")";
     doc += option.name + " : " + TypeDoc(option) + ", default " +
-           py::repr(ValueToPython(option, option.get(defaults))).template cast<std::string>() + "\n    " +
-           option.help + unit + "\n";
+           py::repr(ValueToPython(option, option.get(defaults))).template cast<std::string>() + "\n    " + option.help +
+           unit + "\n";
   }
   return doc;
 }

@@ -215,13 +215,16 @@ const OptionTable<GaussianMapOptions>& GaussianMapOptionTable() {
       RADARGAUSS_OPTION(O, "downsample", downsample_voxel).Above(0.0).Unit("m").Help("voxel downsample edge"),
       RADARGAUSS_OPTION(O, "points_per_gaussian", points_per_gaussian)
           .In(1.0, 1e6)
+          .Sensor()
           .Help("K = round(N_downsampled / this) (about 4 for ARS548, 16 for Oculii Eagle)"),
       RADARGAUSS_OPTION(O, "kmeans_iterations", kmeans_iterations).AtLeast(1).Help("Lloyd iterations per bisection"),
       RADARGAUSS_OPTION(O, "em_iterations", em_iterations).AtLeast(0).Help("hard-EM rounds"),
       RADARGAUSS_OPTION(O, "min_std", min_std).Above(0.0).Unit("m").Help("minimum principal std of a Gaussian"),
       RADARGAUSS_OPTION(O, "map_seed", seed).Help("seed of the bisecting k-means"),
       RADARGAUSS_OPTION(O, "ndt_voxel", ndt_voxel).Above(0.0).Unit("m").Help("voxel edge of the voxel builder"),
-      RADARGAUSS_OPTION(O, "ndt_min_points", ndt_min_points).AtLeast(1).Help("points a voxel of the voxel builder needs"),
+      RADARGAUSS_OPTION(O, "ndt_min_points", ndt_min_points)
+          .AtLeast(1)
+          .Help("points a voxel of the voxel builder needs"),
       RADARGAUSS_OPTION(O, "fit_index_cell", index_cell)
           .In(kMinIndexCell, kMaxIndexCell)
           .Unit("m")

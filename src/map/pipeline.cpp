@@ -7,6 +7,25 @@
 
 namespace radargauss {
 
+const OptionTable<MapOptions>& MapOptionTable() {
+  using O = MapOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {RADARGAUSS_OPTION(O, "doppler_filter", cloud.doppler_filter)
+                            .Help("keep only the scans' ego-velocity inliers (false: dynamic points too)")};
+    AppendNested(
+        t, EgoVelocityOptionTable(), +[](O & o) -> auto& { return o.cloud.ego_velocity; }, "cloud.ego_velocity",
+        "cloud_");
+    AppendNested(
+        t, GaussianMapOptionTable(), +[](O & o) -> auto& { return o.gaussians; }, "gaussians");
+    AppendNested(
+        t, RcsFitOptionTable(), +[](O & o) -> auto& { return o.rcs; }, "rcs");
+    return t;
+  }();
+  return table;
+}
+
+void ValidateOptions(const MapOptions& o) { CheckOptions(MapOptionTable(), o); }
+
 MapGeometry BuildMapGeometry(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
                              const MapOptions& options, const ProgressCallback& progress) {
   MapCloudStats stats;

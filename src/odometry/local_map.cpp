@@ -58,9 +58,12 @@ const OptionTable<LocalMapOptions>& LocalMapOptionTable() {
             .Above(0.0)
             .Help("refit a region once its new points reach this share"),
     };
-    AppendNested(t, GaussianMapOptionTable(), +[](O& o) -> auto& { return o.gaussians; }, "gaussians");
-    AppendNested(t, RcsFitOptionTable(), +[](O& o) -> auto& { return o.rcs; }, "rcs");
-    AppendNested(t, MatchingMapOptionTable(), +[](O& o) -> auto& { return o.matching; }, "matching");
+    AppendNested(
+        t, GaussianMapOptionTable(), +[](O & o) -> auto& { return o.gaussians; }, "gaussians");
+    AppendNested(
+        t, RcsFitOptionTable(), +[](O & o) -> auto& { return o.rcs; }, "rcs");
+    AppendNested(
+        t, MatchingMapOptionTable(), +[](O & o) -> auto& { return o.matching; }, "matching");
     return t;
   }();
   return table;

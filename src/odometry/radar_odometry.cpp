@@ -25,17 +25,24 @@ const OptionTable<OdometryOptions>& OdometryOptionTable() {
         RADARGAUSS_OPTION(O, "velocity_weight", velocity_weight)
             .AtLeast(0.0)
             .Help("weight of the Doppler velocity term (0: off)"),
-        RADARGAUSS_OPTION(O, "velocity_floor", velocity_floor).Above(0.0).Unit("m").Help("std of the velocity term's floor Q"),
+        RADARGAUSS_OPTION(O, "velocity_floor", velocity_floor)
+            .Above(0.0)
+            .Unit("m")
+            .Help("std of the velocity term's floor Q"),
         RADARGAUSS_OPTION(O, "velocity_vertical_floor", velocity_vertical_floor)
             .AtLeast(0.0)
             .Unit("m")
             .Help("its floor along the radar's z (0: velocity_floor); larger leaves the vertical to the map"),
-        RADARGAUSS_OPTION(O, "rotation_weight", rotation_weight).AtLeast(0.0).Help("weight of the rotation term (0: off)"),
+        RADARGAUSS_OPTION(O, "rotation_weight", rotation_weight)
+            .AtLeast(0.0)
+            .Help("weight of the rotation term (0: off)"),
         RADARGAUSS_OPTION(O, "rotation_rate_std", rotation_rate_std_deg)
             .Above(0.0)
             .Unit("deg/s")
             .Help("rotation term: change of the rate between scans about x y z (roll pitch yaw)"),
-        RADARGAUSS_OPTION(O, "gate_sigmas", gate_sigmas).Above(0.0).Help("Doppler gate around the predicted velocity (sigmas)"),
+        RADARGAUSS_OPTION(O, "gate_sigmas", gate_sigmas)
+            .Above(0.0)
+            .Help("Doppler gate around the predicted velocity (sigmas)"),
         RADARGAUSS_OPTION(O, "acceleration_std", acceleration_std)
             .AtLeast(0.0)
             .Unit("m/s^2")
@@ -48,16 +55,23 @@ const OptionTable<OdometryOptions>& OdometryOptionTable() {
             .AtLeast(0.0)
             .Unit("m")
             .Help("a scan enters the map after this distance since the last keyframe ..."),
-        RADARGAUSS_OPTION(O, "keyframe_angle", keyframe_angle_deg).AtLeast(0.0).Unit("deg").Help("... or this rotation"),
+        RADARGAUSS_OPTION(O, "keyframe_angle", keyframe_angle_deg)
+            .AtLeast(0.0)
+            .Unit("deg")
+            .Help("... or this rotation"),
         RADARGAUSS_OPTION(O, "min_matched_points", min_matched_points)
             .AtLeast(3)
             .Help("fewer associated points: the prediction stands in"),
         RADARGAUSS_OPTION(O, "initial_pose", initial_pose).Help("T_world_radar of the first scan: x y z qx qy qz qw"),
     };
-    AppendNested(t, EgoVelocityOptionTable(), +[](O& o) -> auto& { return o.ego_velocity; }, "ego_velocity");
-    AppendNested(t, MatchOptionTable(), +[](O& o) -> auto& { return o.match; }, "match");
-    AppendNested(t, LocalMapOptionTable(), +[](O& o) -> auto& { return o.map; }, "map");
-    AppendNested(t, ElevationBiasOptionTable(), +[](O& o) -> auto& { return o.elevation_bias; }, "elevation_bias");
+    AppendNested(
+        t, EgoVelocityOptionTable(), +[](O & o) -> auto& { return o.ego_velocity; }, "ego_velocity");
+    AppendNested(
+        t, MatchOptionTable(), +[](O & o) -> auto& { return o.match; }, "match");
+    AppendNested(
+        t, LocalMapOptionTable(), +[](O & o) -> auto& { return o.map; }, "map");
+    AppendNested(
+        t, ElevationBiasOptionTable(), +[](O & o) -> auto& { return o.elevation_bias; }, "elevation_bias");
     return t;
   }();
   return table;

@@ -51,9 +51,10 @@ const OptionTable<LoopVerificationOptions>& LoopVerificationOptionTable() {
             .Help("candidates' verification maps kept, the last verified (each built once while kept)"),
     };
     // The loop's match is geometric: its RCS rows are not options.
-    AppendNested(t, MatchOptionTable(), +[](O& o) -> auto& { return o.match; }, "match", "",
+    AppendNested(t, MatchOptionTable(), +[](O & o) -> auto& { return o.match; }, "match", "",
                  {"w_rcs", "rcs_loss", "rcs_loss_scale", "rcs_translation"});
-    AppendNested(t, GaussianMapOptionTable(), +[](O& o) -> auto& { return o.gaussians; }, "gaussians");
+    AppendNested(
+        t, GaussianMapOptionTable(), +[](O & o) -> auto& { return o.gaussians; }, "gaussians");
     return t;
   }();
   return table;

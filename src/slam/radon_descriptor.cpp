@@ -123,9 +123,9 @@ std::shared_ptr<const PlaceDescription> RadonPlaceDescriptor::Describe(const std
 }
 
 PlaceComparison RadonPlaceDescriptor::Compare(const PlaceDescription& query, const PlaceDescription& candidate) const {
-  const RadonMatch match = CompareRadonDescriptors(dynamic_cast<const RadonDescription&>(query).descriptor,
-                                                   dynamic_cast<const RadonDescription&>(candidate).descriptor,
-                                                   options_);
+  const RadonMatch match =
+      CompareRadonDescriptors(dynamic_cast<const RadonDescription&>(query).descriptor,
+                              dynamic_cast<const RadonDescription&>(candidate).descriptor, options_);
   return {match.distance, {match.yaw, match.yaw - M_PI}};  // known up to pi
 }
 

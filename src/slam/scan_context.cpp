@@ -11,8 +11,9 @@
 namespace radargauss {
 
 namespace {
-constexpr NamedValue<ScanContextChannel> kChannelNames[] = {
-    {ScanContextChannel::kGeometric, "geometric"}, {ScanContextChannel::kRcs, "rcs"}, {ScanContextChannel::kBoth, "both"}};
+constexpr NamedValue<ScanContextChannel> kChannelNames[] = {{ScanContextChannel::kGeometric, "geometric"},
+                                                            {ScanContextChannel::kRcs, "rcs"},
+                                                            {ScanContextChannel::kBoth, "both"}};
 }  // namespace
 
 std::string ToString(ScanContextChannel channel) { return NameOf(kChannelNames, channel); }
@@ -139,9 +140,9 @@ std::shared_ptr<const PlaceDescription> ScanContextDescriptor::Describe(const st
 }
 
 PlaceComparison ScanContextDescriptor::Compare(const PlaceDescription& query, const PlaceDescription& candidate) const {
-  const ScanContextMatch match = CompareScanContexts(dynamic_cast<const ScanContextDescription&>(query).context,
-                                                     dynamic_cast<const ScanContextDescription&>(candidate).context,
-                                                     options_);
+  const ScanContextMatch match =
+      CompareScanContexts(dynamic_cast<const ScanContextDescription&>(query).context,
+                          dynamic_cast<const ScanContextDescription&>(candidate).context, options_);
   return {match.distance, {match.yaw}};
 }
 

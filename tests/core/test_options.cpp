@@ -36,9 +36,9 @@ OptionTable<Inner> InnerTable() {
 OptionTable<Outer> OuterTable() {
   using O = Outer;
   OptionTable<O> table = {RADARGAUSS_OPTION(O, "flag", flag).Sensor(),
-                          RADARGAUSS_OPTION(O, "angles", angles).In(-45.0, 45.0),
-                          RADARGAUSS_OPTION(O, "pose", pose)};
-  AppendNested(table, InnerTable(), +[](O& o) -> auto& { return o.inner; }, "inner", "inner_");
+                          RADARGAUSS_OPTION(O, "angles", angles).In(-45.0, 45.0), RADARGAUSS_OPTION(O, "pose", pose)};
+  AppendNested(
+      table, InnerTable(), +[](O & o) -> auto& { return o.inner; }, "inner", "inner_");
   return table;
 }
 
@@ -114,7 +114,8 @@ TEST(Options, CheckNamesTheOptionAndBothOfAPair) {
 
 TEST(Options, ANameTakenTwiceIsRefusedWhenTheTableIsBuilt) {
   OptionTable<Outer> table = OuterTable();
-  EXPECT_THROW(AppendNested(table, InnerTable(), +[](Outer& o) -> auto& { return o.inner; }, "inner", "inner_"),
+  EXPECT_THROW(AppendNested(
+                   table, InnerTable(), +[](Outer & o) -> auto& { return o.inner; }, "inner", "inner_"),
                std::logic_error);
 }
 

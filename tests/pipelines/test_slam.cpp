@@ -246,10 +246,10 @@ const bool range_histogram_registered = RegisterPlaceDescriptor(
 
 TEST(RadarSlam, ANewDescriptorRunsThroughTheInterfaceAlone) {
   ASSERT_TRUE(range_histogram_registered);
-  EXPECT_THROW(RegisterPlaceDescriptor("range-histogram", [](const PlaceRecognitionOptions&) {
-                 return std::make_unique<RangeHistogram>();
-               }),
-               std::invalid_argument);
+  EXPECT_THROW(
+      RegisterPlaceDescriptor("range-histogram",
+                              [](const PlaceRecognitionOptions&) { return std::make_unique<RangeHistogram>(); }),
+      std::invalid_argument);
   SlamOptions options = YardOptions();
   options.place_recognition.descriptor = "range-histogram";
   const std::unique_ptr<RadarSlam> slam = RunYard(options);

@@ -20,6 +20,10 @@ struct MapOptions {
   GaussianMapOptions gaussians;  // builder, density, EM
   RcsFitOptions rcs;             // incidence model, SH degree
 };
+// Its options (options.hpp): the Doppler filter's (cloud_*), the Gaussians'
+// and the RCS models'; ValidateOptions throws std::invalid_argument naming the bad one.
+const OptionTable<MapOptions>& MapOptionTable();
+void ValidateOptions(const MapOptions& options);
 
 // The geometric part of a map: the static cloud, its Gaussians (no RCS
 // models yet) and the Gaussian each cloud point belongs to (-1: none).

@@ -111,7 +111,7 @@ class RadarSlam {
   RadarOdometry odometry_;
   PoseGraph graph_;
   std::vector<Keyframe> keyframes_;
-  PlaceDatabase places_;           // a place per closed keyframe
+  PlaceDatabase places_;         // a place per closed keyframe
   VerificationTargets targets_;  // the last verified keyframes' verification maps
   std::vector<LoopCandidate> candidates_;
   std::vector<std::size_t> scan_keyframe_;  // per scan

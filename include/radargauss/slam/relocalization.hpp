@@ -103,7 +103,7 @@ class Relocalizer {
   RelocalizationOptions options_;
   std::shared_ptr<const GaussianMap> map_;
   std::shared_ptr<const MatchingMap> matching_;
-  std::unique_ptr<PlaceDatabase> places_;  // the map's places by key, described again when compared
+  std::unique_ptr<PlaceDatabase> places_;         // the map's places by key, described again when compared
   std::unique_ptr<VerificationTargets> targets_;  // the last verified places' verification maps
   std::unique_ptr<RadarOdometry> odometry_;
   std::vector<RelocalizationStep> steps_;

@@ -19,7 +19,7 @@
 namespace radargauss {
 
 enum class ScanContextChannel { kGeometric, kRcs, kBoth };
-std::string ToString(ScanContextChannel channel);                        // "geometric", "rcs", "both"
+std::string ToString(ScanContextChannel channel);                          // "geometric", "rcs", "both"
 ScanContextChannel ScanContextChannelFromString(const std::string& name);  // throws std::invalid_argument
 std::vector<std::string> ScanContextChannelNames();
 
