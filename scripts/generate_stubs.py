@@ -15,8 +15,12 @@ import radargauss._radargauss as module
 OPTIONS_OF = {"match": "MatchOptions", "match_options": "MatchOptions", "RadarOdometry.__init__": "OdometryOptions",
               "odometry_options": "OdometryOptions", "RadarSlam.__init__": "SlamOptions", "slam_options": "SlamOptions",
               "Relocalizer.__init__": "RelocalizationOptions", "relocalization_options": "RelocalizationOptions"}
-TABLES = [("MatchOptions", "match", None), ("OdometryOptions", "odometry", "MatchOptions"),
-          ("SlamOptions", "slam", "OdometryOptions"), ("RelocalizationOptions", "relocalization", "OdometryOptions")]
+# (name, option_fields kind, the TypedDicts it extends); PlaceSearchOptions
+# holds what SLAM and relocalisation share beyond the odometry's options.
+TABLES = [("MatchOptions", "match", []), ("OdometryOptions", "odometry", ["MatchOptions"]),
+          ("PlaceSearchOptions", None, []),
+          ("SlamOptions", "slam", ["OdometryOptions", "PlaceSearchOptions"]),
+          ("RelocalizationOptions", "relocalization", ["OdometryOptions", "PlaceSearchOptions"])]
 PY_TYPES = {"float": "float", "int": "int", "bool": "bool", "list of float": "list[float]",
             "sequence of 3 float": "Sequence[float]", "array (4, 4) or (7,)": "ArrayLike"}
 
@@ -30,15 +34,25 @@ def clean(signature):
     return signature
 
 
+def place_search_fields():
+    """The fields of SLAM and relocalisation both, beyond the odometry's."""
+    odometry = {field["keyword"] for field in module.option_fields("odometry")}
+    relocalization = {field["keyword"] for field in module.option_fields("relocalization")}
+    return [field for field in module.option_fields("slam")
+            if field["keyword"] in relocalization and field["keyword"] not in odometry]
+
+
 def typed_dicts():
-    """A TypedDict per option table: its keywords the extended one lacks, each with its default."""
+    """A TypedDict per option table: its keywords those it extends lack, each with its default."""
     out, keywords_of = [], {}
-    for name, kind, base in TABLES:
-        fields = module.option_fields(kind)
+    for name, kind, bases in TABLES:
+        fields = module.option_fields(kind) if kind else place_search_fields()
         keywords_of[name] = {field["keyword"] for field in fields}
-        lines = [f"class {name}({base or 'TypedDict'}, total=False):\n", f'    """option_fields("{kind}")"""\n']
+        inherited = set().union(*(keywords_of[base] for base in bases)) if bases else set()
+        doc = f'option_fields("{kind}")' if kind else "what RadarSlam and Relocalizer share beyond RadarOdometry's"
+        lines = [f"class {name}({', '.join(bases) or 'TypedDict'}, total=False):\n", f'    """{doc}"""\n']
         for field in fields:
-            if base and field["keyword"] in keywords_of[base]:
+            if field["keyword"] in inherited:
                 continue
             kind_of = "str" if field["type"].startswith("{") else PY_TYPES[field["type"]]
             default = "identity" if field["type"].startswith("array") else repr(field["default"])

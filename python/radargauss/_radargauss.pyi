@@ -99,14 +99,9 @@ class OdometryOptions(MatchOptions, total=False):
     elevation_bias_window: int  # 100
     elevation_bias_min_speed: float  # 5.0
 
-class SlamOptions(OdometryOptions, total=False):
-    """option_fields("slam")"""
+class PlaceSearchOptions(TypedDict, total=False):
+    """what RadarSlam and Relocalizer share beyond RadarOdometry's"""
     submap_distance: float  # 10.0
-    min_loop_path: float  # 150.0
-    odometry_translation_std: float  # 0.05
-    odometry_drift: float  # 0.02
-    odometry_rotation_std: float  # 0.1
-    odometry_drift_deg: float  # 0.02
     descriptor: str  # 'scan-context'
     candidates: int  # 20
     max_scan_context_distance: float  # 0.4
@@ -175,6 +170,14 @@ class SlamOptions(OdometryOptions, total=False):
     verify_ndt_min_points: int  # 5
     verify_fit_index_cell: float  # 1.0
     verify_association_gate: float  # 3.0
+
+class SlamOptions(OdometryOptions, PlaceSearchOptions, total=False):
+    """option_fields("slam")"""
+    min_loop_path: float  # 150.0
+    odometry_translation_std: float  # 0.05
+    odometry_drift: float  # 0.02
+    odometry_rotation_std: float  # 0.1
+    odometry_drift_deg: float  # 0.02
     loop_rejection: str  # 'graduated'
     loop_loss: str  # 'geman-mcclure'
     loop_loss_scale: float  # 3.0
@@ -185,83 +188,14 @@ class SlamOptions(OdometryOptions, total=False):
     graph_max_iterations: int  # 100
     graph_threads: int  # 1
 
-class RelocalizationOptions(OdometryOptions, total=False):
+class RelocalizationOptions(OdometryOptions, PlaceSearchOptions, total=False):
     """option_fields("relocalization")"""
-    submap_distance: float  # 10.0
     confirm_window: int  # 3
     confirm_translation: float  # 1.0
     confirm_rotation: float  # 2.0
     ambiguous_translation: float  # 5.0
     ambiguous_rotation: float  # 5.0
     max_unmatched_scans: int  # 10
-    descriptor: str  # 'scan-context'
-    candidates: int  # 20
-    max_scan_context_distance: float  # 0.4
-    max_radon_distance: float  # 0.15
-    submap_voxel: float  # 0.25
-    channel: str  # 'both'
-    scan_context_rings: int  # 20
-    scan_context_sectors: int  # 60
-    scan_context_max_range: float  # 80.0
-    scan_context_rcs_floor: float  # -30.0
-    radon_angles: int  # 60
-    radon_offsets: int  # 64
-    radon_cell: float  # 1.0
-    radon_max_range: float  # 80.0
-    verify_bev_cell: float  # 1.0
-    verify_bev_search: float  # 12.0
-    verify_min_associated: float  # 0.5
-    verify_max_cost: float  # 6.0
-    verify_max_translation_std: float  # 0.2
-    verify_max_rotation_std: float  # 1.0
-    verify_drift: float  # 0.05
-    verify_min_drift: float  # 5.0
-    verify_drift_deg: float  # 0.05
-    verify_min_drift_deg: float  # 10.0
-    verify_translation_floor_std: float  # 0.1
-    verify_rotation_floor_std: float  # 0.5
-    verify_kept_targets: int  # 64
-    verify_solver: str  # 'mh-gn'
-    verify_loss: str  # 'trivial'
-    verify_loss_scale: float  # 1.0
-    verify_jacobians: str  # 'analytic'
-    verify_gate: float  # 3.0
-    verify_max_iterations: int  # 30
-    verify_coarse_iterations: int  # 15
-    verify_coarse_voxel_per_sigma: float  # 2.0
-    verify_coarse_points: int  # 0
-    verify_geometric_first: bool  # True
-    verify_reassociate: bool  # True
-    verify_reassociation_translation: float  # 0.01
-    verify_reassociation_rotation: float  # 0.002
-    verify_translation_tolerance: float  # 0.001
-    verify_rotation_tolerance: float  # 0.0001
-    verify_coarse_translation_tolerance: float  # 0.01
-    verify_coarse_rotation_tolerance: float  # 0.001
-    verify_gn_max_step_halvings: int  # 8
-    verify_gn_loss_curvature: bool  # False
-    verify_ceres_dogleg: bool  # False
-    verify_ceres_max_inner_iterations: int  # 2
-    verify_ceres_max_exact_inner_iterations: int  # 8
-    verify_ceres_blocks: str  # 'square-root'
-    verify_ceres_threads: int  # 1
-    verify_ceres_function_tolerance: float  # 1e-06
-    verify_ceres_gradient_tolerance: float  # 1e-10
-    verify_ceres_parameter_tolerance: float  # 1e-08
-    verify_mh_starts: int  # 13
-    verify_mh_xy_offset: float  # 2.0
-    verify_mh_yaw_offset: float  # 0.1
-    verify_builder: str  # 'kmeans'
-    verify_downsample: float  # 0.25
-    verify_points_per_gaussian: float  # 4.0
-    verify_kmeans_iterations: int  # 8
-    verify_em_iterations: int  # 10
-    verify_min_std: float  # 0.05
-    verify_map_seed: int  # 1
-    verify_ndt_voxel: float  # 1.0
-    verify_ndt_min_points: int  # 5
-    verify_fit_index_cell: float  # 1.0
-    verify_association_gate: float  # 3.0
 
 class DataError(ValueError): ...
 
