@@ -55,6 +55,8 @@ const OptionTable<LoopVerificationOptions>& LoopVerificationOptionTable() {
                  {"w_rcs", "rcs_loss", "rcs_loss_scale", "rcs_translation"});
     AppendNested(
         t, GaussianMapOptionTable(), +[](O & o) -> auto& { return o.gaussians; }, "gaussians");
+    // What an expert of verification changes, whatever the rows are for a scan match or a map.
+    for (Option<O>& option : t) option.group = OptionGroup::kTuning;
     return t;
   }();
   return table;
