@@ -41,7 +41,7 @@ const OptionTable<MatchOptions>& MatchOptionTable() {
   static const OptionTable<O> table = [] {
     OptionTable<O> t = {RADARGAUSS_CHOICE(O, "solver", solver, ScanMatcherNames(), SolverKindFromString)
                             .Sensor()
-                            .Help("gn (own Gauss-Newton), gn-autodiff, ceres, ceres-dogleg, mh-gn")};
+                            .Help("the scan matcher: gn (own Gauss-Newton), gn-autodiff, ceres, ceres-dogleg, mh-gn")};
     AppendNested(
         t, ScanMatchingOptionTable(), +[](O & o) -> auto& { return o.matching; }, "matching");
     for (Option<O> option : OptionTable<O>{

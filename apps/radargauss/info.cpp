@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// radargauss info: summarise a sequence, or list a bag's topics.
+// radargauss info: summarise a sequence and an IMU file, or list a bag's topics.
 #include <algorithm>
 #include <cstdio>
 #include <limits>
 #include <memory>
 
 #include "commands.hpp"
+#include "radargauss/io/imu.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/stats.hpp"
 
@@ -30,7 +31,30 @@ int ListTopics(const std::string& bag) {
   return 0;
 }
 
-int RunInfo(const SequenceOptions& options) {
+struct InfoSettings {
+  SequenceOptions sequence;
+  std::string imu;
+};
+
+// An IMU file's span, rate, gaps and mean rates (io/imu.hpp).
+void PrintImu(const std::string& path) {
+  const ImuSummary s = SummariseImu(ReadImuFile(path));
+  std::printf(
+      "imu: %zu samples, %.9f .. %.9f (%.3f s), %.1f Hz (median interval), %zu gaps over 3 intervals, "
+      "longest %.4f s\n",
+      s.samples, s.start, s.end, s.end - s.start, s.rate_hz, s.gaps, s.max_gap);
+  std::printf("imu mean: angular rate %.5f %.5f %.5f rad/s, specific force %.4f %.4f %.4f m/s^2 (norm %.4f)\n",
+              s.mean_angular_velocity.x(), s.mean_angular_velocity.y(), s.mean_angular_velocity.z(),
+              s.mean_specific_force.x(), s.mean_specific_force.y(), s.mean_specific_force.z(),
+              s.mean_specific_force.norm());
+}
+
+int RunInfo(const InfoSettings& settings) {
+  const SequenceOptions& options = settings.sequence;
+  if (!settings.imu.empty()) {
+    PrintImu(settings.imu);
+    if (options.sequence_dir.empty() && options.bag.empty()) return 0;
+  }
   if (!options.bag.empty() && options.topic.empty()) return ListTopics(options.bag);
   const Sequence sequence = LoadSequence(options);
   std::vector<double> counts;
@@ -73,10 +97,11 @@ int RunInfo(const SequenceOptions& options) {
 }  // namespace
 
 Subcommand AddInfo(CLI::App& parent) {
-  auto options = std::make_shared<SequenceOptions>();
-  CLI::App* app = parent.add_subcommand("info", "Summarise a sequence (or list a bag's topics)");
-  AddSequenceOptions(app, *options);
-  return {app, [options] { return RunInfo(*options); }};
+  auto settings = std::make_shared<InfoSettings>();
+  CLI::App* app = parent.add_subcommand("info", "Summarise a sequence and an IMU file (or list a bag's topics)");
+  AddSequenceOptions(app, settings->sequence);
+  app->add_option("--imu", settings->imu, "IMU file of lines 'stamp wx wy wz ax ay az': its rate, gaps, mean rates");
+  return {app, [settings] { return RunInfo(*settings); }};
 }
 
 }  // namespace radargauss::cli

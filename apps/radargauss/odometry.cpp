@@ -36,9 +36,9 @@ int RunOdometry(const OdometrySettings& s) {
   const std::optional<Trajectory>& reference = inputs.reference;
   StagedFolder folder = RunFolder(s, {"odometry.tum", "levelled.tum", "map.rgm", "map.ply"});  // before the run
   RadarOdometry odometry(options, MatcherOf(s.matcher));
-  if (!s.imu_topic.empty()) {
-    const std::vector<GyroSample> gyro = GyroOf(s);
-    CheckOverlap(gyro, sequence);
+  const std::vector<GyroSample> gyro = GyroOf(s);  // before the run: a bad IMU leaves nothing behind
+  if (!gyro.empty()) {
+    CheckOverlap(gyro, sequence, s.imu_topic.empty() ? "" : "; try --imu-stamps record");
     odometry.AddGyro(gyro);
   }
   RegisterScans(sequence, "odometry", [&](const RadarScan& scan) { odometry.Register(scan); });

@@ -10,7 +10,9 @@
 
 #include "radargauss/error.hpp"
 #include "radargauss/evaluation.hpp"
+#include "radargauss/io/imu.hpp"
 #include "radargauss/io/rosbag.hpp"
+#include "radargauss/io/sequence.hpp"
 #include "radargauss/names.hpp"
 #ifdef RADARGAUSS_HAVE_PCL
 #include "radargauss/peers/pcl_peers.hpp"
@@ -49,22 +51,31 @@ Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw) {
 
 // The bag's gyro rates turned into the radar frame by q_radar_imu.
 std::vector<GyroSample> GyroOf(const OdometrySettings& s) {
-  if (s.sequence.bag.empty()) throw DataError("--imu-topic needs --bag");
-  const Eigen::Matrix3d R = ImuRotation(s.imu_rotation);
-  std::vector<GyroSample> samples;
-  for (const ImuSample& imu : ReadBagImu(s.sequence.bag, s.imu_topic, s.imu_stamps == "record")) {
-    samples.push_back({imu.stamp, R * imu.angular_velocity});
+  if (s.imu_topic.empty() && s.imu_file.empty()) {
+    if (!s.imu_extrinsic.empty()) throw DataError("--imu-extrinsic needs an IMU (--imu or --imu-topic)");
+    return {};
   }
+  if (!s.imu_topic.empty() && s.sequence.bag.empty()) throw DataError("--imu-topic needs --bag");
+  if (!s.imu_topic.empty() && !s.imu_file.empty()) throw DataError("--imu and --imu-topic: one IMU at a time");
+  if (!s.imu_extrinsic.empty() && s.imu_rotation != std::vector<double>{0, 0, 0, 1}) {
+    throw DataError("--imu-extrinsic and --imu-rotation: the IMU's rotation once");
+  }
+  const Eigen::Matrix3d R =
+      s.imu_extrinsic.empty() ? ImuRotation(s.imu_rotation) : ReadExtrinsicFile(s.imu_extrinsic).rotation().Matrix();
+  const std::vector<ImuSample> imu =
+      s.imu_file.empty() ? ReadBagImu(s.sequence.bag, s.imu_topic, s.imu_stamps == "record") : ReadImuFile(s.imu_file);
+  std::vector<GyroSample> samples;
+  for (const ImuSample& sample : imu) samples.push_back({sample.stamp, R * sample.angular_velocity});
   return samples;
 }
 
 // Gyro samples that cover none of the scans' time span are a clock mismatch, not data.
-void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence) {
+void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence, const std::string& hint) {
   const double first = sequence.scans.front().timestamp, last = sequence.scans.back().timestamp;
   if (gyro.back().stamp < first || gyro.front().stamp > last) {
     throw DataError("the IMU's stamps (" + std::to_string(gyro.front().stamp) + " to " +
                     std::to_string(gyro.back().stamp) + " s) do not overlap the scans' (" + std::to_string(first) +
-                    " to " + std::to_string(last) + " s); try --imu-stamps record");
+                    " to " + std::to_string(last) + " s)" + hint);
   }
 }
 
@@ -92,12 +103,18 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
       ->check(CLI::IsMember({"gaussians", "pcl-ndt", "pcl-gicp"}))
       ->capture_default_str();
   AddTableOptions(app, OdometryOptionTable(), s.odometry);
+  AddImuOptions(app, s);
   AddRunOptions(app, s);
 }
 
-void AddRunOptions(CLI::App* app, OdometrySettings& s) {
+void AddImuOptions(CLI::App* app, OdometrySettings& s) {
   CLI::Option* imu_topic =
       app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
+  app->add_option("--imu", s.imu_file,
+                  "IMU file of lines 'stamp wx wy wz ax ay az' (s, rad/s, m/s^2; the IMU's frame): gyro rates for "
+                  "the prediction");
+  app->add_option("--imu-extrinsic", s.imu_extrinsic,
+                  "T_radar_imu: a file 'x y z qx qy qz qw' (the IMU's frame in the radar's)");
   // The IMU's settings without its topic would be read by nothing: refused.
   app->add_option("--imu-stamps", s.imu_stamps, "Stamp the IMU by its header or by the bag's record time")
       ->check(CLI::IsMember({"header", "record"}))
@@ -107,6 +124,9 @@ void AddRunOptions(CLI::App* app, OdometrySettings& s) {
       ->expected(4)
       ->needs(imu_topic)
       ->capture_default_str();
+}
+
+void AddRunOptions(CLI::App* app, OdometrySettings& s) {
   app->add_option("--first-scan", s.first_scan, "Skip the scans before this one (0: none)")->capture_default_str();
   app->add_option("--max-scans", s.max_scans, "Only the first N scans from --first-scan (0: all)")
       ->capture_default_str();

@@ -24,6 +24,8 @@ struct OdometrySettings {
   OdometryOptions odometry;
   std::string out;
   std::string imu_topic;
+  std::string imu_file;       // a text IMU file (io/imu.hpp), instead of a bag's topic
+  std::string imu_extrinsic;  // T_radar_imu file; else --imu-rotation
   std::string imu_stamps = "header";
   std::vector<double> imu_rotation = {0, 0, 0, 1};  // q_radar_imu (x y z w)
   std::size_t first_scan = 0;
@@ -35,10 +37,13 @@ struct OdometrySettings {
 MatcherFactory MatcherOf(const std::string& matcher);
 // R_radar_imu from --imu-rotation, checked whether or not an IMU is read.
 Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw);
-// The bag's gyro rates turned into the radar frame by q_radar_imu.
+// The IMU's gyro rates (the bag's topic or the IMU file) turned into the
+// radar frame by R_radar_imu (--imu-extrinsic, else --imu-rotation); none
+// without an IMU.
 std::vector<GyroSample> GyroOf(const OdometrySettings& s);
-// Gyro samples that cover none of the scans' time span are a clock mismatch.
-void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence);
+// Gyro samples that cover none of the scans' time span are a clock mismatch
+// (`hint`: what to try, appended to the message).
+void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence, const std::string& hint);
 // Throws FileError when fewer than 3 scans lie in the reference's time span.
 void CheckReferenceCovers(const Trajectory& reference, const Sequence& sequence, const std::string& path);
 // What odometry, slam and relocalize run on: every scan of the sequence (not
@@ -78,7 +83,9 @@ void RegisterScans(const Sequence& sequence, const char* stage, RegisterScan&& r
 }
 // Every flag of OdometrySettings: the odometry's from its option table.
 void AddOdometryOptions(CLI::App* app, OdometrySettings& s);
-// The run's own: the IMU, the scans to run on (slam and relocalize take the
+// The IMU's: its file or bag topic, stamps and rotation into the radar frame.
+void AddImuOptions(CLI::App* app, OdometrySettings& s);
+// The run's own: the scans to run on (slam and relocalize take the
 // odometry's options from their own tables).
 void AddRunOptions(CLI::App* app, OdometrySettings& s);
 

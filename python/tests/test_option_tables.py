@@ -14,9 +14,9 @@ CLI = os.environ.get("RADARGAUSS_CLI")
 FLAG = re.compile(r"^\s+(--[a-z0-9-]+)(?: ([A-Z]+:(?:\{[^}]*\}|[\[(][^\])]*[\])])))?")
 # What each command reads and writes besides its options: the run's inputs and outputs.
 RUN_FLAGS = {"--help", "--sequence", "--gt", "--extrinsic", "--bag", "--topic", "--bin-layout", "--rcs-field",
-             "--doppler-field", "--doppler-sign", "--elevation-bias", "--out", "--imu-topic", "--imu-stamps",
-             "--imu-rotation", "--first-scan", "--max-scans"}
-COMMANDS = [("odometry", "odometry", {"--matcher"}),
+             "--doppler-field", "--doppler-sign", "--elevation-bias", "--out", "--first-scan", "--max-scans"}
+IMU_FLAGS = {"--imu", "--imu-extrinsic", "--imu-topic", "--imu-stamps", "--imu-rotation"}
+COMMANDS = [("odometry", "odometry", {"--matcher"} | IMU_FLAGS),
             ("slam", "slam", {"--no-map", "--false-loop-rate", "--false-loop-seed"}),  # and the study's
             ("relocalize", "relocalization", {"--map"})]
 

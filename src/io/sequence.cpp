@@ -51,7 +51,11 @@ SE3d ResolveExtrinsic(const std::string& spec, const std::string& ground_truth_p
   if (!std::filesystem::exists(spec, error)) {
     throw FileError(spec, "not an extrinsic preset (identity, snail-20231213, auto) nor a readable file");
   }
-  std::istringstream in(ReadFileBytes(spec, "pose file (extrinsic)", 1 << 16));
+  return ReadExtrinsicFile(spec);
+}
+
+SE3d ReadExtrinsicFile(const std::string& path) {
+  std::istringstream in(ReadFileBytes(path, "pose file (extrinsic)", 1 << 16));
   std::string line;
   while (std::getline(in, line)) {
     const auto first = line.find_first_not_of(" \t\r");
@@ -59,17 +63,20 @@ SE3d ResolveExtrinsic(const std::string& spec, const std::string& ground_truth_p
     std::istringstream tokens(line);
     double v[7];
     for (double& value : v) {
-      if (!(tokens >> value)) throw FileError(spec, "extrinsic needs 'x y z qx qy qz qw'");
+      if (!(tokens >> value)) throw FileError(path, "extrinsic needs 'x y z qx qy qz qw'");
     }
     std::string rest;
-    if (tokens >> rest) throw FileError(spec, "extrinsic needs exactly 7 numbers");
+    if (tokens >> rest) throw FileError(path, "extrinsic needs exactly 7 numbers");
+    if (!std::all_of(v, v + 7, [](double x) { return std::isfinite(x); })) {
+      throw FileError(path, "extrinsic holds a value that is not finite");
+    }
     const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
     if (std::abs(q.norm() - 1.0) > kTumQuaternionNormTolerance) {
-      throw FileError(spec, "extrinsic quaternion is not unit");
+      throw FileError(path, "extrinsic quaternion is not unit");
     }
     return SE3d(SO3d(q), Eigen::Vector3d(v[0], v[1], v[2]));
   }
-  throw FileError(spec, "extrinsic file is empty");
+  throw FileError(path, "extrinsic file is empty");
 }
 
 namespace {

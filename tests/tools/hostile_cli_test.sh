@@ -123,6 +123,22 @@ expect_fail "an index cell of 1e300" "index-cell: 1e300 is not in \[0.1, 100\]" 
   "$tool" odometry --index-cell 1e300 "${seq[@]}" --out "$work/o"
 expect_fail "a zero quaternion" "--imu-rotation: not a unit quaternion (x y z w), its norm is 0" -- \
   "$tool" odometry --imu-topic /imu --imu-rotation 0 0 0 0 "${seq[@]}" --out "$work/o"
+# IMU files: refused before the run, naming the file and line; nothing written.
+printf '1702450000.00 0 0 0 0 0 9.8\n1702450000.01 0 0 0 0 0 9.8\n1702450000.005 0 0 0 0 0 9.8\n' >"$work/imu_back.txt"
+printf '1702450000.00 0 0 0 0 0 9.8\n1702450000.01 0 nan 0 0 0 9.8\n' >"$work/imu_nan.txt"
+printf '1702450000.00 0 0 0 0 0 9.8\n1702450000.01 0 0 0' >"$work/imu_cut.txt"
+printf '5 0 0 0 0 0 9.8\n6 0 0 0 0 0 9.8\n' >"$work/imu_far.txt"
+expect_fail "an IMU stamp going back" "imu_back.txt:3: stamp does not increase" -- \
+  "$tool" odometry --imu "$work/imu_back.txt" "${seq[@]}" --out "$work/imu_o"
+expect_fail "a NaN in an IMU file" "imu_nan.txt:2: non-finite value" -- \
+  "$tool" odometry --imu "$work/imu_nan.txt" "${seq[@]}" --out "$work/imu_o"
+expect_fail "an IMU file that ends mid-line" "imu_cut.txt:2: expected 7 columns (stamp wx wy wz ax ay az), found 4" -- \
+  "$tool" info --imu "$work/imu_cut.txt"
+expect_fail "an IMU that covers none of the scans" "the IMU's stamps (5.000000 to 6.000000 s) do not overlap the scans'" -- \
+  "$tool" odometry --imu "$work/imu_far.txt" "${seq[@]}" --out "$work/imu_o"
+expect_fail "--imu-extrinsic without an IMU" "--imu-extrinsic needs an IMU (--imu or --imu-topic)" -- \
+  "$tool" odometry --imu-extrinsic "$work/imu_far.txt" "${seq[@]}" --out "$work/imu_o"
+[[ ! -e "$work/imu_o" ]] || { echo "FAIL: a refused IMU left odometry output"; failed=$((failed + 1)); }
 # The IMU's settings without its topic, and its topic without a bag: refused, each flag named.
 expect_fail "--imu-rotation without --imu-topic" "--imu-rotation requires --imu-topic" -- \
   "$tool" odometry --imu-rotation 0 0 0 1 "${seq[@]}" --out "$work/o"

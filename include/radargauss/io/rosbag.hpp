@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "radargauss/io/imu.hpp"
 #include "radargauss/io/field_mapping.hpp"
 #include "radargauss/types.hpp"
 
@@ -56,15 +57,11 @@ RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp, cons
 std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
                                     const FieldMapping& mapping = {});
 
-// The angular velocity of a sensor_msgs/Imu message (rad/s, the IMU's frame).
-struct ImuSample {
-  double stamp = 0.0;  // s: header stamp, or the record time when zero
-  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
-};
-// Every sensor_msgs/Imu message of `topic`, in bag order, stamped by the
+// Every sensor_msgs/Imu message of `topic` (its angular velocity and linear
+// acceleration as ImuSample's), in bag order, stamped by the
 // header or, with `record_time`, by the bag's record time (the clock of
 // scans whose header stamp is zero); throws DataError for a missing topic,
-// another message type, non-finite rates or stamps that do not increase.
+// another message type, non-finite values or stamps that do not increase.
 std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic, bool record_time = false);
 
 }  // namespace radargauss

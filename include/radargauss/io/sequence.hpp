@@ -59,5 +59,8 @@ Trajectory ReadRadarTrajectory(const std::string& ground_truth, const SE3d& extr
 // Resolves SequenceOptions::extrinsic; throws DataError for an unknown preset
 // or a malformed file.
 SE3d ResolveExtrinsic(const std::string& spec, const std::string& ground_truth_path);
+// The pose of a file of one line `x y z qx qy qz qw` (`#` comments): an
+// extrinsic such as T_gt_radar or T_radar_imu. Throws DataError naming the file.
+SE3d ReadExtrinsicFile(const std::string& path);
 
 }  // namespace radargauss

@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// An IMU beside the radar (docs/design.md, "Data in and out"): samples of
+// angular rate and specific force in the IMU's frame, read from a text file
+// or a bag; the IMU's noise as datasheet figures; a file's summary.
+//
+//   # stamp wx wy wz ax ay az     (s on the scans' clock, rad/s, m/s^2)
+//   1702450000.000 0.001 -0.002 0.010 0.05 -0.02 9.81
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "radargauss/lie/se3.hpp"
+#include "radargauss/options.hpp"
+
+namespace radargauss {
+
+struct ImuSample {
+  double stamp = 0.0;                                          // s
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // rad/s, the IMU's frame
+  Eigen::Vector3d specific_force = Eigen::Vector3d::Zero();    // m/s^2, the IMU's frame (gravity's reaction included)
+};
+
+// A file holds at most this many samples: an hour at 1 kHz with room to spare.
+constexpr std::size_t kMaxImuSamples = std::size_t(4) << 20;
+
+// The samples of a text file of lines `stamp wx wy wz ax ay az` (`#`
+// comments, blank lines skipped). Throws DataError naming the file and line
+// for a line without exactly seven numbers, a value that is not finite, a
+// stamp that does not increase, no sample at all, or more than kMaxImuSamples.
+std::vector<ImuSample> ReadImuFile(const std::string& path);
+
+// The IMU's noise, continuous time, as a datasheet gives it; the defaults are
+// a consumer MEMS part's (a BMI088-like gyro at 0.014 deg/s/sqrt(Hz), an
+// accelerometer at 150 ug/sqrt(Hz)).
+struct ImuNoise {
+  double gyro_noise_density = 2.4e-4;      // rad/s/sqrt(Hz)
+  double accel_noise_density = 1.5e-3;     // m/s^2/sqrt(Hz)
+  double gyro_bias_random_walk = 2.0e-5;   // rad/s^2/sqrt(Hz)
+  double accel_bias_random_walk = 3.0e-4;  // m/s^3/sqrt(Hz)
+};
+// Its options (options.hpp).
+const OptionTable<ImuNoise>& ImuNoiseOptionTable();
+
+// What `info` says of an IMU: its span, rate and gaps, and the mean specific
+// force (about 9.81 m/s^2 along the IMU's up at rest or at constant velocity).
+struct ImuSummary {
+  std::size_t samples = 0;
+  double start = 0.0, end = 0.0;  // s
+  double rate_hz = 0.0;           // 1 / the median interval
+  double max_gap = 0.0;           // s: the longest interval
+  std::size_t gaps = 0;           // intervals over 3x the median
+  Eigen::Vector3d mean_angular_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d mean_specific_force = Eigen::Vector3d::Zero();
+};
+// Throws std::invalid_argument for no samples.
+ImuSummary SummariseImu(const std::vector<ImuSample>& samples);
+
+}  // namespace radargauss
