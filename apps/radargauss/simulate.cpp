@@ -41,6 +41,10 @@ int RunSimulate(const SimulateSettings& s) {
   std::printf("simulated %zu scans, %zu detections (seed %u) into %s\n", sequence.scans.size(), detections, config.seed,
               s.out.c_str());
   std::printf("ground truth: %s/gt_radar_tum.txt (radar frame; use --extrinsic identity)\n", s.out.c_str());
+  if (!sequence.imu.empty()) {
+    std::printf("imu: %s/imu.txt (%zu samples at %g Hz), imu_extrinsic.txt (T_radar_imu), imu_biases.txt (the truth)\n",
+                s.out.c_str(), sequence.imu.size(), config.imu_rate_hz);
+  }
   return 0;
 }
 

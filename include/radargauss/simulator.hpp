@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "radargauss/io/imu.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/trajectory.hpp"
 #include "radargauss/types.hpp"
@@ -83,6 +84,23 @@ struct SimulationConfig {
   int rcs_swerling = 0;                // RCS fluctuation per detection: 0 none, 1 Swerling I, 3 Swerling III
   double multipath_probability = 0.0;  // a ray that meets a wall or guardrail also returns a ghost
   double multipath_loss_db = 6.0;      // the ghost's RCS below its target's
+  // An IMU on the vehicle (docs/design.md, "The synthetic world"); none at
+  // imu_rate_hz 0. Noise densities and bias random walks as a datasheet
+  // gives them (io/imu.hpp's ImuNoise); the turn-on biases drawn per axis.
+  double imu_rate_hz = 0.0;
+  double imu_gyro_noise_density = 2.4e-4;      // rad/s/sqrt(Hz)
+  double imu_accel_noise_density = 1.5e-3;     // m/s^2/sqrt(Hz)
+  double imu_gyro_bias_std = 0.005;            // rad/s
+  double imu_accel_bias_std = 0.05;            // m/s^2
+  double imu_gyro_bias_random_walk = 2.0e-5;   // rad/s^2/sqrt(Hz)
+  double imu_accel_bias_random_walk = 3.0e-4;  // m/s^3/sqrt(Hz)
+  double imu_roll_deg = 0.0;                   // the IMU on the vehicle, as the radar's mounting
+  double imu_pitch_deg = 0.0;
+  double imu_yaw_deg = 0.0;
+  double imu_x = 0.0;  // m: its place on the vehicle (x forward, z up; the radar at the origin)
+  double imu_y = 0.0;
+  double imu_z = 0.0;
+  double imu_clock_offset = 0.0;  // s: the IMU's stamps minus the true time (the radar's clock)
   // Scene: "town" (buildings, poles, parked and moving cars along the loop)
   // or "motorway" (guardrails, gantries, three lanes each way of traffic).
   std::string scene = "town";
@@ -124,6 +142,12 @@ struct DetectionTruth {
   Eigen::Vector3d target_velocity = Eigen::Vector3d::Zero();  // world, m/s
 };
 
+// The true IMU biases at a sample (evaluation only).
+struct ImuBias {
+  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   // rad/s
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // m/s^2
+};
+
 struct SimulatedSequence {
   SimulationConfig config;
   std::vector<RadarScan> scans;
@@ -131,9 +155,18 @@ struct SimulatedSequence {
   std::vector<Eigen::Vector3d> sensor_velocity;    // per scan, radar frame, m/s
   Trajectory ground_truth;                         // T_world_radar per scan time
   std::vector<std::string> file_stems;             // "<secs>.<nsecs>" per scan, exact
+  // The IMU's samples (stamped on its clock) and true biases, and T_radar_imu; empty without an IMU.
+  std::vector<ImuSample> imu;
+  std::vector<ImuBias> imu_bias;
+  SE3d radar_from_imu;
 };
 
 SimulatedSequence Simulate(const SimulationConfig& config);
+
+// The IMU's samples over the drive, every 1 / imu_rate_hz from the first
+// scan's time to the last's (0 without an IMU); at most kMaxImuSamples.
+std::size_t ImuSampleCount(const SimulationConfig& config);
+constexpr double kGravity = 9.81;  // m/s^2, along the world's -z
 
 // The simulated scans as a Sequence matched to their ground-truth poses (what
 // LoadSequence gives for the written files, without the float32 rounding).
@@ -141,7 +174,9 @@ Sequence AsSequence(const SimulatedSequence& simulated);
 
 // Writes the Snail-Radar layout: <dir>/ars548/points/<secs>.<nsecs>.pcd (the
 // nine float32 fields), <dir>/ars548/points/times.txt, the radar ground truth
-// <dir>/gt_radar_tum.txt (TUM) and the configuration <dir>/simulation.yaml.
+// <dir>/gt_radar_tum.txt (TUM) and the configuration <dir>/simulation.yaml;
+// with an IMU, <dir>/imu.txt and <dir>/imu_extrinsic.txt (io/imu.hpp's
+// formats) and the true biases <dir>/imu_biases.txt (stamp bg bg bg ba ba ba).
 void WriteSimulatedSequence(const std::string& dir, const SimulatedSequence& sequence);
 
 // "<secs>.<nsecs>" with nine decimals: the Snail-Radar file stem of a time,

@@ -5,9 +5,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <sstream>
+#include <tuple>
 #include <utility>
 #include <variant>
 
@@ -70,6 +72,20 @@ std::vector<std::pair<std::string, ConfigValue>> ConfigFields(SimulationConfig& 
           {"rcs_swerling", &c.rcs_swerling},
           {"multipath_probability", &c.multipath_probability},
           {"multipath_loss_db", &c.multipath_loss_db},
+          {"imu_rate_hz", &c.imu_rate_hz},
+          {"imu_gyro_noise_density", &c.imu_gyro_noise_density},
+          {"imu_accel_noise_density", &c.imu_accel_noise_density},
+          {"imu_gyro_bias_std", &c.imu_gyro_bias_std},
+          {"imu_accel_bias_std", &c.imu_accel_bias_std},
+          {"imu_gyro_bias_random_walk", &c.imu_gyro_bias_random_walk},
+          {"imu_accel_bias_random_walk", &c.imu_accel_bias_random_walk},
+          {"imu_roll_deg", &c.imu_roll_deg},
+          {"imu_pitch_deg", &c.imu_pitch_deg},
+          {"imu_yaw_deg", &c.imu_yaw_deg},
+          {"imu_x", &c.imu_x},
+          {"imu_y", &c.imu_y},
+          {"imu_z", &c.imu_z},
+          {"imu_clock_offset", &c.imu_clock_offset},
           {"scene", &c.scene},
           {"traffic_min_speed", &c.traffic_min_speed},
           {"traffic_max_speed", &c.traffic_max_speed},
@@ -118,6 +134,27 @@ void ValidateMagnitudes(const SimulationConfig& c, const std::string& source) {
     bounded(db, 0.0, 200.0, key);
   }
   bounded(c.detection_threshold_db, -200.0, 200.0, "detection_threshold_db");
+  // The IMU: up to 2 kHz; noise and biases up to what no working MEMS part exceeds tenfold.
+  bounded(c.imu_rate_hz, 0.0, 2000.0, "imu_rate_hz");
+  for (const auto& [key, value, high] :
+       {std::tuple<const char*, double, double>{"imu_gyro_noise_density", c.imu_gyro_noise_density, 0.1},
+        {"imu_accel_noise_density", c.imu_accel_noise_density, 1.0},
+        {"imu_gyro_bias_std", c.imu_gyro_bias_std, 1.0},
+        {"imu_accel_bias_std", c.imu_accel_bias_std, 10.0},
+        {"imu_gyro_bias_random_walk", c.imu_gyro_bias_random_walk, 0.1},
+        {"imu_accel_bias_random_walk", c.imu_accel_bias_random_walk, 1.0}}) {
+    bounded(value, 0.0, high, key);
+  }
+  for (const auto& [key, angle] : {std::pair<const char*, double>{"imu_roll_deg", c.imu_roll_deg},
+                                   {"imu_pitch_deg", c.imu_pitch_deg},
+                                   {"imu_yaw_deg", c.imu_yaw_deg}}) {
+    bounded(angle, -180.0, 180.0, key);
+  }
+  for (const auto& [key, length] :
+       {std::pair<const char*, double>{"imu_x", c.imu_x}, {"imu_y", c.imu_y}, {"imu_z", c.imu_z}}) {
+    bounded(length, -10.0, 10.0, key);
+  }
+  bounded(c.imu_clock_offset, -0.5, 0.5, "imu_clock_offset");
 }
 
 }  // namespace
@@ -155,6 +192,8 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
   require(c.multipath_probability >= 0.0 && c.multipath_probability <= 1.0, "multipath_probability must be in [0, 1]");
   require(c.scene == "town" || c.scene == "motorway", "scene must be town or motorway");
   require(c.traffic_max_speed >= c.traffic_min_speed, "need traffic_min_speed <= traffic_max_speed");
+  require(double(c.scans - 1) / c.rate_hz * c.imu_rate_hz < double(kMaxImuSamples),
+          "imu_rate_hz over the drive gives more than " + std::to_string(kMaxImuSamples) + " IMU samples");
   for (const char* name : {"ground", "wall", "pole", "car", "guardrail"}) {
     const auto it = c.materials.find(name);
     require(it != c.materials.end(), std::string("material '") + name + "' missing");
@@ -167,6 +206,11 @@ void ValidateSimulationConfig(const SimulationConfig& c, const std::string& sour
                 it->second.diffuse + it->second.specular > 0.0,
             std::string("material '") + name + "' needs diffuse, specular >= 0 (not both 0) and lobe_width_deg > 0");
   }
+}
+
+std::size_t ImuSampleCount(const SimulationConfig& config) {
+  if (!(config.imu_rate_hz > 0.0)) return 0;
+  return std::size_t(std::floor((config.scans - 1) / config.rate_hz * config.imu_rate_hz + 1e-9)) + 1;
 }
 
 SimulationConfig LoadSimulationConfig(const std::string& path) {
@@ -243,6 +287,43 @@ Sequence AsSequence(const SimulatedSequence& simulated) {
   return sequence;
 }
 
+namespace {
+
+// imu.txt, imu_extrinsic.txt and imu_biases.txt of docs/design.md, "The synthetic world".
+void WriteSimulatedImu(const std::string& dir, const SimulatedSequence& sequence) {
+  namespace fs = std::filesystem;
+  WriteFileAtomically((fs::path(dir) / "imu.txt").string(), [&](std::ostream& out) {
+    out << "# stamp wx wy wz ax ay az (s, rad/s, m/s^2; the IMU's frame)\n";
+    char line[256];
+    for (const ImuSample& s : sequence.imu) {
+      std::snprintf(line, sizeof(line), "%.9f %.17g %.17g %.17g %.17g %.17g %.17g\n", s.stamp, s.angular_velocity.x(),
+                    s.angular_velocity.y(), s.angular_velocity.z(), s.specific_force.x(), s.specific_force.y(),
+                    s.specific_force.z());
+      out << line;
+    }
+  });
+  WriteFileAtomically((fs::path(dir) / "imu_extrinsic.txt").string(), [&](std::ostream& out) {
+    const Eigen::Vector3d& t = sequence.radar_from_imu.translation();
+    const Eigen::Quaterniond& q = sequence.radar_from_imu.rotation().quaternion();
+    char line[256];
+    std::snprintf(line, sizeof(line), "%.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", t.x(), t.y(), t.z(), q.x(), q.y(),
+                  q.z(), q.w());
+    out << "# x y z qx qy qz qw: T_radar_imu\n" << line;
+  });
+  WriteFileAtomically((fs::path(dir) / "imu_biases.txt").string(), [&](std::ostream& out) {
+    out << "# stamp bgx bgy bgz bax bay baz: the true biases (rad/s, m/s^2), for evaluation only\n";
+    char line[256];
+    for (std::size_t k = 0; k < sequence.imu.size(); ++k) {
+      const ImuBias& b = sequence.imu_bias[k];
+      std::snprintf(line, sizeof(line), "%.9f %.9g %.9g %.9g %.9g %.9g %.9g\n", sequence.imu[k].stamp, b.gyro.x(),
+                    b.gyro.y(), b.gyro.z(), b.accel.x(), b.accel.y(), b.accel.z());
+      out << line;
+    }
+  });
+}
+
+}  // namespace
+
 void WriteSimulatedSequence(const std::string& dir, const SimulatedSequence& sequence) {
   namespace fs = std::filesystem;
   const fs::path points = fs::path(dir) / "ars548" / "points";
@@ -257,6 +338,7 @@ void WriteSimulatedSequence(const std::string& dir, const SimulatedSequence& seq
   }
   WriteFileAtomically((points / "times.txt").string(), [&](std::ostream& out) { out << times; });
   WriteTum((fs::path(dir) / "gt_radar_tum.txt").string(), sequence.ground_truth);
+  if (!sequence.imu.empty()) WriteSimulatedImu(dir, sequence);
   WriteFileAtomically((fs::path(dir) / "simulation.yaml").string(), [&](std::ostream& out) {
     out << "# radargauss simulate: the configuration that produced this sequence\n"
         << SimulationConfigToYaml(sequence.config);

@@ -178,6 +178,52 @@ struct ScanTime {
   double since_start = 0.0;
 };
 
+// The IMU's samples over the drive (docs/design.md, "The synthetic world"):
+// the IMU frame's true rate and specific force by central differences of
+// the drive (1 ms), plus turn-on biases, their random walks and white noise,
+// drawn from a generator of their own so that the scans are the same with an
+// IMU or without.
+void SimulateImu(const SimulationConfig& config, const simulation::LoopPath& path, const SE3d& vehicle_from_radar,
+                 SimulatedSequence& sequence) {
+  const SE3d vehicle_from_imu(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, config.imu_yaw_deg * kDeg)) *
+                                  SO3d::Exp(Eigen::Vector3d(0.0, config.imu_pitch_deg * kDeg, 0.0)) *
+                                  SO3d::Exp(Eigen::Vector3d(config.imu_roll_deg * kDeg, 0.0, 0.0)),
+                              Eigen::Vector3d(config.imu_x, config.imu_y, config.imu_z));
+  sequence.radar_from_imu = vehicle_from_radar.Inverse() * vehicle_from_imu;
+  std::mt19937 rng(config.seed ^ 0x9e3779b9u);
+  std::normal_distribution<double> normal;
+  const auto draw = [&](double std) -> Eigen::Vector3d {
+    return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)) * std;
+  };
+  ImuBias bias{draw(config.imu_gyro_bias_std), draw(config.imu_accel_bias_std)};
+  const double dt = 1.0 / config.imu_rate_hz;
+  const double h = 1e-3;
+  const Eigen::Vector3d gravity(0.0, 0.0, -kGravity);
+  const auto imu_pose = [&](double t) {
+    SE3d pose;
+    Eigen::Vector3d velocity;
+    SensorState(config, path, t, pose, velocity);
+    return pose * vehicle_from_imu;
+  };
+  const std::size_t count = ImuSampleCount(config);
+  for (std::size_t k = 0; k < count; ++k) {
+    const double t = double(k) * dt;
+    const SE3d before = imu_pose(t - h), at = imu_pose(t), after = imu_pose(t + h);
+    const Eigen::Vector3d rate = (before.rotation().Inverse() * after.rotation()).Log() / (2.0 * h);
+    const Eigen::Vector3d acceleration =
+        (after.translation() - 2.0 * at.translation() + before.translation()) / (h * h);
+    ImuSample sample;
+    sample.stamp = config.start_time + t + config.imu_clock_offset;
+    sample.angular_velocity = rate + bias.gyro + draw(config.imu_gyro_noise_density / std::sqrt(dt));
+    sample.specific_force = at.rotation().Inverse() * (acceleration - gravity) + bias.accel +
+                            draw(config.imu_accel_noise_density / std::sqrt(dt));
+    sequence.imu.push_back(sample);
+    sequence.imu_bias.push_back(bias);
+    bias.gyro += draw(config.imu_gyro_bias_random_walk * std::sqrt(dt));
+    bias.accel += draw(config.imu_accel_bias_random_walk * std::sqrt(dt));
+  }
+}
+
 ScanTime TimeOfScan(const SimulationConfig& config, int k) {
   const long long start_seconds = static_cast<long long>(std::floor(config.start_time));
   const long long start_nanoseconds = std::llround((config.start_time - static_cast<double>(start_seconds)) * 1e9);
@@ -245,6 +291,7 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
   for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
     ValidateScan(sequence.scans[k], "simulation config (scan " + std::to_string(k) + ")");
   }
+  if (config.imu_rate_hz > 0.0) SimulateImu(config, path, mounting, sequence);
   return sequence;
 }
 

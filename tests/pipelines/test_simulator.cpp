@@ -223,9 +223,21 @@ TEST_F(SimulatorFiles, EveryNumberIsBoundedAndTheBoundsSimulate) {
   config.speed = 150.0;
   config.doppler_noise = config.range_noise = 100.0;
   config.rcs_noise_db = 200.0;
+  config.imu_rate_hz = 2000.0;
+  config.imu_gyro_noise_density = config.imu_gyro_bias_random_walk = 0.1;
+  config.imu_accel_noise_density = config.imu_accel_bias_random_walk = 1.0;
+  config.imu_gyro_bias_std = 1.0;
+  config.imu_accel_bias_std = 10.0;
+  config.imu_x = config.imu_y = config.imu_z = 10.0;
+  config.imu_clock_offset = 0.5;
   const SimulatedSequence sequence = Simulate(config);
   ASSERT_EQ(sequence.scans.size(), 3u);
   for (const RadarScan& scan : sequence.scans) EXPECT_NO_THROW(ValidateScan(scan, "scan"));
+  ASSERT_EQ(sequence.imu.size(), 401u);
+  for (const ImuSample& sample : sequence.imu) {
+    EXPECT_TRUE(std::isfinite(sample.stamp) && sample.angular_velocity.allFinite() &&
+                sample.specific_force.allFinite());
+  }
 }
 
 TEST(Simulator, TimestampStems) {
