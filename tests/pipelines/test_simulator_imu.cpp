@@ -66,7 +66,9 @@ TEST(SimulatedImu, GyroRatesIntegrateToTheTrueRotations) {
     const SO3d truth = (s.ground_truth[k].pose * s.radar_from_imu).rotation().Inverse() *
                        (s.ground_truth[k + 10].pose * s.radar_from_imu).rotation();
     EXPECT_LT((truth.Inverse() * integrated).Log().norm(), 1e-3) << "scan " << k;
-    if (k == 0) EXPECT_LT((truth.Inverse() * integrated).Log().norm(), 1e-7);  // the first second is straight
+    if (k == 0) {
+      EXPECT_LT((truth.Inverse() * integrated).Log().norm(), 1e-7);  // the first second is straight
+    }
   }
 }
 
