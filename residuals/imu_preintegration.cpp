@@ -6,7 +6,7 @@
 
 namespace radargauss {
 
-ImuPreintegration::ImuPreintegration(const ImuBiases& linearisation, const ImuNoise& noise)
+ImuPreintegration::ImuPreintegration(const ImuBias& linearisation, const ImuNoise& noise)
     : linearisation_(linearisation) {
   CheckOptions(ImuNoiseOptionTable(), noise);
   if (!linearisation.gyro.allFinite() || !linearisation.accel.allFinite()) {
@@ -58,12 +58,12 @@ void ImuPreintegration::Integrate(const Eigen::Vector3d& gyro, const Eigen::Vect
   delta_.duration += dt;
 }
 
-bool ImuPreintegration::WithinCorrection(const ImuBiases& biases) const {
+bool ImuPreintegration::WithinCorrection(const ImuBias& biases) const {
   return (biases.gyro - linearisation_.gyro).norm() <= kMaxGyroCorrection &&
          (biases.accel - linearisation_.accel).norm() <= kMaxAccelCorrection;
 }
 
-ImuDelta ImuPreintegration::Corrected(const ImuBiases& biases) const {
+ImuDelta ImuPreintegration::Corrected(const ImuBias& biases) const {
   if (!WithinCorrection(biases)) {
     throw std::out_of_range("ImuPreintegration: the bias moved past the first-order correction; integrate again");
   }

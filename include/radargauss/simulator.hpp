@@ -142,12 +142,6 @@ struct DetectionTruth {
   Eigen::Vector3d target_velocity = Eigen::Vector3d::Zero();  // world, m/s
 };
 
-// The true IMU biases at a sample (evaluation only).
-struct ImuBias {
-  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   // rad/s
-  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // m/s^2
-};
-
 struct SimulatedSequence {
   SimulationConfig config;
   std::vector<RadarScan> scans;

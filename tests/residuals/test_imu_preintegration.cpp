@@ -29,7 +29,7 @@ State Predict(const State& i, const ImuDelta& d) {
 TEST(ImuPreintegration, ConstantRateAtConstantVelocityIntegratesExactly) {
   const Eigen::Vector3d omega(0.1, -0.2, 0.3), v0(3.0, -1.0, 0.5), p0(1.0, 2.0, 3.0);
   const SO3d R0 = SO3d::Exp(Eigen::Vector3d(0.3, -0.1, 1.2));
-  const ImuBiases bias{Eigen::Vector3d(0.01, -0.02, 0.005), Eigen::Vector3d(0.1, 0.05, -0.2)};
+  const ImuBias bias{Eigen::Vector3d(0.01, -0.02, 0.005), Eigen::Vector3d(0.1, 0.05, -0.2)};
   ImuPreintegration between(bias, ImuNoise{});
   const double dt = 0.005;
   SO3d R = R0;
@@ -46,7 +46,7 @@ TEST(ImuPreintegration, ConstantRateAtConstantVelocityIntegratesExactly) {
 TEST(ImuPreintegration, ConstantAccelerationIntegratesExactly) {
   const Eigen::Vector3d a(0.7, -0.4, 0.2), v0(5.0, 0.0, 0.0), p0(-2.0, 1.0, 0.0);
   const SO3d R0 = SO3d::Exp(Eigen::Vector3d(0.05, 0.02, -0.8));
-  ImuPreintegration between(ImuBiases{}, ImuNoise{});
+  ImuPreintegration between(ImuBias{}, ImuNoise{});
   for (int k = 0; k < 400; ++k) between.Integrate(Eigen::Vector3d::Zero(), R0.Inverse() * (a - kG), 0.0025);
   const State j = Predict({R0, v0, p0}, between.delta());
   EXPECT_LT((j.v - (v0 + a * 1.0)).norm(), 1e-9);
@@ -64,7 +64,7 @@ std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> Drive() {
   return samples;
 }
 
-ImuDelta Integrated(const ImuBiases& bias) {
+ImuDelta Integrated(const ImuBias& bias) {
   ImuPreintegration between(bias, ImuNoise{});
   for (const auto& [gyro, accel] : Drive()) between.Integrate(gyro, accel, 0.005);
   return between.delta();
@@ -76,13 +76,13 @@ double Difference(const ImuDelta& a, const ImuDelta& b) {
 }
 
 TEST(ImuPreintegration, FirstOrderBiasCorrectionAgreesWithIntegratingAgain) {
-  const ImuBiases linearisation{Eigen::Vector3d(0.002, -0.001, 0.003), Eigen::Vector3d(0.05, -0.02, 0.01)};
+  const ImuBias linearisation{Eigen::Vector3d(0.002, -0.001, 0.003), Eigen::Vector3d(0.05, -0.02, 0.01)};
   ImuPreintegration between(linearisation, ImuNoise{});
   for (const auto& [gyro, accel] : Drive()) between.Integrate(gyro, accel, 0.005);
   const Eigen::Vector3d direction_g(0.6, -0.8, 0.3), direction_a(-0.5, 0.2, 0.9);
   double previous = 0.0;
   for (const double step : {4e-3, 2e-3, 1e-3}) {
-    const ImuBiases moved{linearisation.gyro + step * direction_g, linearisation.accel + 10 * step * direction_a};
+    const ImuBias moved{linearisation.gyro + step * direction_g, linearisation.accel + 10 * step * direction_a};
     const double error = Difference(between.Corrected(moved), Integrated(moved));
     const double uncorrected = Difference(between.delta(), Integrated(moved));
     EXPECT_LT(error, 1e-2 * uncorrected) << step;
@@ -91,7 +91,7 @@ TEST(ImuPreintegration, FirstOrderBiasCorrectionAgreesWithIntegratingAgain) {
     }
     previous = error;
   }
-  const ImuBiases far{linearisation.gyro + Eigen::Vector3d(0.02, 0.0, 0.0), linearisation.accel};
+  const ImuBias far{linearisation.gyro + Eigen::Vector3d(0.02, 0.0, 0.0), linearisation.accel};
   EXPECT_FALSE(between.WithinCorrection(far));
   EXPECT_THROW(between.Corrected(far), std::out_of_range);
 }
@@ -101,7 +101,7 @@ TEST(ImuPreintegration, CovarianceMatchesMonteCarlo) {
   noise.gyro_noise_density = 2e-3;
   noise.accel_noise_density = 2e-2;
   const double dt = 0.005;
-  ImuPreintegration mean(ImuBiases{}, noise);
+  ImuPreintegration mean(ImuBias{}, noise);
   for (const auto& [gyro, accel] : Drive()) mean.Integrate(gyro, accel, dt);
   std::mt19937 rng(7);
   std::normal_distribution<double> normal;
@@ -111,7 +111,7 @@ TEST(ImuPreintegration, CovarianceMatchesMonteCarlo) {
   const int runs = 4000;
   Eigen::Matrix<double, 9, 9> sample = Eigen::Matrix<double, 9, 9>::Zero();
   for (int r = 0; r < runs; ++r) {
-    ImuPreintegration noisy(ImuBiases{}, noise);
+    ImuPreintegration noisy(ImuBias{}, noise);
     for (const auto& [gyro, accel] : Drive()) {
       noisy.Integrate(gyro + draw(noise.gyro_noise_density / std::sqrt(dt)),
                       accel + draw(noise.accel_noise_density / std::sqrt(dt)), dt);
@@ -127,12 +127,12 @@ TEST(ImuPreintegration, CovarianceMatchesMonteCarlo) {
 }
 
 TEST(ImuPreintegration, RefusesBadSamples) {
-  ImuPreintegration between(ImuBiases{}, ImuNoise{});
+  ImuPreintegration between(ImuBias{}, ImuNoise{});
   EXPECT_THROW(between.Integrate(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0), std::invalid_argument);
   EXPECT_THROW(between.Integrate(Eigen::Vector3d(NAN, 0, 0), Eigen::Vector3d::Zero(), 0.01), std::invalid_argument);
   ImuNoise bad;
   bad.gyro_noise_density = -1.0;
-  EXPECT_THROW(ImuPreintegration(ImuBiases{}, bad), std::invalid_argument);
+  EXPECT_THROW(ImuPreintegration(ImuBias{}, bad), std::invalid_argument);
 }
 
 }  // namespace

@@ -24,6 +24,12 @@ struct ImuSample {
   Eigen::Vector3d specific_force = Eigen::Vector3d::Zero();    // m/s^2, the IMU's frame (gravity's reaction included)
 };
 
+// An IMU's biases: what its gyro and accelerometer read beyond the truth.
+struct ImuBias {
+  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   // rad/s
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // m/s^2
+};
+
 // A file holds at most this many samples: an hour at 1 kHz with room to spare.
 constexpr std::size_t kMaxImuSamples = std::size_t(4) << 20;
 

@@ -18,11 +18,6 @@
 
 namespace radargauss {
 
-struct ImuBiases {
-  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   // rad/s
-  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // m/s^2
-};
-
 // The increments in the frame of the first state (body i):
 // R_j = R_i dR, v_j = v_i + g dt + R_i dv, p_j = p_i + v_i dt + g dt^2 / 2 + R_i dp.
 struct ImuDelta {
@@ -41,14 +36,14 @@ class ImuPreintegration {
   static constexpr double kMaxGyroCorrection = 0.01;  // rad/s
   static constexpr double kMaxAccelCorrection = 0.2;  // m/s^2
 
-  ImuPreintegration(const ImuBiases& linearisation, const ImuNoise& noise);
+  ImuPreintegration(const ImuBias& linearisation, const ImuNoise& noise);
 
   // One sample held over `dt` seconds (the rates and specific force in the
   // IMU's frame). Throws std::invalid_argument for dt <= 0 or a non-finite value.
   void Integrate(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel, double dt);
 
   const ImuDelta& delta() const { return delta_; }
-  const ImuBiases& linearisation() const { return linearisation_; }
+  const ImuBias& linearisation() const { return linearisation_; }
   // The covariance of [dphi; dv; dp] (the rotation's tangent on the right).
   const Matrix9& covariance() const { return covariance_; }
   // d[dphi; dv; dp] / d(gyro bias) and / d(accel bias).
@@ -58,11 +53,11 @@ class ImuPreintegration {
   // The increments at `biases`, to first order about the linearisation.
   // Throws std::out_of_range when the change exceeds kMax*Correction:
   // the samples must be integrated again (Reintegrate).
-  ImuDelta Corrected(const ImuBiases& biases) const;
-  bool WithinCorrection(const ImuBiases& biases) const;
+  ImuDelta Corrected(const ImuBias& biases) const;
+  bool WithinCorrection(const ImuBias& biases) const;
 
  private:
-  ImuBiases linearisation_;
+  ImuBias linearisation_;
   Eigen::Matrix3d gyro_covariance_, accel_covariance_;  // continuous: density^2
   ImuDelta delta_;
   Matrix9 covariance_ = Matrix9::Zero();
