@@ -46,12 +46,7 @@ const OptionTable<SlamOptions>& SlamOptionTable() {
             .Unit("deg per m")
             .Help("and its growth"),
     };
-    AppendNested(
-        t, OdometryOptionTable(), +[](O & o) -> auto& { return o.odometry; }, "odometry");
-    AppendNested(
-        t, PlaceRecognitionOptionTable(), +[](O & o) -> auto& { return o.place_recognition; }, "place_recognition");
-    AppendNested(
-        t, LoopVerificationOptionTable(), +[](O & o) -> auto& { return o.verification; }, "verification", "verify_");
+    AppendPlaceSearchRows(t);
     AppendNested(
         t, PoseGraphOptionTable(), +[](O & o) -> auto& { return o.graph; }, "graph");
     return t;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "radargauss/error.hpp"
+#include "radargauss/slam/radar_slam.hpp"
 
 namespace radargauss {
 
@@ -47,12 +48,7 @@ const OptionTable<RelocalizationOptions>& RelocalizationOptionTable() {
             .AtLeast(1)
             .Help("scans in a row without a match that drop the fix"),
     };
-    AppendNested(
-        t, OdometryOptionTable(), +[](O & o) -> auto& { return o.odometry; }, "odometry");
-    AppendNested(
-        t, PlaceRecognitionOptionTable(), +[](O & o) -> auto& { return o.place_recognition; }, "place_recognition");
-    AppendNested(
-        t, LoopVerificationOptionTable(), +[](O & o) -> auto& { return o.verification; }, "verification", "verify_");
+    AppendPlaceSearchRows(t);
     return t;
   }();
   return table;

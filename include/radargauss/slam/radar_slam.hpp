@@ -53,6 +53,21 @@ struct FalseLoopStudy {
 const OptionTable<FalseLoopStudy>& FalseLoopStudyOptionTable();
 
 // Throws std::invalid_argument naming the bad option.
+// The rows a search for places shares, SLAM's and relocalisation's alike:
+// the odometry's, place recognition's and the loop verification's
+// (verify_*), of a struct that holds the three under those names.
+template <typename Options>
+void AppendPlaceSearchRows(OptionTable<Options>& table) {
+  AppendNested(
+      table, OdometryOptionTable(), +[](Options & o) -> auto& { return o.odometry; }, "odometry");
+  AppendNested(
+      table, PlaceRecognitionOptionTable(), +[](Options & o) -> auto& { return o.place_recognition; },
+      "place_recognition");
+  AppendNested(
+      table, LoopVerificationOptionTable(), +[](Options & o) -> auto& { return o.verification; }, "verification",
+      "verify_");
+}
+
 // Its options (options.hpp): its own, the odometry's, place recognition's,
 // the loop verification's (verify_*) and the pose graph's.
 const OptionTable<SlamOptions>& SlamOptionTable();
