@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "radargauss/residuals/geometric_residual.hpp"
+#include "radargauss/residuals/imu_residual.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
 #include "radargauss/residuals/relative_pose_residual.hpp"
 #include "radargauss/residuals/rotation_residual.hpp"
@@ -59,6 +60,11 @@ ceres::CostFunction* RotationResidual::Create(const SO3d& predicted, const Eigen
 ceres::CostFunction* VelocityResidual::Create(const SE3d& previous, const Eigen::Vector3d& velocity, double dt,
                                               const Eigen::Matrix3d& sqrt_information) {
   return new AutoDiff(new VelocityResidual(previous, velocity, dt, sqrt_information));
+}
+
+ceres::CostFunction* ImuResidual::Create(const ImuPreintegration& preintegration, const ImuNoise& noise,
+                                         const Eigen::Vector3d& gravity) {
+  return new AutoDiff(new ImuResidual(preintegration, noise, gravity));
 }
 
 }  // namespace radargauss

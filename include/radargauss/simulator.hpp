@@ -160,7 +160,6 @@ SimulatedSequence Simulate(const SimulationConfig& config);
 // The IMU's samples over the drive, every 1 / imu_rate_hz from the first
 // scan's time to the last's (0 without an IMU); at most kMaxImuSamples.
 std::size_t ImuSampleCount(const SimulationConfig& config);
-constexpr double kGravity = 9.81;  // m/s^2, along the world's -z
 
 // The simulated scans as a Sequence matched to their ground-truth poses (what
 // LoadSequence gives for the written files, without the float32 rounding).

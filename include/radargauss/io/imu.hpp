@@ -30,6 +30,9 @@ struct ImuBias {
   Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // m/s^2
 };
 
+// Gravity's magnitude; a gravity-aligned world has it along -z.
+constexpr double kGravity = 9.81;  // m/s^2
+
 // A file holds at most this many samples: an hour at 1 kHz with room to spare.
 constexpr std::size_t kMaxImuSamples = std::size_t(4) << 20;
 

@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The preintegrated IMU term (docs/design.md, "The IMU term"): analytic
+// Jacobians against automatic differentiation and central differences, and
+// a zero residual at the states of a planted motion whose exact IMU it integrates.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+
+#include "radargauss/residuals/imu_residual.hpp"
+#include "support/cost_function_checks.hpp"
+
+namespace radargauss {
+namespace {
+
+const Eigen::Vector3d kG(0.0, 0.0, -kGravity);
+
+// 0.5 s of a turning, accelerating drive at 200 Hz, integrated at `linearisation`.
+ImuPreintegration DriveBetween(const ImuBias& linearisation) {
+  ImuPreintegration between(linearisation, ImuNoise{});
+  for (int k = 0; k < 100; ++k) {
+    const double t = k * 0.005;
+    between.Integrate(Eigen::Vector3d(0.05 * std::sin(3 * t), -0.03, 0.4 + 0.2 * t),
+                      Eigen::Vector3d(1.0 + std::cos(2 * t), 0.5 * t, 9.81 + 0.1 * std::sin(5 * t)), 0.005);
+  }
+  return between;
+}
+
+Eigen::Matrix<double, 9, 1> RandomMotion(std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Matrix<double, 9, 1> m;
+  for (int k = 0; k < 3; ++k) {
+    m(kMotionVelocity + k) = 5.0 * n(rng);
+    m(kMotionGyroBias + k) = 0.004 * n(rng);
+    m(kMotionAccelBias + k) = 0.08 * n(rng);
+  }
+  return m;
+}
+
+TEST(ImuResidualJacobians, AnalyticAutodiffNumeric) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const ImuBias linearisation{0.003 * testing::RandomUnitVector(rng), 0.05 * testing::RandomUnitVector(rng)};
+    const ImuPreintegration between = DriveBetween(linearisation);
+    const ImuCostFunction analytic(between, ImuNoise{});
+    const std::unique_ptr<ceres::CostFunction> autodiff(ImuResidual::Create(between, ImuNoise{}));
+    Eigen::Vector4d qi = SO3d::Exp(Eigen::Vector3d(n(rng), n(rng), n(rng))).quaternion().coeffs();
+    Eigen::Vector4d qj = SO3d::Exp(Eigen::Vector3d(n(rng), n(rng), n(rng))).quaternion().coeffs();
+    Eigen::Vector3d pi(n(rng), n(rng), n(rng)), pj(n(rng), n(rng), n(rng));
+    pi *= 10.0;
+    pj *= 10.0;
+    Eigen::Matrix<double, 9, 1> mi = RandomMotion(rng), mj = RandomMotion(rng);
+    const std::vector<double*> blocks = {qi.data(), pi.data(), mi.data(), qj.data(), pj.data(), mj.data()};
+    std::vector<Eigen::MatrixXd> ja, jd;
+    const Eigen::VectorXd ra = EvaluateWithJacobians(analytic, blocks, ja);
+    const Eigen::VectorXd rd = EvaluateWithJacobians(*autodiff, blocks, jd);
+    EXPECT_LT(Relative(ra, rd), 1e-12);
+    for (int b = 0; b < 6; ++b) {
+      EXPECT_LT(Relative(ja[b], jd[b]), 1e-8) << "block " << b;
+      EXPECT_LT(Relative(ja[b], NumericBlockJacobian(analytic, blocks, b)), 1e-5) << "block " << b;
+    }
+  }
+}
+
+// A constant rate and a constant acceleration in the world, with biases:
+// the exact samples make the states at both ends a zero of the term.
+TEST(ImuResidual, ZeroAtThePlantedStates) {
+  const Eigen::Vector3d omega(0.1, -0.05, 0.3), a(0.6, -0.3, 0.1), v0(4.0, 1.0, 0.0), p0(5.0, -2.0, 1.0);
+  const ImuBias bias{Eigen::Vector3d(0.002, -0.001, 0.003), Eigen::Vector3d(0.04, -0.02, 0.06)};
+  const SO3d R0 = SO3d::Exp(Eigen::Vector3d(0.02, -0.01, 0.7));
+  ImuPreintegration between(bias, ImuNoise{});
+  SO3d R = R0;
+  const double dt = 0.004;
+  const int steps = 250;
+  for (int k = 0; k < steps; ++k) {
+    // f = R^T (a - g) at the sample's start, where the integrator holds R.
+    between.Integrate(omega + bias.gyro, R.Inverse() * (a - kG) + bias.accel, dt);
+    R = R * SO3d::Exp(omega * dt);
+  }
+  // The world acceleration is a throughout: v and p follow exactly.
+  const double T = steps * dt;
+  Eigen::Vector4d qi = R0.quaternion().coeffs(), qj = R.quaternion().coeffs();
+  Eigen::Vector3d pi = p0, pj = p0 + v0 * T + 0.5 * a * T * T;
+  Eigen::Matrix<double, 9, 1> mi, mj;
+  mi << v0, bias.gyro, bias.accel;
+  mj << v0 + a * T, bias.gyro, bias.accel;
+  const ImuCostFunction term(between, ImuNoise{});
+  const double* blocks[] = {qi.data(), pi.data(), mi.data(), qj.data(), pj.data(), mj.data()};
+  Eigen::Matrix<double, 15, 1> r;
+  ASSERT_TRUE(term.Evaluate(blocks, r.data(), nullptr));
+  EXPECT_LT(r.norm(), 1e-5);
+  // A wrong end velocity shows: 1 cm/s is many sigmas of half a second of a MEMS accelerometer.
+  mj(kMotionVelocity) += 0.01;
+  ASSERT_TRUE(term.Evaluate(blocks, r.data(), nullptr));
+  EXPECT_GT(r.norm(), 1.0);
+}
+
+TEST(ImuResidual, NoSamplesIsRefused) {
+  const ImuPreintegration empty(ImuBias{}, ImuNoise{});
+  EXPECT_THROW(ImuCostFunction(empty, ImuNoise{}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace radargauss
