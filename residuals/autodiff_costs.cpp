@@ -8,6 +8,7 @@
 
 #include "radargauss/residuals/geometric_residual.hpp"
 #include "radargauss/residuals/imu_residual.hpp"
+#include "radargauss/residuals/radar_inertial_residuals.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
 #include "radargauss/residuals/relative_pose_residual.hpp"
 #include "radargauss/residuals/rotation_residual.hpp"
@@ -65,6 +66,17 @@ ceres::CostFunction* VelocityResidual::Create(const SE3d& previous, const Eigen:
 ceres::CostFunction* ImuResidual::Create(const ImuPreintegration& preintegration, const ImuNoise& noise,
                                          const Eigen::Vector3d& gravity) {
   return new AutoDiff(new ImuResidual(preintegration, noise, gravity));
+}
+
+ceres::CostFunction* RadarPoseResidual::Create(const SE3d& measured,
+                                               const Eigen::Matrix<double, 6, 6>& sqrt_information) {
+  return new AutoDiff(new RadarPoseResidual(measured, sqrt_information));
+}
+
+ceres::CostFunction* RadarVelocityResidual::Create(const Eigen::Vector3d& radar_velocity,
+                                                   const Eigen::Vector3d& gyro_rate,
+                                                   const Eigen::Matrix3d& sqrt_information) {
+  return new AutoDiff(new RadarVelocityResidual(radar_velocity, gyro_rate, sqrt_information));
 }
 
 }  // namespace radargauss

@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/residuals/imu_preintegration.hpp"
 
+#include "radargauss/error.hpp"
+
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <stdexcept>
 
 namespace radargauss {
@@ -74,6 +78,26 @@ ImuDelta ImuPreintegration::Corrected(const ImuBias& biases) const {
   corrected.velocity += gyro_jacobian_.block<3, 3>(3, 0) * dbg + accel_jacobian_.block<3, 3>(3, 0) * dba;
   corrected.position += gyro_jacobian_.block<3, 3>(6, 0) * dbg + accel_jacobian_.block<3, 3>(6, 0) * dba;
   return corrected;
+}
+
+ImuPreintegration Preintegrate(const std::vector<ImuSample>& samples, double from, double to, const ImuBias& bias,
+                               const ImuNoise& noise) {
+  const auto after_from = std::upper_bound(samples.begin(), samples.end(), from,
+                                           [](double t, const ImuSample& sample) { return t < sample.stamp; });
+  if (!(to > from) || after_from == samples.begin()) {
+    throw DataError("the IMU does not cover " + std::to_string(from) + " .. " + std::to_string(to) + " s");
+  }
+  ImuPreintegration between(bias, noise);
+  for (auto sample = after_from - 1; sample != samples.end() && sample->stamp < to; ++sample) {
+    const double start = std::max(from, sample->stamp);
+    const double end = (sample + 1 == samples.end()) ? to : std::min(to, (sample + 1)->stamp);
+    if (end - sample->stamp > kMaxImuHold) {
+      throw DataError("the IMU has no sample from " + std::to_string(sample->stamp) + " to " + std::to_string(end) +
+                      " s");
+    }
+    if (end > start) between.Integrate(sample->angular_velocity, sample->specific_force, end - start);
+  }
+  return between;
 }
 
 }  // namespace radargauss

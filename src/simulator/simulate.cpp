@@ -179,8 +179,8 @@ struct ScanTime {
 };
 
 // The IMU's samples over the drive (docs/design.md, "The synthetic world"):
-// the IMU frame's true rate and specific force by central differences of
-// the drive (1 ms), plus turn-on biases, their random walks and white noise,
+// the IMU frame's mean rate and specific force over the interval from each
+// sample to the next (delta angle and delta velocity over dt), plus turn-on biases, their random walks and white noise,
 // drawn from a generator of their own so that the scans are the same with an
 // IMU or without.
 void SimulateImu(const SimulationConfig& config, const simulation::LoopPath& path, const SE3d& vehicle_from_radar,
@@ -205,13 +205,17 @@ void SimulateImu(const SimulationConfig& config, const simulation::LoopPath& pat
     SensorState(config, path, t, pose, velocity);
     return pose * vehicle_from_imu;
   };
+  // The IMU frame's velocity by central differences (h): continuous except
+  // where the path's curvature steps and the IMU sits off the vehicle's origin.
+  const auto imu_velocity = [&](double t) -> Eigen::Vector3d {
+    return (imu_pose(t + h).translation() - imu_pose(t - h).translation()) / (2.0 * h);
+  };
   const std::size_t count = ImuSampleCount(config);
   for (std::size_t k = 0; k < count; ++k) {
     const double t = double(k) * dt;
-    const SE3d before = imu_pose(t - h), at = imu_pose(t), after = imu_pose(t + h);
-    const Eigen::Vector3d rate = (before.rotation().Inverse() * after.rotation()).Log() / (2.0 * h);
-    const Eigen::Vector3d acceleration =
-        (after.translation() - 2.0 * at.translation() + before.translation()) / (h * h);
+    const SE3d at = imu_pose(t), next = imu_pose(t + dt);
+    const Eigen::Vector3d rate = (at.rotation().Inverse() * next.rotation()).Log() / dt;
+    const Eigen::Vector3d acceleration = (imu_velocity(t + dt) - imu_velocity(t)) / dt;
     ImuSample sample;
     sample.stamp = config.start_time + t + config.imu_clock_offset;
     sample.angular_velocity = rate + bias.gyro + draw(config.imu_gyro_noise_density / std::sqrt(dt));

@@ -11,6 +11,8 @@
 //   const ImuDelta delta = between.Corrected(new_bias);  // or Reintegrate past MaxCorrection
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "radargauss/io/imu.hpp"
@@ -64,5 +66,12 @@ class ImuPreintegration {
   Matrix93 gyro_jacobian_ = Matrix93::Zero();
   Matrix93 accel_jacobian_ = Matrix93::Zero();
 };
+
+// The samples (time order, each held until the next) integrated from `from`
+// to `to`; the last one before `to` is held up to it. Throws DataError when
+// no sample is at or before `from` or a sample is held longer than kMaxImuHold.
+constexpr double kMaxImuHold = 0.05;  // s
+ImuPreintegration Preintegrate(const std::vector<ImuSample>& samples, double from, double to, const ImuBias& bias,
+                               const ImuNoise& noise);
 
 }  // namespace radargauss

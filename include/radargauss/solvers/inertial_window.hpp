@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// A sliding window of IMU states at the radar's scans (docs/design.md, "The
+// sliding window"): pose, velocity and biases in a gravity-aligned world,
+// tied by preintegrated IMU terms (residuals/imu_residual.hpp) and held by
+// the radar's terms (residuals/radar_inertial_residuals.hpp): the scan
+// match's pose and information, and the Doppler ego velocity. A state that
+// leaves the window is marginalised into a prior (solvers/marginalization.hpp)
+// or dropped. Solved by Ceres's Levenberg-Marquardt or dogleg, or by the own
+// Gauss-Newton on the same terms. The radar-IMU extrinsic and the tilt of the
+// matcher's world against gravity are blocks too, fixed or estimated.
+//
+//   InertialWindow window(options, radar_from_imu);
+//   window.AddImu(samples);
+//   window.Start(first_state);             // at the first scan
+//   window.AddPose(match_pose, information); window.AddVelocity(v, S, gyro);
+//   window.Solve();
+//   window.AddState(next_scan_stamp); ...  // then its measurements, Solve
+#pragma once
+
+#include <cstddef>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "radargauss/io/imu.hpp"
+#include "radargauss/lie/se3.hpp"
+#include "radargauss/options.hpp"
+
+namespace radargauss {
+
+enum class WindowSolver { kCeresLm, kCeresDogleg, kGaussNewton };
+std::string ToString(WindowSolver solver);                     // "ceres-lm", "ceres-dogleg", "gn"
+WindowSolver WindowSolverFromString(const std::string& name);  // throws std::invalid_argument
+std::vector<std::string> WindowSolverNames();
+
+struct InertialWindowOptions {
+  std::size_t size = 20;  // states kept (2 s at 10 Hz: shorter windows marginalise states not yet settled)
+  WindowSolver solver = WindowSolver::kCeresLm;
+  int max_iterations = 10;  // per Solve
+  bool marginalize = true;  // false: a leaving state is dropped with all it knew
+  ImuNoise noise;
+  // The first state's prior (std): its biases about zero, its velocity about the start's.
+  double gyro_bias_prior = 0.01;  // rad/s
+  double accel_bias_prior = 0.2;  // m/s^2
+  double velocity_prior = 1.0;    // m/s
+  bool estimate_tilt = true;      // the matcher's world's roll and pitch against gravity
+  bool estimate_extrinsic_rotation = false;
+  bool estimate_extrinsic_translation = false;
+};
+
+// Its options (options.hpp), named window_*, imu_* (the noise) and estimate_*.
+const OptionTable<InertialWindowOptions>& InertialWindowOptionTable();
+
+// An IMU state: T_world_imu in the gravity-aligned world, the velocity there, the biases.
+struct InertialState {
+  double stamp = 0.0;
+  SE3d pose;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s
+  ImuBias bias;
+};
+
+struct WindowSolveSummary {
+  int iterations = 0;
+  double initial_cost = 0.0, final_cost = 0.0;
+  bool converged = false;
+  std::size_t reintegrated = 0;  // IMU terms integrated again at a moved bias
+  double time_ms = 0.0;
+};
+
+class InertialWindow {
+ public:
+  // T_radar_imu: the IMU's frame in the radar's (the extrinsic's start when estimated).
+  InertialWindow(const InertialWindowOptions& options, const SE3d& radar_from_imu);
+  ~InertialWindow();
+  InertialWindow(const InertialWindow&) = delete;
+  InertialWindow& operator=(const InertialWindow&) = delete;
+
+  // Appends samples (time order, after those given before; throws DataError otherwise).
+  void AddImu(const std::vector<ImuSample>& samples);
+  // The first state, with the first-state prior on its biases and velocity.
+  void Start(const InertialState& state);
+  // A new state at `stamp` (after the last), predicted by the IMU from the
+  // last. Throws DataError when the IMU does not cover the interval.
+  void AddState(double stamp);
+  // Measurements of the newest state: the matcher's T_world_radar with eq. 2's
+  // information (translation first), and the Doppler velocity of the radar in
+  // its frame with its covariance, at the gyro rate `gyro` (the IMU's frame).
+  void AddPose(const SE3d& world_from_radar, const Eigen::Matrix<double, 6, 6>& information);
+  void AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance,
+                   const Eigen::Vector3d& gyro);
+  WindowSolveSummary Solve();
+
+  std::size_t size() const;
+  InertialState state(std::size_t index) const;  // 0: the oldest in the window
+  InertialState newest() const;
+  // The newest state's radar pose in the matcher's world: A T_world_imu T_imu_radar.
+  SE3d RadarPoseInMatcherWorld() const;
+  SE3d radar_from_imu() const;
+  Eigen::Vector2d tilt() const;  // rad: roll, pitch of the matcher's world against gravity
+  void set_tilt(const Eigen::Vector2d& roll_pitch);
+  const InertialWindowOptions& options() const { return options_; }
+
+ private:
+  struct Node;
+  struct Impl;
+  void RemoveOldest();
+  InertialWindowOptions options_;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The first state and the tilt of the matcher's world, from the first scan:
+// its matched T_world_radar, its Doppler velocity (radar frame) and the IMU
+// samples within span / 2 of it, whose mean specific force is taken for
+// gravity's reaction (the acceleration as zero: a 0.1 m/s^2 one tilts the
+// start by 0.6 deg, which the window then corrects). Biases start at zero.
+// Throws DataError when no sample lies within span / 2.
+struct InertialStart {
+  InertialState state;
+  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();  // rad: roll, pitch
+};
+InertialStart StartFromGravity(const std::vector<ImuSample>& samples, double stamp, const SE3d& world_from_radar,
+                               const Eigen::Vector3d& radar_velocity, const SE3d& radar_from_imu, double span = 0.2);
+
+}  // namespace radargauss

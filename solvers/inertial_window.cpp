@@ -1,0 +1,452 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/solvers/inertial_window.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include <ceres/crs_matrix.h>
+#include <ceres/normal_prior.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include "radargauss/error.hpp"
+#include "radargauss/lie/manifold.hpp"
+#include "radargauss/names.hpp"
+#include "radargauss/residuals/imu_preintegration.hpp"
+#include "radargauss/residuals/imu_residual.hpp"
+#include "radargauss/residuals/radar_inertial_residuals.hpp"
+#include "radargauss/solvers/marginalization.hpp"
+
+namespace radargauss {
+
+namespace {
+
+const NamedValue<WindowSolver> kWindowSolverNames[] = {{WindowSolver::kCeresLm, "ceres-lm"},
+                                                       {WindowSolver::kCeresDogleg, "ceres-dogleg"},
+                                                       {WindowSolver::kGaussNewton, "gn"}};
+
+// W with W^T W = information, for a positive semi-definite information.
+Eigen::MatrixXd SqrtInformation(const Eigen::MatrixXd& information) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(0.5 * (information + information.transpose()));
+  const Eigen::VectorXd roots = eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  return roots.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+using CostPointer = std::shared_ptr<ceres::CostFunction>;
+
+}  // namespace
+
+std::string ToString(WindowSolver solver) { return NameOf(kWindowSolverNames, solver); }
+WindowSolver WindowSolverFromString(const std::string& name) {
+  return ValueNamed(kWindowSolverNames, name, "window solver");
+}
+std::vector<std::string> WindowSolverNames() { return NamesOf(kWindowSolverNames); }
+
+const OptionTable<InertialWindowOptions>& InertialWindowOptionTable() {
+  using O = InertialWindowOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {
+        RADARGAUSS_OPTION(O, "window_size", size).In(2, 1000).Help("IMU states the sliding window keeps"),
+        RADARGAUSS_CHOICE(O, "window_solver", solver, WindowSolverNames(), WindowSolverFromString)
+            .Help("the window's solver: ceres-lm, ceres-dogleg or gn (own Gauss-Newton)"),
+        RADARGAUSS_OPTION(O, "window_iterations", max_iterations).In(1, 1000).Help("iterations per solve"),
+        RADARGAUSS_OPTION(O, "window_marginalize", marginalize)
+            .Help("a leaving state becomes a prior (Schur complement); false: it is dropped"),
+        RADARGAUSS_OPTION(O, "window_gyro_bias_prior", gyro_bias_prior)
+            .Above(0.0)
+            .Unit("rad/s")
+            .Help("std of the first state's gyro bias about zero"),
+        RADARGAUSS_OPTION(O, "window_accel_bias_prior", accel_bias_prior)
+            .Above(0.0)
+            .Unit("m/s^2")
+            .Help("std of the first state's accelerometer bias about zero"),
+        RADARGAUSS_OPTION(O, "window_velocity_prior", velocity_prior)
+            .Above(0.0)
+            .Unit("m/s")
+            .Help("std of the first state's velocity about the start's"),
+        RADARGAUSS_OPTION(O, "estimate_tilt", estimate_tilt)
+            .Help("estimate the roll and pitch of the matcher's world against gravity"),
+        RADARGAUSS_OPTION(O, "estimate_extrinsic_rotation", estimate_extrinsic_rotation)
+            .Help("estimate the radar-IMU rotation online"),
+        RADARGAUSS_OPTION(O, "estimate_extrinsic_translation", estimate_extrinsic_translation)
+            .Help("estimate the radar-IMU translation online (where the motion excites it)"),
+    };
+    AppendNested(
+        t, ImuNoiseOptionTable(), +[](O & o) -> auto& { return o.noise; }, "noise", "imu_");
+    return t;
+  }();
+  return table;
+}
+
+// One state and the terms that end at it.
+struct InertialWindow::Node {
+  double stamp = 0.0;
+  Eigen::Vector4d rotation = Eigen::Vector4d(0, 0, 0, 1);  // R_world_imu, x y z w
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 9, 1> motion = Eigen::Matrix<double, 9, 1>::Zero();  // v, b_g, b_a
+  std::optional<ImuPreintegration> from_previous;  // the IMU between the node before and this one
+  CostPointer imu, pose, velocity;                 // terms on this node (imu: from the one before)
+  std::vector<std::pair<CostPointer, std::vector<double*>>> first_priors;  // the first state's
+
+  InertialState State() const {
+    InertialState s;
+    s.stamp = stamp;
+    s.pose = SE3d(SO3d::FromXyzw(rotation.data()), position);
+    s.velocity = motion.segment<3>(kMotionVelocity);
+    s.bias.gyro = motion.segment<3>(kMotionGyroBias);
+    s.bias.accel = motion.segment<3>(kMotionAccelBias);
+    return s;
+  }
+  ImuBias Bias() const { return {motion.segment<3>(kMotionGyroBias), motion.segment<3>(kMotionAccelBias)}; }
+};
+
+struct InertialWindow::Impl {
+  std::deque<Node> nodes;  // a deque keeps the blocks' addresses as states come and go
+  std::vector<ImuSample> imu;
+  SO3Manifold so3;
+  Eigen::Vector4d extrinsic_rotation;  // R_imu_radar, x y z w
+  Eigen::Vector3d extrinsic_translation;
+  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
+  std::shared_ptr<MarginalizationPrior> prior;
+
+  // The blocks the solvers move, in a fixed order.
+  std::vector<double*> VariableBlocks(const InertialWindowOptions& options) {
+    std::vector<double*> blocks;
+    for (Node& node : nodes) {
+      blocks.insert(blocks.end(), {node.rotation.data(), node.position.data(), node.motion.data()});
+    }
+    for (double* global : GlobalBlocks(options)) blocks.push_back(global);
+    return blocks;
+  }
+  std::vector<double*> GlobalBlocks(const InertialWindowOptions& options) {
+    std::vector<double*> blocks;
+    if (options.estimate_tilt) blocks.push_back(tilt.data());
+    if (options.estimate_extrinsic_rotation) blocks.push_back(extrinsic_rotation.data());
+    if (options.estimate_extrinsic_translation) blocks.push_back(extrinsic_translation.data());
+    return blocks;
+  }
+
+  // Every term of the window in `problem`; the ids of those on the oldest state in `oldest_terms`.
+  void Build(ceres::Problem& problem, const InertialWindowOptions& options,
+             std::vector<ceres::ResidualBlockId>* oldest_terms) {
+    for (Node& node : nodes) {
+      problem.AddParameterBlock(node.rotation.data(), 4, &so3);
+      problem.AddParameterBlock(node.position.data(), 3);
+      problem.AddParameterBlock(node.motion.data(), 9);
+    }
+    problem.AddParameterBlock(extrinsic_rotation.data(), 4, &so3);
+    problem.AddParameterBlock(extrinsic_translation.data(), 3);
+    problem.AddParameterBlock(tilt.data(), 2);
+    if (!options.estimate_extrinsic_rotation) problem.SetParameterBlockConstant(extrinsic_rotation.data());
+    if (!options.estimate_extrinsic_translation) problem.SetParameterBlockConstant(extrinsic_translation.data());
+    if (!options.estimate_tilt) problem.SetParameterBlockConstant(tilt.data());
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      Node& node = nodes[k];
+      std::vector<ceres::ResidualBlockId> ids;
+      for (auto& [cost, blocks] : node.first_priors)
+        ids.push_back(problem.AddResidualBlock(cost.get(), nullptr, blocks));
+      if (node.pose) {
+        ids.push_back(problem.AddResidualBlock(node.pose.get(), nullptr,
+                                               {node.rotation.data(), node.position.data(), extrinsic_rotation.data(),
+                                                extrinsic_translation.data(), tilt.data()}));
+      }
+      if (node.velocity) {
+        ids.push_back(problem.AddResidualBlock(
+            node.velocity.get(), nullptr,
+            {node.rotation.data(), node.motion.data(), extrinsic_rotation.data(), extrinsic_translation.data()}));
+      }
+      if (k > 0 && node.imu) {
+        Node& before = nodes[k - 1];
+        const ceres::ResidualBlockId id =
+            problem.AddResidualBlock(node.imu.get(), nullptr,
+                                     {before.rotation.data(), before.position.data(), before.motion.data(),
+                                      node.rotation.data(), node.position.data(), node.motion.data()});
+        if (k == 1) ids.push_back(id);
+      }
+      if (k == 0 && oldest_terms != nullptr) *oldest_terms = ids;
+    }
+    if (prior) {
+      const ceres::ResidualBlockId id = problem.AddResidualBlock(prior.get(), nullptr, prior->parameter_blocks());
+      if (oldest_terms != nullptr) oldest_terms->push_back(id);
+    }
+  }
+};
+
+InertialWindow::InertialWindow(const InertialWindowOptions& options, const SE3d& radar_from_imu)
+    : options_(options), impl_(std::make_unique<Impl>()) {
+  CheckOptions(InertialWindowOptionTable(), options);
+  const SE3d imu_from_radar = radar_from_imu.Inverse();
+  impl_->extrinsic_rotation = imu_from_radar.rotation().quaternion().coeffs();
+  impl_->extrinsic_translation = imu_from_radar.translation();
+}
+
+InertialWindow::~InertialWindow() = default;
+
+void InertialWindow::AddImu(const std::vector<ImuSample>& samples) {
+  std::vector<ImuSample>& imu = impl_->imu;
+  for (const ImuSample& sample : samples) {
+    if (!imu.empty() && !(sample.stamp > imu.back().stamp)) {
+      throw DataError("IMU sample at " + std::to_string(sample.stamp) + " s does not follow the one at " +
+                      std::to_string(imu.back().stamp) + " s");
+    }
+    imu.push_back(sample);
+  }
+}
+
+void InertialWindow::Start(const InertialState& state) {
+  if (!impl_->nodes.empty()) throw std::logic_error("InertialWindow::Start: the window has started");
+  Node node;
+  node.stamp = state.stamp;
+  node.rotation = state.pose.rotation().quaternion().coeffs();
+  node.position = state.pose.translation();
+  node.motion << state.velocity, state.bias.gyro, state.bias.accel;
+  impl_->nodes.push_back(node);
+  Node& first = impl_->nodes.back();
+  // Biases about zero, the velocity about the start's; the tilt about its start.
+  Eigen::Matrix<double, 9, 1> sigmas;
+  sigmas << Eigen::Vector3d::Constant(options_.velocity_prior), Eigen::Vector3d::Constant(options_.gyro_bias_prior),
+      Eigen::Vector3d::Constant(options_.accel_bias_prior);
+  Eigen::Matrix<double, 9, 1> mean;
+  mean << state.velocity, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero();
+  const Eigen::MatrixXd A = sigmas.cwiseInverse().asDiagonal();
+  first.first_priors.push_back({std::make_shared<ceres::NormalPrior>(A, mean), {first.motion.data()}});
+  if (options_.estimate_tilt) {
+    constexpr double kTiltPrior = 0.1;  // rad: the start's tilt from the accelerometer is this good at worst
+    first.first_priors.push_back(
+        {std::make_shared<ceres::NormalPrior>(Eigen::Matrix2d::Identity() / kTiltPrior, Eigen::Vector2d(impl_->tilt)),
+         {impl_->tilt.data()}});
+  }
+}
+
+void InertialWindow::AddState(double stamp) {
+  if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::AddState before Start");
+  const Node& last = impl_->nodes.back();
+  if (!(stamp > last.stamp)) {
+    throw DataError("state at " + std::to_string(stamp) + " s does not follow the one at " +
+                    std::to_string(last.stamp) + " s");
+  }
+  const ImuPreintegration between = Preintegrate(impl_->imu, last.stamp, stamp, last.Bias(), options_.noise);
+  // The prediction (imu_preintegration.hpp's model) is the new state's start.
+  const SE3d pose = last.State().pose;
+  const ImuDelta& d = between.delta();
+  const Eigen::Vector3d g(0.0, 0.0, -kGravity), v = last.motion.segment<3>(kMotionVelocity);
+  Node node;
+  node.stamp = stamp;
+  node.rotation = (pose.rotation() * d.rotation).quaternion().coeffs();
+  node.position =
+      pose.translation() + v * d.duration + 0.5 * g * d.duration * d.duration + pose.rotation() * d.position;
+  node.motion = last.motion;
+  node.motion.segment<3>(kMotionVelocity) = v + g * d.duration + pose.rotation() * d.velocity;
+  node.from_previous = between;
+  node.imu = std::make_shared<ImuCostFunction>(between, options_.noise);
+  impl_->nodes.push_back(std::move(node));
+}
+
+void InertialWindow::AddPose(const SE3d& world_from_radar, const Eigen::Matrix<double, 6, 6>& information) {
+  if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::AddPose before Start");
+  const Eigen::Matrix<double, 6, 6> W = SqrtInformation(information);
+  impl_->nodes.back().pose.reset(RadarPoseResidual::Create(world_from_radar, W));
+}
+
+void InertialWindow::AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance,
+                                 const Eigen::Vector3d& gyro) {
+  if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::AddVelocity before Start");
+  const Eigen::LLT<Eigen::Matrix3d> factor(covariance);
+  if (factor.info() != Eigen::Success) throw std::invalid_argument("AddVelocity: covariance not positive definite");
+  const Eigen::Matrix3d W = SqrtInformation(factor.solve(Eigen::Matrix3d::Identity()));
+  impl_->nodes.back().velocity.reset(RadarVelocityResidual::Create(radar_velocity, gyro, W));
+}
+
+std::size_t InertialWindow::size() const { return impl_->nodes.size(); }
+InertialState InertialWindow::state(std::size_t index) const { return impl_->nodes.at(index).State(); }
+InertialState InertialWindow::newest() const { return impl_->nodes.back().State(); }
+Eigen::Vector2d InertialWindow::tilt() const { return impl_->tilt; }
+void InertialWindow::set_tilt(const Eigen::Vector2d& roll_pitch) { impl_->tilt = roll_pitch; }
+
+SE3d InertialWindow::radar_from_imu() const {
+  return SE3d(SO3d::FromXyzw(impl_->extrinsic_rotation.data()), impl_->extrinsic_translation).Inverse();
+}
+
+SE3d InertialWindow::RadarPoseInMatcherWorld() const {
+  const SE3d tilt(TiltRotation(impl_->tilt.data()), Eigen::Vector3d::Zero());
+  return tilt * newest().pose * radar_from_imu().Inverse();
+}
+
+namespace {
+
+ceres::Problem::Options BorrowingProblem() {
+  ceres::Problem::Options options;
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return options;
+}
+
+// The own Gauss-Newton on the window: the normal equations of the terms'
+// tangent Jacobians (Ceres evaluates them), block-banded and solved by a
+// sparse LDL^T, each step halved while it raises the cost.
+WindowSolveSummary GaussNewton(ceres::Problem& problem, const std::vector<double*>& blocks, int max_iterations) {
+  WindowSolveSummary summary;
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = blocks;
+  double cost = 0.0;
+  std::vector<double> residuals;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(evaluate, &cost, &residuals, nullptr, &crs);
+  summary.initial_cost = cost;
+  std::vector<Eigen::VectorXd> saved(blocks.size());
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
+    const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> J(
+        crs.num_rows, crs.num_cols, Eigen::Index(crs.values.size()), crs.rows.data(), crs.cols.data(),
+        crs.values.data());
+    const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(residuals.data(), Eigen::Index(residuals.size()));
+    Eigen::SparseMatrix<double> H = Eigen::SparseMatrix<double>(J.transpose()) * J;
+    for (int k = 0; k < H.rows(); ++k) H.coeffRef(k, k) += 1e-12 * (1.0 + std::abs(H.coeff(k, k)));
+    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor(H);
+    const Eigen::VectorXd step = factor.solve(-(J.transpose() * r));
+    ++summary.iterations;
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      saved[b] = Eigen::Map<const Eigen::VectorXd>(blocks[b], problem.ParameterBlockSize(blocks[b]));
+    }
+    double scale = 1.0, new_cost = cost;
+    for (int halving = 0; halving < 8; ++halving, scale *= 0.5) {
+      int column = 0;
+      for (std::size_t b = 0; b < blocks.size(); ++b) {
+        const ceres::Manifold* manifold = problem.GetManifold(blocks[b]);
+        const int n = manifold == nullptr ? int(saved[b].size()) : manifold->TangentSize();
+        const Eigen::VectorXd delta = scale * step.segment(column, n);
+        if (manifold == nullptr) {
+          Eigen::Map<Eigen::VectorXd>(blocks[b], n) = saved[b] + delta;
+        } else {
+          manifold->Plus(saved[b].data(), delta.data(), blocks[b]);
+        }
+        column += n;
+      }
+      problem.Evaluate(evaluate, &new_cost, nullptr, nullptr, nullptr);
+      if (new_cost <= cost) break;
+    }
+    if (new_cost > cost) {  // no halving helped: stay where the cost was lowest
+      for (std::size_t b = 0; b < blocks.size(); ++b) {
+        std::copy(saved[b].data(), saved[b].data() + saved[b].size(), blocks[b]);
+      }
+      summary.converged = true;
+      break;
+    }
+    const bool small = cost - new_cost <= 1e-10 * cost || (scale * step).norm() < 1e-10;
+    problem.Evaluate(evaluate, &cost, &residuals, nullptr, &crs);
+    if (small) {
+      summary.converged = true;
+      break;
+    }
+  }
+  summary.final_cost = cost;
+  return summary;
+}
+
+WindowSolveSummary CeresSolve(ceres::Problem& problem, const InertialWindowOptions& options) {
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;  // the window's Hessian is block-banded
+  solver.trust_region_strategy_type =
+      options.solver == WindowSolver::kCeresDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
+  solver.max_num_iterations = options.max_iterations;
+  solver.num_threads = 1;
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(solver, &problem, &ceres_summary);
+  WindowSolveSummary summary;
+  summary.iterations = int(ceres_summary.iterations.size()) - 1;
+  summary.initial_cost = ceres_summary.initial_cost;
+  summary.final_cost = ceres_summary.final_cost;
+  summary.converged = ceres_summary.termination_type == ceres::CONVERGENCE;
+  return summary;
+}
+
+}  // namespace
+
+WindowSolveSummary InertialWindow::Solve() {
+  const auto start = std::chrono::steady_clock::now();
+  if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::Solve before Start");
+  std::deque<Node>& nodes = impl_->nodes;
+  while (nodes.size() > options_.size) RemoveOldest();
+  // The IMU terms whose bias moved past the first-order correction, integrated again.
+  std::size_t reintegrated = 0;
+  for (std::size_t k = 1; k < nodes.size(); ++k) {
+    Node& node = nodes[k];
+    if (!node.from_previous || node.from_previous->WithinCorrection(nodes[k - 1].Bias())) continue;
+    node.from_previous = Preintegrate(impl_->imu, nodes[k - 1].stamp, node.stamp, nodes[k - 1].Bias(), options_.noise);
+    node.imu = std::make_shared<ImuCostFunction>(*node.from_previous, options_.noise);
+    ++reintegrated;
+  }
+  ceres::Problem problem(BorrowingProblem());
+  impl_->Build(problem, options_, nullptr);
+  WindowSolveSummary summary = options_.solver == WindowSolver::kGaussNewton
+                                   ? GaussNewton(problem, impl_->VariableBlocks(options_), options_.max_iterations)
+                                   : CeresSolve(problem, options_);
+  summary.reintegrated = reintegrated;
+  summary.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+// The oldest state leaves: its terms become a prior on what they share with
+// the rest (the next state and the estimated globals), or are dropped.
+void InertialWindow::RemoveOldest() {
+  std::deque<Node>& nodes = impl_->nodes;
+  if (options_.marginalize && nodes.size() > 1) {
+    ceres::Problem problem(BorrowingProblem());
+    std::vector<ceres::ResidualBlockId> terms;
+    impl_->Build(problem, options_, &terms);
+    Node& oldest = nodes.front();
+    Node& next = nodes[1];
+    std::vector<double*> kept = {next.rotation.data(), next.position.data(), next.motion.data()};
+    for (double* global : impl_->GlobalBlocks(options_)) kept.push_back(global);
+    impl_->prior =
+        Marginalize(problem, terms, {oldest.rotation.data(), oldest.position.data(), oldest.motion.data()}, kept);
+  }
+  // The IMU samples before the new oldest state are no longer needed.
+  const double keep_from = nodes[1].stamp;
+  nodes.pop_front();
+  nodes.front().from_previous.reset();
+  nodes.front().imu.reset();
+  std::vector<ImuSample>& imu = impl_->imu;
+  auto first_needed = std::upper_bound(imu.begin(), imu.end(), keep_from,
+                                       [](double t, const ImuSample& sample) { return t < sample.stamp; });
+  if (first_needed != imu.begin()) --first_needed;
+  imu.erase(imu.begin(), first_needed);
+}
+
+// A = Ry(pitch) Rx(roll) takes gravity's up (0, 0, 1) to (cos r sin p, -sin r, cos r cos p).
+InertialStart StartFromGravity(const std::vector<ImuSample>& samples, double stamp, const SE3d& world_from_radar,
+                               const Eigen::Vector3d& radar_velocity, const SE3d& radar_from_imu, double span) {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero(), rate = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (const ImuSample& sample : samples) {
+    if (std::abs(sample.stamp - stamp) > 0.5 * span) continue;
+    force += sample.specific_force;
+    rate += sample.angular_velocity;
+    ++count;
+  }
+  if (count == 0) throw DataError("no IMU sample within " + std::to_string(0.5 * span) + " s of the first scan");
+  force /= count;
+  rate /= count;
+  const SE3d world_from_imu = world_from_radar * radar_from_imu;
+  const Eigen::Vector3d up = world_from_imu.rotation() * force.normalized();  // in the matcher's world
+  InertialStart start;
+  start.tilt = Eigen::Vector2d(-std::asin(std::clamp(up.y(), -1.0, 1.0)), std::atan2(up.x(), up.z()));
+  const SO3d tilt_inverse = TiltRotation(start.tilt.data()).Inverse();
+  start.state.stamp = stamp;
+  start.state.pose = SE3d(tilt_inverse, Eigen::Vector3d::Zero()) * world_from_imu;
+  // R^T v = R_e v_radar - w x t_e (residuals/radar_inertial_residuals.hpp), with T_imu_radar = (R_e, t_e).
+  const SE3d imu_from_radar = radar_from_imu.Inverse();
+  const Eigen::Vector3d imu_velocity =
+      imu_from_radar.rotation() * radar_velocity - rate.cross(imu_from_radar.translation());
+  start.state.velocity = start.state.pose.rotation() * imu_velocity;
+  return start;
+}
+
+}  // namespace radargauss
