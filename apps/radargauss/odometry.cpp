@@ -27,6 +27,42 @@ void PrintSummary(const OdometrySummary& summary) {
       summary.global_gaussians);
 }
 
+// The window's last estimate: the tilt of the odometry's world against
+// gravity, the biases, and its cost per scan.
+void PrintInertial(const RadarInertialOdometry& inertial) {
+  const auto& states = inertial.states();
+  if (states.empty() || !states.back()) {
+    std::printf("inertial: the window never started (no Doppler velocity)\n");
+    return;
+  }
+  const InertialState& last = *states.back();
+  const Eigen::Vector2d tilt = inertial.window().tilt() * (180.0 / M_PI);
+  std::printf(
+      "inertial: tilt roll %.3f pitch %.3f deg; gyro bias %.5f %.5f %.5f rad/s; accelerometer bias %.4f %.4f %.4f "
+      "m/s^2\n",
+      tilt.x(), tilt.y(), last.bias.gyro.x(), last.bias.gyro.y(), last.bias.gyro.z(), last.bias.accel.x(),
+      last.bias.accel.y(), last.bias.accel.z());
+}
+
+// Per scan: the window's newest state (empty fields before it started).
+void WriteInertialStates(const std::string& path, const RadarInertialOdometry& inertial) {
+  std::string text = "stamp,vx,vy,vz,bgx,bgy,bgz,bax,bay,baz\n";
+  const auto& steps = inertial.odometry().steps();
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    char line[320];
+    const std::optional<InertialState>& s = inertial.states()[k];
+    if (!s) {
+      std::snprintf(line, sizeof(line), "%.9f,,,,,,,,,\n", steps[k].stamp);
+    } else {
+      std::snprintf(line, sizeof(line), "%.9f,%.6f,%.6f,%.6f,%.7f,%.7f,%.7f,%.6f,%.6f,%.6f\n", steps[k].stamp,
+                    s->velocity.x(), s->velocity.y(), s->velocity.z(), s->bias.gyro.x(), s->bias.gyro.y(),
+                    s->bias.gyro.z(), s->bias.accel.x(), s->bias.accel.y(), s->bias.accel.z());
+    }
+    text += line;
+  }
+  WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
+}
+
 int RunOdometry(const OdometrySettings& s) {
   const OdometryOptions& options = s.odometry;
   ValidateOptions(options);
@@ -35,16 +71,24 @@ int RunOdometry(const OdometrySettings& s) {
   const Sequence& sequence = inputs.sequence;
   const std::optional<Trajectory>& reference = inputs.reference;
   StagedFolder folder = RunFolder(s, {"odometry.tum", "levelled.tum", "map.rgm", "map.ply"});  // before the run
-  RadarOdometry odometry(options, MatcherOf(s.matcher));
-  const std::vector<GyroSample> gyro = GyroOf(s);  // before the run: a bad IMU leaves nothing behind
-  if (!gyro.empty()) {
-    CheckOverlap(gyro, sequence, s.imu_topic.empty() ? "" : "; try --imu-stamps record");
-    odometry.AddGyro(gyro);
+  const ImuInput imu = ImuOf(s);  // before the run: a bad IMU leaves nothing behind
+  if (!imu.samples.empty()) CheckOverlap(GyroOf(imu), sequence, s.imu_topic.empty() ? "" : "; try --imu-stamps record");
+  std::optional<RadarInertialOdometry> inertial;
+  std::optional<RadarOdometry> radar_only;
+  if (!imu.samples.empty() && s.imu_fusion == "window") {
+    if (s.matcher != "gaussians") throw DataError("--imu-fusion window needs --matcher gaussians");
+    inertial.emplace(options, s.inertial, imu.radar_from_imu, imu.samples);
+    RegisterScans(sequence, "odometry", [&](const RadarScan& scan) { inertial->Register(scan); });
+  } else {
+    radar_only.emplace(options, MatcherOf(s.matcher));
+    if (!imu.samples.empty()) radar_only->AddGyro(GyroOf(imu));
+    RegisterScans(sequence, "odometry", [&](const RadarScan& scan) { radar_only->Register(scan); });
   }
-  RegisterScans(sequence, "odometry", [&](const RadarScan& scan) { odometry.Register(scan); });
+  const RadarOdometry& odometry = inertial ? inertial->odometry() : *radar_only;
   std::optional<Evaluation> evaluation;
   if (reference) evaluation = EvaluateTrajectory(odometry.trajectory(), *reference);
   WriteOdometry(folder.path(), odometry);
+  if (inertial) WriteInertialStates(folder.path() + "/inertial.csv", *inertial);
   const std::string table = evaluation ? WriteEvaluation(folder.path(), *evaluation) : std::string();
   folder.Commit();
   PrintSummary(Summarise(odometry));
@@ -55,9 +99,11 @@ int RunOdometry(const OdometrySettings& s) {
                 mounting->pitch_deg, mounting->pitch_scans, mounting->yaw_deg, mounting->yaw_scans,
                 levelled[levelled.size() - 1].pose.translation().z());
   }
+  if (inertial) PrintInertial(*inertial);
   std::printf("%s", table.c_str());
-  std::printf("wrote %s (odometry.tum, %sper_scan.csv, summary.json, map.rgm, map.ply%s)\n", s.out.c_str(),
-              mounting ? "levelled.tum, " : "", evaluation ? ", evaluation.json, evaluation.md" : "");
+  std::printf("wrote %s (odometry.tum, %sper_scan.csv, summary.json, map.rgm, map.ply%s%s)\n", s.out.c_str(),
+              mounting ? "levelled.tum, " : "", inertial ? ", inertial.csv" : "",
+              evaluation ? ", evaluation.json, evaluation.md" : "");
   return 0;
 }
 

@@ -49,8 +49,9 @@ Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw) {
   return q.normalized().toRotationMatrix();
 }
 
-// The bag's gyro rates turned into the radar frame by q_radar_imu.
-std::vector<GyroSample> GyroOf(const OdometrySettings& s) {
+// The IMU's samples (the bag's topic or the IMU file) and T_radar_imu
+// (--imu-extrinsic, else the rotation of --imu-rotation); none without an IMU.
+ImuInput ImuOf(const OdometrySettings& s) {
   if (s.imu_topic.empty() && s.imu_file.empty()) {
     if (!s.imu_extrinsic.empty()) throw DataError("--imu-extrinsic needs an IMU (--imu or --imu-topic)");
     return {};
@@ -60,12 +61,19 @@ std::vector<GyroSample> GyroOf(const OdometrySettings& s) {
   if (!s.imu_extrinsic.empty() && s.imu_rotation != std::vector<double>{0, 0, 0, 1}) {
     throw DataError("--imu-extrinsic and --imu-rotation: the IMU's rotation once");
   }
-  const Eigen::Matrix3d R =
-      s.imu_extrinsic.empty() ? ImuRotation(s.imu_rotation) : ReadExtrinsicFile(s.imu_extrinsic).rotation().Matrix();
-  const std::vector<ImuSample> imu =
+  ImuInput input;
+  input.radar_from_imu = s.imu_extrinsic.empty()
+                             ? SE3d(SO3d::FromMatrix(ImuRotation(s.imu_rotation)), Eigen::Vector3d::Zero())
+                             : ReadExtrinsicFile(s.imu_extrinsic);
+  input.samples =
       s.imu_file.empty() ? ReadBagImu(s.sequence.bag, s.imu_topic, s.imu_stamps == "record") : ReadImuFile(s.imu_file);
+  return input;
+}
+
+std::vector<GyroSample> GyroOf(const ImuInput& imu) {
+  const SO3d R = imu.radar_from_imu.rotation();
   std::vector<GyroSample> samples;
-  for (const ImuSample& sample : imu) samples.push_back({sample.stamp, R * sample.angular_velocity});
+  for (const ImuSample& sample : imu.samples) samples.push_back({sample.stamp, R * sample.angular_velocity});
   return samples;
 }
 
@@ -104,26 +112,33 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
       ->capture_default_str();
   AddTableOptions(app, OdometryOptionTable(), s.odometry);
   AddImuOptions(app, s);
+  AddTableOptions(app, RadarInertialOptionTable(), s.inertial);
   AddRunOptions(app, s);
 }
 
 void AddImuOptions(CLI::App* app, OdometrySettings& s) {
   CLI::Option* imu_topic =
-      app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: gyro rates for the prediction");
+      app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: the IMU (--imu-fusion)");
   app->add_option("--imu", s.imu_file,
-                  "IMU file of lines 'stamp wx wy wz ax ay az' (s, rad/s, m/s^2; the IMU's frame): gyro rates for "
-                  "the prediction");
+                  "IMU file of lines 'stamp wx wy wz ax ay az' (s, rad/s, m/s^2; the IMU's frame)");
+  app->add_option("--imu-fusion", s.imu_fusion,
+                  "window: a sliding window of IMU states with the matches and Doppler velocities (biases, "
+                  "gravity); gyro: the gyro's rates for the prediction only")
+      ->check(CLI::IsMember({"window", "gyro"}))
+      ->capture_default_str();
   app->add_option("--imu-extrinsic", s.imu_extrinsic,
                   "T_radar_imu: a file 'x y z qx qy qz qw' (the IMU's frame in the radar's)");
   // The IMU's settings without its topic would be read by nothing: refused.
   app->add_option("--imu-stamps", s.imu_stamps, "Stamp the IMU by its header or by the bag's record time")
       ->check(CLI::IsMember({"header", "record"}))
       ->needs(imu_topic)
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(HelpGroup(OptionGroup::kTuning));  // a bag's IMU details: --help-all
   app->add_option("--imu-rotation", s.imu_rotation, "q_radar_imu as x y z w (rotates gyro rates into the radar frame)")
       ->expected(4)
       ->needs(imu_topic)
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(HelpGroup(OptionGroup::kTuning));
 }
 
 void AddRunOptions(CLI::App* app, OdometrySettings& s) {

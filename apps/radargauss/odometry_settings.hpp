@@ -13,6 +13,7 @@
 #include "option_flags.hpp"
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/progress.hpp"
 #include "radargauss/trajectory.hpp"
@@ -31,16 +32,23 @@ struct OdometrySettings {
   std::size_t first_scan = 0;
   std::size_t max_scans = 0;
   std::string matcher = "gaussians";  // or a PCL peer
+  std::string imu_fusion = "window";  // or "gyro": the rates for the prediction only
+  RadarInertialOptions inertial;      // the window's, with --imu-fusion window
 };
 
 // The matcher of a map version: the Gaussian solvers, or a PCL peer.
 MatcherFactory MatcherOf(const std::string& matcher);
 // R_radar_imu from --imu-rotation, checked whether or not an IMU is read.
 Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw);
-// The IMU's gyro rates (the bag's topic or the IMU file) turned into the
-// radar frame by R_radar_imu (--imu-extrinsic, else --imu-rotation); none
-// without an IMU.
-std::vector<GyroSample> GyroOf(const OdometrySettings& s);
+// The IMU's samples (the bag's topic or the IMU file) and T_radar_imu
+// (--imu-extrinsic, else --imu-rotation); none without an IMU.
+struct ImuInput {
+  std::vector<ImuSample> samples;
+  SE3d radar_from_imu;
+};
+ImuInput ImuOf(const OdometrySettings& s);
+// Its gyro rates turned into the radar frame.
+std::vector<GyroSample> GyroOf(const ImuInput& imu);
 // Gyro samples that cover none of the scans' time span are a clock mismatch
 // (`hint`: what to try, appended to the message).
 void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence, const std::string& hint);

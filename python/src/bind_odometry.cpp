@@ -6,6 +6,7 @@
 
 #include "bindings.hpp"
 #include "option_fields.hpp"
+#include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/slam/radar_slam.hpp"
 #include "radargauss/slam/relocalization.hpp"
@@ -122,12 +123,15 @@ void BindOdometry(py::module_& m) {
         if (kind == "odometry") return FieldsToList(OdometryOptionTable());
         if (kind == "slam") return FieldsToList(SlamOptionTable());
         if (kind == "relocalization") return FieldsToList(RelocalizationOptionTable());
-        throw py::value_error("option_fields takes 'match', 'odometry', 'slam' or 'relocalization', not '" + kind +
-                              "'");
+        if (kind == "radar_inertial") return FieldsToList(RadarInertialOptionTable());
+        throw py::value_error(
+            "option_fields takes 'match', 'odometry', 'slam', 'relocalization' or 'radar_inertial', not '" + kind +
+            "'");
       },
       py::arg("kind"),
-      "The keywords of match, RadarOdometry, RadarSlam or Relocalizer ('match', 'odometry', 'slam', "
-      "'relocalization'): one dict per option with its keyword, the C++ member it sets (path), type, doc, default, "
+      "The keywords of match, RadarOdometry, RadarSlam, Relocalizer or the radar-inertial window ('match', "
+      "'odometry', 'slam', 'relocalization', 'radar_inertial'): one dict per option with its keyword, the C++ member "
+      "it sets (path), type, doc, default, "
       "group, unit and range.");
 }
 

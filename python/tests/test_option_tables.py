@@ -15,10 +15,11 @@ FLAG = re.compile(r"^\s+(--[a-z0-9-]+)(?: ([A-Z]+:(?:\{[^}]*\}|[\[(][^\])]*[\])]
 # What each command reads and writes besides its options: the run's inputs and outputs.
 RUN_FLAGS = {"--help", "--sequence", "--gt", "--extrinsic", "--bag", "--topic", "--bin-layout", "--rcs-field",
              "--doppler-field", "--doppler-sign", "--elevation-bias", "--out", "--first-scan", "--max-scans"}
-IMU_FLAGS = {"--imu", "--imu-extrinsic", "--imu-topic", "--imu-stamps", "--imu-rotation"}
-COMMANDS = [("odometry", "odometry", {"--matcher"} | IMU_FLAGS),
-            ("slam", "slam", {"--no-map", "--false-loop-rate", "--false-loop-seed"}),  # and the study's
-            ("relocalize", "relocalization", {"--map"})]
+IMU_FLAGS = {"--imu", "--imu-extrinsic", "--imu-topic", "--imu-stamps", "--imu-rotation", "--imu-fusion"}
+# command, the option tables its flags come from, its own flags.
+COMMANDS = [("odometry", ("odometry", "radar_inertial"), {"--matcher"} | IMU_FLAGS),
+            ("slam", ("slam",), {"--no-map", "--false-loop-rate", "--false-loop-seed"}),  # and the study's
+            ("relocalize", ("relocalization",), {"--map"})]
 
 pytestmark = pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool")
 
@@ -38,10 +39,14 @@ def flag_of(field):
     return "--" + field["keyword"].replace("_", "-")
 
 
+def fields_of(kinds):
+    return [field for kind in kinds for field in rg.option_fields(kind)]
+
+
 @pytest.mark.parametrize("command, kind, own", COMMANDS)
 def test_the_flags_are_the_table(command, kind, own):
     flags = help_flags(command)
-    fields = rg.option_fields(kind)
+    fields = fields_of(kind)
     table = {flag_of(field) for field in fields}
     assert set(flags) - RUN_FLAGS - own == table
     for field in fields:
@@ -54,7 +59,7 @@ def test_the_flags_are_the_table(command, kind, own):
 @pytest.mark.parametrize("command, kind, own", COMMANDS)
 def test_help_shows_the_sensor_group_and_help_all_the_rest(command, kind, own):
     shown = set(help_flags(command, "--help"))
-    groups = {flag_of(field): field["group"] for field in rg.option_fields(kind)}
+    groups = {flag_of(field): field["group"] for field in fields_of(kind)}
     assert {flag for flag, group in groups.items() if group == "sensor"} <= shown
     assert not {flag for flag, group in groups.items() if group != "sensor"} & shown
     lines = subprocess.run([CLI, command, "--help"], capture_output=True, text=True, check=True).stdout.splitlines()
@@ -75,7 +80,7 @@ def yaml_value(field):
 @pytest.mark.parametrize("command, kind, own", COMMANDS)
 def test_every_keyword_is_a_yaml_key(command, kind, own, tmp_path):
     config = tmp_path / "every.yaml"
-    config.write_text("".join(flag_of(f)[2:] + ": " + yaml_value(f) + "\n" for f in rg.option_fields(kind)))
+    config.write_text("".join(flag_of(f)[2:] + ": " + yaml_value(f) + "\n" for f in fields_of(kind)))
     inputs = ["--sequence", str(tmp_path / "absent"), "--out", str(tmp_path / "out")]
     if command == "relocalize":
         inputs += ["--map", str(tmp_path / "absent.rgm")]

@@ -234,7 +234,8 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& input) {
   if (state_) prediction = Predict(scan.timestamp);
   const Velocity velocity = MeasureVelocity(scan, prediction);
   if (velocity.measured && !velocity.standstill) elevation_bias_.Observe(velocity.value);
-  const PoseEstimate estimate = EstimatePose(scan, prediction, velocity);
+  PoseEstimate estimate = EstimatePose(scan, prediction, velocity);
+  if (fusion_) estimate.pose = fusion_(EstimateOf(scan, velocity, estimate));
   const bool keyframe = !fixed_map_ && IsKeyframe(estimate.pose, velocity);
   if (keyframe) InsertKeyframe(scan, velocity.static_points, estimate.pose);
   last_static_points_ = velocity.static_points;
@@ -346,6 +347,22 @@ void RadarOdometry::InsertKeyframe(const RadarScan& scan, const std::vector<std:
   map_.Insert(points, rcs, pose);
   map_.Evict(pose.translation());
   last_keyframe_ = pose;
+}
+
+ScanEstimate RadarOdometry::EstimateOf(const RadarScan& scan, const Velocity& velocity, const PoseEstimate& estimate) {
+  ScanEstimate e;
+  e.stamp = scan.timestamp;
+  e.pose = estimate.pose;
+  e.matched = estimate.matched;
+  if (estimate.matched) {
+    e.information = estimate.match->information;
+    e.matched_points = estimate.match->n_geo;
+  }
+  e.velocity_measured = velocity.measured;
+  e.standstill = velocity.standstill;
+  e.velocity = velocity.value;
+  e.velocity_covariance = velocity.covariance;
+  return e;
 }
 
 OdometryStep RadarOdometry::StepOf(const RadarScan& scan, const std::optional<Prediction>& prediction,

@@ -117,6 +117,22 @@ struct GyroSample {
   Eigen::Vector3d rate = Eigen::Vector3d::Zero();
 };
 
+// What a scan's estimate is before its pose is kept: what a fusion with
+// other sensors (odometry/radar_inertial.hpp) needs.
+struct ScanEstimate {
+  double stamp = 0.0;
+  SE3d pose;             // T_world_radar: matched, or predicted
+  bool matched = false;  // `information` and `matched_points` hold
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();  // eq. 2's, normalised
+  std::size_t matched_points = 0;                                                 // N_geo
+  bool velocity_measured = false;
+  bool standstill = false;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s, radar frame
+  Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();
+};
+// Returns the pose to keep (for the map, the motion model and the record).
+using PoseFusion = std::function<SE3d(const ScanEstimate& estimate)>;
+
 // The scan matcher of a version of the active map: by default
 // MakeScanMatcher(options.match). RadarOdometry calls it once per
 // LocalMap::version() (the map changes on keyframes) and hands each scan its
@@ -135,6 +151,8 @@ class RadarOdometry {
   const OdometryStep& Register(const RadarScan& scan);
   // Adds gyro samples (radar frame, time order) used from the next scan on.
   void AddGyro(const std::vector<GyroSample>& samples);
+  // From the next scan on, each scan's pose is `fusion`'s answer to its estimate.
+  void SetPoseFusion(PoseFusion fusion) { fusion_ = std::move(fusion); }
   // From the next scan on, matches against `map`, fixed (nothing is
   // inserted), with the motion model carried into the map's frame by
   // `map_from_odometry`: localisation in a given map (relocalisation's tracking).
@@ -207,6 +225,7 @@ class RadarOdometry {
   // Whether the scan at `pose` enters the map (the first, or far or turned enough since the last keyframe).
   bool IsKeyframe(const SE3d& pose, const Velocity& velocity) const;
   void InsertKeyframe(const RadarScan& scan, const std::vector<std::size_t>& static_points, const SE3d& pose);
+  static ScanEstimate EstimateOf(const RadarScan& scan, const Velocity& velocity, const PoseEstimate& estimate);
   OdometryStep StepOf(const RadarScan& scan, const std::optional<Prediction>& prediction, const Velocity& velocity,
                       const PoseEstimate& estimate, bool keyframe) const;
 
@@ -224,6 +243,7 @@ class RadarOdometry {
   SE3d last_keyframe_;
   std::vector<std::size_t> last_static_points_;
   std::shared_ptr<const MatchingMap> fixed_map_;  // LocalizeIn's; null: the run's own map
+  PoseFusion fusion_;                             // null: the estimate's pose is kept
   std::size_t map_bytes_ = 0;                     // LocalMap::MemoryBytes after the last keyframe
 };
 

@@ -6,7 +6,9 @@
 // then pitch; M and G share the origin and the heading):
 //
 //   pose:     T_M_radar = A (R R_e, p + R t_e) against the match's Z:
-//             r = W [ R_z^T (A (p + R t_e) - t_z) ; Log(R_z^T A R R_e) ]
+//             r = W [ A (p + R t_e) - t_z ; Log(R_z^T A R R_e) ]
+//             (the matcher's tangent: translation in the world, rotation on
+//             the right, as its information; solvers/scan_matcher.hpp)
 //   velocity: the radar's velocity in its own frame from the state,
 //             r = W (v_d - R_e^T (R^T v + (w - b_g) x t_e))
 //
@@ -34,7 +36,7 @@ SO3<T> TiltRotation(const T* roll_pitch) {
 class RadarPoseResidual {
  public:
   RadarPoseResidual(const SE3d& measured, const Eigen::Matrix<double, 6, 6>& sqrt_information)
-      : measured_inverse_(measured.Inverse()), sqrt_information_(sqrt_information) {}
+      : measured_(measured), sqrt_information_(sqrt_information) {}
 
   template <typename T>
   bool operator()(const T* rotation, const T* position, const T* extrinsic_rotation, const T* extrinsic_translation,
@@ -42,12 +44,11 @@ class RadarPoseResidual {
     using Vector3 = Eigen::Matrix<T, 3, 1>;
     const SO3<T> A = TiltRotation(tilt);
     const SO3<T> R = SO3<T>::FromXyzw(rotation);
-    const SO3<T> Rz_inverse = measured_inverse_.rotation().template cast<T>();
+    const SO3<T> Rz_inverse = measured_.rotation().Inverse().template cast<T>();
     const Vector3 radar_position =
         A * Vector3(Eigen::Map<const Vector3>(position) + R * Eigen::Map<const Vector3>(extrinsic_translation));
     Eigen::Matrix<T, 6, 1> error;
-    error.template segment<3>(kTranslationOffset) =
-        Rz_inverse * radar_position + measured_inverse_.translation().template cast<T>();
+    error.template segment<3>(kTranslationOffset) = radar_position - measured_.translation().template cast<T>();
     error.template segment<3>(kRotationOffset) = (Rz_inverse * A * R * SO3<T>::FromXyzw(extrinsic_rotation)).Log();
     Eigen::Map<Eigen::Matrix<T, 6, 1>> r(residual);
     r = sqrt_information_.cast<T>() * error;
@@ -59,7 +60,7 @@ class RadarPoseResidual {
   static ceres::CostFunction* Create(const SE3d& measured, const Eigen::Matrix<double, 6, 6>& sqrt_information);
 
  private:
-  const SE3d measured_inverse_;
+  const SE3d measured_;
   const Eigen::Matrix<double, 6, 6> sqrt_information_;
 };
 

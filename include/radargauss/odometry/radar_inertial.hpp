@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Radar-inertial odometry (docs/design.md, "Radar-inertial odometry"): the
+// radar odometry of odometry/radar_odometry.hpp with an IMU. The prediction
+// turns by the gyro's rates less the window's gyro bias; each scan's match
+// (its pose and eq. 2's information) and Doppler velocity enter a sliding
+// window of IMU states (solvers/inertial_window.hpp), and the window's pose
+// of the radar is what the map and the motion model keep. The window starts
+// at the first scan with a Doppler velocity, from gravity.
+//
+//   RadarInertialOdometry odometry(options, inertial, radar_from_imu, imu);
+//   for (const RadarScan& scan : sequence.scans) odometry.Register(scan);
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "radargauss/io/imu.hpp"
+#include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/options.hpp"
+#include "radargauss/solvers/inertial_window.hpp"
+
+namespace radargauss {
+
+struct RadarInertialOptions {
+  InertialWindowOptions window;
+  // The match's points are not independent (the map was built from the
+  // same poses): its information N_geo * H counts for this fraction.
+  double match_information_scale = 0.001;
+  double velocity_floor = 0.05;  // m/s: added in quadrature to the Doppler velocity's std
+};
+
+// Its options (options.hpp): its own, then the window's.
+const OptionTable<RadarInertialOptions>& RadarInertialOptionTable();
+
+class RadarInertialOdometry {
+ public:
+  // `imu`: the IMU's samples (time order) on the scans' clock, in its frame;
+  // radar_from_imu = T_radar_imu. Throws DataError for samples out of order.
+  RadarInertialOdometry(const OdometryOptions& odometry, const RadarInertialOptions& options,
+                        const SE3d& radar_from_imu, std::vector<ImuSample> imu);
+
+  // Registers the next scan (RadarOdometry::Register). Throws DataError when
+  // the IMU does not cover the time since the last scan.
+  const OdometryStep& Register(const RadarScan& scan);
+
+  const RadarOdometry& odometry() const { return odometry_; }
+  // The window's newest state after each scan; empty before the window started.
+  const std::vector<std::optional<InertialState>>& states() const { return states_; }
+  const InertialWindow& window() const { return window_; }
+  const RadarInertialOptions& options() const { return options_; }
+  double last_window_ms() const { return last_window_ms_; }
+
+ private:
+  SE3d Fuse(const ScanEstimate& estimate);
+  Eigen::Vector3d GyroAt(double stamp) const;
+  void FeedGyroUntil(double stamp);
+
+  RadarInertialOptions options_;
+  SE3d radar_from_imu_;
+  std::vector<ImuSample> imu_;
+  InertialWindow window_;
+  RadarOdometry odometry_;
+  bool started_ = false;
+  std::size_t fed_ = 0;  // IMU samples handed to the odometry's prediction
+  std::vector<std::optional<InertialState>> states_;
+  double last_window_ms_ = 0.0;
+};
+
+}  // namespace radargauss

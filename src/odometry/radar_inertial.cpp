@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/odometry/radar_inertial.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include "radargauss/error.hpp"
+
+namespace radargauss {
+
+const OptionTable<RadarInertialOptions>& RadarInertialOptionTable() {
+  using O = RadarInertialOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {
+        RADARGAUSS_OPTION(O, "match_information_scale", match_information_scale)
+            .In(0.0, 1.0)
+            .Help("the share of a match's information N_geo H the window trusts"),
+        RADARGAUSS_OPTION(O, "inertial_velocity_floor", velocity_floor)
+            .AtLeast(0.0)
+            .Unit("m/s")
+            .Help("std added in quadrature to the Doppler velocity's in the window"),
+    };
+    AppendNested(
+        t, InertialWindowOptionTable(), +[](O & o) -> auto& { return o.window; }, "window");
+    return t;
+  }();
+  return table;
+}
+
+RadarInertialOdometry::RadarInertialOdometry(const OdometryOptions& odometry, const RadarInertialOptions& options,
+                                             const SE3d& radar_from_imu, std::vector<ImuSample> imu)
+    : options_(options),
+      radar_from_imu_(radar_from_imu),
+      imu_(std::move(imu)),
+      window_(options.window, radar_from_imu),
+      odometry_(odometry) {
+  CheckOptions(RadarInertialOptionTable(), options);
+  window_.AddImu(imu_);  // checks the order
+  odometry_.SetPoseFusion([this](const ScanEstimate& estimate) { return Fuse(estimate); });
+}
+
+const OdometryStep& RadarInertialOdometry::Register(const RadarScan& scan) {
+  FeedGyroUntil(scan.timestamp);
+  const OdometryStep& step = odometry_.Register(scan);
+  states_.push_back(started_ ? std::make_optional(window_.newest()) : std::nullopt);
+  return step;
+}
+
+// The rates up to the first sample at or after `stamp` (GyroIncrement needs
+// one), less the window's gyro bias now, turned into the radar frame.
+void RadarInertialOdometry::FeedGyroUntil(double stamp) {
+  const Eigen::Vector3d bias = started_ ? window_.newest().bias.gyro : Eigen::Vector3d::Zero();
+  const SO3d radar_from_imu = radar_from_imu_.rotation();
+  std::vector<GyroSample> samples;
+  for (; fed_ < imu_.size() && (fed_ == 0 || imu_[fed_ - 1].stamp < stamp); ++fed_) {
+    samples.push_back({imu_[fed_].stamp, radar_from_imu * (imu_[fed_].angular_velocity - bias)});
+  }
+  odometry_.AddGyro(samples);
+}
+
+Eigen::Vector3d RadarInertialOdometry::GyroAt(double stamp) const {
+  const auto after = std::upper_bound(imu_.begin(), imu_.end(), stamp,
+                                      [](double t, const ImuSample& sample) { return t < sample.stamp; });
+  return (after == imu_.begin() ? *after : *(after - 1)).angular_velocity;  // the sample in force
+}
+
+SE3d RadarInertialOdometry::Fuse(const ScanEstimate& e) {
+  if (!started_) {
+    if (!e.velocity_measured || imu_.empty()) return e.pose;
+    const InertialStart start = StartFromGravity(imu_, e.stamp, e.pose, e.velocity, radar_from_imu_);
+    window_.set_tilt(start.tilt);
+    window_.Start(start.state);
+    started_ = true;
+  } else {
+    window_.AddState(e.stamp);
+  }
+  if (e.matched && e.matched_points > 0) {
+    window_.AddPose(e.pose, e.information * (double(e.matched_points) * options_.match_information_scale));
+  }
+  if (e.velocity_measured) {
+    const Eigen::Matrix3d covariance =
+        e.velocity_covariance + options_.velocity_floor * options_.velocity_floor * Eigen::Matrix3d::Identity();
+    window_.AddVelocity(e.velocity, covariance, GyroAt(e.stamp));
+  }
+  last_window_ms_ = window_.Solve().time_ms;
+  return window_.RadarPoseInMatcherWorld();
+}
+
+}  // namespace radargauss
