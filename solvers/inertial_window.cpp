@@ -408,7 +408,7 @@ void InertialWindow::RemoveOldest() {
     impl_->prior =
         Marginalize(problem, terms, {oldest.rotation.data(), oldest.position.data(), oldest.motion.data()}, kept);
   }
-  // The IMU samples before the new oldest state are no longer needed.
+  // The IMU samples before the new oldest state are not needed any more.
   const double keep_from = nodes[1].stamp;
   nodes.pop_front();
   nodes.front().from_previous.reset();
