@@ -42,6 +42,14 @@ void PrintInertial(const RadarInertialOdometry& inertial) {
       "m/s^2\n",
       tilt.x(), tilt.y(), last.bias.gyro.x(), last.bias.gyro.y(), last.bias.gyro.z(), last.bias.accel.x(),
       last.bias.accel.y(), last.bias.accel.z());
+  const RadarInertialOptions& o = inertial.options();
+  if (o.window.estimate_extrinsic_rotation || o.window.estimate_extrinsic_translation) {
+    const SE3d radar_from_imu = inertial.window().radar_from_imu();
+    const Eigen::Vector3d angle = radar_from_imu.rotation().Log() * (180.0 / M_PI);
+    const Eigen::Vector3d& t = radar_from_imu.translation();
+    std::printf("inertial: T_radar_imu estimated: rotation vector %.3f %.3f %.3f deg, translation %.3f %.3f %.3f m\n",
+                angle.x(), angle.y(), angle.z(), t.x(), t.y(), t.z());
+  }
 }
 
 // Per scan: the window's newest state (empty fields before it started).

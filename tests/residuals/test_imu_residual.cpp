@@ -1,13 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The preintegrated IMU term (docs/design.md, "The IMU term"): analytic
 // Jacobians against automatic differentiation and central differences, and
-// a zero residual at the states of a planted motion whose exact IMU it integrates.
+// a zero residual at the states of a planted motion whose exact IMU it
+// integrates; the radar's pose and velocity terms on an IMU state likewise.
 #include <gtest/gtest.h>
 
 #include <memory>
 #include <random>
 
 #include "radargauss/residuals/imu_residual.hpp"
+#include "radargauss/residuals/radar_inertial_residuals.hpp"
 #include "support/cost_function_checks.hpp"
 
 namespace radargauss {
@@ -99,6 +101,58 @@ TEST(ImuResidual, ZeroAtThePlantedStates) {
 TEST(ImuResidual, NoSamplesIsRefused) {
   const ImuPreintegration empty(ImuBias{}, ImuNoise{});
   EXPECT_THROW(ImuCostFunction(empty, ImuNoise{}), std::invalid_argument);
+}
+
+// The radar's terms on an IMU state (docs/design.md, "The sliding window"):
+// zero at a hand-made state and its exact measurements, and automatic
+// differentiation against central differences on every block.
+struct RadarOnImu {
+  Eigen::Vector4d q = SO3d::Exp(Eigen::Vector3d(0.1, -0.05, 0.8)).quaternion().coeffs();
+  Eigen::Vector3d p = Eigen::Vector3d(3.0, -1.0, 0.5);
+  Eigen::Matrix<double, 9, 1> motion;
+  Eigen::Vector4d qe = SO3d::Exp(Eigen::Vector3d(3.1, 0.02, 0.5)).quaternion().coeffs();  // an IMU upside down
+  Eigen::Vector3d te = Eigen::Vector3d(1.2, -0.3, -0.4);
+  Eigen::Vector2d tilt = Eigen::Vector2d(0.02, -0.015);
+  RadarOnImu() { motion << 6.0, 0.5, -0.1, 0.002, -0.001, 0.003, 0.05, 0.02, -0.04; }
+  SO3d R() const { return SO3d::FromXyzw(q.data()); }
+  SO3d Re() const { return SO3d::FromXyzw(qe.data()); }
+};
+
+TEST(RadarPoseResidual, ZeroAtTheRadarsPoseAndAgreesWithCentralDifferences) {
+  RadarOnImu s;
+  const SO3d A = TiltRotation(s.tilt.data());
+  // The radar in the matcher's world, composed by hand: A (R R_e, p + R t_e).
+  const SE3d radar(A * s.R() * s.Re(), A * (s.p + s.R() * s.te));
+  const std::unique_ptr<ceres::CostFunction> term(
+      RadarPoseResidual::Create(radar, Eigen::Matrix<double, 6, 6>::Identity() * 10.0));
+  const std::vector<double*> blocks = {s.q.data(), s.p.data(), s.qe.data(), s.te.data(), s.tilt.data()};
+  std::vector<Eigen::MatrixXd> J;
+  EXPECT_LT(EvaluateWithJacobians(*term, blocks, J).norm(), 1e-12);
+  for (int b = 0; b < 5; ++b) EXPECT_LT(Relative(J[b], NumericBlockJacobian(*term, blocks, b)), 1e-5) << "block " << b;
+  // 1 cm off along the world's x: 10 x 0.01 in the first residual.
+  const SE3d moved(radar.rotation(), radar.translation() + Eigen::Vector3d(0.01, 0.0, 0.0));
+  const std::unique_ptr<ceres::CostFunction> off(
+      RadarPoseResidual::Create(moved, Eigen::Matrix<double, 6, 6>::Identity() * 10.0));
+  EXPECT_NEAR(EvaluateWithJacobians(*off, blocks, J)(kTranslationOffset), -0.1, 1e-12);
+}
+
+TEST(RadarVelocityResidual, ZeroAtTheLeverArmsVelocityAndAgreesWithCentralDifferences) {
+  RadarOnImu s;
+  const Eigen::Vector3d gyro(0.05, -0.02, 0.7);  // rad/s, the IMU's reading with its bias
+  const Eigen::Vector3d omega = gyro - s.motion.segment<3>(kMotionGyroBias);
+  // The radar's velocity: the IMU's plus omega x t_e, in the radar frame.
+  const Eigen::Vector3d world = s.motion.segment<3>(kMotionVelocity) + s.R() * omega.cross(s.te);
+  const Eigen::Vector3d radar_velocity = (s.R() * s.Re()).Inverse() * world;
+  const std::unique_ptr<ceres::CostFunction> term(
+      RadarVelocityResidual::Create(radar_velocity, gyro, Eigen::Matrix3d::Identity() * 20.0));
+  const std::vector<double*> blocks = {s.q.data(), s.motion.data(), s.qe.data(), s.te.data()};
+  std::vector<Eigen::MatrixXd> J;
+  EXPECT_LT(EvaluateWithJacobians(*term, blocks, J).norm(), 1e-12);
+  for (int b = 0; b < 4; ++b) EXPECT_LT(Relative(J[b], NumericBlockJacobian(*term, blocks, b)), 1e-5) << "block " << b;
+  // Without the lever arm the residual is 20 |omega x t_e|.
+  Eigen::Vector3d no_lever = Eigen::Vector3d::Zero();
+  const std::vector<double*> without = {s.q.data(), s.motion.data(), s.qe.data(), no_lever.data()};
+  EXPECT_NEAR(EvaluateWithJacobians(*term, without, J).norm(), 20.0 * omega.cross(s.te).norm(), 1e-9);
 }
 
 }  // namespace
