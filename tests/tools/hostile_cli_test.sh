@@ -136,6 +136,16 @@ expect_fail "an IMU file that ends mid-line" "imu_cut.txt:2: expected 7 columns 
   "$tool" info --imu "$work/imu_cut.txt"
 expect_fail "an IMU that covers none of the scans" "the IMU's stamps (5.000000 to 6.000000 s) do not overlap the scans'" -- \
   "$tool" odometry --imu "$work/imu_far.txt" "${seq[@]}" --out "$work/imu_o"
+# A 1 kHz file of 10^7 lines (sparse: no disk) is refused by its size, unread.
+truncate -s 800M "$work/imu_huge.txt"
+expect_fail "an IMU file of 10^7 lines" "imu_huge.txt: IMU file of 838860800 bytes, more than 671088640" -- \
+  "$tool" odometry --imu "$work/imu_huge.txt" "${seq[@]}" --out "$work/imu_o"
+rm -f "$work/imu_huge.txt"
+# An IMU that ends a tenth of a second into the drive: the radar-inertial window stops there, nothing is written.
+first=$(awk '!/^#/ { print $1; exit }' "$work/seq/gt_radar_tum.txt")
+awk -v t0="$first" 'BEGIN { for (k = 0; k <= 20; ++k) printf "%.6f 0 0 0 0 0 9.81\n", t0 + k * 0.005 }' >"$work/imu_short.txt"
+expect_fail "an IMU that ends before the scans" "the IMU has no sample from" -- \
+  "$tool" odometry --imu "$work/imu_short.txt" "${seq[@]}" --out "$work/imu_o"
 expect_fail "--imu-extrinsic without an IMU" "--imu-extrinsic needs an IMU (--imu or --imu-topic)" -- \
   "$tool" odometry --imu-extrinsic "$work/imu_far.txt" "${seq[@]}" --out "$work/imu_o"
 [[ ! -e "$work/imu_o" ]] || { echo "FAIL: a refused IMU left odometry output"; failed=$((failed + 1)); }
