@@ -188,6 +188,18 @@ expect_fail "odometry with two rotation rate stds" "rotation-rate-std" -- \
   "$tool" odometry --sequence "$work/seq10" --rotation-rate-std 1 1 --out "$work/odometry_tilt2"
 expect_fail "odometry with an IMU topic but no bag" "needs --bag" -- \
   "$tool" odometry --sequence "$work/seq10" --imu-topic /imu --out "$work/odometry_imu"
+# Radar-inertial odometry: the same trajectory and states for any thread count.
+printf 'scans: 30\nimu_rate_hz: 200\n' >"$work/imu_world.yaml"
+"$tool" simulate --config "$work/imu_world.yaml" --out "$work/seq_imu" >/dev/null
+for threads in 1 2; do
+  expect_ok "radar-inertial odometry, $threads threads" "inertial.csv" -- \
+    "$tool" --threads "$threads" odometry --sequence "$work/seq_imu" --imu "$work/seq_imu/imu.txt" \
+    --imu-extrinsic "$work/seq_imu/imu_extrinsic.txt" --out "$work/inertial_$threads"
+done
+for file in odometry.tum inertial.csv; do
+  cmp -s "$work/inertial_1/$file" "$work/inertial_2/$file" ||
+    { echo "FAIL: radar-inertial $file differs between 1 and 2 threads"; failed=1; }
+done
 expect_fail "evaluate with a missing reference" "cannot open" -- \
   "$tool" evaluate --est "$work/results/reference.tum" --ref "$work/absent.tum"
 expect_fail "evaluate with an unknown alignment" "align" -- \
