@@ -35,6 +35,12 @@ int RunSlam(const SlamSettings& s) {
   const std::optional<Trajectory>& reference = inputs.reference;
   StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "odometry", "map.rgm", "map.ply"});
   RadarSlam slam(options, s.study);
+  const ImuInput imu = ImuOf(s.odometry);  // before the run: a bad IMU leaves nothing behind
+  if (!imu.samples.empty()) {
+    if (s.odometry.imu_fusion != "window") throw DataError("slam takes --imu-fusion window only");
+    CheckOverlap(GyroOf(imu), sequence, s.odometry.imu_topic.empty() ? "" : "; try --imu-stamps record");
+    slam.UseImu(s.odometry.inertial, imu.radar_from_imu, imu.samples);
+  }
   RegisterScans(sequence, "slam", [&](const RadarScan& scan) { slam.Register(scan); });
   slam.Finish();
   GaussianMap map;
@@ -80,6 +86,8 @@ Subcommand AddSlam(CLI::App& parent) {
   app->add_option("--out", s->odometry.out, "Output folder")->required();
   AddTableOptions(app, SlamOptionTable(), s->slam);
   AddTableOptions(app, FalseLoopStudyOptionTable(), s->study);
+  AddImuOptions(app, s->odometry);
+  AddTableOptions(app, RadarInertialOptionTable(), s->odometry.inertial);
   AddRunOptions(app, s->odometry);
   app->add_flag("--no-map", s->no_map, "Write no map of the place (trajectories and loops only)");
   return {app, [s] { return RunSlam(*s); }};

@@ -75,12 +75,10 @@ const OptionTable<ImuNoise>& ImuNoiseOptionTable() {
       RADARGAUSS_OPTION(O, "gyro_noise_density", gyro_noise_density)
           .Above(0.0)
           .Unit("rad/s/sqrt(Hz)")
-          .Sensor()
           .Help("the gyro's white noise, as its datasheet gives it"),
       RADARGAUSS_OPTION(O, "accel_noise_density", accel_noise_density)
           .Above(0.0)
           .Unit("m/s^2/sqrt(Hz)")
-          .Sensor()
           .Help("the accelerometer's white noise"),
       RADARGAUSS_OPTION(O, "gyro_bias_random_walk", gyro_bias_random_walk)
           .Above(0.0)

@@ -27,44 +27,54 @@ const OptionTable<RadarInertialOptions>& RadarInertialOptionTable() {
   return table;
 }
 
-RadarInertialOdometry::RadarInertialOdometry(const OdometryOptions& odometry, const RadarInertialOptions& options,
-                                             const SE3d& radar_from_imu, std::vector<ImuSample> imu)
+InertialFusion::InertialFusion(const RadarInertialOptions& options, const SE3d& radar_from_imu,
+                               std::vector<ImuSample> imu)
     : options_(options),
       radar_from_imu_(radar_from_imu),
       imu_(std::move(imu)),
-      window_(options.window, radar_from_imu),
-      odometry_(odometry) {
+      window_(options.window, radar_from_imu) {
   CheckOptions(RadarInertialOptionTable(), options);
   window_.AddImu(imu_);  // checks the order
-  odometry_.SetPoseFusion([this](const ScanEstimate& estimate) { return Fuse(estimate); });
 }
 
-const OdometryStep& RadarInertialOdometry::Register(const RadarScan& scan) {
-  FeedGyroUntil(scan.timestamp);
-  const OdometryStep& step = odometry_.Register(scan);
-  states_.push_back(started_ ? std::make_optional(window_.newest()) : std::nullopt);
-  return step;
+void InertialFusion::Attach(RadarOdometry& odometry) {
+  odometry.SetPoseFusion([this](const ScanEstimate& estimate) { return Fuse(estimate); });
 }
 
 // The rates up to the first sample at or after `stamp` (GyroIncrement needs
 // one), less the window's gyro bias now, turned into the radar frame.
-void RadarInertialOdometry::FeedGyroUntil(double stamp) {
+void InertialFusion::BeforeScan(RadarOdometry& odometry, double stamp) {
   const Eigen::Vector3d bias = started_ ? window_.newest().bias.gyro : Eigen::Vector3d::Zero();
   const SO3d radar_from_imu = radar_from_imu_.rotation();
   std::vector<GyroSample> samples;
   for (; fed_ < imu_.size() && (fed_ == 0 || imu_[fed_ - 1].stamp < stamp); ++fed_) {
     samples.push_back({imu_[fed_].stamp, radar_from_imu * (imu_[fed_].angular_velocity - bias)});
   }
-  odometry_.AddGyro(samples);
+  odometry.AddGyro(samples);
 }
 
-Eigen::Vector3d RadarInertialOdometry::GyroAt(double stamp) const {
+void InertialFusion::AfterScan() { states_.push_back(started_ ? std::make_optional(window_.newest()) : std::nullopt); }
+
+RadarInertialOdometry::RadarInertialOdometry(const OdometryOptions& odometry, const RadarInertialOptions& options,
+                                             const SE3d& radar_from_imu, std::vector<ImuSample> imu)
+    : fusion_(options, radar_from_imu, std::move(imu)), odometry_(odometry) {
+  fusion_.Attach(odometry_);
+}
+
+const OdometryStep& RadarInertialOdometry::Register(const RadarScan& scan) {
+  fusion_.BeforeScan(odometry_, scan.timestamp);
+  const OdometryStep& step = odometry_.Register(scan);
+  fusion_.AfterScan();
+  return step;
+}
+
+Eigen::Vector3d InertialFusion::GyroAt(double stamp) const {
   const auto after = std::upper_bound(imu_.begin(), imu_.end(), stamp,
                                       [](double t, const ImuSample& sample) { return t < sample.stamp; });
   return (after == imu_.begin() ? *after : *(after - 1)).angular_velocity;  // the sample in force
 }
 
-SE3d RadarInertialOdometry::Fuse(const ScanEstimate& e) {
+SE3d InertialFusion::Fuse(const ScanEstimate& e) {
   if (!started_) {
     if (!e.velocity_measured || imu_.empty()) return e.pose;
     const InertialStart start = StartFromGravity(imu_, e.stamp, e.pose, e.velocity, radar_from_imu_);
@@ -82,7 +92,7 @@ SE3d RadarInertialOdometry::Fuse(const ScanEstimate& e) {
         e.velocity_covariance + options_.velocity_floor * options_.velocity_floor * Eigen::Matrix3d::Identity();
     window_.AddVelocity(e.velocity, covariance, GyroAt(e.stamp));
   }
-  last_window_ms_ = window_.Solve().time_ms;
+  window_.Solve();
   return window_.RadarPoseInMatcherWorld();
 }
 

@@ -82,9 +82,16 @@ RadarSlam::RadarSlam(const SlamOptions& options, const FalseLoopStudy& study)
   CheckOptions(FalseLoopStudyOptionTable(), study_);
 }
 
+void RadarSlam::UseImu(const RadarInertialOptions& options, const SE3d& radar_from_imu, std::vector<ImuSample> imu) {
+  inertial_ = std::make_unique<InertialFusion>(options, radar_from_imu, std::move(imu));
+  inertial_->Attach(odometry_);
+}
+
 const OdometryStep& RadarSlam::Register(const RadarScan& scan) {
   const std::size_t index = odometry_.steps().size();
+  if (inertial_) inertial_->BeforeScan(odometry_, scan.timestamp);
   const OdometryStep& step = odometry_.Register(scan);
+  if (inertial_) inertial_->AfterScan();
   if (index > 0) path_ += (step.pose.translation() - odometry_.steps()[index - 1].pose.translation()).norm();
   if (!open_) {
     OpenKeyframe(index, step.pose, step.stamp);

@@ -1,14 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Radar-inertial odometry (docs/design.md, "Radar-inertial odometry") on a
 // simulated drive with a MEMS IMU: its drift below the radar's alone, the
-// window's gyro bias near the truth, the same trajectory for the same input,
-// and an IMU that ends before the scans refused with one line.
+// window's gyro bias near the truth, the same trajectory for the same input
+// and in SLAM's front end, and an IMU that ends before the scans refused.
 #include <gtest/gtest.h>
 
 #include "radargauss/error.hpp"
 #include "radargauss/evaluation.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/simulator.hpp"
+#include "radargauss/slam/radar_slam.hpp"
 
 namespace radargauss {
 namespace {
@@ -53,6 +54,23 @@ TEST(RadarInertialOdometry, DriftsLessThanTheRadarAlone) {
   for (std::size_t k = 0; k < a.size(); ++k) {
     ASSERT_EQ(a[k].pose.translation(), b[k].pose.translation()) << "scan " << k;
   }
+}
+
+// SLAM's front end with UseImu is the same radar-inertial odometry, scan for scan.
+TEST(RadarInertialOdometry, SlamsFrontEndIsTheSame) {
+  const SimulatedSequence& s = Drive();
+  const Sequence sequence = AsSequence(s);
+  RadarInertialOdometry inertial(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, s.imu);
+  RadarSlam slam;
+  slam.UseImu(RadarInertialOptions{}, s.radar_from_imu, s.imu);
+  for (std::size_t k = 0; k < 60; ++k) {
+    inertial.Register(sequence.scans[k]);
+    slam.Register(sequence.scans[k]);
+    ASSERT_EQ(inertial.odometry().steps()[k].pose.translation(), slam.odometry().steps()[k].pose.translation())
+        << "scan " << k;
+  }
+  ASSERT_NE(slam.inertial(), nullptr);
+  EXPECT_EQ(slam.inertial()->states().back()->bias.gyro, inertial.states().back()->bias.gyro);
 }
 
 TEST(RadarInertialOdometry, AnImuThatEndsEarlyIsRefused) {

@@ -35,38 +35,58 @@ struct RadarInertialOptions {
 // Its options (options.hpp): its own, then the window's.
 const OptionTable<RadarInertialOptions>& RadarInertialOptionTable();
 
-class RadarInertialOdometry {
+// The window beside a RadarOdometry: Attach sets its PoseFusion; around
+// each Register, BeforeScan feeds the gyro's rates (less the window's bias)
+// to the prediction and AfterScan records the window's state. RadarSlam and
+// RadarInertialOdometry hold one.
+class InertialFusion {
  public:
   // `imu`: the IMU's samples (time order) on the scans' clock, in its frame;
   // radar_from_imu = T_radar_imu. Throws DataError for samples out of order.
-  RadarInertialOdometry(const OdometryOptions& odometry, const RadarInertialOptions& options,
-                        const SE3d& radar_from_imu, std::vector<ImuSample> imu);
+  InertialFusion(const RadarInertialOptions& options, const SE3d& radar_from_imu, std::vector<ImuSample> imu);
+  InertialFusion(const InertialFusion&) = delete;  // the odometry's hook holds `this`
+  InertialFusion& operator=(const InertialFusion&) = delete;
 
-  // Registers the next scan (RadarOdometry::Register). Throws DataError when
-  // the IMU does not cover the time since the last scan.
-  const OdometryStep& Register(const RadarScan& scan);
+  void Attach(RadarOdometry& odometry);
+  void BeforeScan(RadarOdometry& odometry, double stamp);
+  void AfterScan();
 
-  const RadarOdometry& odometry() const { return odometry_; }
   // The window's newest state after each scan; empty before the window started.
   const std::vector<std::optional<InertialState>>& states() const { return states_; }
   const InertialWindow& window() const { return window_; }
   const RadarInertialOptions& options() const { return options_; }
-  double last_window_ms() const { return last_window_ms_; }
 
  private:
   SE3d Fuse(const ScanEstimate& estimate);
   Eigen::Vector3d GyroAt(double stamp) const;
-  void FeedGyroUntil(double stamp);
 
   RadarInertialOptions options_;
   SE3d radar_from_imu_;
   std::vector<ImuSample> imu_;
   InertialWindow window_;
-  RadarOdometry odometry_;
   bool started_ = false;
   std::size_t fed_ = 0;  // IMU samples handed to the odometry's prediction
   std::vector<std::optional<InertialState>> states_;
-  double last_window_ms_ = 0.0;
+};
+
+class RadarInertialOdometry {
+ public:
+  // As InertialFusion's; Register throws DataError when the IMU does not
+  // cover the time since the last scan.
+  RadarInertialOdometry(const OdometryOptions& odometry, const RadarInertialOptions& options,
+                        const SE3d& radar_from_imu, std::vector<ImuSample> imu);
+
+  const OdometryStep& Register(const RadarScan& scan);
+
+  const RadarOdometry& odometry() const { return odometry_; }
+  const InertialFusion& fusion() const { return fusion_; }
+  const std::vector<std::optional<InertialState>>& states() const { return fusion_.states(); }
+  const InertialWindow& window() const { return fusion_.window(); }
+  const RadarInertialOptions& options() const { return fusion_.options(); }
+
+ private:
+  InertialFusion fusion_;
+  RadarOdometry odometry_;
 };
 
 }  // namespace radargauss

@@ -16,10 +16,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/slam/loop_verification.hpp"
 #include "radargauss/slam/place_recognition.hpp"
@@ -96,12 +98,16 @@ class RadarSlam {
  public:
   explicit RadarSlam(const SlamOptions& options = {}, const FalseLoopStudy& study = {});
 
+  // From the next scan on, the odometry is radar-inertial (odometry/radar_inertial.hpp):
+  // the IMU's samples on the scans' clock, T_radar_imu, the window's options.
+  void UseImu(const RadarInertialOptions& options, const SE3d& radar_from_imu, std::vector<ImuSample> imu);
   // As RadarOdometry::Register; a keyframe that closes is described and searched.
   const OdometryStep& Register(const RadarScan& scan);
   // Closes the last keyframe (described and searched).
   void Finish();
 
   const RadarOdometry& odometry() const { return odometry_; }
+  const InertialFusion* inertial() const { return inertial_.get(); }  // null without UseImu
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   const std::vector<LoopCandidate>& candidates() const { return candidates_; }
   const PoseGraph& graph() const { return graph_; }
@@ -124,6 +130,7 @@ class RadarSlam {
   SlamOptions options_;
   FalseLoopStudy study_;
   RadarOdometry odometry_;
+  std::unique_ptr<InertialFusion> inertial_;
   PoseGraph graph_;
   std::vector<Keyframe> keyframes_;
   PlaceDatabase places_;         // a place per closed keyframe
