@@ -14,6 +14,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -148,35 +149,37 @@ struct InertialWindow::Impl {
     if (!options.estimate_extrinsic_rotation) problem.SetParameterBlockConstant(extrinsic_rotation.data());
     if (!options.estimate_extrinsic_translation) problem.SetParameterBlockConstant(extrinsic_translation.data());
     if (!options.estimate_tilt) problem.SetParameterBlockConstant(tilt.data());
+    std::vector<ceres::ResidualBlockId> ids;  // the terms on the oldest state
     for (std::size_t k = 0; k < nodes.size(); ++k) {
       Node& node = nodes[k];
-      std::vector<ceres::ResidualBlockId> ids;
-      for (auto& [cost, blocks] : node.first_priors)
-        ids.push_back(problem.AddResidualBlock(cost.get(), nullptr, blocks));
+      const auto on_oldest = [&](ceres::ResidualBlockId id, bool touches_oldest) {
+        if (touches_oldest) ids.push_back(id);
+      };
+      for (auto& [cost, blocks] : node.first_priors) {
+        on_oldest(problem.AddResidualBlock(cost.get(), nullptr, blocks), k == 0);
+      }
       if (node.pose) {
-        ids.push_back(problem.AddResidualBlock(node.pose.get(), nullptr,
-                                               {node.rotation.data(), node.position.data(), extrinsic_rotation.data(),
-                                                extrinsic_translation.data(), tilt.data()}));
+        on_oldest(problem.AddResidualBlock(node.pose.get(), nullptr,
+                                           {node.rotation.data(), node.position.data(), extrinsic_rotation.data(),
+                                            extrinsic_translation.data(), tilt.data()}),
+                  k == 0);
       }
       if (node.velocity) {
-        ids.push_back(problem.AddResidualBlock(
-            node.velocity.get(), nullptr,
-            {node.rotation.data(), node.motion.data(), extrinsic_rotation.data(), extrinsic_translation.data()}));
+        on_oldest(problem.AddResidualBlock(node.velocity.get(), nullptr,
+                                           {node.rotation.data(), node.motion.data(), extrinsic_rotation.data(),
+                                            extrinsic_translation.data()}),
+                  k == 0);
       }
       if (k > 0 && node.imu) {
         Node& before = nodes[k - 1];
-        const ceres::ResidualBlockId id =
-            problem.AddResidualBlock(node.imu.get(), nullptr,
-                                     {before.rotation.data(), before.position.data(), before.motion.data(),
-                                      node.rotation.data(), node.position.data(), node.motion.data()});
-        if (k == 1) ids.push_back(id);
+        on_oldest(problem.AddResidualBlock(node.imu.get(), nullptr,
+                                           {before.rotation.data(), before.position.data(), before.motion.data(),
+                                            node.rotation.data(), node.position.data(), node.motion.data()}),
+                  k == 1);
       }
-      if (k == 0 && oldest_terms != nullptr) *oldest_terms = ids;
     }
-    if (prior) {
-      const ceres::ResidualBlockId id = problem.AddResidualBlock(prior.get(), nullptr, prior->parameter_blocks());
-      if (oldest_terms != nullptr) oldest_terms->push_back(id);
-    }
+    if (prior) ids.push_back(problem.AddResidualBlock(prior.get(), nullptr, prior->parameter_blocks()));
+    if (oldest_terms != nullptr) *oldest_terms = ids;
   }
 };
 
@@ -397,6 +400,44 @@ WindowSolveSummary InertialWindow::Solve() {
   summary.reintegrated = reintegrated;
   summary.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return summary;
+}
+
+WindowUncertainty InertialWindow::Uncertainty() const {
+  if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::Uncertainty before Start");
+  ceres::Problem problem(BorrowingProblem());
+  impl_->Build(problem, options_, nullptr);
+  const std::vector<double*> blocks = impl_->VariableBlocks(options_);
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = blocks;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) J(row, crs.cols[k]) = crs.values[k];
+  }
+  const Eigen::MatrixXd covariance = (J.transpose() * J).completeOrthogonalDecomposition().pseudoInverse();
+  // The tangent offset of each block, in VariableBlocks' order.
+  std::vector<int> offset(blocks.size() + 1, 0);
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const ceres::Manifold* manifold = problem.GetManifold(blocks[b]);
+    offset[b + 1] = offset[b] + (manifold ? manifold->TangentSize() : problem.ParameterBlockSize(blocks[b]));
+  }
+  const auto std_of = [&](std::size_t block, int first, int n) {
+    Eigen::VectorXd s(n);
+    for (int i = 0; i < n; ++i)
+      s(i) = std::sqrt(std::max(0.0, covariance(offset[block] + first + i, offset[block] + first + i)));
+    return s;
+  };
+  WindowUncertainty u;
+  const std::size_t motion = 3 * impl_->nodes.size() - 1;  // the newest state's [v; b_g; b_a]
+  u.velocity = std_of(motion, kMotionVelocity, 3);
+  u.gyro_bias = std_of(motion, kMotionGyroBias, 3);
+  u.accel_bias = std_of(motion, kMotionAccelBias, 3);
+  std::size_t global = 3 * impl_->nodes.size();
+  if (options_.estimate_tilt) u.tilt = std_of(global++, 0, 2);
+  if (options_.estimate_extrinsic_rotation) u.extrinsic_rotation = std_of(global++, 0, 3);
+  if (options_.estimate_extrinsic_translation) u.extrinsic_translation = std_of(global++, 0, 3);
+  return u;
 }
 
 // The oldest state leaves: its terms become a prior on what they share with

@@ -52,25 +52,6 @@ void PrintInertial(const RadarInertialOdometry& inertial) {
   }
 }
 
-// Per scan: the window's newest state (empty fields before it started).
-void WriteInertialStates(const std::string& path, const RadarInertialOdometry& inertial) {
-  std::string text = "stamp,vx,vy,vz,bgx,bgy,bgz,bax,bay,baz\n";
-  const auto& steps = inertial.odometry().steps();
-  for (std::size_t k = 0; k < steps.size(); ++k) {
-    char line[320];
-    const std::optional<InertialState>& s = inertial.states()[k];
-    if (!s) {
-      std::snprintf(line, sizeof(line), "%.9f,,,,,,,,,\n", steps[k].stamp);
-    } else {
-      std::snprintf(line, sizeof(line), "%.9f,%.6f,%.6f,%.6f,%.7f,%.7f,%.7f,%.6f,%.6f,%.6f\n", steps[k].stamp,
-                    s->velocity.x(), s->velocity.y(), s->velocity.z(), s->bias.gyro.x(), s->bias.gyro.y(),
-                    s->bias.gyro.z(), s->bias.accel.x(), s->bias.accel.y(), s->bias.accel.z());
-    }
-    text += line;
-  }
-  WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
-}
-
 int RunOdometry(const OdometrySettings& s) {
   const OdometryOptions& options = s.odometry;
   ValidateOptions(options);
@@ -95,8 +76,7 @@ int RunOdometry(const OdometrySettings& s) {
   const RadarOdometry& odometry = inertial ? inertial->odometry() : *radar_only;
   std::optional<Evaluation> evaluation;
   if (reference) evaluation = EvaluateTrajectory(odometry.trajectory(), *reference);
-  WriteOdometry(folder.path(), odometry);
-  if (inertial) WriteInertialStates(folder.path() + "/inertial.csv", *inertial);
+  WriteOdometry(folder.path(), odometry, inertial ? &inertial->fusion() : nullptr);
   const std::string table = evaluation ? WriteEvaluation(folder.path(), *evaluation) : std::string();
   folder.Commit();
   PrintSummary(Summarise(odometry));

@@ -52,7 +52,7 @@ int RunSlam(const SlamSettings& s) {
                     "trajectory without a map)");
   }
   const std::string out = folder.path();
-  WriteOdometry((std::filesystem::path(out) / "odometry").string(), slam.odometry());
+  WriteOdometry((std::filesystem::path(out) / "odometry").string(), slam.odometry(), slam.inertial());
   WriteSlam(out, slam);
   if (!s.no_map) {
     WriteMap((std::filesystem::path(out) / "map.rgm").string(), map);

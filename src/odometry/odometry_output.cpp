@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <filesystem>
 #include <iomanip>
+#include <optional>
 #include <system_error>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -11,6 +13,7 @@
 #include "radargauss/error.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/odometry/mounting.hpp"
+#include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/stats.hpp"
 
@@ -64,7 +67,60 @@ void WritePerScan(std::ostream& out, const std::vector<OdometryStep>& steps) {
 
 }  // namespace
 
-void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
+namespace {
+
+std::vector<double> Values(const Eigen::VectorXd& v, double scale = 1.0) {
+  std::vector<double> out;
+  for (Eigen::Index i = 0; i < v.size(); ++i) out.push_back(v(i) * scale);
+  return out;
+}
+
+// The window's last estimate of what does not change along the drive, with its standard deviations.
+nlohmann::json Calibration(const InertialFusion& inertial) {
+  const auto& states = inertial.states();
+  if (states.empty() || !states.back()) return nullptr;  // the window never started
+  const InertialWindow& window = inertial.window();
+  const InertialState& last = *states.back();
+  const WindowUncertainty u = window.Uncertainty();
+  constexpr double kDeg = 180.0 / M_PI;
+  nlohmann::json c = {{"tilt_roll_pitch_deg", Values(window.tilt(), kDeg)},
+                      {"tilt_std_deg", Values(u.tilt, kDeg)},
+                      {"gyro_bias", Values(last.bias.gyro)},
+                      {"gyro_bias_std", Values(u.gyro_bias)},
+                      {"accel_bias", Values(last.bias.accel)},
+                      {"accel_bias_std", Values(u.accel_bias)}};
+  const InertialWindowOptions& o = inertial.options().window;
+  if (o.estimate_extrinsic_rotation || o.estimate_extrinsic_translation) {
+    const SE3d radar_from_imu = window.radar_from_imu();
+    c["radar_from_imu_rotation_vector_deg"] = Values(radar_from_imu.rotation().Log(), kDeg);
+    c["radar_from_imu_translation"] = Values(radar_from_imu.translation());
+    c["imu_from_radar_rotation_std_deg"] = Values(u.extrinsic_rotation, kDeg);
+    c["imu_from_radar_translation_std"] = Values(u.extrinsic_translation);
+  }
+  return c;
+}
+
+// inertial.csv: the window's newest state per scan (empty fields before it started).
+void WriteInertialStates(const std::string& path, const RadarOdometry& odometry, const InertialFusion& inertial) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "stamp,vx,vy,vz,bgx,bgy,bgz,bax,bay,baz\n" << std::setprecision(9);
+    const std::vector<OdometryStep>& steps = odometry.steps();
+    for (std::size_t k = 0; k < steps.size() && k < inertial.states().size(); ++k) {
+      out << std::fixed << std::setprecision(9) << steps[k].stamp << std::defaultfloat << std::setprecision(9);
+      const std::optional<InertialState>& s = inertial.states()[k];
+      for (int i = 0; i < 9; ++i) {
+        out << ',';
+        if (!s) continue;
+        out << (i < 3 ? s->velocity(i) : i < 6 ? s->bias.gyro(i - 3) : s->bias.accel(i - 6));
+      }
+      out << '\n';
+    }
+  });
+}
+
+}  // namespace
+
+void WriteOdometry(const std::string& dir, const RadarOdometry& odometry, const InertialFusion* inertial) {
   namespace fs = std::filesystem;
   std::error_code error;
   fs::create_directories(dir, error);
@@ -101,6 +157,10 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
                            {"yaw_scans", mounting->yaw_scans},
                            {"levelled_end_m", {end.x(), end.y(), end.z()}}};
     WriteTum((out / "levelled.tum").string(), levelled);
+  }
+  if (inertial != nullptr) {
+    summary["calibration"] = Calibration(*inertial);
+    WriteInertialStates((out / "inertial.csv").string(), odometry, *inertial);
   }
   WriteFileAtomically((out / "summary.json").string(),
                       [&](std::ostream& stream) { stream << summary.dump(2) << "\n"; });

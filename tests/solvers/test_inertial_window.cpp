@@ -64,6 +64,7 @@ struct Result {
   ImuBias truth;
   Eigen::Vector3d true_velocity;
   Eigen::Vector2d tilt;
+  WindowUncertainty uncertainty;
   double max_cost = 0.0;
 };
 
@@ -113,6 +114,7 @@ Result RunWindow(const InertialWindowOptions& options) {
   };
   result.true_velocity = (imu_position(t) - imu_position(t - h)) / h;
   result.tilt = window.tilt();
+  result.uncertainty = window.Uncertainty();
   return result;
 }
 
@@ -127,7 +129,13 @@ TEST_P(InertialWindowSolvers, RecoversBiasesTiltAndVelocity) {
       << r.last.bias.gyro.transpose() << " vs " << r.truth.gyro.transpose();
   EXPECT_LT((r.last.bias.accel - r.truth.accel).norm(), 0.03)
       << r.last.bias.accel.transpose() << " vs " << r.truth.accel.transpose();
-  EXPECT_LT((r.tilt - kTilt).norm(), 0.1 * kDeg) << r.tilt.transpose() / kDeg;
+  EXPECT_LT((r.tilt - kTilt).norm(), 0.05 * kDeg) << r.tilt.transpose() / kDeg;
+  // Each within three of the window's standard deviations, which say something (not the priors').
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(std::abs(r.last.bias.gyro(i) - r.truth.gyro(i)), 3.0 * r.uncertainty.gyro_bias(i)) << "axis " << i;
+    EXPECT_LT(r.uncertainty.gyro_bias(i), 1e-3);
+    EXPECT_LT(std::abs(r.last.bias.accel(i) - r.truth.accel(i)), 3.0 * r.uncertainty.accel_bias(i)) << "axis " << i;
+  }
   EXPECT_LT((r.last.velocity - r.true_velocity).norm(), 0.05)
       << r.last.velocity.transpose() << " vs " << r.true_velocity.transpose();
   EXPECT_LT(r.max_cost, 100.0);  // no state's terms far beyond their noise

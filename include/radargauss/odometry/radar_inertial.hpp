@@ -28,7 +28,7 @@ struct RadarInertialOptions {
   InertialWindowOptions window;
   // The match's points are not independent (the map was built from the
   // same poses): its information N_geo * H counts for this fraction.
-  double match_information_scale = 0.001;
+  double match_information_scale = 0.003;
   double velocity_floor = 0.05;  // m/s: added in quadrature to the Doppler velocity's std
 };
 

@@ -255,9 +255,14 @@ struct OdometrySummary {
 };
 OdometrySummary Summarise(const RadarOdometry& odometry);
 
+class InertialFusion;  // odometry/radar_inertial.hpp
+
 // Writes odometry.tum (T_world_radar), levelled.tum (when the mounting is
 // observable, odometry/mounting.hpp), per_scan.csv, summary.json, map.rgm
-// and map.ply into `dir` (created), each file whole or not at all.
-void WriteOdometry(const std::string& dir, const RadarOdometry& odometry);
+// and map.ply into `dir` (created), each file whole or not at all. With the
+// odometry's `inertial` fusion also inertial.csv (the window's newest state
+// per scan) and summary.json's `calibration` (the tilt, the biases, the
+// extrinsic when estimated, each with its standard deviation).
+void WriteOdometry(const std::string& dir, const RadarOdometry& odometry, const InertialFusion* inertial = nullptr);
 
 }  // namespace radargauss

@@ -38,9 +38,9 @@ WindowSolver WindowSolverFromString(const std::string& name);  // throws std::in
 std::vector<std::string> WindowSolverNames();
 
 struct InertialWindowOptions {
-  std::size_t size = 20;  // states kept (2 s at 10 Hz: shorter windows marginalise states not yet settled)
+  std::size_t size = 5;  // states kept
   WindowSolver solver = WindowSolver::kCeresLm;
-  int max_iterations = 5;  // per Solve
+  int max_iterations = 5;   // per Solve
   bool marginalize = true;  // false: a leaving state is dropped with all it knew
   ImuNoise noise;
   // The first state's prior (std): its biases about zero, its velocity about the start's.
@@ -61,6 +61,18 @@ struct InertialState {
   SE3d pose;
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s
   ImuBias bias;
+};
+
+// Standard deviations of the newest state's biases and velocity and of the
+// estimated globals, from the inverse of the window's Gauss-Newton matrix
+// at the current estimate (its prior included); zero for what is held fixed.
+struct WindowUncertainty {
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();               // m/s
+  Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();              // rad/s
+  Eigen::Vector3d accel_bias = Eigen::Vector3d::Zero();             // m/s^2
+  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();                   // rad
+  Eigen::Vector3d extrinsic_rotation = Eigen::Vector3d::Zero();     // rad, on the right of R_imu_radar
+  Eigen::Vector3d extrinsic_translation = Eigen::Vector3d::Zero();  // m
 };
 
 struct WindowSolveSummary {
@@ -93,6 +105,8 @@ class InertialWindow {
   void AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance,
                    const Eigen::Vector3d& gyro);
   WindowSolveSummary Solve();
+  // After a Solve: costs a dense inverse of the window's matrix.
+  WindowUncertainty Uncertainty() const;
 
   std::size_t size() const;
   InertialState state(std::size_t index) const;  // 0: the oldest in the window
