@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "radargauss/error.hpp"
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/stats.hpp"
@@ -34,11 +35,12 @@ int ListTopics(const std::string& bag) {
 struct InfoSettings {
   SequenceOptions sequence;
   std::string imu;
+  std::string imu_topic;  // a sensor_msgs/Imu topic of --bag
 };
 
-// An IMU file's span, rate, gaps and mean rates (io/imu.hpp).
-void PrintImu(const std::string& path) {
-  const ImuSummary s = SummariseImu(ReadImuFile(path));
+// An IMU's span, rate, gaps and mean rates (io/imu.hpp).
+void PrintImu(const std::vector<ImuSample>& samples) {
+  const ImuSummary s = SummariseImu(samples);
   std::printf(
       "imu: %zu samples, %.9f .. %.9f (%.3f s), %.1f Hz (median interval), %zu gaps over 3 intervals, "
       "longest %.4f s\n",
@@ -52,8 +54,13 @@ void PrintImu(const std::string& path) {
 int RunInfo(const InfoSettings& settings) {
   const SequenceOptions& options = settings.sequence;
   if (!settings.imu.empty()) {
-    PrintImu(settings.imu);
+    PrintImu(ReadImuFile(settings.imu));
     if (options.sequence_dir.empty() && options.bag.empty()) return 0;
+  }
+  if (!settings.imu_topic.empty()) {
+    if (options.bag.empty()) throw DataError("--imu-topic needs --bag");
+    PrintImu(ReadBagImu(options.bag, settings.imu_topic, false));
+    if (options.topic.empty()) return 0;
   }
   if (!options.bag.empty() && options.topic.empty()) return ListTopics(options.bag);
   const Sequence sequence = LoadSequence(options);
@@ -101,6 +108,7 @@ Subcommand AddInfo(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand("info", "Summarise a sequence and an IMU file (or list a bag's topics)");
   AddSequenceOptions(app, settings->sequence);
   app->add_option("--imu", settings->imu, "IMU file of lines 'stamp wx wy wz ax ay az': its rate, gaps, mean rates");
+  app->add_option("--imu-topic", settings->imu_topic, "sensor_msgs/Imu topic of --bag: its rate, gaps, mean rates");
   return {app, [settings] { return RunInfo(*settings); }};
 }
 

@@ -34,6 +34,8 @@ if [ "${2:-}" = bag ]; then
     expect_ok "odometry on the TI bag with its IMU" "wrote $work/ti" -- \
       "$tool" odometry --bag "$ti_bag" --topic /ti_mmwave/radar_scan_pcl --rcs-field none --max-scans 60 \
       --imu-topic /sensor_platform/imu --imu-stamps record --out "$work/ti"
+    expect_ok "info on the TI bag's IMU" "imu: 8270 samples" -- \
+      "$tool" info --bag "$ti_bag" --imu-topic /sensor_platform/imu
     expect_fail "odometry on a bag without the topic" "no messages on topic" -- \
       "$tool" odometry --bag "$ti_bag" --topic /absent --out "$work/ti_absent"
     expect_fail "odometry with an IMU topic of the wrong type" "not sensor_msgs/Imu" -- \
