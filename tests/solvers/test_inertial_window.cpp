@@ -3,8 +3,10 @@
 // a simulated drive with a MEMS IMU, turned and away from the radar: from
 // noisy radar poses in a tilted world and noisy Doppler velocities it
 // recovers the planted biases, the world's tilt against gravity and the
-// velocity, with each solver; the start from gravity is right on a level
-// straight; and the window refuses what it cannot use.
+// velocity, with each solver, each bias within three of its standard
+// deviations; a bias past the first-order correction is integrated again;
+// the start from gravity is right on a level straight; and the window
+// refuses what it cannot use.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -66,11 +68,11 @@ struct Result {
   Eigen::Vector2d tilt;
   WindowUncertainty uncertainty;
   double max_cost = 0.0;
+  std::size_t reintegrated = 0;  // IMU terms integrated again over the run
 };
 
 // Feeds every scan's pose and velocity, solving after each.
-Result RunWindow(const InertialWindowOptions& options) {
-  const SimulatedSequence& s = Drive();
+Result RunWindow(const InertialWindowOptions& options, const SimulatedSequence& s = Drive()) {
   std::mt19937 rng(7);
   std::normal_distribution<double> n(0.0, 1.0);
   const auto noise = [&](double std) { return Eigen::Vector3d(n(rng), n(rng), n(rng)) * std; };
@@ -99,6 +101,7 @@ Result RunWindow(const InertialWindowOptions& options) {
     window.AddPose(measured, information);
     window.AddVelocity(velocity, velocity_covariance, GyroAt(s, stamp));
     const WindowSolveSummary summary = window.Solve();
+    result.reintegrated += summary.reintegrated;
     if (k > 20) result.max_cost = std::max(result.max_cost, summary.final_cost / double(window.size()));
   }
   result.last = window.newest();
@@ -149,6 +152,19 @@ INSTANTIATE_TEST_SUITE_P(EachSolver, InertialWindowSolvers,
                            name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
                            return name;
                          });
+
+// Gyro biases of several 0.01 rad/s, past the first-order correction's bound:
+// the terms are integrated again at the moved bias, and the bias is found.
+TEST(InertialWindow, IntegratesAgainWhenABiasMovesPastTheCorrection) {
+  SimulationConfig config = WindowConfig();
+  config.imu_gyro_bias_std = 0.03;
+  const SimulatedSequence biased = Simulate(config);
+  const Result r = RunWindow(InertialWindowOptions{}, biased);
+  EXPECT_GT(r.truth.gyro.norm(), 0.02);
+  EXPECT_GT(r.reintegrated, 0u);
+  EXPECT_LT((r.last.bias.gyro - r.truth.gyro).norm(), 1e-3)
+      << r.last.bias.gyro.transpose() << " vs " << r.truth.gyro.transpose();
+}
 
 TEST(InertialWindow, StartFromGravityOnALevelStraight) {
   const SimulatedSequence& s = Drive();
