@@ -206,6 +206,11 @@ void InertialWindow::AddImu(const std::vector<ImuSample>& samples) {
 
 void InertialWindow::Start(const InertialState& state) {
   if (!impl_->nodes.empty()) throw std::logic_error("InertialWindow::Start: the window has started");
+  if (!state.pose.translation().allFinite() || !state.pose.rotation().quaternion().coeffs().allFinite() ||
+      !state.velocity.allFinite() || !state.bias.gyro.allFinite() || !state.bias.accel.allFinite() ||
+      !std::isfinite(state.stamp)) {
+    throw std::invalid_argument("InertialWindow::Start: the first state is not finite");
+  }
   Node node;
   node.stamp = state.stamp;
   node.rotation = state.pose.rotation().quaternion().coeffs();
@@ -255,6 +260,10 @@ void InertialWindow::AddState(double stamp) {
 
 void InertialWindow::AddPose(const SE3d& world_from_radar, const Eigen::Matrix<double, 6, 6>& information) {
   if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::AddPose before Start");
+  if (!world_from_radar.translation().allFinite() || !world_from_radar.rotation().quaternion().coeffs().allFinite() ||
+      !information.allFinite()) {
+    throw std::invalid_argument("InertialWindow::AddPose: a pose or information that is not finite");
+  }
   const Eigen::Matrix<double, 6, 6> W = SqrtInformation(information);
   impl_->nodes.back().pose.reset(RadarPoseResidual::Create(world_from_radar, W));
 }
@@ -262,6 +271,9 @@ void InertialWindow::AddPose(const SE3d& world_from_radar, const Eigen::Matrix<d
 void InertialWindow::AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance,
                                  const Eigen::Vector3d& gyro) {
   if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::AddVelocity before Start");
+  if (!radar_velocity.allFinite() || !gyro.allFinite()) {
+    throw std::invalid_argument("InertialWindow::AddVelocity: a velocity or rate that is not finite");
+  }
   const Eigen::LLT<Eigen::Matrix3d> factor(covariance);
   if (factor.info() != Eigen::Success) throw std::invalid_argument("AddVelocity: covariance not positive definite");
   const Eigen::Matrix3d W = SqrtInformation(factor.solve(Eigen::Matrix3d::Identity()));
