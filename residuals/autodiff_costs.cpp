@@ -69,14 +69,14 @@ ceres::CostFunction* ImuResidual::Create(const ImuPreintegration& preintegration
 }
 
 ceres::CostFunction* RadarPoseResidual::Create(const SE3d& measured,
-                                               const Eigen::Matrix<double, 6, 6>& sqrt_information) {
-  return new AutoDiff(new RadarPoseResidual(measured, sqrt_information));
+                                               const Eigen::Matrix<double, 6, 6>& sqrt_information,
+                                               const ImuAtScan& imu) {
+  return new AutoDiff(new RadarPoseResidual(measured, sqrt_information, imu));
 }
 
 ceres::CostFunction* RadarVelocityResidual::Create(const Eigen::Vector3d& radar_velocity,
-                                                   const Eigen::Vector3d& gyro_rate,
-                                                   const Eigen::Matrix3d& sqrt_information) {
-  return new AutoDiff(new RadarVelocityResidual(radar_velocity, gyro_rate, sqrt_information));
+                                                   const Eigen::Matrix3d& sqrt_information, const ImuAtScan& imu) {
+  return new AutoDiff(new RadarVelocityResidual(radar_velocity, sqrt_information, imu));
 }
 
 }  // namespace radargauss

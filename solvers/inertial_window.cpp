@@ -30,6 +30,8 @@ namespace radargauss {
 
 namespace {
 
+constexpr double kClockRelinearisation = 0.002;  // s
+
 const NamedValue<WindowSolver> kWindowSolverNames[] = {{WindowSolver::kCeresLm, "ceres-lm"},
                                                        {WindowSolver::kCeresDogleg, "ceres-dogleg"},
                                                        {WindowSolver::kGaussNewton, "gn"}};
@@ -79,6 +81,12 @@ const OptionTable<InertialWindowOptions>& InertialWindowOptionTable() {
             .Help("estimate the radar-IMU rotation online"),
         RADARGAUSS_OPTION(O, "estimate_extrinsic_translation", estimate_extrinsic_translation)
             .Help("estimate the radar-IMU translation online (where the motion excites it)"),
+        RADARGAUSS_OPTION(O, "imu_clock_offset", clock_offset)
+            .In(-0.1, 0.1)
+            .Unit("s")
+            .Help("the IMU's stamps minus the radar's clock (the start when estimated)"),
+        RADARGAUSS_OPTION(O, "estimate_clock_offset", estimate_clock_offset)
+            .Help("estimate the IMU-radar clock offset online"),
     };
     AppendNested(
         t, ImuNoiseOptionTable(), +[](O & o) -> auto& { return o.noise; }, "noise", "imu_");
@@ -95,7 +103,10 @@ struct InertialWindow::Node {
   Eigen::Matrix<double, 9, 1> motion = Eigen::Matrix<double, 9, 1>::Zero();  // v, b_g, b_a
   std::optional<ImuPreintegration> from_previous;  // the IMU between the node before and this one
   CostPointer imu, pose, velocity;                 // terms on this node (imu: from the one before)
-  std::vector<std::pair<CostPointer, std::vector<double*>>> first_priors;  // the first state's
+  // The measurements, kept to make their terms again at a new clock offset.
+  std::optional<std::pair<SE3d, Eigen::Matrix<double, 6, 6>>> pose_measurement;     // pose, W
+  std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> velocity_measurement;  // velocity, W
+  std::vector<std::pair<CostPointer, std::vector<double*>>> first_priors;           // the first state's
 
   InertialState State() const {
     InertialState s;
@@ -116,7 +127,29 @@ struct InertialWindow::Impl {
   Eigen::Vector4d extrinsic_rotation;  // R_imu_radar, x y z w
   Eigen::Vector3d extrinsic_translation;
   Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
+  double clock_offset[1] = {0.0};    // t_d: the block
+  double clock_linearisation = 0.0;  // t_0: where the samples were read
   std::shared_ptr<MarginalizationPrior> prior;
+
+  // The IMU's reading in force at a scan's stamp, at the clock offset t_0.
+  ImuAtScan ImuAt(double stamp) const {
+    const double t = stamp + clock_linearisation;
+    auto after =
+        std::upper_bound(imu.begin(), imu.end(), t, [](double s, const ImuSample& sample) { return s < sample.stamp; });
+    if (after != imu.begin()) --after;
+    if (after == imu.end()) throw DataError("no IMU sample at " + std::to_string(t) + " s");
+    return {after->angular_velocity, after->specific_force, clock_linearisation};
+  }
+  void MakeRadarTerms(Node& node) const {
+    if (node.pose_measurement) {
+      node.pose.reset(
+          RadarPoseResidual::Create(node.pose_measurement->first, node.pose_measurement->second, ImuAt(node.stamp)));
+    }
+    if (node.velocity_measurement) {
+      node.velocity.reset(RadarVelocityResidual::Create(node.velocity_measurement->first,
+                                                        node.velocity_measurement->second, ImuAt(node.stamp)));
+    }
+  }
 
   // The blocks the solvers move, in a fixed order.
   std::vector<double*> VariableBlocks(const InertialWindowOptions& options) {
@@ -132,6 +165,7 @@ struct InertialWindow::Impl {
     if (options.estimate_tilt) blocks.push_back(tilt.data());
     if (options.estimate_extrinsic_rotation) blocks.push_back(extrinsic_rotation.data());
     if (options.estimate_extrinsic_translation) blocks.push_back(extrinsic_translation.data());
+    if (options.estimate_clock_offset) blocks.push_back(clock_offset);
     return blocks;
   }
 
@@ -146,6 +180,8 @@ struct InertialWindow::Impl {
     problem.AddParameterBlock(extrinsic_rotation.data(), 4, &so3);
     problem.AddParameterBlock(extrinsic_translation.data(), 3);
     problem.AddParameterBlock(tilt.data(), 2);
+    problem.AddParameterBlock(clock_offset, 1);
+    if (!options.estimate_clock_offset) problem.SetParameterBlockConstant(clock_offset);
     if (!options.estimate_extrinsic_rotation) problem.SetParameterBlockConstant(extrinsic_rotation.data());
     if (!options.estimate_extrinsic_translation) problem.SetParameterBlockConstant(extrinsic_translation.data());
     if (!options.estimate_tilt) problem.SetParameterBlockConstant(tilt.data());
@@ -159,15 +195,16 @@ struct InertialWindow::Impl {
         on_oldest(problem.AddResidualBlock(cost.get(), nullptr, blocks), k == 0);
       }
       if (node.pose) {
-        on_oldest(problem.AddResidualBlock(node.pose.get(), nullptr,
-                                           {node.rotation.data(), node.position.data(), extrinsic_rotation.data(),
-                                            extrinsic_translation.data(), tilt.data()}),
+        on_oldest(problem.AddResidualBlock(
+                      node.pose.get(), nullptr,
+                      {node.rotation.data(), node.position.data(), node.motion.data(), extrinsic_rotation.data(),
+                       extrinsic_translation.data(), tilt.data(), clock_offset}),
                   k == 0);
       }
       if (node.velocity) {
         on_oldest(problem.AddResidualBlock(node.velocity.get(), nullptr,
                                            {node.rotation.data(), node.motion.data(), extrinsic_rotation.data(),
-                                            extrinsic_translation.data()}),
+                                            extrinsic_translation.data(), clock_offset}),
                   k == 0);
       }
       if (k > 0 && node.imu) {
@@ -189,6 +226,7 @@ InertialWindow::InertialWindow(const InertialWindowOptions& options, const SE3d&
   const SE3d imu_from_radar = radar_from_imu.Inverse();
   impl_->extrinsic_rotation = imu_from_radar.rotation().quaternion().coeffs();
   impl_->extrinsic_translation = imu_from_radar.translation();
+  impl_->clock_offset[0] = impl_->clock_linearisation = options.clock_offset;
 }
 
 InertialWindow::~InertialWindow() = default;
@@ -226,6 +264,14 @@ void InertialWindow::Start(const InertialState& state) {
   mean << state.velocity, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero();
   const Eigen::MatrixXd A = sigmas.cwiseInverse().asDiagonal();
   first.first_priors.push_back({std::make_shared<ceres::NormalPrior>(A, mean), {first.motion.data()}});
+  if (options_.estimate_clock_offset) {
+    // Unobservable while the drive is straight and even: held near its start until it turns.
+    constexpr double kClockPrior = 0.05;  // s
+    first.first_priors.push_back(
+        {std::make_shared<ceres::NormalPrior>(Eigen::Matrix<double, 1, 1>(1.0 / kClockPrior),
+                                              Eigen::Matrix<double, 1, 1>(impl_->clock_offset[0])),
+         {impl_->clock_offset}});
+  }
   if (options_.estimate_tilt) {
     constexpr double kTiltPrior = 0.1;  // rad: the start's tilt from the accelerometer is this good at worst
     first.first_priors.push_back(
@@ -241,7 +287,8 @@ void InertialWindow::AddState(double stamp) {
     throw DataError("state at " + std::to_string(stamp) + " s does not follow the one at " +
                     std::to_string(last.stamp) + " s");
   }
-  const ImuPreintegration between = Preintegrate(impl_->imu, last.stamp, stamp, last.Bias(), options_.noise);
+  const double t0 = impl_->clock_linearisation;
+  const ImuPreintegration between = Preintegrate(impl_->imu, last.stamp + t0, stamp + t0, last.Bias(), options_.noise);
   // The prediction (imu_preintegration.hpp's model) is the new state's start.
   const SE3d pose = last.State().pose;
   const ImuDelta& d = between.delta();
@@ -264,26 +311,29 @@ void InertialWindow::AddPose(const SE3d& world_from_radar, const Eigen::Matrix<d
       !information.allFinite()) {
     throw std::invalid_argument("InertialWindow::AddPose: a pose or information that is not finite");
   }
-  const Eigen::Matrix<double, 6, 6> W = SqrtInformation(information);
-  impl_->nodes.back().pose.reset(RadarPoseResidual::Create(world_from_radar, W));
+  Node& node = impl_->nodes.back();
+  node.pose_measurement = std::make_pair(world_from_radar, Eigen::Matrix<double, 6, 6>(SqrtInformation(information)));
+  impl_->MakeRadarTerms(node);
 }
 
-void InertialWindow::AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance,
-                                 const Eigen::Vector3d& gyro) {
+void InertialWindow::AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance) {
   if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::AddVelocity before Start");
-  if (!radar_velocity.allFinite() || !gyro.allFinite()) {
-    throw std::invalid_argument("InertialWindow::AddVelocity: a velocity or rate that is not finite");
+  if (!radar_velocity.allFinite() || !covariance.allFinite()) {
+    throw std::invalid_argument("InertialWindow::AddVelocity: a velocity or covariance that is not finite");
   }
   const Eigen::LLT<Eigen::Matrix3d> factor(covariance);
   if (factor.info() != Eigen::Success) throw std::invalid_argument("AddVelocity: covariance not positive definite");
-  const Eigen::Matrix3d W = SqrtInformation(factor.solve(Eigen::Matrix3d::Identity()));
-  impl_->nodes.back().velocity.reset(RadarVelocityResidual::Create(radar_velocity, gyro, W));
+  Node& node = impl_->nodes.back();
+  node.velocity_measurement =
+      std::make_pair(radar_velocity, Eigen::Matrix3d(SqrtInformation(factor.solve(Eigen::Matrix3d::Identity()))));
+  impl_->MakeRadarTerms(node);
 }
 
 std::size_t InertialWindow::size() const { return impl_->nodes.size(); }
 InertialState InertialWindow::state(std::size_t index) const { return impl_->nodes.at(index).State(); }
 InertialState InertialWindow::newest() const { return impl_->nodes.back().State(); }
 Eigen::Vector2d InertialWindow::tilt() const { return impl_->tilt; }
+double InertialWindow::clock_offset() const { return impl_->clock_offset[0]; }
 void InertialWindow::set_tilt(const Eigen::Vector2d& roll_pitch) { impl_->tilt = roll_pitch; }
 
 SE3d InertialWindow::radar_from_imu() const {
@@ -367,10 +417,11 @@ WindowSolveSummary GaussNewton(ceres::Problem& problem, const std::vector<double
 
 WindowSolveSummary CeresSolve(ceres::Problem& problem, const InertialWindowOptions& options) {
   ceres::Solver::Options solver;
-  // The window's Hessian is block-banded and small: Eigen's sparse Cholesky
-  // has less overhead than SuiteSparse's here (4.74 against 4.93 ms per scan).
+  // The window's Hessian is block-banded: SuiteSparse's Cholesky. (Ceres's
+  // EIGEN_SPARSE instantiates Eigen's templates in both Debian's library and
+  // ours, whose allocators disagree under the address sanitizer.)
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  solver.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
+  solver.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   // The IMU's prediction starts the new state near the optimum: LM starts
   // nearly Gauss-Newton (Ceres's 1e4 damps the first steps into many small ones).
   solver.initial_trust_region_radius = 1e8;
@@ -395,12 +446,22 @@ WindowSolveSummary InertialWindow::Solve() {
   if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::Solve before Start");
   std::deque<Node>& nodes = impl_->nodes;
   while (nodes.size() > options_.size) RemoveOldest();
-  // The IMU terms whose bias moved past the first-order correction, integrated again.
+  // A clock offset moved past kClockRelinearisation: every term read again
+  // at it (the terms' first-order move d stays small).
+  const double t0 = impl_->clock_offset[0];
+  const bool clock_moved = std::abs(t0 - impl_->clock_linearisation) > kClockRelinearisation;
+  if (clock_moved) {
+    impl_->clock_linearisation = t0;
+    for (Node& node : nodes) impl_->MakeRadarTerms(node);
+  }
+  // The IMU terms whose bias moved past the first-order correction (or whose
+  // clock did), integrated again.
   std::size_t reintegrated = 0;
   for (std::size_t k = 1; k < nodes.size(); ++k) {
     Node& node = nodes[k];
-    if (!node.from_previous || node.from_previous->WithinCorrection(nodes[k - 1].Bias())) continue;
-    node.from_previous = Preintegrate(impl_->imu, nodes[k - 1].stamp, node.stamp, nodes[k - 1].Bias(), options_.noise);
+    if (!node.from_previous || (!clock_moved && node.from_previous->WithinCorrection(nodes[k - 1].Bias()))) continue;
+    node.from_previous = Preintegrate(impl_->imu, nodes[k - 1].stamp + impl_->clock_linearisation,
+                                      node.stamp + impl_->clock_linearisation, nodes[k - 1].Bias(), options_.noise);
     node.imu = std::make_shared<ImuCostFunction>(*node.from_previous, options_.noise);
     ++reintegrated;
   }
@@ -449,6 +510,7 @@ WindowUncertainty InertialWindow::Uncertainty() const {
   if (options_.estimate_tilt) u.tilt = std_of(global++, 0, 2);
   if (options_.estimate_extrinsic_rotation) u.extrinsic_rotation = std_of(global++, 0, 3);
   if (options_.estimate_extrinsic_translation) u.extrinsic_translation = std_of(global++, 0, 3);
+  if (options_.estimate_clock_offset) u.clock_offset = std_of(global++, 0, 1)(0);
   return u;
 }
 
@@ -468,7 +530,7 @@ void InertialWindow::RemoveOldest() {
         Marginalize(problem, terms, {oldest.rotation.data(), oldest.position.data(), oldest.motion.data()}, kept);
   }
   // The IMU samples before the new oldest state are not needed any more.
-  const double keep_from = nodes[1].stamp;
+  const double keep_from = nodes[1].stamp + impl_->clock_linearisation - 0.2;  // room for the offset to move
   nodes.pop_front();
   nodes.front().from_previous.reset();
   nodes.front().imu.reset();
@@ -481,11 +543,12 @@ void InertialWindow::RemoveOldest() {
 
 // A = Ry(pitch) Rx(roll) takes gravity's up (0, 0, 1) to (cos r sin p, -sin r, cos r cos p).
 InertialStart StartFromGravity(const std::vector<ImuSample>& samples, double stamp, const SE3d& world_from_radar,
-                               const Eigen::Vector3d& radar_velocity, const SE3d& radar_from_imu, double span) {
+                               const Eigen::Vector3d& radar_velocity, const SE3d& radar_from_imu, double span,
+                               double clock_offset) {
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), rate = Eigen::Vector3d::Zero();
   int count = 0;
   for (const ImuSample& sample : samples) {
-    if (std::abs(sample.stamp - stamp) > 0.5 * span) continue;
+    if (std::abs(sample.stamp - clock_offset - stamp) > 0.5 * span) continue;
     force += sample.specific_force;
     rate += sample.angular_velocity;
     ++count;

@@ -43,6 +43,10 @@ void PrintInertial(const RadarInertialOdometry& inertial) {
       tilt.x(), tilt.y(), last.bias.gyro.x(), last.bias.gyro.y(), last.bias.gyro.z(), last.bias.accel.x(),
       last.bias.accel.y(), last.bias.accel.z());
   const RadarInertialOptions& o = inertial.options();
+  if (o.window.estimate_clock_offset) {
+    std::printf("inertial: clock offset estimated: %.2f ms (the IMU's stamps minus the radar's)\n",
+                inertial.window().clock_offset() * 1e3);
+  }
   if (o.window.estimate_extrinsic_rotation || o.window.estimate_extrinsic_translation) {
     const SE3d radar_from_imu = inertial.window().radar_from_imu();
     const Eigen::Vector3d angle = radar_from_imu.rotation().Log() * (180.0 / M_PI);

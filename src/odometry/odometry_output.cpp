@@ -90,6 +90,10 @@ nlohmann::json Calibration(const InertialFusion& inertial) {
                       {"accel_bias", Values(last.bias.accel)},
                       {"accel_bias_std", Values(u.accel_bias)}};
   const InertialWindowOptions& o = inertial.options().window;
+  if (o.estimate_clock_offset) {
+    c["clock_offset_s"] = window.clock_offset();
+    c["clock_offset_std_s"] = u.clock_offset;
+  }
   if (o.estimate_extrinsic_rotation || o.estimate_extrinsic_translation) {
     const SE3d radar_from_imu = window.radar_from_imu();
     c["radar_from_imu_rotation_vector_deg"] = Values(radar_from_imu.rotation().Log(), kDeg);

@@ -46,9 +46,13 @@ void InertialFusion::Attach(RadarOdometry& odometry) {
 void InertialFusion::BeforeScan(RadarOdometry& odometry, double stamp) {
   const Eigen::Vector3d bias = started_ ? window_.newest().bias.gyro : Eigen::Vector3d::Zero();
   const SO3d radar_from_imu = radar_from_imu_.rotation();
+  const double offset = window_.clock_offset();  // the IMU's stamps minus the radar's
   std::vector<GyroSample> samples;
-  for (; fed_ < imu_.size() && (fed_ == 0 || imu_[fed_ - 1].stamp < stamp); ++fed_) {
-    samples.push_back({imu_[fed_].stamp, radar_from_imu * (imu_[fed_].angular_velocity - bias)});
+  for (; fed_ < imu_.size() && (fed_ == 0 || imu_[fed_ - 1].stamp - offset < stamp); ++fed_) {
+    const double on_radar_clock = imu_[fed_].stamp - offset;
+    if (on_radar_clock <= last_fed_) continue;  // the offset moved back by more than a sample
+    samples.push_back({on_radar_clock, radar_from_imu * (imu_[fed_].angular_velocity - bias)});
+    last_fed_ = on_radar_clock;
   }
   odometry.AddGyro(samples);
 }
@@ -68,16 +72,14 @@ const OdometryStep& RadarInertialOdometry::Register(const RadarScan& scan) {
   return step;
 }
 
-Eigen::Vector3d InertialFusion::GyroAt(double stamp) const {
-  const auto after = std::upper_bound(imu_.begin(), imu_.end(), stamp,
-                                      [](double t, const ImuSample& sample) { return t < sample.stamp; });
-  return (after == imu_.begin() ? *after : *(after - 1)).angular_velocity;  // the sample in force
-}
-
 SE3d InertialFusion::Fuse(const ScanEstimate& e) {
   if (!started_) {
-    if (!e.velocity_measured || imu_.empty()) return e.pose;
-    const InertialStart start = StartFromGravity(imu_, e.stamp, e.pose, e.velocity, radar_from_imu_);
+    // The window starts at the first scan with a Doppler velocity that the IMU covers.
+    if (!e.velocity_measured || imu_.empty() || imu_.front().stamp > e.stamp + options_.window.clock_offset) {
+      return e.pose;
+    }
+    const InertialStart start =
+        StartFromGravity(imu_, e.stamp, e.pose, e.velocity, radar_from_imu_, 0.2, options_.window.clock_offset);
     window_.set_tilt(start.tilt);
     window_.Start(start.state);
     started_ = true;
@@ -90,7 +92,7 @@ SE3d InertialFusion::Fuse(const ScanEstimate& e) {
   if (e.velocity_measured) {
     const Eigen::Matrix3d covariance =
         e.velocity_covariance + options_.velocity_floor * options_.velocity_floor * Eigen::Matrix3d::Identity();
-    window_.AddVelocity(e.velocity, covariance, GyroAt(e.stamp));
+    window_.AddVelocity(e.velocity, covariance);
   }
   window_.Solve();
   return window_.RadarPoseInMatcherWorld();

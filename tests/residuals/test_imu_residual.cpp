@@ -121,37 +121,55 @@ struct RadarOnImu {
 TEST(RadarPoseResidual, ZeroAtTheRadarsPoseAndAgreesWithCentralDifferences) {
   RadarOnImu s;
   const SO3d A = TiltRotation(s.tilt.data());
+  const ImuAtScan imu{Eigen::Vector3d(0.05, -0.02, 0.7), Eigen::Vector3d(0.3, -0.2, 9.9), 0.010};
+  double clock = 0.010;  // as the samples were read: the state stands at the scan
   // The radar in the matcher's world, composed by hand: A (R R_e, p + R t_e).
   const SE3d radar(A * s.R() * s.Re(), A * (s.p + s.R() * s.te));
   const std::unique_ptr<ceres::CostFunction> term(
-      RadarPoseResidual::Create(radar, Eigen::Matrix<double, 6, 6>::Identity() * 10.0));
-  const std::vector<double*> blocks = {s.q.data(), s.p.data(), s.qe.data(), s.te.data(), s.tilt.data()};
+      RadarPoseResidual::Create(radar, Eigen::Matrix<double, 6, 6>::Identity() * 10.0, imu));
+  const std::vector<double*> blocks = {s.q.data(),  s.p.data(),    s.motion.data(), s.qe.data(),
+                                       s.te.data(), s.tilt.data(), &clock};
   std::vector<Eigen::MatrixXd> J;
   EXPECT_LT(EvaluateWithJacobians(*term, blocks, J).norm(), 1e-12);
-  for (int b = 0; b < 5; ++b) EXPECT_LT(Relative(J[b], NumericBlockJacobian(*term, blocks, b)), 1e-5) << "block " << b;
+  // At an offset 20 ms later the scan saw the state moved by R Exp(w d), p + v d.
+  clock = 0.030;
+  EvaluateWithJacobians(*term, blocks, J);
+  for (int b = 0; b < 7; ++b) EXPECT_LT(Relative(J[b], NumericBlockJacobian(*term, blocks, b)), 1e-5) << "block " << b;
+  const Eigen::Vector3d omega = imu.gyro - s.motion.segment<3>(kMotionGyroBias);
+  const SO3d R_d = s.R() * SO3d::Exp(omega * 0.020);
+  const Eigen::Vector3d p_d = s.p + s.motion.segment<3>(kMotionVelocity) * 0.020;
+  const SE3d later(A * R_d * s.Re(), A * (p_d + R_d * s.te));
+  const std::unique_ptr<ceres::CostFunction> moved(
+      RadarPoseResidual::Create(later, Eigen::Matrix<double, 6, 6>::Identity() * 10.0, imu));
+  EXPECT_LT(EvaluateWithJacobians(*moved, blocks, J).norm(), 1e-12);
+  for (int b = 0; b < 7; ++b) EXPECT_LT(Relative(J[b], NumericBlockJacobian(*moved, blocks, b)), 1e-5) << "block " << b;
   // 1 cm off along the world's x: 10 x 0.01 in the first residual.
-  const SE3d moved(radar.rotation(), radar.translation() + Eigen::Vector3d(0.01, 0.0, 0.0));
+  const SE3d off_pose(later.rotation(), later.translation() + Eigen::Vector3d(0.01, 0.0, 0.0));
   const std::unique_ptr<ceres::CostFunction> off(
-      RadarPoseResidual::Create(moved, Eigen::Matrix<double, 6, 6>::Identity() * 10.0));
+      RadarPoseResidual::Create(off_pose, Eigen::Matrix<double, 6, 6>::Identity() * 10.0, imu));
   EXPECT_NEAR(EvaluateWithJacobians(*off, blocks, J)(kTranslationOffset), -0.1, 1e-12);
 }
 
 TEST(RadarVelocityResidual, ZeroAtTheLeverArmsVelocityAndAgreesWithCentralDifferences) {
   RadarOnImu s;
-  const Eigen::Vector3d gyro(0.05, -0.02, 0.7);  // rad/s, the IMU's reading with its bias
-  const Eigen::Vector3d omega = gyro - s.motion.segment<3>(kMotionGyroBias);
+  const ImuAtScan imu{Eigen::Vector3d(0.05, -0.02, 0.7), Eigen::Vector3d(0.3, -0.2, 9.9), 0.0};
+  double clock = 0.0;
+  const Eigen::Vector3d omega = imu.gyro - s.motion.segment<3>(kMotionGyroBias);
   // The radar's velocity: the IMU's plus omega x t_e, in the radar frame.
   const Eigen::Vector3d world = s.motion.segment<3>(kMotionVelocity) + s.R() * omega.cross(s.te);
   const Eigen::Vector3d radar_velocity = (s.R() * s.Re()).Inverse() * world;
   const std::unique_ptr<ceres::CostFunction> term(
-      RadarVelocityResidual::Create(radar_velocity, gyro, Eigen::Matrix3d::Identity() * 20.0));
-  const std::vector<double*> blocks = {s.q.data(), s.motion.data(), s.qe.data(), s.te.data()};
+      RadarVelocityResidual::Create(radar_velocity, Eigen::Matrix3d::Identity() * 20.0, imu));
+  const std::vector<double*> blocks = {s.q.data(), s.motion.data(), s.qe.data(), s.te.data(), &clock};
   std::vector<Eigen::MatrixXd> J;
   EXPECT_LT(EvaluateWithJacobians(*term, blocks, J).norm(), 1e-12);
-  for (int b = 0; b < 4; ++b) EXPECT_LT(Relative(J[b], NumericBlockJacobian(*term, blocks, b)), 1e-5) << "block " << b;
+  clock = -0.015;
+  EvaluateWithJacobians(*term, blocks, J);
+  for (int b = 0; b < 5; ++b) EXPECT_LT(Relative(J[b], NumericBlockJacobian(*term, blocks, b)), 1e-5) << "block " << b;
+  clock = 0.0;
   // Without the lever arm the residual is 20 |omega x t_e|.
   Eigen::Vector3d no_lever = Eigen::Vector3d::Zero();
-  const std::vector<double*> without = {s.q.data(), s.motion.data(), s.qe.data(), no_lever.data()};
+  const std::vector<double*> without = {s.q.data(), s.motion.data(), s.qe.data(), no_lever.data(), &clock};
   EXPECT_NEAR(EvaluateWithJacobians(*term, without, J).norm(), 20.0 * omega.cross(s.te).norm(), 1e-9);
 }
 

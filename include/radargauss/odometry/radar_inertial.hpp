@@ -5,13 +5,14 @@
 // (its pose and eq. 2's information) and Doppler velocity enter a sliding
 // window of IMU states (solvers/inertial_window.hpp), and the window's pose
 // of the radar is what the map and the motion model keep. The window starts
-// at the first scan with a Doppler velocity, from gravity.
+// at the first scan with a Doppler velocity that the IMU covers, from gravity.
 //
 //   RadarInertialOdometry odometry(options, inertial, radar_from_imu, imu);
 //   for (const RadarScan& scan : sequence.scans) odometry.Register(scan);
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -58,14 +59,14 @@ class InertialFusion {
 
  private:
   SE3d Fuse(const ScanEstimate& estimate);
-  Eigen::Vector3d GyroAt(double stamp) const;
 
   RadarInertialOptions options_;
   SE3d radar_from_imu_;
   std::vector<ImuSample> imu_;
   InertialWindow window_;
   bool started_ = false;
-  std::size_t fed_ = 0;  // IMU samples handed to the odometry's prediction
+  std::size_t fed_ = 0;                                         // IMU samples handed to the odometry's prediction
+  double last_fed_ = -std::numeric_limits<double>::infinity();  // their last stamp, on the radar's clock
   std::vector<std::optional<InertialState>> states_;
 };
 

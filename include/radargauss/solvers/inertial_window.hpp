@@ -12,7 +12,7 @@
 //   InertialWindow window(options, radar_from_imu);
 //   window.AddImu(samples);
 //   window.Start(first_state);             // at the first scan
-//   window.AddPose(match_pose, information); window.AddVelocity(v, S, gyro);
+//   window.AddPose(match_pose, information); window.AddVelocity(v, S);
 //   window.Solve();
 //   window.AddState(next_scan_stamp); ...  // then its measurements, Solve
 #pragma once
@@ -50,6 +50,9 @@ struct InertialWindowOptions {
   bool estimate_tilt = true;      // the matcher's world's roll and pitch against gravity
   bool estimate_extrinsic_rotation = false;
   bool estimate_extrinsic_translation = false;
+  // s: the IMU's stamps minus the radar's clock (the start when estimated).
+  double clock_offset = 0.0;
+  bool estimate_clock_offset = false;
 };
 
 // Its options (options.hpp), named window_*, imu_* (the noise) and estimate_*.
@@ -73,6 +76,7 @@ struct WindowUncertainty {
   Eigen::Vector2d tilt = Eigen::Vector2d::Zero();                   // rad
   Eigen::Vector3d extrinsic_rotation = Eigen::Vector3d::Zero();     // rad, on the right of R_imu_radar
   Eigen::Vector3d extrinsic_translation = Eigen::Vector3d::Zero();  // m
+  double clock_offset = 0.0;                                        // s
 };
 
 struct WindowSolveSummary {
@@ -100,10 +104,10 @@ class InertialWindow {
   void AddState(double stamp);
   // Measurements of the newest state: the matcher's T_world_radar with eq. 2's
   // information (translation first), and the Doppler velocity of the radar in
-  // its frame with its covariance, at the gyro rate `gyro` (the IMU's frame).
+  // its frame with its covariance. The IMU's reading at the scan comes from
+  // the samples (the one in force at the stamp plus the clock offset).
   void AddPose(const SE3d& world_from_radar, const Eigen::Matrix<double, 6, 6>& information);
-  void AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance,
-                   const Eigen::Vector3d& gyro);
+  void AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance);
   WindowSolveSummary Solve();
   // After a Solve: costs a dense inverse of the window's matrix.
   WindowUncertainty Uncertainty() const;
@@ -115,6 +119,7 @@ class InertialWindow {
   SE3d RadarPoseInMatcherWorld() const;
   SE3d radar_from_imu() const;
   Eigen::Vector2d tilt() const;  // rad: roll, pitch of the matcher's world against gravity
+  double clock_offset() const;   // s: the IMU's stamps minus the radar's
   void set_tilt(const Eigen::Vector2d& roll_pitch);
   const InertialWindowOptions& options() const { return options_; }
 
@@ -128,7 +133,7 @@ class InertialWindow {
 
 // The first state and the tilt of the matcher's world, from the first scan:
 // its matched T_world_radar, its Doppler velocity (radar frame) and the IMU
-// samples within span / 2 of it, whose mean specific force is taken for
+// samples within span / 2 of it (plus the clock offset), whose mean specific force is taken for
 // gravity's reaction (the acceleration as zero: a 0.1 m/s^2 one tilts the
 // start by 0.6 deg, which the window then corrects). Biases start at zero.
 // Throws DataError when no sample lies within span / 2.
@@ -137,6 +142,7 @@ struct InertialStart {
   Eigen::Vector2d tilt = Eigen::Vector2d::Zero();  // rad: roll, pitch
 };
 InertialStart StartFromGravity(const std::vector<ImuSample>& samples, double stamp, const SE3d& world_from_radar,
-                               const Eigen::Vector3d& radar_velocity, const SE3d& radar_from_imu, double span = 0.2);
+                               const Eigen::Vector3d& radar_velocity, const SE3d& radar_from_imu, double span = 0.2,
+                               double clock_offset = 0.0);
 
 }  // namespace radargauss
