@@ -8,19 +8,20 @@
 
 Poses are T_world_radar, as 4x4 matrices or [x y z qx qy qz qw]
 (Sequence.poses_matrix and pose_matrices give the 4x4 form). match and
-RadarOdometry, RadarSlam and Relocalizer take every option as a keyword
+RadarOdometry, RadarInertialOdometry (with read_imu's samples), RadarSlam
+and Relocalizer take every option as a keyword
 (option_fields lists them; match_options, odometry_options, slam_options
 and relocalization_options read them back).
 Every function's help() lists its arguments; docs/python.md tells the rest.
 """
-from ._radargauss import (DataError, GaussianMap, MatchResult, RadarOdometry, RadarSlam, Relocalizer, Scan, Sequence,
-                          build_map, compose,
+from ._radargauss import (DataError, GaussianMap, MatchResult, RadarInertialOdometry, RadarOdometry, RadarSlam,
+                          Relocalizer, Scan, Sequence, build_map, compose,
                           evaluate, initial_errors, match, match_options, odometry_options, option_fields,
-                          pose_matrices, pose_matrix, read_map, read_pcd, read_sequence, read_tum,
+                          pose_matrices, pose_matrix, read_imu, read_map, read_pcd, read_sequence, read_tum,
                           relocalization_options, set_threads, simulate, slam_options, write_map, write_tum)
 from .sweep import Task, plan, run_task, sweep
 
-__all__ = ["DataError", "GaussianMap", "MatchResult", "RadarOdometry", "RadarSlam", "Relocalizer", "Scan", "Sequence", "build_map", "compose",
+__all__ = ["DataError", "GaussianMap", "MatchResult", "RadarInertialOdometry", "RadarOdometry", "RadarSlam", "Relocalizer", "Scan", "Sequence", "build_map", "compose",
            "evaluate", "initial_errors", "match", "match_options", "odometry_options", "option_fields",
-           "pose_matrices", "pose_matrix", "read_map", "read_pcd", "read_sequence", "read_tum",
+           "pose_matrices", "pose_matrix", "read_imu", "read_map", "read_pcd", "read_sequence", "read_tum",
            "relocalization_options", "set_threads", "simulate", "slam_options", "write_map", "write_tum", "Task", "plan", "run_task", "sweep"]

@@ -243,6 +243,19 @@ class MatchResult:
     @property
     def time_ms(self) -> Any: ...
 
+class RadarInertialOdometry:
+    """Radar-inertial odometry (docs/design.md, "Radar-inertial odometry"): the radar odometry with a sliding window of IMU states. Threads may share one: its calls take turns."""
+    def __init__(self: RadarInertialOdometry, imu: Any, radar_from_imu: Any = None, **kwargs) -> None:
+        ...
+    def __len__(self: RadarInertialOdometry) -> int:
+        ...
+    def calibration(self: RadarInertialOdometry) -> dict:
+        """The window's tilt (rad, roll and pitch of the matcher's world against gravity), clock offset (s), T_radar_imu, and the standard deviations of those estimated and of the newest biases"""
+    def register(self: RadarInertialOdometry, scan: Scan) -> dict:
+        """Adds the next scan; returns RadarOdometry.register's dict with 'inertial': the window's newest state (pose, velocity, gyro_bias, accel_bias) or None before the window started"""
+    def trajectory(self: RadarInertialOdometry) -> tuple:
+        """(stamps (N,), poses (N, 7)) of the radar so far, in the matcher's world"""
+
 class RadarOdometry:
     """Radar odometry on a map it builds as it goes (docs/design.md, "Odometry"): register scans in time order. Threads may share one: its calls take turns."""
     def __init__(self: RadarOdometry, **options: Unpack[OdometryOptions]) -> None:
@@ -355,6 +368,9 @@ def pose_matrices(poses: Any) -> numpy.ndarray:
 
 def pose_matrix(pose: Any) -> numpy.ndarray:
     """A pose [x y z qx qy qz qw] (or 4x4) as its 4x4 matrix."""
+
+def read_imu(path: str) -> numpy.ndarray:
+    """An IMU file (lines 'stamp wx wy wz ax ay az') as an (N, 7) array; DataError names the line"""
 
 def read_map(path: str) -> GaussianMap:
     """Reads a .rgm map file (validated: docs/design.md, "Bounds on input")."""

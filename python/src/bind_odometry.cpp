@@ -2,10 +2,16 @@
 // Radar odometry and the option tables in Python.
 #include <pybind11/stl.h>
 
+#include <cmath>
+#include <optional>
 #include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include "bindings.hpp"
 #include "option_fields.hpp"
+#include "radargauss/io/imu.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/slam/radar_slam.hpp"
@@ -56,9 +62,134 @@ OdometryOptions OdometryOptionsFrom(const py::kwargs& kwargs) {
   return options;
 }
 
+// An (N, 7) array [stamp wx wy wz ax ay az] (s, rad/s, m/s^2, the IMU's frame).
+std::vector<ImuSample> ImuFromArray(const py::handle& value) {
+  const Array imu = CheckedArray(value, {-1, 7}, "imu");
+  const auto rows = imu.unchecked<2>();
+  std::vector<ImuSample> samples(std::size_t(rows.shape(0)));
+  for (py::ssize_t i = 0; i < rows.shape(0); ++i) {
+    samples[std::size_t(i)] = {rows(i, 0), Eigen::Vector3d(rows(i, 1), rows(i, 2), rows(i, 3)),
+                               Eigen::Vector3d(rows(i, 4), rows(i, 5), rows(i, 6))};
+    for (int c = 0; c < 7; ++c) {
+      if (!std::isfinite(rows(i, c))) throw py::value_error("imu: row " + std::to_string(i) + " is not finite");
+    }
+  }
+  return samples;
+}
+
+py::object StateToDict(const std::optional<InertialState>& s) {
+  if (!s) return py::none();
+  py::dict d;
+  d["stamp"] = s->stamp;
+  d["pose"] = PoseToMatrix(s->pose);
+  d["velocity"] = MatrixToArray<3, 1>(s->velocity);
+  d["gyro_bias"] = MatrixToArray<3, 1>(s->bias.gyro);
+  d["accel_bias"] = MatrixToArray<3, 1>(s->bias.accel);
+  return std::move(d);
+}
+
+// The keywords split between the odometry's table and the window's.
+std::pair<OdometryOptions, RadarInertialOptions> InertialOptionsFrom(const py::kwargs& kwargs) {
+  py::kwargs odometry, inertial;
+  for (const auto& [key, value] : kwargs) {
+    const std::string keyword = py::str(key);
+    (FindOption(RadarInertialOptionTable(), keyword) ? inertial : odometry)[key] = value;
+  }
+  const RadarInertialOptions options = OptionsFrom(RadarInertialOptionTable(), inertial);
+  CheckOptions(RadarInertialOptionTable(), options);
+  return {OdometryOptionsFrom(odometry), options};
+}
+
+const char* InertialDoc() {
+  static const std::string doc =
+      "Radar-inertial odometry (docs/design.md, \"Radar-inertial odometry\"): the radar odometry with a sliding "
+      "window of IMU states. Threads may share one: its calls take turns.\n\nParameters\n----------\n"
+      "imu : array (N, 7)\n    [stamp wx wy wz ax ay az] per sample, time order, on the scans' clock (s, rad/s, "
+      "m/s^2, the IMU's frame)\nradar_from_imu : array (4, 4) or [x y z qx qy qz qw], default identity\n    "
+      "T_radar_imu, the IMU's frame in the radar's\n**options\n    any keyword of RadarOdometry and these "
+      "(option_fields('radar_inertial')):\n" +
+      ParametersDoc(RadarInertialOptionTable());
+  return doc.c_str();
+}
+
 }  // namespace
 
 void BindOdometry(py::module_& m) {
+  using LockedInertial = Locked<RadarInertialOdometry>;
+  py::class_<LockedInertial>(m, "RadarInertialOdometry", InertialDoc())
+      .def(py::init([](const py::handle& imu, const py::object& radar_from_imu, const py::kwargs& kwargs) {
+             const auto [odometry, inertial] = InertialOptionsFrom(kwargs);
+             const SE3d extrinsic =
+                 radar_from_imu.is_none() ? SE3d() : PoseFromPython(radar_from_imu, "radar_from_imu");
+             return std::make_unique<LockedInertial>(
+                 std::make_unique<RadarInertialOdometry>(odometry, inertial, extrinsic, ImuFromArray(imu)));
+           }),
+           py::arg("imu"), py::arg("radar_from_imu") = py::none())
+      .def(
+          "register",
+          [](LockedInertial& odometry, const RadarScan& scan) {
+            const auto [step, state] = odometry.With([&](RadarInertialOdometry& o) {
+              const OdometryStep s = o.Register(scan);
+              return std::make_pair(s, o.states().back());
+            });
+            py::dict d = StepToDict(step);
+            d["inertial"] = StateToDict(state);
+            return d;
+          },
+          py::arg("scan"),
+          "Adds the next scan; returns RadarOdometry.register's dict with 'inertial': the window's newest state "
+          "(pose, velocity, gyro_bias, accel_bias) or None before the window started")
+      .def(
+          "trajectory",
+          [](LockedInertial& odometry) {
+            return TrajectoryToArrays(
+                odometry.With([](RadarInertialOdometry& o) { return o.odometry().trajectory(); }));
+          },
+          "(stamps (N,), poses (N, 7)) of the radar so far, in the matcher's world")
+      .def(
+          "calibration",
+          [](LockedInertial& odometry) {
+            const auto [tilt, offset, radar_from_imu, u] = odometry.With([](RadarInertialOdometry& o) {
+              const InertialWindow& w = o.window();
+              return std::make_tuple(Eigen::Vector2d(w.tilt()), w.clock_offset(), w.radar_from_imu(),
+                                     w.size() > 0 ? w.Uncertainty() : WindowUncertainty{});
+            });
+            py::dict d;
+            d["tilt"] = MatrixToArray<2, 1>(tilt);
+            d["tilt_std"] = MatrixToArray<2, 1>(u.tilt);
+            d["clock_offset"] = offset;
+            d["clock_offset_std"] = u.clock_offset;
+            d["radar_from_imu"] = PoseToMatrix(radar_from_imu);
+            d["gyro_bias_std"] = MatrixToArray<3, 1>(u.gyro_bias);
+            d["accel_bias_std"] = MatrixToArray<3, 1>(u.accel_bias);
+            return d;
+          },
+          "The window's tilt (rad, roll and pitch of the matcher's world against gravity), clock offset (s), "
+          "T_radar_imu, and the standard deviations of those estimated and of the newest biases")
+      .def("__len__", [](LockedInertial& odometry) {
+        return odometry.With([](RadarInertialOdometry& o) { return o.odometry().steps().size(); });
+      });
+  m.def(
+      "read_imu",
+      [](const std::string& path) {
+        const std::vector<ImuSample> samples = ReadImuFile(path);
+        Array out = NewArray({py::ssize_t(samples.size()), 7});
+        auto rows = out.mutable_unchecked<2>();
+        for (std::size_t i = 0; i < samples.size(); ++i) {
+          const ImuSample& s = samples[i];
+          const double row[7] = {s.stamp,
+                                 s.angular_velocity.x(),
+                                 s.angular_velocity.y(),
+                                 s.angular_velocity.z(),
+                                 s.specific_force.x(),
+                                 s.specific_force.y(),
+                                 s.specific_force.z()};
+          for (int c = 0; c < 7; ++c) rows(py::ssize_t(i), c) = row[c];
+        }
+        return out;
+      },
+      py::arg("path"), "An IMU file (lines 'stamp wx wy wz ax ay az') as an (N, 7) array; DataError names the line");
+
   using LockedOdometry = Locked<RadarOdometry>;
   py::class_<LockedOdometry>(m, "RadarOdometry", OdometryDoc())
       .def(py::init([](const py::kwargs& kwargs) {

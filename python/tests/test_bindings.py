@@ -235,3 +235,36 @@ def test_slam_closes_the_yard_and_relocalizes_a_second_run(tmp_path):
         rg.RadarSlam(descriptor="sift")
     with pytest.raises(ValueError, match="graph_initialization = odometry is not one of"):
         rg.RadarSlam(graph_initialization="odometry")
+
+
+def test_radar_inertial_odometry(cli, tmp_path):
+    """An IMU file read and fused: the drift below the radar's alone, the biases near the truth."""
+    config = tmp_path / "world.yaml"
+    config.write_text("scans: 120\nimu_rate_hz: 200\n")
+    sequence_dir = str(tmp_path / "seq")
+    subprocess.run([cli, "simulate", "--config", str(config), "--out", sequence_dir], check=True,
+                   stdout=subprocess.DEVNULL)
+    sequence = rg.read_sequence(sequence_dir, gt=os.path.join(sequence_dir, "gt_radar_tum.txt"), extrinsic="identity")
+    imu = rg.read_imu(os.path.join(sequence_dir, "imu.txt"))
+    assert imu.shape[1] == 7 and imu.shape[0] > 2000
+    extrinsic = np.loadtxt(os.path.join(sequence_dir, "imu_extrinsic.txt"))
+    inertial = rg.RadarInertialOdometry(imu, radar_from_imu=extrinsic, window_size=5, w_rcs=0.0)
+    radar = rg.RadarOdometry()
+    for scan in sequence.scans:
+        step = inertial.register(scan)
+        radar.register(scan)
+    assert step["inertial"] is not None and np.isfinite(step["inertial"]["velocity"]).all()
+    reference = (sequence.stamps, sequence.poses)
+    fused = rg.evaluate(inertial.trajectory(), reference)["rpe"]["translation_percent"]
+    alone = rg.evaluate(radar.trajectory(), reference)["rpe"]["translation_percent"]
+    assert fused < 0.6 * alone, (fused, alone)
+    truth = np.loadtxt(os.path.join(sequence_dir, "imu_biases.txt"))[-1]
+    assert np.linalg.norm(step["inertial"]["gyro_bias"].ravel() - truth[1:4]) < 1e-3
+    calibration = inertial.calibration()
+    assert np.all(calibration["gyro_bias_std"] > 0) and calibration["tilt"].size == 2
+    with pytest.raises(TypeError, match="unknown keyword 'window_sise'"):
+        rg.RadarInertialOdometry(imu, window_sise=5)
+    with pytest.raises(ValueError, match="window_size"):
+        rg.RadarInertialOdometry(imu, window_size=1)
+    with pytest.raises(ValueError, match="imu"):
+        rg.RadarInertialOdometry(imu[:, :6])
