@@ -80,17 +80,18 @@ void BM_ImuResidual(benchmark::State& state) {
 BENCHMARK_TEMPLATE(BM_ImuResidual, Analytic);
 BENCHMARK_TEMPLATE(BM_ImuResidual, AutoDiff);
 
-// The radar's pose term on an IMU state (autodiff; 7 blocks, 26 parameters).
+// The radar's pose term on an IMU state (7 blocks, 26 parameters).
+template <typename Kind>
 void BM_RadarPoseResidual(benchmark::State& state) {
   const SE3d measured(SO3d::Exp(Eigen::Vector3d(0.0, 0.02, 0.4)), Eigen::Vector3d(10.0, 2.0, 0.8));
-  const std::unique_ptr<ceres::CostFunction> cost(
-      RadarPoseResidual::Create(measured, Eigen::Matrix<double, 6, 6>::Identity() * 10.0,
-                                {Eigen::Vector3d(0, 0, 0.3), Eigen::Vector3d(0, 0, 9.8), 0.0}));
+  const ImuAtScan imu{Eigen::Vector3d(0, 0, 0.3), Eigen::Vector3d(0, 0, 9.8), 0.0};
+  const Eigen::Matrix<double, 6, 6> W = Eigen::Matrix<double, 6, 6>::Identity() * 10.0;
+  const auto cost = MakeCost<Kind, RadarPoseCostFunction, RadarPoseResidual>(measured, W, imu);
   Eigen::Vector4d q = SO3d::Exp(Eigen::Vector3d(0.0, 0.02, 0.41)).quaternion().coeffs(), qe(0, 0, 0, 1);
-  Eigen::Vector3d p(10.1, 2.0, 0.8), te = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p(10.1, 2.0, 0.8), te(0.5, 0.1, -0.2);
   Eigen::Matrix<double, 9, 1> m = Eigen::Matrix<double, 9, 1>::Zero();
-  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
-  double clock = 0.0;
+  Eigen::Vector2d tilt(0.01, -0.02);
+  double clock = 0.01;
   const double* parameters[7] = {q.data(), p.data(), m.data(), qe.data(), te.data(), tilt.data(), &clock};
   double residuals[6], j0[24], j1[18], j2[54], j3[24], j4[18], j5[12], j6[6];
   double* jacobians[7] = {j0, j1, j2, j3, j4, j5, j6};
@@ -99,7 +100,8 @@ void BM_RadarPoseResidual(benchmark::State& state) {
     benchmark::DoNotOptimize(j0[0]);
   }
 }
-BENCHMARK(BM_RadarPoseResidual);
+BENCHMARK_TEMPLATE(BM_RadarPoseResidual, Analytic);
+BENCHMARK_TEMPLATE(BM_RadarPoseResidual, AutoDiff);
 
 RcsTerm BenchmarkTerm(IncidenceModel incidence) {
   RcsTerm term;

@@ -8,7 +8,6 @@
 #include <utility>
 
 #include <ceres/crs_matrix.h>
-#include <ceres/normal_prior.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
@@ -44,6 +43,32 @@ Eigen::MatrixXd SqrtInformation(const Eigen::MatrixXd& information) {
 }
 
 using CostPointer = std::shared_ptr<ceres::CostFunction>;
+
+// r_i = (x_i - mean_i) / sigma_i on one Euclidean block: the first state's
+// priors. (Not ceres::NormalPrior: its Eigen members are allocated inside
+// Debian's library and would be freed here, which the address sanitizer
+// refuses.)
+class DiagonalPrior final : public ceres::CostFunction {
+ public:
+  DiagonalPrior(const Eigen::VectorXd& mean, const Eigen::VectorXd& sigma)
+      : mean_(mean), weight_(sigma.cwiseInverse()) {
+    set_num_residuals(int(mean.size()));
+    mutable_parameter_block_sizes()->push_back(int(mean.size()));
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const Eigen::Map<const Eigen::VectorXd> x(parameters[0], mean_.size());
+    Eigen::Map<Eigen::VectorXd>(residuals, mean_.size()) = weight_.cwiseProduct(x - mean_);
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(jacobians[0], mean_.size(),
+                                                                                           mean_.size());
+      J = weight_.asDiagonal();
+    }
+    return true;
+  }
+
+ private:
+  Eigen::VectorXd mean_, weight_;
+};
 
 }  // namespace
 
@@ -142,12 +167,12 @@ struct InertialWindow::Impl {
   }
   void MakeRadarTerms(Node& node) const {
     if (node.pose_measurement) {
-      node.pose.reset(
-          RadarPoseResidual::Create(node.pose_measurement->first, node.pose_measurement->second, ImuAt(node.stamp)));
+      node.pose = std::make_shared<RadarPoseCostFunction>(node.pose_measurement->first, node.pose_measurement->second,
+                                                          ImuAt(node.stamp));
     }
     if (node.velocity_measurement) {
-      node.velocity.reset(RadarVelocityResidual::Create(node.velocity_measurement->first,
-                                                        node.velocity_measurement->second, ImuAt(node.stamp)));
+      node.velocity = std::make_shared<RadarVelocityCostFunction>(node.velocity_measurement->first,
+                                                                  node.velocity_measurement->second, ImuAt(node.stamp));
     }
   }
 
@@ -256,27 +281,24 @@ void InertialWindow::Start(const InertialState& state) {
   node.motion << state.velocity, state.bias.gyro, state.bias.accel;
   impl_->nodes.push_back(node);
   Node& first = impl_->nodes.back();
-  // Biases about zero, the velocity about the start's; the tilt about its start.
+  // Biases about zero, the velocity about the start's; the tilt and the clock offset about their starts.
   Eigen::Matrix<double, 9, 1> sigmas;
   sigmas << Eigen::Vector3d::Constant(options_.velocity_prior), Eigen::Vector3d::Constant(options_.gyro_bias_prior),
       Eigen::Vector3d::Constant(options_.accel_bias_prior);
   Eigen::Matrix<double, 9, 1> mean;
   mean << state.velocity, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero();
-  const Eigen::MatrixXd A = sigmas.cwiseInverse().asDiagonal();
-  first.first_priors.push_back({std::make_shared<ceres::NormalPrior>(A, mean), {first.motion.data()}});
+  first.first_priors.push_back({std::make_shared<DiagonalPrior>(mean, sigmas), {first.motion.data()}});
   if (options_.estimate_clock_offset) {
     // Unobservable while the drive is straight and even: held near its start until it turns.
     constexpr double kClockPrior = 0.05;  // s
-    first.first_priors.push_back(
-        {std::make_shared<ceres::NormalPrior>(Eigen::Matrix<double, 1, 1>(1.0 / kClockPrior),
-                                              Eigen::Matrix<double, 1, 1>(impl_->clock_offset[0])),
-         {impl_->clock_offset}});
+    first.first_priors.push_back({std::make_shared<DiagonalPrior>(Eigen::VectorXd::Constant(1, impl_->clock_offset[0]),
+                                                                  Eigen::VectorXd::Constant(1, kClockPrior)),
+                                  {impl_->clock_offset}});
   }
   if (options_.estimate_tilt) {
     constexpr double kTiltPrior = 0.1;  // rad: the start's tilt from the accelerometer is this good at worst
     first.first_priors.push_back(
-        {std::make_shared<ceres::NormalPrior>(Eigen::Matrix2d::Identity() / kTiltPrior, Eigen::Vector2d(impl_->tilt)),
-         {impl_->tilt.data()}});
+        {std::make_shared<DiagonalPrior>(impl_->tilt, Eigen::Vector2d::Constant(kTiltPrior)), {impl_->tilt.data()}});
   }
 }
 

@@ -21,6 +21,7 @@
 #pragma once
 
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
 
@@ -120,6 +121,32 @@ class RadarVelocityResidual {
   // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& sqrt_information,
                                      const ImuAtScan& imu);
+
+ private:
+  const Eigen::Vector3d radar_velocity_;
+  const Eigen::Matrix3d sqrt_information_;
+  const ImuAtScan imu_;
+};
+
+// The analytic twins (docs/design.md, "The sliding window", gives each block).
+class RadarPoseCostFunction final : public ceres::SizedCostFunction<6, 4, 3, 9, 4, 3, 2, 1> {
+ public:
+  RadarPoseCostFunction(const SE3d& measured, const Eigen::Matrix<double, 6, 6>& sqrt_information, const ImuAtScan& imu)
+      : measured_(measured), sqrt_information_(sqrt_information), imu_(imu) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+ private:
+  const SE3d measured_;
+  const Eigen::Matrix<double, 6, 6> sqrt_information_;
+  const ImuAtScan imu_;
+};
+
+class RadarVelocityCostFunction final : public ceres::SizedCostFunction<3, 4, 9, 4, 3, 1> {
+ public:
+  RadarVelocityCostFunction(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& sqrt_information,
+                            const ImuAtScan& imu)
+      : radar_velocity_(radar_velocity), sqrt_information_(sqrt_information), imu_(imu) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
 
  private:
   const Eigen::Vector3d radar_velocity_;
