@@ -110,15 +110,18 @@ void SolveExactly(ceres::Problem& problem) {
   ceres::Solve(options, &problem, &summary);
 }
 
+// The chain solved whole; its states are left there.
+std::vector<Vector3> WholeOptimum(Chain& chain) {
+  ceres::Problem whole(NotOwning());
+  chain.AddTo(whole, 0);
+  SolveExactly(whole);
+  return chain.x;
+}
+
 TEST(Marginalization, PriorReproducesTheWholeProblemsOptimumOnALinearChain) {
   std::mt19937 rng(5);
   Chain chain(rng);
-  {
-    ceres::Problem whole(NotOwning());
-    chain.AddTo(whole, 0);
-    SolveExactly(whole);
-  }
-  const std::vector<Vector3> batch = chain.x;
+  const std::vector<Vector3> batch = WholeOptimum(chain);
 
   // Marginalise x0 and then x1, each linearised away from the optimum.
   std::normal_distribution<double> n(0.0, 1.0);
@@ -145,12 +148,7 @@ TEST(Marginalization, PriorReproducesTheWholeProblemsOptimumOnALinearChain) {
 TEST(Marginalization, DroppingInsteadMovesTheOptimum) {
   std::mt19937 rng(5);
   Chain chain(rng);
-  {
-    ceres::Problem whole(NotOwning());
-    chain.AddTo(whole, 0);
-    SolveExactly(whole);
-  }
-  const std::vector<Vector3> batch = chain.x;
+  const std::vector<Vector3> batch = WholeOptimum(chain);
   ceres::Problem rest(NotOwning());
   chain.AddTo(rest, 2);
   SolveExactly(rest);
