@@ -69,6 +69,14 @@ bool MarginalizationPrior::Evaluate(double const* const* parameters, double* res
   return true;
 }
 
+Eigen::MatrixXd DenseJacobian(const ceres::CRSMatrix& crs) {
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) J(row, crs.cols[k]) = crs.values[k];
+  }
+  return J;
+}
+
 namespace {
 
 int TangentSize(const ceres::Problem& problem, double* block) {
@@ -107,10 +115,7 @@ std::shared_ptr<MarginalizationPrior> Marginalize(ceres::Problem& problem,
   if (!problem.Evaluate(evaluate, &cost, &residuals, nullptr, &crs)) {
     throw std::runtime_error("Marginalize: the factors could not be evaluated");
   }
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
-  for (int row = 0; row < crs.num_rows; ++row) {
-    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) J(row, crs.cols[k]) = crs.values[k];
-  }
+  const Eigen::MatrixXd J = DenseJacobian(crs);
   const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(residuals.data(), Eigen::Index(residuals.size()));
   const Eigen::MatrixXd H = J.transpose() * J;
   const Eigen::VectorXd b = J.transpose() * r;

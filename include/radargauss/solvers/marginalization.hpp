@@ -17,6 +17,7 @@
 #include <vector>
 
 #include <ceres/cost_function.h>
+#include <ceres/crs_matrix.h>
 #include <ceres/manifold.h>
 #include <ceres/problem.h>
 
@@ -48,6 +49,9 @@ class MarginalizationPrior final : public ceres::CostFunction {
   Eigen::MatrixXd jacobian_;  // J*, tangent columns
   Eigen::VectorXd residual_;  // r*
 };
+
+// The Jacobian Ceres's Problem::Evaluate gives (tangent columns), dense.
+Eigen::MatrixXd DenseJacobian(const ceres::CRSMatrix& crs);
 
 // The prior left by removing `leaving` and the residual blocks `factors` (all
 // those of `problem` that touch `leaving`, and maybe more) from `problem`,
