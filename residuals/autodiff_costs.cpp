@@ -75,8 +75,13 @@ ceres::CostFunction* RadarPoseResidual::Create(const SE3d& measured,
 }
 
 ceres::CostFunction* RadarVelocityResidual::Create(const Eigen::Vector3d& radar_velocity,
-                                                   const Eigen::Matrix3d& sqrt_information, const ImuAtScan& imu) {
-  return new AutoDiff(new RadarVelocityResidual(radar_velocity, sqrt_information, imu));
+                                                   const Eigen::Matrix3d& sqrt_information, const ImuAtScan& imu,
+                                                   double elevation_bias_removed) {
+  return new AutoDiff(new RadarVelocityResidual(radar_velocity, sqrt_information, imu, elevation_bias_removed));
+}
+
+ceres::CostFunction* VehicleMotionResidual::Create(double sigma) {
+  return new AutoDiff(new VehicleMotionResidual(sigma));
 }
 
 }  // namespace radargauss

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/residuals/radar_inertial_residuals.hpp"
 
+#include <cmath>
+
 #include "radargauss/lie/manifold.hpp"
 
 namespace radargauss {
@@ -124,7 +126,8 @@ bool RadarPoseCostFunction::Evaluate(double const* const* parameters, double* re
 
 // u = R_d^T v_d + w x t_e, e = v_r - R_e^T u: du/dphi = Exp(w d)^T ([R^T v_d]x - [a_b]x d),
 // du/dv = R_d^T, du/db_a = -Exp(w d)^T d, du/db_g = -[R_d^T v_d]x Jr(w d) d + [t_e]x,
-// du/dt_e = [w]x, du/dt_d = [R_d^T v_d]x Jr(w d) w + Exp(w d)^T (a_b + R^T g); de/dphi_e = -[R_e^T u]x.
+// du/dt_e = [w]x, du/dt_d = [R_d^T v_d]x Jr(w d) w + Exp(w d)^T (a_b + R^T g); de/dphi_e = -[R_e^T u]x;
+// de/db = dL/ddelta = |v_r| (sin(el - delta) h, -cos(el - delta)), h the horizontal direction.
 bool RadarVelocityCostFunction::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
   const Moved m = Move(parameters[0], parameters[1], parameters[4], imu_);
   const SO3d R_e = SO3d::FromXyzw(parameters[2]);
@@ -132,8 +135,9 @@ bool RadarVelocityCostFunction::Evaluate(double const* const* parameters, double
   const Vector3d in_imu = m.R_d.Inverse() * m.v_d;
   const Vector3d u = in_imu + m.omega.cross(t_e);
   const Vector3d predicted = R_e.Inverse() * u;
+  const double delta = parameters[5][0] - elevation_bias_removed_;
   Eigen::Map<Vector3d> r(residuals);
-  r = sqrt_information_ * (radar_velocity_ - predicted);
+  r = sqrt_information_ * (LowerElevation(radar_velocity_, delta) - predicted);
   if (jacobians == nullptr) return true;
 
   const Matrix3d step_T = SO3d::Exp(m.omega * m.d).Inverse().Matrix();
@@ -159,6 +163,35 @@ bool RadarVelocityCostFunction::Evaluate(double const* const* parameters, double
     const Vector3d du =
         SO3d::Hat(in_imu) * m.Jr * m.omega + step_T * (m.a_b + m.R.Inverse() * Vector3d(0.0, 0.0, -kGravity));
     Columns<3, 1>(Eigen::Matrix<double, 3, 1>(minus_WR_e_T * du), jacobians[4]);
+  }
+  if (jacobians[5] != nullptr) {
+    const double horizontal = std::hypot(radar_velocity_.x(), radar_velocity_.y());
+    Vector3d dL = Vector3d::Zero();
+    if (horizontal >= 1e-9) {
+      const double elevation = std::atan2(radar_velocity_.z(), horizontal), speed = radar_velocity_.norm();
+      const double across = speed * std::sin(elevation - delta) / horizontal;
+      dL << across * radar_velocity_.x(), across * radar_velocity_.y(), -speed * std::cos(elevation - delta);
+    }
+    Columns<3, 1>(Eigen::Matrix<double, 3, 1>(sqrt_information_ * dL), jacobians[5]);
+  }
+  return true;
+}
+
+// u = R^T v: du/dphi = [R^T v]x, du/dv = R^T; the rows of u's y and z.
+bool VehicleMotionCostFunction::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
+  const SO3d R = SO3d::FromXyzw(parameters[0]);
+  const Vector3d u = R.Inverse() * Eigen::Map<const Vector3d>(parameters[1] + kMotionVelocity);
+  residuals[0] = weight_ * u.y();
+  residuals[1] = weight_ * u.z();
+  if (jacobians == nullptr) return true;
+  if (jacobians[0] != nullptr) {
+    const Eigen::Matrix<double, 2, 3> J = weight_ * SO3d::Hat(u).bottomRows<2>();
+    QuaternionColumns<2>(J, parameters[0], jacobians[0]);
+  }
+  if (jacobians[1] != nullptr) {
+    Eigen::Matrix<double, 2, 9> J = Eigen::Matrix<double, 2, 9>::Zero();
+    J.block<2, 3>(0, kMotionVelocity) = weight_ * R.Inverse().Matrix().bottomRows<2>();
+    Columns<2, 9>(J, jacobians[1]);
   }
   return true;
 }

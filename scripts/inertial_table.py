@@ -14,7 +14,19 @@ RPE, horizontal RPE, ATE, per-scan median and p90 time, and the window's
 final gyro and accelerometer bias errors against the truth.
 
 Table 2, the window's solvers on the faulty demo world: Ceres LM, dogleg
-and the own Gauss-Newton at window sizes 5 / 10 / 20.
+and the own Gauss-Newton at window sizes 5 / 10 / 20, with the iterations
+per solve.
+
+Table 3, calibration, per faulty scene (the realistic world; the motorway
+with the same faults) with the IMU's stamps 20 ms late: radar only with
+the true mounting given and its elevation bias estimated; radar-inertial
+with the true T_radar_imu, clock offset and elevation bias given; and
+radar-inertial from a nominal (identity) T_radar_imu, a zero offset and no
+bias, all three estimated. Both radar-inertial rows use the vehicle's
+motion term (--vehicle-motion-std 0.1; the simulated IMU is aligned with
+the vehicle). Errors against the truth: the radar-IMU rotation's roll,
+pitch and yaw (deg), the clock offset (ms), the elevation bias (deg) and
+the gyro bias in units of the window's own standard deviation (largest axis).
 
     scripts/inertial_table.py [--tool build/release/bin/radargauss] [--work /tmp/inertial_table] [--scenes demo,realistic,motorway]
 """
@@ -29,7 +41,11 @@ import sys
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCENES = {"demo": [], "realistic": ["synthetic_realistic.yaml"], "motorway": ["synthetic_motorway.yaml"]}
+SCENES = {"demo": [], "realistic": ["synthetic_realistic.yaml"], "motorway": ["synthetic_motorway.yaml"],
+          "realistic_late": ["synthetic_realistic.yaml"],
+          "motorway_late": ["synthetic_motorway.yaml", "synthetic_realistic.yaml"]}
+LATE = 0.020  # s: the IMU's stamps behind the radar's in the *_late scenes
+ELEVATION_BIAS = 0.5  # deg: synthetic_realistic.yaml's
 MOUNTED = ["--mounting", "0.5", "1.5", "-1", "--estimate-elevation-bias"]
 
 
@@ -49,6 +65,8 @@ def simulate(tool, work, scene):
             lines += [line for line in open(os.path.join(ROOT, "configs", name)).read().splitlines()
                       if line and not line.startswith("#")]
         lines.append("imu_rate_hz: 200")
+        if scene.endswith("_late"):
+            lines.append(f"imu_clock_offset: {LATE}")
         config = out + ".yaml"
         with open(config, "w") as f:
             f.write("\n".join(lines) + "\n")
@@ -61,14 +79,14 @@ def true_bias_at_end(sequence):
     return rows[-1, 1:4], rows[-1, 4:7]
 
 
-def odometry(tool, sequence, name, flags, imu):
+def odometry(tool, sequence, name, flags, imu, imu_extrinsic=None):
     out = os.path.join(sequence + "_runs", name)
     shutil.rmtree(out, ignore_errors=True)
     command = tool + ["odometry", "--sequence", sequence, "--gt", os.path.join(sequence, "gt_radar_tum.txt"),
                       "--extrinsic", "identity", "--out", out] + flags
     if imu:
         command += ["--imu", os.path.join(sequence, "imu.txt"), "--imu-extrinsic",
-                    os.path.join(sequence, "imu_extrinsic.txt")]
+                    imu_extrinsic or os.path.join(sequence, "imu_extrinsic.txt")]
     run(command)
     evaluation = json.load(open(os.path.join(out, "evaluation.json")))
     summary = json.load(open(os.path.join(out, "summary.json")))
@@ -81,7 +99,46 @@ def odometry(tool, sequence, name, flags, imu):
         gyro, accel = true_bias_at_end(sequence)
         row["gyro"] = "%.5f" % np.linalg.norm([float(last[k]) for k in ("bgx", "bgy", "bgz")] - gyro)
         row["accel"] = "%.4f" % np.linalg.norm([float(last[k]) for k in ("bax", "bay", "baz")] - accel)
+        row["gyro_sigmas"] = np.max(np.abs([float(last[k]) for k in ("bgx", "bgy", "bgz")] - gyro) /
+                                    np.array(summary["calibration"]["gyro_bias_std"]))
+        row["iterations"] = summary["window"]["iterations_mean"]
+    row["summary"] = summary
     return row
+
+
+def rotation_vector(quaternion_xyzw):
+    """The rotation vector (rad) of a unit quaternion x y z w."""
+    q = np.array(quaternion_xyzw, dtype=float)
+    q = q / np.linalg.norm(q) * (1.0 if q[3] >= 0 else -1.0)
+    angle = 2.0 * np.arctan2(np.linalg.norm(q[:3]), q[3])
+    return q[:3] / np.linalg.norm(q[:3]) * angle if np.linalg.norm(q[:3]) > 1e-12 else np.zeros(3)
+
+
+def so3(vector):
+    """The rotation matrix of a rotation vector (rad)."""
+    angle = np.linalg.norm(vector)
+    if angle < 1e-12:
+        return np.eye(3)
+    k = np.asarray(vector) / angle
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+def log(R):
+    """The rotation vector (rad) of a rotation matrix."""
+    angle = np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))
+    if angle < 1e-12:
+        return np.zeros(3)
+    return angle / (2 * np.sin(angle)) * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+
+
+def calibration_errors(sequence, summary):
+    """Roll, pitch, yaw (deg) of R_radar_imu^T estimated, clock (ms), elevation bias (deg)."""
+    truth = np.loadtxt(os.path.join(sequence, "imu_extrinsic.txt"), comments="#")
+    c = summary["calibration"]
+    estimated = so3(np.radians(c["radar_from_imu_rotation_vector_deg"]))
+    rotation = np.degrees(log(so3(rotation_vector(truth[3:7])).T @ estimated))
+    return (rotation, (c["clock_offset_s"] - LATE) * 1e3, c["elevation_bias_deg"] - ELEVATION_BIAS)
 
 
 def line(label, r):
@@ -89,18 +146,12 @@ def line(label, r):
             f"{r['p90']:.2f} | {r['gyro']} | {r['accel']} |")
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--tool", default=os.path.join(ROOT, "build", "release", "bin", "radargauss"))
-    parser.add_argument("--work", default="/tmp/inertial_table")
-    parser.add_argument("--scenes", default="demo,realistic,motorway")
-    args = parser.parse_args()
-    tool = [args.tool, "--threads", "1"] if "--threads" in run([args.tool, "--help"]) else [args.tool]
+def scenes_table(tool, work, scenes):
     print("| scene, front end | RPE % | horizontal % | ATE m | median ms | p90 ms | gyro bias error rad/s | "
           "accel bias error m/s^2 |")
     print("|---|---|---|---|---|---|---|---|")
-    for scene in args.scenes.split(","):
-        sequence = simulate(tool, args.work, scene)
+    for scene in scenes:
+        sequence = simulate(tool, work, scene)
         print(line(f"{scene}: radar only", odometry(tool, sequence, "radar", [], False)))
         if scene == "realistic":
             print(line(f"{scene}: radar only, mounting given, bias estimated",
@@ -108,16 +159,63 @@ def main():
         print(line(f"{scene}: gyro in the prediction", odometry(tool, sequence, "gyro", ["--imu-fusion", "gyro"],
                                                                 True)))
         print(line(f"{scene}: radar-inertial", odometry(tool, sequence, "inertial", [], True)), flush=True)
-    sequence = simulate(tool, args.work, "realistic")
-    print()
+
+
+def solver_table(tool, work):
+    sequence = simulate(tool, work, "realistic")
     print("| window solver | size | RPE % | horizontal % | ATE m | median ms | p90 ms | gyro bias error rad/s | "
-          "accel bias error m/s^2 |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "accel bias error m/s^2 | iterations per solve |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for solver in ("ceres-lm", "ceres-dogleg", "gn"):
         for size in (5, 10, 20):
             r = odometry(tool, sequence, f"{solver}_{size}", ["--window-solver", solver, "--window-size", str(size)],
                          True)
-            print(line(f"{solver} | {size}", r), flush=True)
+            print(line(f"{solver} | {size}", r) + f" {r['iterations']:.2f} |", flush=True)
+
+
+def calibration_table(tool, work):
+    print("| scene, calibration | RPE % | horizontal % | ATE m | median ms | p90 ms | roll, pitch, yaw error deg | "
+          "clock error ms | elevation bias error deg | gyro bias error / std |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    nominal = os.path.join(work, "nominal.txt")
+    for scene in ("realistic_late", "motorway_late"):
+        sequence = simulate(tool, work, scene)
+        with open(nominal, "w") as f:
+            f.write("0 0 0 0 0 0 1\n")
+        r = odometry(tool, sequence, "radar_mounted", MOUNTED, False)
+        print(f"| {scene}: radar only, mounting given | {r['rpe']:.3f} | {r['horizontal']:.3f} | {r['ate']:.3f} | "
+              f"{r['median']:.2f} | {r['p90']:.2f} | | | | |")
+        given = ["--vehicle-motion-std", "0.1", "--imu-clock-offset", str(LATE), "--elevation-bias",
+                 str(ELEVATION_BIAS)]
+        r = odometry(tool, sequence, "inertial_given", given, True)
+        print(f"| {scene}: radar-inertial, given | {r['rpe']:.3f} | {r['horizontal']:.3f} | {r['ate']:.3f} | "
+              f"{r['median']:.2f} | {r['p90']:.2f} | | | | {r['gyro_sigmas']:.1f} |")
+        estimated = ["--vehicle-motion-std", "0.1", "--estimate-extrinsic-rotation", "--estimate-clock-offset",
+                     "--estimate-elevation-bias"]
+        r = odometry(tool, sequence, "inertial_estimated", estimated, True, nominal)
+        rotation, clock, bias = calibration_errors(sequence, r["summary"])
+        print(f"| {scene}: radar-inertial, estimated | {r['rpe']:.3f} | {r['horizontal']:.3f} | {r['ate']:.3f} | "
+              f"{r['median']:.2f} | {r['p90']:.2f} | {rotation[0]:.2f}, {rotation[1]:.2f}, {rotation[2]:.2f} | "
+              f"{clock:.1f} | {bias:.2f} | {r['gyro_sigmas']:.1f} |", flush=True)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--tool", default=os.path.join(ROOT, "build", "release", "bin", "radargauss"))
+    parser.add_argument("--work", default="/tmp/inertial_table")
+    parser.add_argument("--scenes", default="demo,realistic,motorway", help="table 1's scenes")
+    parser.add_argument("--tables", default="1,2,3", help="which tables to make")
+    args = parser.parse_args()
+    tool = [args.tool, "--threads", "1"] if "--threads" in run([args.tool, "--help"]) else [args.tool]
+    tables = args.tables.split(",")
+    if "1" in tables:
+        scenes_table(tool, args.work, args.scenes.split(","))
+        print()
+    if "2" in tables:
+        solver_table(tool, args.work)
+        print()
+    if "3" in tables:
+        calibration_table(tool, args.work)
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@
 #include "radargauss/residuals/imu_preintegration.hpp"
 #include "radargauss/residuals/imu_residual.hpp"
 #include "radargauss/residuals/radar_inertial_residuals.hpp"
+#include "radargauss/residuals/rotation_residual.hpp"
 #include "radargauss/solvers/marginalization.hpp"
 #include "radargauss/solvers/window_solvers.hpp"
 
@@ -110,6 +111,10 @@ const OptionTable<InertialWindowOptions>& InertialWindowOptionTable() {
             .Help("the IMU's stamps minus the radar's clock (the start when estimated)"),
         RADARGAUSS_OPTION(O, "estimate_clock_offset", estimate_clock_offset)
             .Help("estimate the IMU-radar clock offset online"),
+        RADARGAUSS_OPTION(O, "vehicle_motion_std", vehicle_motion_std)
+            .AtLeast(0.0)
+            .Unit("m/s")
+            .Help("a ground vehicle's IMU, aligned with it: std of its lateral and vertical velocity (0: off)"),
     };
     AppendNested(
         t, ImuNoiseOptionTable(), +[](O & o) -> auto& { return o.noise; }, "noise", "imu_");
@@ -125,11 +130,16 @@ struct InertialWindow::Node {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Matrix<double, 9, 1> motion = Eigen::Matrix<double, 9, 1>::Zero();  // v, b_g, b_a
   std::optional<ImuPreintegration> from_previous;  // the IMU between the node before and this one
-  CostPointer imu, pose, velocity;                 // terms on this node (imu: from the one before)
+  CostPointer imu, pose, velocity, vehicle;        // terms on this node (imu: from the one before)
   // The measurements, kept to make their terms again at a new clock offset.
-  std::optional<std::pair<SE3d, Eigen::Matrix<double, 6, 6>>> pose_measurement;     // pose, W
-  std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> velocity_measurement;  // velocity, W
-  std::vector<std::pair<CostPointer, std::vector<double*>>> first_priors;           // the first state's
+  std::optional<std::pair<SE3d, Eigen::Matrix<double, 6, 6>>> pose_measurement;  // pose, W
+  struct VelocityMeasurement {
+    Eigen::Vector3d velocity;
+    Eigen::Matrix3d sqrt_information;
+    double elevation_bias_removed = 0.0;  // rad
+  };
+  std::optional<VelocityMeasurement> velocity_measurement;
+  std::vector<std::pair<CostPointer, std::vector<double*>>> first_priors;  // the first state's
 
   InertialState State() const {
     InertialState s;
@@ -152,6 +162,7 @@ struct InertialWindow::Impl {
   Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
   double clock_offset[1] = {0.0};    // t_d: the block
   double clock_linearisation = 0.0;  // t_0: where the samples were read
+  double elevation_bias[1] = {0.0};  // b: the block
   std::shared_ptr<MarginalizationPrior> prior;
 
   // The IMU's reading in force at a scan's stamp, at the clock offset t_0.
@@ -169,8 +180,9 @@ struct InertialWindow::Impl {
                                                           ImuAt(node.stamp));
     }
     if (node.velocity_measurement) {
-      node.velocity = std::make_shared<RadarVelocityCostFunction>(node.velocity_measurement->first,
-                                                                  node.velocity_measurement->second, ImuAt(node.stamp));
+      const Node::VelocityMeasurement& m = *node.velocity_measurement;
+      node.velocity = std::make_shared<RadarVelocityCostFunction>(m.velocity, m.sqrt_information, ImuAt(node.stamp),
+                                                                  m.elevation_bias_removed);
     }
   }
 
@@ -189,6 +201,7 @@ struct InertialWindow::Impl {
     if (options.estimate_extrinsic_rotation) blocks.push_back(extrinsic_rotation.data());
     if (options.estimate_extrinsic_translation) blocks.push_back(extrinsic_translation.data());
     if (options.estimate_clock_offset) blocks.push_back(clock_offset);
+    if (options.estimate_elevation_bias) blocks.push_back(elevation_bias);
     return blocks;
   }
 
@@ -204,7 +217,9 @@ struct InertialWindow::Impl {
     problem.AddParameterBlock(extrinsic_translation.data(), 3);
     problem.AddParameterBlock(tilt.data(), 2);
     problem.AddParameterBlock(clock_offset, 1);
+    problem.AddParameterBlock(elevation_bias, 1);
     if (!options.estimate_clock_offset) problem.SetParameterBlockConstant(clock_offset);
+    if (!options.estimate_elevation_bias) problem.SetParameterBlockConstant(elevation_bias);
     if (!options.estimate_extrinsic_rotation) problem.SetParameterBlockConstant(extrinsic_rotation.data());
     if (!options.estimate_extrinsic_translation) problem.SetParameterBlockConstant(extrinsic_translation.data());
     if (!options.estimate_tilt) problem.SetParameterBlockConstant(tilt.data());
@@ -227,7 +242,11 @@ struct InertialWindow::Impl {
       if (node.velocity) {
         on_oldest(problem.AddResidualBlock(node.velocity.get(), nullptr,
                                            {node.rotation.data(), node.motion.data(), extrinsic_rotation.data(),
-                                            extrinsic_translation.data(), clock_offset}),
+                                            extrinsic_translation.data(), clock_offset, elevation_bias}),
+                  k == 0);
+      }
+      if (node.vehicle) {
+        on_oldest(problem.AddResidualBlock(node.vehicle.get(), nullptr, node.rotation.data(), node.motion.data()),
                   k == 0);
       }
       if (k > 0 && node.imu) {
@@ -277,6 +296,9 @@ void InertialWindow::Start(const InertialState& state) {
   node.rotation = state.pose.rotation().quaternion().coeffs();
   node.position = state.pose.translation();
   node.motion << state.velocity, state.bias.gyro, state.bias.accel;
+  if (options_.vehicle_motion_std > 0.0) {
+    node.vehicle = std::make_shared<VehicleMotionCostFunction>(options_.vehicle_motion_std);
+  }
   impl_->nodes.push_back(node);
   Node& first = impl_->nodes.back();
   // Biases about zero, the velocity about the start's; the tilt and the clock offset about their starts.
@@ -292,6 +314,19 @@ void InertialWindow::Start(const InertialState& state) {
     first.first_priors.push_back({std::make_shared<DiagonalPrior>(Eigen::VectorXd::Constant(1, impl_->clock_offset[0]),
                                                                   Eigen::VectorXd::Constant(1, kClockPrior)),
                                   {impl_->clock_offset}});
+  }
+  if (options_.estimate_extrinsic_rotation) {
+    constexpr double kExtrinsicRotationPrior = 3.0 * M_PI / 180.0;  // rad: a mounting is known to a few degrees
+    const RotationPrior prior{SO3d::FromXyzw(impl_->extrinsic_rotation.data()),
+                              Eigen::Matrix3d::Identity() / kExtrinsicRotationPrior};
+    first.first_priors.push_back({std::make_shared<RotationCostFunction>(prior), {impl_->extrinsic_rotation.data()}});
+  }
+  if (options_.estimate_elevation_bias) {
+    constexpr double kElevationBiasPrior = 2.0 * M_PI / 180.0;  // rad: a radar's bias is a fraction of a degree
+    first.first_priors.push_back(
+        {std::make_shared<DiagonalPrior>(Eigen::VectorXd::Constant(1, impl_->elevation_bias[0]),
+                                         Eigen::VectorXd::Constant(1, kElevationBiasPrior)),
+         {impl_->elevation_bias}});
   }
   if (options_.estimate_tilt) {
     constexpr double kTiltPrior = 0.1;  // rad: the start's tilt from the accelerometer is this good at worst
@@ -322,6 +357,9 @@ void InertialWindow::AddState(double stamp) {
   node.motion.segment<3>(kMotionVelocity) = v + g * d.duration + pose.rotation() * d.velocity;
   node.from_previous = between;
   node.imu = std::make_shared<ImuCostFunction>(between, options_.noise);
+  if (options_.vehicle_motion_std > 0.0) {
+    node.vehicle = std::make_shared<VehicleMotionCostFunction>(options_.vehicle_motion_std);
+  }
   impl_->nodes.push_back(std::move(node));
 }
 
@@ -336,16 +374,17 @@ void InertialWindow::AddPose(const SE3d& world_from_radar, const Eigen::Matrix<d
   impl_->MakeRadarTerms(node);
 }
 
-void InertialWindow::AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance) {
+void InertialWindow::AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance,
+                                 double elevation_bias_removed) {
   if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::AddVelocity before Start");
-  if (!radar_velocity.allFinite() || !covariance.allFinite()) {
+  if (!radar_velocity.allFinite() || !covariance.allFinite() || !std::isfinite(elevation_bias_removed)) {
     throw std::invalid_argument("InertialWindow::AddVelocity: a velocity or covariance that is not finite");
   }
   const Eigen::LLT<Eigen::Matrix3d> factor(covariance);
   if (factor.info() != Eigen::Success) throw std::invalid_argument("AddVelocity: covariance not positive definite");
   Node& node = impl_->nodes.back();
-  node.velocity_measurement =
-      std::make_pair(radar_velocity, Eigen::Matrix3d(SqrtInformation(factor.solve(Eigen::Matrix3d::Identity()))));
+  node.velocity_measurement = Node::VelocityMeasurement{
+      radar_velocity, SqrtInformation(factor.solve(Eigen::Matrix3d::Identity())), elevation_bias_removed};
   impl_->MakeRadarTerms(node);
 }
 
@@ -354,6 +393,7 @@ InertialState InertialWindow::state(std::size_t index) const { return impl_->nod
 InertialState InertialWindow::newest() const { return impl_->nodes.back().State(); }
 Eigen::Vector2d InertialWindow::tilt() const { return impl_->tilt; }
 double InertialWindow::clock_offset() const { return impl_->clock_offset[0]; }
+double InertialWindow::elevation_bias() const { return impl_->elevation_bias[0]; }
 void InertialWindow::set_tilt(const Eigen::Vector2d& roll_pitch) { impl_->tilt = roll_pitch; }
 
 SE3d InertialWindow::radar_from_imu() const {
@@ -444,6 +484,7 @@ WindowUncertainty InertialWindow::Uncertainty() const {
   if (options_.estimate_extrinsic_rotation) u.extrinsic_rotation = std_of(global++, 0, 3);
   if (options_.estimate_extrinsic_translation) u.extrinsic_translation = std_of(global++, 0, 3);
   if (options_.estimate_clock_offset) u.clock_offset = std_of(global++, 0, 1)(0);
+  if (options_.estimate_elevation_bias) u.elevation_bias = std_of(global++, 0, 1)(0);
   return u;
 }
 

@@ -14,7 +14,8 @@ const OptionTable<ElevationBiasOptions>& ElevationBiasOptionTable() {
   static const OptionTable<O> table = {
       RADARGAUSS_OPTION(O, "estimate_elevation_bias", estimate)
           .Sensor()
-          .Help("estimate the elevation bias (beyond the sequence's) from the Doppler velocity (needs the mounting)"),
+          .Help("estimate the elevation bias (beyond the sequence's) from the Doppler velocity: needs the mounting, or "
+                "with --imu the vehicle's motion term"),
       RADARGAUSS_OPTION(O, "elevation_bias_window", window).In(1, 1e6).Help("scans the bias's median is over"),
       RADARGAUSS_OPTION(O, "elevation_bias_min_speed", min_speed)
           .Above(0.0)
@@ -40,11 +41,17 @@ RadarScan ElevationBias::Corrected(const RadarScan& scan) const {
 }
 
 void ElevationBias::Observe(const Eigen::Vector3d& velocity) {
-  if (!options_.estimate || velocity.norm() < options_.min_speed) return;
+  if (!options_.estimate || held_ || velocity.norm() < options_.min_speed) return;
   const Eigen::Vector3d forward = vehicle_from_radar_ * velocity;
   window_.push_back(std::atan2(forward.z(), forward.x()) + bias_);
   if (window_.size() > options_.window) window_.pop_front();
   bias_ = Median(std::vector<double>(window_.begin(), window_.end()));
+}
+
+void ElevationBias::Hold(double bias) {
+  if (!std::isfinite(bias)) throw std::invalid_argument("ElevationBias::Hold: the bias is not finite");
+  bias_ = bias;
+  held_ = true;
 }
 
 }  // namespace radargauss

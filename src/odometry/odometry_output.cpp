@@ -94,6 +94,10 @@ nlohmann::json Calibration(const InertialFusion& inertial) {
     c["clock_offset_s"] = window.clock_offset();
     c["clock_offset_std_s"] = u.clock_offset;
   }
+  if (o.estimate_elevation_bias) {
+    c["elevation_bias_deg"] = window.elevation_bias() * kDeg;
+    c["elevation_bias_std_deg"] = u.elevation_bias * kDeg;
+  }
   if (o.estimate_extrinsic_rotation || o.estimate_extrinsic_translation) {
     const SE3d radar_from_imu = window.radar_from_imu();
     c["radar_from_imu_rotation_vector_deg"] = Values(radar_from_imu.rotation().Log(), kDeg);
@@ -102,6 +106,24 @@ nlohmann::json Calibration(const InertialFusion& inertial) {
     c["imu_from_radar_translation_std"] = Values(u.extrinsic_translation);
   }
   return c;
+}
+
+// The window's solves: iterations per solve (mean, max) and integrations again.
+nlohmann::json WindowSolves(const InertialFusion& inertial) {
+  const std::vector<WindowSolveSummary>& solves = inertial.solves();
+  if (solves.empty()) return nullptr;
+  double iterations = 0.0;
+  int most = 0;
+  std::size_t reintegrated = 0;
+  for (const WindowSolveSummary& solve : solves) {
+    iterations += solve.iterations;
+    most = std::max(most, solve.iterations);
+    reintegrated += solve.reintegrated;
+  }
+  return {{"solves", solves.size()},
+          {"iterations_mean", iterations / double(solves.size())},
+          {"iterations_max", most},
+          {"reintegrated", reintegrated}};
 }
 
 // inertial.csv: the window's newest state per scan (empty fields before it started).
@@ -164,6 +186,7 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry, const 
   }
   if (inertial != nullptr) {
     summary["calibration"] = Calibration(*inertial);
+    summary["window"] = WindowSolves(*inertial);
     WriteInertialStates((out / "inertial.csv").string(), odometry, *inertial);
   }
   WriteFileAtomically((out / "summary.json").string(),

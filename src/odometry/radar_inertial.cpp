@@ -2,6 +2,7 @@
 #include "radargauss/odometry/radar_inertial.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <utility>
 
 #include "radargauss/error.hpp"
@@ -32,21 +33,33 @@ InertialFusion::InertialFusion(const RadarInertialOptions& options, const SE3d& 
     : options_(options),
       radar_from_imu_(radar_from_imu),
       imu_(std::move(imu)),
-      window_(options.window, radar_from_imu) {
+      window_(std::make_unique<InertialWindow>(options.window, radar_from_imu)) {
   CheckOptions(RadarInertialOptionTable(), options);
-  window_.AddImu(imu_);  // checks the order
+  window_->AddImu(imu_);  // checks the order
 }
 
 void InertialFusion::Attach(RadarOdometry& odometry) {
+  if (started_) throw std::logic_error("InertialFusion::Attach after the window started");
+  const bool estimate = odometry.options().elevation_bias.estimate;
+  if (estimate != options_.window.estimate_elevation_bias) {
+    options_.window.estimate_elevation_bias = estimate;
+    window_ = std::make_unique<InertialWindow>(options_.window, radar_from_imu_);
+    window_->AddImu(imu_);
+  }
+  if (estimate) odometry.HoldElevationBias(elevation_bias_removed_);
   odometry.SetPoseFusion([this](const ScanEstimate& estimate) { return Fuse(estimate); });
 }
 
 // The rates up to the first sample at or after `stamp` (GyroIncrement needs
 // one), less the window's gyro bias now, turned into the radar frame.
 void InertialFusion::BeforeScan(RadarOdometry& odometry, double stamp) {
-  const Eigen::Vector3d bias = started_ ? window_.newest().bias.gyro : Eigen::Vector3d::Zero();
-  const SO3d radar_from_imu = radar_from_imu_.rotation();
-  const double offset = window_.clock_offset();  // the IMU's stamps minus the radar's
+  const Eigen::Vector3d bias = started_ ? window_->newest().bias.gyro : Eigen::Vector3d::Zero();
+  const SO3d radar_from_imu = window_->radar_from_imu().rotation();
+  const double offset = window_->clock_offset();  // the IMU's stamps minus the radar's
+  if (options_.window.estimate_elevation_bias) {
+    elevation_bias_removed_ = window_->elevation_bias();
+    odometry.HoldElevationBias(elevation_bias_removed_);
+  }
   std::vector<GyroSample> samples;
   for (; fed_ < imu_.size() && (fed_ == 0 || imu_[fed_ - 1].stamp - offset < stamp); ++fed_) {
     const double on_radar_clock = imu_[fed_].stamp - offset;
@@ -57,7 +70,7 @@ void InertialFusion::BeforeScan(RadarOdometry& odometry, double stamp) {
   odometry.AddGyro(samples);
 }
 
-void InertialFusion::AfterScan() { states_.push_back(started_ ? std::make_optional(window_.newest()) : std::nullopt); }
+void InertialFusion::AfterScan() { states_.push_back(started_ ? std::make_optional(window_->newest()) : std::nullopt); }
 
 RadarInertialOdometry::RadarInertialOdometry(const OdometryOptions& odometry, const RadarInertialOptions& options,
                                              const SE3d& radar_from_imu, std::vector<ImuSample> imu)
@@ -80,22 +93,22 @@ SE3d InertialFusion::Fuse(const ScanEstimate& e) {
     }
     const InertialStart start =
         StartFromGravity(imu_, e.stamp, e.pose, e.velocity, radar_from_imu_, 0.2, options_.window.clock_offset);
-    window_.set_tilt(start.tilt);
-    window_.Start(start.state);
+    window_->set_tilt(start.tilt);
+    window_->Start(start.state);
     started_ = true;
   } else {
-    window_.AddState(e.stamp);
+    window_->AddState(e.stamp);
   }
   if (e.matched && e.matched_points > 0) {
-    window_.AddPose(e.pose, e.information * (double(e.matched_points) * options_.match_information_scale));
+    window_->AddPose(e.pose, e.information * (double(e.matched_points) * options_.match_information_scale));
   }
   if (e.velocity_measured) {
     const Eigen::Matrix3d covariance =
         e.velocity_covariance + options_.velocity_floor * options_.velocity_floor * Eigen::Matrix3d::Identity();
-    window_.AddVelocity(e.velocity, covariance);
+    window_->AddVelocity(e.velocity, covariance, elevation_bias_removed_);
   }
-  window_.Solve();
-  return window_.RadarPoseInMatcherWorld();
+  solves_.push_back(window_->Solve());
+  return window_->RadarPoseInMatcherWorld();
 }
 
 }  // namespace radargauss

@@ -153,29 +153,64 @@ TEST(RadarPoseResidual, ZeroAtTheRadarsPoseAndAgreesWithCentralDifferences) {
 TEST(RadarVelocityResidual, ZeroAtTheLeverArmsVelocityAndAgreesWithCentralDifferences) {
   RadarOnImu s;
   const ImuAtScan imu{Eigen::Vector3d(0.05, -0.02, 0.7), Eigen::Vector3d(0.3, -0.2, 9.9), 0.0};
-  double clock = 0.0;
+  double clock = 0.0, elevation_bias = 0.0;
   const Eigen::Vector3d omega = imu.gyro - s.motion.segment<3>(kMotionGyroBias);
   // The radar's velocity: the IMU's plus omega x t_e, in the radar frame.
   const Eigen::Vector3d world = s.motion.segment<3>(kMotionVelocity) + s.R() * omega.cross(s.te);
   const Eigen::Vector3d radar_velocity = (s.R() * s.Re()).Inverse() * world;
   const std::unique_ptr<ceres::CostFunction> term(
       RadarVelocityResidual::Create(radar_velocity, Eigen::Matrix3d::Identity() * 20.0, imu));
-  const std::vector<double*> blocks = {s.q.data(), s.motion.data(), s.qe.data(), s.te.data(), &clock};
+  const std::vector<double*> blocks = {s.q.data(), s.motion.data(), s.qe.data(), s.te.data(), &clock, &elevation_bias};
   std::vector<Eigen::MatrixXd> J;
   EXPECT_LT(EvaluateWithJacobians(*term, blocks, J).norm(), 1e-12);
   clock = -0.015;
+  elevation_bias = 0.01;
   EvaluateWithJacobians(*term, blocks, J);
-  for (int b = 0; b < 5; ++b) EXPECT_LT(Relative(J[b], NumericBlockJacobian(*term, blocks, b)), 1e-5) << "block " << b;
-  clock = 0.0;
+  for (int b = 0; b < 6; ++b) EXPECT_LT(Relative(J[b], NumericBlockJacobian(*term, blocks, b)), 1e-5) << "block " << b;
+  clock = elevation_bias = 0.0;
   // Without the lever arm the residual is 20 |omega x t_e|.
   Eigen::Vector3d no_lever = Eigen::Vector3d::Zero();
-  const std::vector<double*> without = {s.q.data(), s.motion.data(), s.qe.data(), no_lever.data(), &clock};
+  const std::vector<double*> without = {s.q.data(),      s.motion.data(), s.qe.data(),
+                                        no_lever.data(), &clock,          &elevation_bias};
   EXPECT_NEAR(EvaluateWithJacobians(*term, without, J).norm(), 20.0 * omega.cross(s.te).norm(), 1e-9);
 }
 
+// A Doppler velocity raised by 0.7 deg of elevation (speed and azimuth kept,
+// composed by hand) is zero at b = 0.7 deg; one raised by 0.3 deg, from a
+// scan that had 0.4 deg removed, is zero at b = 0.7 deg too; lowering keeps the speed.
+TEST(RadarVelocityResidual, ZeroWhereTheElevationBiasRaisedTheVelocity) {
+  RadarOnImu s;
+  const ImuAtScan imu{Eigen::Vector3d(0.05, -0.02, 0.7), Eigen::Vector3d(0.3, -0.2, 9.9), 0.0};
+  const Eigen::Vector3d omega = imu.gyro - s.motion.segment<3>(kMotionGyroBias);
+  const Eigen::Vector3d world = s.motion.segment<3>(kMotionVelocity) + s.R() * omega.cross(s.te);
+  const Eigen::Vector3d truth = (s.R() * s.Re()).Inverse() * world;
+  constexpr double kDeg = M_PI / 180.0;
+  const auto raised_by = [&](double angle) -> Eigen::Vector3d {
+    const double azimuth = std::atan2(truth.y(), truth.x());
+    const double elevation = std::atan2(truth.z(), std::hypot(truth.x(), truth.y())) + angle;
+    return truth.norm() * Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                                          std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+  };
+  const Eigen::Vector3d raised = raised_by(0.7 * kDeg);
+  EXPECT_NEAR(LowerElevation(raised, 0.7 * kDeg).norm(), raised.norm(), 1e-12);
+  double clock = 0.0, estimate = 0.7 * kDeg;
+  const std::vector<double*> blocks = {s.q.data(), s.motion.data(), s.qe.data(), s.te.data(), &clock, &estimate};
+  std::vector<Eigen::MatrixXd> J;
+  const std::unique_ptr<ceres::CostFunction> term(
+      RadarVelocityResidual::Create(raised, Eigen::Matrix3d::Identity() * 20.0, imu));
+  EXPECT_LT(EvaluateWithJacobians(*term, blocks, J).norm(), 1e-10);
+  const std::unique_ptr<ceres::CostFunction> partly(
+      RadarVelocityResidual::Create(raised_by(0.3 * kDeg), Eigen::Matrix3d::Identity() * 20.0, imu, 0.4 * kDeg));
+  EXPECT_LT(EvaluateWithJacobians(*partly, blocks, J).norm(), 1e-10);
+  estimate = 0.3 * kDeg;  // the removed part forgotten
+  EXPECT_GT(EvaluateWithJacobians(*partly, blocks, J).norm(), 1e-3);
+  // A velocity with no horizontal part is left as it is.
+  EXPECT_EQ(LowerElevation(Eigen::Vector3d(0.0, 0.0, 2.0), 0.3), Eigen::Vector3d(0.0, 0.0, 2.0));
+}
+
 // The analytic twins of the radar's terms against automatic differentiation
-// (1e-8) and central differences (1e-5), at random states, extrinsics, tilts
-// and clock offsets away from the samples' reading.
+// (1e-8) and central differences (1e-5), at random states, extrinsics, tilts,
+// clock offsets away from the samples' reading and elevation biases.
 TEST(RadarTermJacobians, AnalyticAutodiffNumeric) {
   std::mt19937 rng(21);
   std::normal_distribution<double> n(0.0, 1.0);
@@ -206,16 +241,49 @@ TEST(RadarTermJacobians, AnalyticAutodiffNumeric) {
       EXPECT_LT(Relative(ja[b], NumericBlockJacobian(pose, pose_blocks, b)), 1e-5) << "pose block " << b;
     }
     const Eigen::Vector3d radar_velocity = vector(5.0);
-    const RadarVelocityCostFunction velocity(radar_velocity, W3, imu);
+    const double removed = 0.01 * n(rng);
+    double elevation_bias = 0.02 * n(rng);
+    const RadarVelocityCostFunction velocity(radar_velocity, W3, imu, removed);
     const std::unique_ptr<ceres::CostFunction> velocity_autodiff(
-        RadarVelocityResidual::Create(radar_velocity, W3, imu));
-    const std::vector<double*> velocity_blocks = {q.data(), motion.data(), qe.data(), te.data(), &clock};
+        RadarVelocityResidual::Create(radar_velocity, W3, imu, removed));
+    const std::vector<double*> velocity_blocks = {q.data(),  motion.data(), qe.data(),
+                                                  te.data(), &clock,        &elevation_bias};
     EXPECT_LT(Relative(EvaluateWithJacobians(velocity, velocity_blocks, ja),
                        EvaluateWithJacobians(*velocity_autodiff, velocity_blocks, jd)),
               1e-12);
-    for (int b = 0; b < 5; ++b) {
+    for (int b = 0; b < 6; ++b) {
       EXPECT_LT(Relative(ja[b], jd[b]), 1e-8) << "velocity block " << b;
       EXPECT_LT(Relative(ja[b], NumericBlockJacobian(velocity, velocity_blocks, b)), 1e-5) << "velocity block " << b;
+    }
+  }
+}
+
+// The vehicle's motion term: zero for a velocity along the IMU's x, the
+// lateral and vertical parts weighted otherwise; analytic = autodiff (1e-8)
+// = central differences (1e-5) on random states.
+TEST(VehicleMotionResidual, ZeroAlongTheImusXAndAnalyticAutodiffNumeric) {
+  Eigen::Vector4d q = SO3d::Exp(Eigen::Vector3d(0.05, -0.1, 1.2)).quaternion().coeffs();
+  Eigen::Matrix<double, 9, 1> motion = Eigen::Matrix<double, 9, 1>::Zero();
+  motion.segment<3>(kMotionVelocity) = SO3d::FromXyzw(q.data()) * Eigen::Vector3d(8.0, 0.0, 0.0);
+  const VehicleMotionCostFunction analytic(0.1);
+  const std::unique_ptr<ceres::CostFunction> autodiff(VehicleMotionResidual::Create(0.1));
+  std::vector<double*> blocks = {q.data(), motion.data()};
+  std::vector<Eigen::MatrixXd> ja, jd;
+  EXPECT_LT(EvaluateWithJacobians(analytic, blocks, ja).norm(), 1e-12);
+  motion.segment<3>(kMotionVelocity) = SO3d::FromXyzw(q.data()) * Eigen::Vector3d(8.0, 0.3, -0.2);
+  const Eigen::VectorXd r = EvaluateWithJacobians(analytic, blocks, ja);
+  EXPECT_NEAR(r(0), 3.0, 1e-12);
+  EXPECT_NEAR(r(1), -2.0, 1e-12);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    q = SO3d::Exp(Eigen::Vector3d(n(rng), n(rng), n(rng))).quaternion().coeffs();
+    for (int i = 0; i < 9; ++i) motion(i) = 5.0 * n(rng);
+    EXPECT_LT(Relative(EvaluateWithJacobians(analytic, blocks, ja), EvaluateWithJacobians(*autodiff, blocks, jd)),
+              1e-12);
+    for (int b = 0; b < 2; ++b) {
+      EXPECT_LT(Relative(ja[b], jd[b]), 1e-8) << "block " << b;
+      EXPECT_LT(Relative(ja[b], NumericBlockJacobian(analytic, blocks, b)), 1e-5) << "block " << b;
     }
   }
 }

@@ -40,18 +40,21 @@ class ElevationBias {
   // vehicle_from_radar: the mounting (R_vehicle_radar).
   ElevationBias(const ElevationBiasOptions& options, const SO3d& vehicle_from_radar);
 
-  bool active() const { return options_.estimate; }
+  bool active() const { return options_.estimate || held_; }
   double bias_deg() const;  // the estimate (0 until a scan at speed)
   // The scan with every point's elevation lowered by the current bias
   // (range and azimuth kept).
   RadarScan Corrected(const RadarScan& scan) const;
   // A measured ego velocity (radar frame) of a corrected scan.
   void Observe(const Eigen::Vector3d& velocity);
+  // Removes `bias` (rad), estimated elsewhere, from now on; Observe then leaves it.
+  void Hold(double bias);
 
  private:
   ElevationBiasOptions options_;
   SO3d vehicle_from_radar_;
   double bias_ = 0.0;          // rad
+  bool held_ = false;          // set by Hold
   std::deque<double> window_;  // raw elevations: residual + the bias then removed (rad)
 };
 

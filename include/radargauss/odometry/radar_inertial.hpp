@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -48,13 +49,17 @@ class InertialFusion {
   InertialFusion(const InertialFusion&) = delete;  // the odometry's hook holds `this`
   InertialFusion& operator=(const InertialFusion&) = delete;
 
+  // With the odometry's estimate_elevation_bias the window estimates the
+  // bias, and the odometry removes the window's estimate from each scan.
   void Attach(RadarOdometry& odometry);
   void BeforeScan(RadarOdometry& odometry, double stamp);
   void AfterScan();
 
   // The window's newest state after each scan; empty before the window started.
   const std::vector<std::optional<InertialState>>& states() const { return states_; }
-  const InertialWindow& window() const { return window_; }
+  // Each solve's summary, one per scan since the window started.
+  const std::vector<WindowSolveSummary>& solves() const { return solves_; }
+  const InertialWindow& window() const { return *window_; }
   const RadarInertialOptions& options() const { return options_; }
 
  private:
@@ -63,11 +68,13 @@ class InertialFusion {
   RadarInertialOptions options_;
   SE3d radar_from_imu_;
   std::vector<ImuSample> imu_;
-  InertialWindow window_;
+  std::unique_ptr<InertialWindow> window_;  // made again by Attach when the elevation bias is estimated
   bool started_ = false;
+  double elevation_bias_removed_ = 0.0;                         // rad: what the odometry removes from the scan now
   std::size_t fed_ = 0;                                         // IMU samples handed to the odometry's prediction
   double last_fed_ = -std::numeric_limits<double>::infinity();  // their last stamp, on the radar's clock
   std::vector<std::optional<InertialState>> states_;
+  std::vector<WindowSolveSummary> solves_;
 };
 
 class RadarInertialOdometry {

@@ -153,6 +153,9 @@ class RadarOdometry {
   void AddGyro(const std::vector<GyroSample>& samples);
   // From the next scan on, each scan's pose is `fusion`'s answer to its estimate.
   void SetPoseFusion(PoseFusion fusion) { fusion_ = std::move(fusion); }
+  // From the next scan on, removes an elevation bias estimated elsewhere (rad;
+  // the radar-inertial window) instead of following the Doppler velocity's.
+  void HoldElevationBias(double bias) { elevation_bias_.Hold(bias); }
   // From the next scan on, matches against `map`, fixed (nothing is
   // inserted), with the motion model carried into the map's frame by
   // `map_from_odometry`: localisation in a given map (relocalisation's tracking).

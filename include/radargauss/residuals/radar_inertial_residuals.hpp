@@ -14,11 +14,16 @@
 //             (the matcher's tangent: translation in the world, rotation on
 //             the right, as its information; solvers/scan_matcher.hpp)
 //   velocity: the radar's velocity in its own frame from the state,
-//             r = W (v_r - R_e^T (R_d^T v_d + (w - b_g) x t_e))
+//             r = W (L(v_r, b - b_0) - R_e^T (R_d^T v_d + (w - b_g) x t_e))
+//             where the radar's elevations read b too high, b_0 of it was
+//             removed from the scan, and L lowers the Doppler velocity's
+//             elevation by the rest (its speed and azimuth kept)
 //
 // Blocks, pose: R (x y z w), p, [v; b_g; b_a], R_e (x y z w), t_e,
-// [roll; pitch], t_d; velocity: R, [v; b_g; b_a], R_e, t_e, t_d.
+// [roll; pitch], t_d; velocity: R, [v; b_g; b_a], R_e, t_e, t_d, b.
 #pragma once
+
+#include <cmath>
 
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/sized_cost_function.h>
@@ -61,6 +66,20 @@ void MovedState(const T* rotation, const T* motion, const T* clock_offset, const
   v_d = v + (R * Vector3(imu.accel.cast<T>() - ba) + gravity) * d;
 }
 
+// L(v, delta): v with its elevation lowered by delta; v itself when it has
+// no horizontal part. A scan whose elevations read delta too high fits a
+// Doppler velocity raised by about delta (docs/design.md, "The faults of real radars").
+template <typename T>
+Eigen::Matrix<T, 3, 1> LowerElevation(const Eigen::Vector3d& v, const T& delta) {
+  using std::cos;
+  using std::sin;
+  const double horizontal = std::hypot(v.x(), v.y());
+  if (horizontal < 1e-9) return v.cast<T>();
+  const double elevation = std::atan2(v.z(), horizontal), speed = v.norm();
+  const T across = speed * cos(elevation - delta) / horizontal;
+  return Eigen::Matrix<T, 3, 1>(across * v.x(), across * v.y(), speed * sin(elevation - delta));
+}
+
 class RadarPoseResidual {
  public:
   RadarPoseResidual(const SE3d& measured, const Eigen::Matrix<double, 6, 6>& sqrt_information, const ImuAtScan& imu)
@@ -98,13 +117,17 @@ class RadarPoseResidual {
 
 class RadarVelocityResidual {
  public:
+  // elevation_bias_removed: b_0, the elevation bias taken off the scan before its Doppler fit (rad).
   RadarVelocityResidual(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& sqrt_information,
-                        const ImuAtScan& imu)
-      : radar_velocity_(radar_velocity), sqrt_information_(sqrt_information), imu_(imu) {}
+                        const ImuAtScan& imu, double elevation_bias_removed = 0.0)
+      : radar_velocity_(radar_velocity),
+        sqrt_information_(sqrt_information),
+        imu_(imu),
+        elevation_bias_removed_(elevation_bias_removed) {}
 
   template <typename T>
   bool operator()(const T* rotation, const T* motion, const T* extrinsic_rotation, const T* extrinsic_translation,
-                  const T* clock_offset, T* residual) const {
+                  const T* clock_offset, const T* elevation_bias, T* residual) const {
     using Vector3 = Eigen::Matrix<T, 3, 1>;
     SO3<T> R_d;
     Vector3 p_shift, v_d, omega;
@@ -112,20 +135,47 @@ class RadarVelocityResidual {
     const Vector3 predicted =
         SO3<T>::FromXyzw(extrinsic_rotation).Inverse() *
         Vector3(R_d.Inverse() * v_d + omega.cross(Eigen::Map<const Vector3>(extrinsic_translation)));
+    const Vector3 measured = LowerElevation(radar_velocity_, T(elevation_bias[0] - elevation_bias_removed_));
     Eigen::Map<Vector3> r(residual);
-    r = sqrt_information_.cast<T>() * (radar_velocity_.cast<T>() - predicted);
+    r = sqrt_information_.cast<T>() * (measured - predicted);
     return true;
   }
 
-  using AutoDiff = ceres::AutoDiffCostFunction<RadarVelocityResidual, 3, 4, 9, 4, 3, 1>;
+  using AutoDiff = ceres::AutoDiffCostFunction<RadarVelocityResidual, 3, 4, 9, 4, 3, 1, 1>;
   // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& sqrt_information,
-                                     const ImuAtScan& imu);
+                                     const ImuAtScan& imu, double elevation_bias_removed = 0.0);
 
  private:
   const Eigen::Vector3d radar_velocity_;
   const Eigen::Matrix3d sqrt_information_;
   const ImuAtScan imu_;
+  const double elevation_bias_removed_;
+};
+
+// A ground vehicle rolls along its own x axis: the velocity of an IMU
+// aligned with it (and near its rear axle) has no lateral or vertical part
+// in its own frame, r = [e_y e_z]^T R^T v / sigma. It tells a level drive
+// with a radar whose elevations read high from a climb. Blocks: R, [v; b_g; b_a].
+class VehicleMotionResidual {
+ public:
+  explicit VehicleMotionResidual(double sigma) : weight_(1.0 / sigma) {}
+
+  template <typename T>
+  bool operator()(const T* rotation, const T* motion, T* residual) const {
+    using Vector3 = Eigen::Matrix<T, 3, 1>;
+    const Vector3 in_imu = SO3<T>::FromXyzw(rotation).Inverse() * Vector3(Eigen::Map<const Vector3>(motion));
+    residual[0] = T(weight_) * in_imu.y();
+    residual[1] = T(weight_) * in_imu.z();
+    return true;
+  }
+
+  using AutoDiff = ceres::AutoDiffCostFunction<VehicleMotionResidual, 2, 4, 9>;
+  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
+  static ceres::CostFunction* Create(double sigma);
+
+ private:
+  const double weight_;
 };
 
 // The analytic twins (docs/design.md, "The sliding window", gives each block).
@@ -141,17 +191,30 @@ class RadarPoseCostFunction final : public ceres::SizedCostFunction<6, 4, 3, 9, 
   const ImuAtScan imu_;
 };
 
-class RadarVelocityCostFunction final : public ceres::SizedCostFunction<3, 4, 9, 4, 3, 1> {
+class RadarVelocityCostFunction final : public ceres::SizedCostFunction<3, 4, 9, 4, 3, 1, 1> {
  public:
   RadarVelocityCostFunction(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& sqrt_information,
-                            const ImuAtScan& imu)
-      : radar_velocity_(radar_velocity), sqrt_information_(sqrt_information), imu_(imu) {}
+                            const ImuAtScan& imu, double elevation_bias_removed = 0.0)
+      : radar_velocity_(radar_velocity),
+        sqrt_information_(sqrt_information),
+        imu_(imu),
+        elevation_bias_removed_(elevation_bias_removed) {}
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
 
  private:
   const Eigen::Vector3d radar_velocity_;
   const Eigen::Matrix3d sqrt_information_;
   const ImuAtScan imu_;
+  const double elevation_bias_removed_;
+};
+
+class VehicleMotionCostFunction final : public ceres::SizedCostFunction<2, 4, 9> {
+ public:
+  explicit VehicleMotionCostFunction(double sigma) : weight_(1.0 / sigma) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+ private:
+  const double weight_;
 };
 
 }  // namespace radargauss

@@ -53,6 +53,13 @@ struct InertialWindowOptions {
   // s: the IMU's stamps minus the radar's clock (the start when estimated).
   double clock_offset = 0.0;
   bool estimate_clock_offset = false;
+  // The radar's elevation bias b in the Doppler velocity's term. Not in the
+  // table: radar-inertial odometry sets it from OdometryOptions'
+  // estimate_elevation_bias, one flag for both front ends.
+  bool estimate_elevation_bias = false;
+  // m/s: std of the IMU's lateral and vertical velocity in its own frame, a
+  // ground vehicle's with the IMU aligned to it (VehicleMotionResidual); 0: no such term.
+  double vehicle_motion_std = 0.0;
 };
 
 // Its options (options.hpp), named window_*, imu_* (the noise) and estimate_*.
@@ -77,6 +84,7 @@ struct WindowUncertainty {
   Eigen::Vector3d extrinsic_rotation = Eigen::Vector3d::Zero();     // rad, on the right of R_imu_radar
   Eigen::Vector3d extrinsic_translation = Eigen::Vector3d::Zero();  // m
   double clock_offset = 0.0;                                        // s
+  double elevation_bias = 0.0;                                      // rad
 };
 
 struct WindowSolveSummary {
@@ -104,10 +112,12 @@ class InertialWindow {
   void AddState(double stamp);
   // Measurements of the newest state: the matcher's T_world_radar with eq. 2's
   // information (translation first), and the Doppler velocity of the radar in
-  // its frame with its covariance. The IMU's reading at the scan comes from
-  // the samples (the one in force at the stamp plus the clock offset).
+  // its frame with its covariance, fitted to a scan whose elevations were
+  // lowered by `elevation_bias_removed` (rad). The IMU's reading at the scan
+  // comes from the samples (the one in force at the stamp plus the clock offset).
   void AddPose(const SE3d& world_from_radar, const Eigen::Matrix<double, 6, 6>& information);
-  void AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance);
+  void AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance,
+                   double elevation_bias_removed = 0.0);
   WindowSolveSummary Solve();
   // After a Solve: costs a dense inverse of the window's matrix.
   WindowUncertainty Uncertainty() const;
@@ -118,8 +128,9 @@ class InertialWindow {
   // The newest state's radar pose in the matcher's world: A T_world_imu T_imu_radar.
   SE3d RadarPoseInMatcherWorld() const;
   SE3d radar_from_imu() const;
-  Eigen::Vector2d tilt() const;  // rad: roll, pitch of the matcher's world against gravity
-  double clock_offset() const;   // s: the IMU's stamps minus the radar's
+  Eigen::Vector2d tilt() const;   // rad: roll, pitch of the matcher's world against gravity
+  double clock_offset() const;    // s: the IMU's stamps minus the radar's
+  double elevation_bias() const;  // rad: how much too high the radar's elevations read
   void set_tilt(const Eigen::Vector2d& roll_pitch);
   const InertialWindowOptions& options() const { return options_; }
 
