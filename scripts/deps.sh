@@ -12,6 +12,7 @@ packages=(
   # core (docs/design.md, "Dependencies and pitfalls")
   libceres-dev libeigen3-dev libsuitesparse-dev libmetis-dev
   libyaml-cpp-dev liblzf-dev libcli11-dev nlohmann-json3-dev libtbb-dev zlib1g-dev
+  libsqlite3-dev libzstd-dev liblz4-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

@@ -20,6 +20,7 @@ struct Subcommand {
 };
 
 Subcommand AddInfo(CLI::App& parent);
+Subcommand AddConvert(CLI::App& parent);
 Subcommand AddMerge(CLI::App& parent);
 Subcommand AddSimulate(CLI::App& parent);
 Subcommand AddBuildMap(CLI::App& parent);

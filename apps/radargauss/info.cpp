@@ -24,10 +24,14 @@ struct Range {
   }
 };
 
+// Every topic: type, count, rate over its span and the span (record times).
 int ListTopics(const std::string& bag) {
   std::printf("bag: %s\n", bag.c_str());
   for (const BagTopic& topic : ListBagTopics(bag)) {
-    std::printf("  %-40s %-28s %zu messages\n", topic.name.c_str(), topic.type.c_str(), topic.messages);
+    const double span = topic.last - topic.first;
+    const double rate = topic.messages > 1 && span > 0.0 ? double(topic.messages - 1) / span : 0.0;
+    std::printf("  %-40s %-32s %8zu messages %9.2f Hz  %.3f .. %.3f s (%.3f s)\n", Printable(topic.name).c_str(),
+                Printable(topic.type).c_str(), topic.messages, rate, topic.first, topic.last, span);
   }
   return 0;
 }

@@ -19,7 +19,8 @@ void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::stri
   app->add_option("--extrinsic", options.extrinsic,
                   "T_gt_radar: auto, identity, snail-20231213, or a file 'x y z qx qy qz qw'")
       ->capture_default_str();
-  app->add_option("--bag", options.bag, "ROS1 bag with sensor_msgs/PointCloud2 scans");
+  app->add_option("--bag", options.bag,
+                  "Bag of sensor_msgs/PointCloud2 scans: ROS1 .bag, ROS 2 .db3 or .mcap, or a rosbag2 folder");
   app->add_option("--topic", options.topic, "Topic of the scans in --bag");
   app->add_option("--bin-layout", options.bin_layout,
                   "Field order of .bin records (vod = 'x y z rcs v_r v_r_comp time')")

@@ -128,4 +128,29 @@ RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp, cons
   return scan;
 }
 
+PointCloud2Data EncodePointCloud2(const RadarScan& scan) {
+  PointCloud2Data cloud;
+  std::vector<std::string> names = {"x", "y", "z"};
+  if (scan.has_doppler) names.push_back("doppler");
+  if (scan.has_rcs) names.push_back("rcs");
+  for (std::size_t i = 0; i < names.size(); ++i) cloud.fields.push_back({names[i], std::uint32_t(8 * i), 8, 1});
+  cloud.point_step = std::uint32_t(8 * names.size());
+  cloud.width = std::uint32_t(scan.points.size());
+  cloud.row_step = cloud.width * cloud.point_step;
+  cloud.data.resize(std::size_t(cloud.row_step));
+  std::uint8_t* out = cloud.data.data();
+  for (const RadarPoint& p : scan.points) {
+    double values[5] = {p.position.x(), p.position.y(), p.position.z(), 0.0, 0.0};
+    int n = 3;
+    if (scan.has_doppler) values[n++] = p.doppler;
+    if (scan.has_rcs) values[n++] = p.rcs;
+    for (int i = 0; i < n; ++i) {  // little-endian on every host
+      std::uint64_t bits;
+      std::memcpy(&bits, &values[i], 8);
+      for (int b = 0; b < 8; ++b) *out++ = std::uint8_t(bits >> (8 * b));
+    }
+  }
+  return cloud;
+}
+
 }  // namespace radargauss

@@ -7,6 +7,7 @@
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/PointCloud2.h>
 
+#include <algorithm>
 #include <map>
 
 #include "radargauss/error.hpp"
@@ -29,7 +30,7 @@ void OpenBag(rosbag::Bag& bag, const std::string& path) {
 
 }  // namespace
 
-std::vector<BagTopic> ListBagTopics(const std::string& bag_path) {
+std::vector<BagTopic> ListRos1BagTopics(const std::string& bag_path) {
   rosbag::Bag bag;
   OpenBag(bag, bag_path);
   std::map<std::string, BagTopic> topics;
@@ -40,7 +41,13 @@ std::vector<BagTopic> ListBagTopics(const std::string& bag_path) {
       topic.name = connection->topic;
       topic.type = connection->datatype;
     }
-    for (const rosbag::MessageInstance& message : view) ++topics[message.getTopic()].messages;
+    for (const rosbag::MessageInstance& message : view) {
+      BagTopic& topic = topics[message.getTopic()];
+      const double t = message.getTime().toSec();
+      topic.first = topic.messages == 0 ? t : std::min(topic.first, t);
+      topic.last = std::max(topic.last, t);
+      ++topic.messages;
+    }
   } catch (const std::exception& e) {
     throw FileError(bag_path, std::string("corrupt ROS1 bag: ") + e.what());
   }
@@ -83,8 +90,8 @@ typename Message::ConstPtr Instantiate(const rosbag::MessageInstance& message, c
 
 }  // namespace
 
-std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
-                                    const FieldMapping& mapping) {
+std::vector<RadarScan> ReadRos1BagScans(const std::string& bag_path, const std::string& topic,
+                                        const FieldMapping& mapping) {
   std::vector<RadarScan> scans;
   ForEachMessage(bag_path, topic, [&](const rosbag::MessageInstance& message, const std::string& source) {
     const auto msg = Instantiate<sensor_msgs::PointCloud2>(message, source, "sensor_msgs/PointCloud2");
@@ -102,7 +109,7 @@ std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::stri
   return scans;
 }
 
-std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic, bool record_time) {
+std::vector<ImuSample> ReadRos1BagImu(const std::string& bag_path, const std::string& topic, bool record_time) {
   std::vector<ImuSample> samples;
   ForEachMessage(bag_path, topic, [&](const rosbag::MessageInstance& message, const std::string& source) {
     const auto msg = Instantiate<sensor_msgs::Imu>(message, source, "sensor_msgs/Imu");

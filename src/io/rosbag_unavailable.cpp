@@ -14,11 +14,11 @@ DataError Unavailable(const std::string& path) {
 }  // namespace
 
 bool RosbagSupported() { return false; }
-std::vector<BagTopic> ListBagTopics(const std::string& bag_path) { throw Unavailable(bag_path); }
-std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string&, const FieldMapping&) {
+std::vector<BagTopic> ListRos1BagTopics(const std::string& bag_path) { throw Unavailable(bag_path); }
+std::vector<RadarScan> ReadRos1BagScans(const std::string& bag_path, const std::string&, const FieldMapping&) {
   throw Unavailable(bag_path);
 }
-std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string&, bool) {
+std::vector<ImuSample> ReadRos1BagImu(const std::string& bag_path, const std::string&, bool) {
   throw Unavailable(bag_path);
 }
 

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// sensor_msgs/PointCloud2 topics of ROS1 bags, read through Debian's ROS1 bag
-// library (rosbag::Bag / rosbag::View: uncompressed, bz2 and lz4 bags). An
-// optional component: without it (RosbagSupported() false) every call throws
-// DataError saying so.
+// Bags: ROS1 bags, read through Debian's ROS1 bag library (rosbag::Bag /
+// rosbag::View: uncompressed, bz2 and lz4 bags), and ROS 2 bags
+// (io/rosbag2.hpp: a rosbag2 folder, a .db3 or an .mcap file), told apart by
+// content. ROS1 support is an optional component: without it
+// (RosbagSupported() false) a ROS1 bag gets a DataError saying so.
 #pragma once
 
 #include <cstddef>
@@ -24,8 +25,10 @@ struct BagTopic {
   std::string name;
   std::string type;
   std::size_t messages = 0;
+  double first = 0.0, last = 0.0;  // s: the first and last message's record time
 };
 
+// Every topic of a bag of any kind, with its type, count and time span.
 std::vector<BagTopic> ListBagTopics(const std::string& bag_path);
 
 // One PointCloud2 message, as the bag holds it (for decoding and tests).
@@ -51,9 +54,14 @@ struct PointCloud2Data {
 RadarScan DecodePointCloud2(const PointCloud2Data& cloud, double timestamp, const FieldMapping& mapping,
                             const std::string& source);
 
-// Every PointCloud2 message of `topic`, in bag order. The scan time is the
-// message header stamp, or the bag record time when the stamp is zero (the
-// ti_mmwave driver leaves it zero).
+// A scan as a PointCloud2 of one row: x y z, and doppler and rcs when the
+// scan has them, as FLOAT64 (every value goes back exactly); little-endian.
+PointCloud2Data EncodePointCloud2(const RadarScan& scan);
+
+// Every PointCloud2 message of `topic`, in bag order (a ROS1 bag's time
+// order; a ROS 2 file's: sqlite3 by time, MCAP as written). The scan time is
+// the message header stamp, or the bag record time when the stamp is zero
+// (the ti_mmwave driver leaves it zero).
 std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
                                     const FieldMapping& mapping = {});
 
@@ -63,5 +71,12 @@ std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::stri
 // scans whose header stamp is zero); throws DataError for a missing topic,
 // another message type, non-finite values or stamps that do not increase.
 std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic, bool record_time = false);
+
+// The same three for ROS1 bags alone (src/io/rosbag.cpp, or its stand-in
+// without the library).
+std::vector<BagTopic> ListRos1BagTopics(const std::string& bag_path);
+std::vector<RadarScan> ReadRos1BagScans(const std::string& bag_path, const std::string& topic,
+                                        const FieldMapping& mapping);
+std::vector<ImuSample> ReadRos1BagImu(const std::string& bag_path, const std::string& topic, bool record_time);
 
 }  // namespace radargauss

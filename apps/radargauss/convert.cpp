@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// radargauss convert: a sequence (PCD or KITTI folder, the Snail-Radar
+// layout, a bag of any kind) with its IMU and reference to a ROS 2 bag.
+#include <cstdio>
+#include <memory>
+#include <optional>
+
+#include "commands.hpp"
+#include "radargauss/atomic_file.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/io/imu.hpp"
+#include "radargauss/io/rosbag2.hpp"
+
+namespace radargauss::cli {
+
+namespace {
+
+struct ConvertSettings {
+  SequenceOptions sequence;
+  std::string imu, imu_topic, imu_stamps = "header";
+  std::string out;
+  std::string format;  // mcap, db3; empty: from --out's extension
+  std::string compression = "zstd";
+  bool unchunked = false;
+  BagExportOptions bag;
+};
+
+BagFormat FormatOf(const ConvertSettings& s) {
+  std::string format = s.format;
+  if (format.empty()) {
+    const std::size_t dot = s.out.rfind('.');
+    format = dot == std::string::npos ? "" : s.out.substr(dot + 1);
+  }
+  if (format == "mcap") return BagFormat::kMcap;
+  if (format == "db3") return BagFormat::kSqlite3;
+  throw DataError("--out " + s.out + ": say --format mcap or db3 (or end the name in .mcap or .db3)");
+}
+
+int RunConvert(ConvertSettings s) {
+  const BagFormat format = FormatOf(s);
+  if (!s.imu.empty() && !s.imu_topic.empty()) throw DataError("--imu and --imu-topic: give one");
+  if (!s.imu_topic.empty() && s.sequence.bag.empty()) throw DataError("--imu-topic needs --bag");
+  s.bag.mcap.compression = s.compression == "lz4"    ? McapCompression::kLz4
+                           : s.compression == "none" ? McapCompression::kNone
+                                                     : McapCompression::kZstd;
+  s.bag.mcap.chunked = !s.unchunked;
+  CheckOutputFile(s.out);
+  // Every scan, the reference (when given) at those within its span.
+  SequenceOptions scans_only = s.sequence;
+  scans_only.ground_truth.clear();
+  const Sequence sequence = LoadSequence(scans_only);
+  std::optional<Trajectory> reference;
+  if (!s.sequence.ground_truth.empty()) {
+    reference =
+        ReadRadarTrajectory(s.sequence.ground_truth, ResolveExtrinsic(s.sequence.extrinsic, s.sequence.ground_truth));
+  }
+  const std::vector<ImuSample> imu = !s.imu.empty() ? ReadImuFile(s.imu)
+                                     : !s.imu_topic.empty()
+                                         ? ReadBagImu(s.sequence.bag, s.imu_topic, s.imu_stamps == "record")
+                                         : std::vector<ImuSample>{};
+  WriteRos2Bag(s.out, format, sequence.scans, imu, reference ? &*reference : nullptr, s.bag);
+  std::printf("wrote %s: %zu scans on %s%s%s\n", s.out.c_str(), sequence.scans.size(), s.bag.scan_topic.c_str(),
+              imu.empty() ? "" : (", " + std::to_string(imu.size()) + " IMU samples on " + s.bag.imu_topic).c_str(),
+              reference ? (", reference poses on " + s.bag.pose_topic).c_str() : "");
+  return 0;
+}
+
+}  // namespace
+
+Subcommand AddConvert(CLI::App& parent) {
+  auto s = std::make_shared<ConvertSettings>();
+  CLI::App* app = parent.add_subcommand("convert", "Write a sequence (scans, IMU, reference) as a ROS 2 bag");
+  AddSequenceOptions(app, s->sequence);
+  app->add_option("--imu", s->imu, "IMU file of lines 'stamp wx wy wz ax ay az' to include");
+  app->add_option("--imu-topic", s->imu_topic, "sensor_msgs/Imu topic of --bag to include");
+  app->add_option("--imu-stamps", s->imu_stamps, "Stamp the IMU by its header or by the bag's record time")
+      ->check(CLI::IsMember({"header", "record"}))
+      ->capture_default_str();
+  app->add_option("--out", s->out, "The bag file to write (.mcap or .db3)")->required();
+  app->add_option("--format", s->format, "mcap or db3 (default: --out's extension)")
+      ->check(CLI::IsMember({"mcap", "db3"}));
+  app->add_option("--compression", s->compression, "MCAP chunk compression")
+      ->check(CLI::IsMember({"zstd", "lz4", "none"}))
+      ->capture_default_str();
+  app->add_flag("--unchunked", s->unchunked, "MCAP without chunks (no compression, no message indexes)");
+  app->add_option("--scan-topic", s->bag.scan_topic, "Topic of the scans")->capture_default_str();
+  app->add_option("--imu-topic-out", s->bag.imu_topic, "Topic of the IMU")->capture_default_str();
+  app->add_option("--pose-topic", s->bag.pose_topic, "Topic of the reference poses")->capture_default_str();
+  return {app, [s] { return RunConvert(*s); }};
+}
+
+}  // namespace radargauss::cli
