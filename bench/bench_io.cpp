@@ -11,6 +11,7 @@
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/rosbag.hpp"
+#include "radargauss/io/rosbag2.hpp"
 #include "radargauss/simulator.hpp"
 
 namespace radargauss {
@@ -90,8 +91,49 @@ void BM_ReadBag(benchmark::State& state) {
     }
   }
   state.counters["points/s"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate);
+  state.counters["scans/s"] = benchmark::Counter(412.0 * double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["file MB/s"] =
+      benchmark::Counter(double(fs::file_size(bag)) * double(state.iterations()) / 1e6, benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_ReadBag)->Unit(benchmark::kMillisecond);
+
+// The same 412 scans converted to ROS 2 bags (x y z doppler rcs as FLOAT64),
+// written once into the temporary folder: 0 zstd .mcap, 1 lz4 .mcap,
+// 2 unchunked .mcap, 3 .db3. Counters: scans and file bytes per second.
+void BM_ReadRos2Bag(benchmark::State& state) {
+  const std::string ros1 = std::string(RADARGAUSS_SHARED_DATA_DIR) + "/ti_mmwave_demo/demo_ti_mmwave_rospkg_format.bag";
+  if (!RosbagSupported() || !fs::exists(ros1)) {
+    state.SkipWithError("no ROS1 bag support or no shared data");
+    return;
+  }
+  static const std::vector<std::string> bags = [&] {
+    const std::vector<RadarScan> scans = ReadBagScans(ros1, "/ti_mmwave/radar_scan_pcl");
+    const std::string dir = (fs::temp_directory_path() / "radargauss_bench_io").string();
+    fs::create_directories(dir);
+    std::vector<std::string> paths;
+    const std::pair<const char*, McapCompression> mcaps[] = {{"zstd.mcap", McapCompression::kZstd},
+                                                             {"lz4.mcap", McapCompression::kLz4},
+                                                             {"unchunked.mcap", McapCompression::kNone}};
+    for (const auto& [name, compression] : mcaps) {
+      BagExportOptions options;
+      options.mcap.compression = compression;
+      options.mcap.chunked = std::string(name) != "unchunked.mcap";
+      paths.push_back(dir + "/" + name);
+      WriteRos2Bag(paths.back(), BagFormat::kMcap, scans, {}, nullptr, options);
+    }
+    paths.push_back(dir + "/bag.db3");
+    WriteRos2Bag(paths.back(), BagFormat::kSqlite3, scans, {}, nullptr);
+    return paths;
+  }();
+  const std::string& bag = bags[std::size_t(state.range(0))];
+  std::size_t scans = 0;
+  for (auto _ : state) scans += ReadBagScans(bag, "/radar/points").size();
+  state.SetLabel(fs::path(bag).filename().string());
+  state.counters["scans/s"] = benchmark::Counter(double(scans), benchmark::Counter::kIsRate);
+  state.counters["file MB/s"] =
+      benchmark::Counter(double(fs::file_size(bag)) * double(state.iterations()) / 1e6, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_ReadRos2Bag)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 
 void BM_EgoVelocity800(benchmark::State& state) {
   const RadarScan& scan = BenchmarkScan();

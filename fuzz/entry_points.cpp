@@ -14,7 +14,9 @@
 #include "radargauss/error.hpp"
 #include "radargauss/experiment.hpp"
 #include "radargauss/io/kitti_bin.hpp"
+#include "radargauss/io/mcap.hpp"
 #include "radargauss/io/pcd.hpp"
+#include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/simulator.hpp"
@@ -144,6 +146,40 @@ void PointCloud2(const std::uint8_t* data, std::size_t size) {
   Expecting([&] { DecodePointCloud2(cloud, 1702450000.5, FieldMapping(), "message"); });
 }
 
+// An MCAP file, every message visited (chunks decompressed, CRCs checked).
+void Mcap(const std::uint8_t* data, std::size_t size) {
+  const std::string path = WriteInput(data, size, "bag.mcap");
+  Expecting([&] {
+    McapReader reader(path);
+    reader.ForEachMessage([](const McapMessage&) {});
+  });
+}
+
+// The first byte picks the message type; the rest is its CDR. A point cloud
+// that decodes goes on to DecodePointCloud2, as a bag's scans do.
+void Cdr(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return;
+  static const char* kPoseTypes[] = {"geometry_msgs/msg/PoseStamped", "nav_msgs/msg/Odometry",
+                                     "tf2_msgs/msg/TFMessage"};
+  const int kind = data[0] % 5;
+  ++data;
+  --size;
+  Expecting([&] {
+    if (kind == 0) {
+      PointCloud2Data cloud;
+      const Ros2Header header = DecodeRos2PointCloud2(data, size, "message", cloud);
+      DecodePointCloud2(cloud, header.stamp, FieldMapping(), "message");
+    } else if (kind == 1) {
+      ImuSample sample;
+      DecodeRos2Imu(data, size, "message", sample);
+    } else {
+      double stamp = 0.0;
+      SE3d pose;
+      DecodeRos2Pose(kPoseTypes[kind - 2], data, size, "message", "base_link", stamp, pose);
+    }
+  });
+}
+
 void SimulatorYaml(const std::uint8_t* data, std::size_t size) {
   const std::string path = WriteInput(data, size, "world.yaml");
   Expecting([&] { LoadSimulationConfig(path); });
@@ -176,7 +212,8 @@ const std::vector<Target>& Targets() {
   static const std::vector<Target> targets = {
       {"pcd", Pcd},          {"kitti_bin", KittiBin},      {"tum", Tum},
       {"map_file", MapFile}, {"pointcloud2", PointCloud2}, {"simulator_yaml", SimulatorYaml},
-      {"cli_yaml", CliYaml}, {"shard_json", ShardJson},    {"map_places", MapPlaces}};
+      {"cli_yaml", CliYaml}, {"shard_json", ShardJson},    {"map_places", MapPlaces},
+      {"mcap", Mcap},        {"cdr", Cdr}};
   return targets;
 }
 

@@ -22,7 +22,7 @@ struct Target {
 };
 
 // pcd, kitti_bin, tum, map_file, pointcloud2, simulator_yaml, cli_yaml,
-// shard_json, map_places.
+// shard_json, map_places, mcap, cdr.
 const std::vector<Target>& Targets();
 
 }  // namespace radargauss::fuzz

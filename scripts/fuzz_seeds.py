@@ -134,6 +134,78 @@ def pointcloud2_seeds(rng):
         struct.pack("<dddhf", *p[:3], int(p[3]), p[4]) for p in cloud[:2]))
 
 
+def mcap_record(opcode, body):
+    return struct.pack("<BQ", opcode, len(body)) + body
+
+
+def mcap_string(text):
+    return struct.pack("<I", len(text)) + text.encode()
+
+
+def mcap_bytes(chunked):
+    """An MCAP file of one channel and three messages, chunked (uncompressed) or not, with a summary."""
+    magic = b"\x89MCAP0\r\n"
+    schema = mcap_record(0x03, struct.pack("<H", 1) + mcap_string("std_msgs/msg/String") + mcap_string("ros2msg") +
+                         mcap_string("string data\n"))
+    channel = mcap_record(0x04, struct.pack("<HH", 1, 1) + mcap_string("/chatter") + mcap_string("cdr") +
+                          struct.pack("<I", 0))
+    messages = b"".join(mcap_record(0x05, struct.pack("<HIQQ", 1, k, 100 + k, 100 + k) + b"\x00\x01\x00\x00" +
+                                    struct.pack("<I", 3) + b"hi\x00") for k in range(3))
+    data = schema + channel + messages
+    if chunked:
+        data = mcap_record(0x06, struct.pack("<QQQI", 100, 102, len(data), zlib.crc32(data)) + mcap_string("") +
+                           struct.pack("<Q", len(data)) + data)
+    head = magic + mcap_record(0x01, mcap_string("ros2") + mcap_string("seed")) + data
+    head += mcap_record(0x0F, struct.pack("<I", zlib.crc32(head)))
+    summary_start = len(head)
+    summary = schema + channel + mcap_record(0x0B, struct.pack("<QHIIIIQQI", 3, 1, 1, 0, 0, int(chunked), 100, 102,
+                                                                 10) + struct.pack("<HQ", 1, 3))
+    footer_head = struct.pack("<BQQQ", 0x02, 20, summary_start, 0)
+    crc = zlib.crc32(summary + footer_head)
+    return head + summary + footer_head + struct.pack("<I", crc) + magic
+
+
+def mcap_seeds(rng):
+    yield "unchunked.mcap", mcap_bytes(False)
+    yield "chunked.mcap", mcap_bytes(True)
+    yield from files("tests/data/rosbag2/*.mcap", "tests/data/rosbag2/talker/*.mcap")
+
+
+def cdr_header(stamp, frame):
+    out = b"\x00\x01\x00\x00" + struct.pack("<iI", int(stamp), 0) + struct.pack("<I", len(frame) + 1)
+    return out + frame.encode() + b"\x00"
+
+
+def cdr_align(out, n):
+    return out + b"\x00" * ((-(len(out) - 4)) % n)
+
+
+def cdr_seeds(rng):
+    cloud = points(6, rng)
+    msg = cdr_header(1702450000, "radar")
+    msg = cdr_align(msg, 4) + struct.pack("<II", 1, len(cloud)) + struct.pack("<I", 5)
+    for k, name in enumerate(["x", "y", "z", "rcs", "doppler"]):
+        msg = cdr_align(msg, 4) + struct.pack("<I", len(name) + 1) + name.encode() + b"\x00"
+        msg = cdr_align(msg, 4) + struct.pack("<I", 4 * k) + struct.pack("<B", 7)
+        msg = cdr_align(msg, 4) + struct.pack("<I", 1)
+    msg += struct.pack("<B", 0)
+    msg = cdr_align(msg, 4) + struct.pack("<III", 20, 20 * len(cloud), 20 * len(cloud))
+    msg += b"".join(struct.pack("<5f", *p) for p in cloud) + b"\x01"
+    yield "pointcloud2.bin", b"\x00" + msg
+    imu = cdr_align(cdr_header(5, "imu"), 8) + struct.pack("<4d", 0, 0, 0, 1) + struct.pack("<9d", *[0] * 9)
+    imu += struct.pack("<3d", 0.01, -0.02, 0.3) + struct.pack("<9d", *[0] * 9)
+    imu += struct.pack("<3d", 0.1, 0.2, 9.81) + struct.pack("<9d", *[0] * 9)
+    yield "imu.bin", b"\x01" + imu
+    pose = struct.pack("<7d", 1, 2, 3, 0, 0, 0, 1)
+    yield "pose_stamped.bin", b"\x02" + cdr_align(cdr_header(7, "map"), 8) + pose
+    odometry = cdr_header(8, "odom")
+    odometry = cdr_align(odometry, 4) + struct.pack("<I", 10) + b"base_link\x00"
+    yield "odometry.bin", b"\x03" + cdr_align(odometry, 8) + pose + struct.pack("<36d", *[0] * 36)
+    tf = b"\x00\x01\x00\x00" + struct.pack("<I", 1) + struct.pack("<iI", 9, 0) + struct.pack("<I", 4) + b"map\x00"
+    tf = cdr_align(tf + struct.pack("<I", 10) + b"base_link\x00", 8) + pose
+    yield "tf.bin", b"\x04" + tf
+
+
 def shard_json_seeds(rng):
     """Valid shard.json files (one shard of one and the first of two)."""
     import json
@@ -173,6 +245,7 @@ def main():
         "pointcloud2": pointcloud2_seeds(rng), "simulator_yaml": files("configs/synthetic_world.yaml", "configs/synthetic_long_drive.yaml"),
         "cli_yaml": files("configs/*_localize.yaml", "configs/*_odometry.yaml"),
         "shard_json": shard_json_seeds(rng), "map_places": map_places_seeds(rng),
+        "mcap": mcap_seeds(rng), "cdr": cdr_seeds(rng),
     }
     for target, items in seeds.items():
         folder = os.path.join(sys.argv[1], target)

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@ struct Subcommand {
 
 Subcommand AddInfo(CLI::App& parent);
 Subcommand AddConvert(CLI::App& parent);
+Subcommand AddExport(CLI::App& parent);
 Subcommand AddMerge(CLI::App& parent);
 Subcommand AddSimulate(CLI::App& parent);
 Subcommand AddBuildMap(CLI::App& parent);
@@ -64,6 +66,12 @@ MapGeometry BuildGeometry(const Sequence& sequence, const MapBuildSettings& sett
 // summary when `verbose`.
 GaussianMap FitRcsModelsOf(const MapGeometry& geometry, const MapBuildSettings& settings, IncidenceModel incidence,
                            int degree, bool verbose);
+
+// The results folder `run` as an MCAP file (run_mcap.hpp) at `mcap`, with
+// the scans registered by the run's poses (matched by stamp) and the
+// reference aligned to the run at its first pose.
+void WriteRunForViewer(const std::string& run, const std::vector<RadarScan>& scans,
+                       const std::optional<Trajectory>& reference, const std::string& mcap);
 
 // reference.tum of a localisation experiment into `out`: the reference pose
 // of each matched scan (times in scan order; repeated times once).

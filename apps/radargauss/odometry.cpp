@@ -83,6 +83,7 @@ int RunOdometry(const OdometrySettings& s) {
   WriteOdometry(folder.path(), odometry, inertial ? &inertial->fusion() : nullptr);
   const std::string table = evaluation ? WriteEvaluation(folder.path(), *evaluation) : std::string();
   folder.Commit();
+  if (!s.mcap.empty()) WriteRunForViewer(s.out, sequence.scans, reference, s.mcap);
   PrintSummary(Summarise(odometry));
   const std::optional<Mounting> mounting = EstimateMounting(odometry.steps());
   if (mounting) {

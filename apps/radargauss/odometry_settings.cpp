@@ -145,6 +145,7 @@ void AddRunOptions(CLI::App* app, OdometrySettings& s) {
   app->add_option("--first-scan", s.first_scan, "Skip the scans before this one (0: none)")->capture_default_str();
   app->add_option("--max-scans", s.max_scans, "Only the first N scans from --first-scan (0: all)")
       ->capture_default_str();
+  app->add_option("--mcap", s.mcap, "Also write the run as an MCAP file a robotics viewer opens (as export does)");
 }
 
 std::string SequenceName(const SequenceOptions& sequence) {
@@ -180,6 +181,7 @@ RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs) {
 }
 
 StagedFolder RunFolder(const OdometrySettings& s, std::vector<std::string> outputs) {
+  if (!s.mcap.empty()) CheckOutputFile(s.mcap);
   std::error_code error;
   if (!s.sequence.sequence_dir.empty() && std::filesystem::equivalent(s.out, s.sequence.sequence_dir, error)) {
     throw FileError(s.out, "is the sequence's own folder; refused as an output folder");

@@ -34,6 +34,7 @@ struct OdometrySettings {
   std::string matcher = "gaussians";  // or a PCL peer
   std::string imu_fusion = "window";  // or "gyro": the rates for the prediction only
   RadarInertialOptions inertial;      // the window's, with --imu-fusion window
+  std::string mcap;                   // --mcap: the run for a viewer (run_mcap.hpp)
 };
 
 // The matcher of a map version: the Gaussian solvers, or a PCL peer.

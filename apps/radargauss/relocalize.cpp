@@ -94,6 +94,7 @@ int RunRelocalize(const RelocalizeSettings& s) {
   std::string table;
   if (reference && located.size() >= 3) table = WriteEvaluation(out.string(), EvaluateTrajectory(located, *reference));
   folder.Commit();
+  if (!s.odometry.mcap.empty()) WriteRunForViewer(s.odometry.out, sequence.scans, reference, s.odometry.mcap);
   if (fix) {
     std::printf("relocalize: first fix at scan %zu (%.1f s in); %zu of %zu scans located, %zu matched to the map\n",
                 *fix, sequence.scans[*fix].timestamp - sequence.scans.front().timestamp, located.size(),

@@ -65,6 +65,7 @@ int RunSlam(const SlamSettings& s) {
     tables = WriteEvaluation(out, EvaluateTrajectory(slam.trajectory(), *reference));
   }
   folder.Commit();
+  if (!s.odometry.mcap.empty()) WriteRunForViewer(s.odometry.out, sequence.scans, reference, s.odometry.mcap);
   const SlamSummary summary = Summarise(slam);
   std::printf(
       "slam: %zu scans, %zu keyframes, %zu candidates compared, %zu verified, %zu loops (%zu false injected); place "

@@ -379,7 +379,7 @@ def read_pcd(path: str) -> Scan:
     """One PCD scan (ascii, binary or binary_compressed); the stamp from a <secs>.<nsecs>.pcd name."""
 
 def read_sequence(path: str = '', gt: str = '', extrinsic: str = 'auto', bag: str = '', topic: str = '', rcs_field: str = '', doppler_field: str = '', elevation_bias_deg: float = 0.0) -> Sequence:
-    """Reads a sequence as `radargauss info` does: a Snail-Radar folder, a folder of .pcd or .bin scans (path), or a ROS1 bag (bag, topic); gt: a TUM file of reference poses, extrinsic T_gt_radar; elevation_bias_deg removed from every point."""
+    """Reads a sequence as `radargauss info` does: a Snail-Radar folder, a folder of .pcd or .bin scans (path), or a bag (bag, topic: a ROS1 .bag, a ROS 2 .db3 or .mcap, a rosbag2 folder); gt: a TUM file of reference poses, extrinsic T_gt_radar; elevation_bias_deg removed from every point."""
 
 def read_tum(path: str) -> tuple:
     """A TUM file as (stamps (N,), poses (N, 7) [x y z qx qy qz qw])."""

@@ -127,7 +127,8 @@ void BindSequence(py::module_& m) {
       py::arg("topic") = "", py::arg("rcs_field") = "", py::arg("doppler_field") = "",
       py::arg("elevation_bias_deg") = 0.0,
       "Reads a sequence as `radargauss info` does: a Snail-Radar folder, a folder of .pcd or .bin scans "
-      "(path), or a ROS1 bag (bag, topic); gt: a TUM file of reference poses, extrinsic T_gt_radar; "
+      "(path), or a bag (bag, topic: a ROS1 .bag, a ROS 2 .db3 or .mcap, a rosbag2 folder); gt: a TUM file of "
+      "reference poses, extrinsic T_gt_radar; "
       "elevation_bias_deg removed from every point.");
   m.def(
       "read_pcd", [](const std::string& path) { return ReadPcdScan(path); }, py::arg("path"),

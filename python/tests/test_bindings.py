@@ -69,6 +69,22 @@ def test_tum_round_trip_is_byte_exact(written, tmp_path):
     assert open(copy).read() == open(written["gt"]).read()
 
 
+@pytest.mark.parametrize("suffix", [".mcap", ".db3"])
+def test_read_sequence_from_a_ros2_bag_equals_the_folder(cli, written, tmp_path, suffix):
+    bag = str(tmp_path / ("seq" + suffix))
+    subprocess.run([cli, "convert", "--sequence", written["sequence"], "--out", bag], check=True,
+                   stdout=subprocess.DEVNULL)
+    folder = rg.read_sequence(written["sequence"])
+    from_bag = rg.read_sequence(bag=bag, topic="/radar/points")
+    assert len(from_bag.scans) == len(folder.scans) == 20
+    for a, b in zip(folder.scans, from_bag.scans):
+        assert a.stamp == b.stamp
+        assert np.array_equal(a.points, b.points) and np.array_equal(a.doppler, b.doppler)
+        assert np.array_equal(a.rcs, b.rcs)
+    with pytest.raises(ValueError, match="no messages on topic"):
+        rg.read_sequence(bag=bag, topic="/absent")
+
+
 def test_build_map_in_python_equals_build_map_of_the_cli(written):
     sequence = rg.read_sequence(written["sequence"], gt=written["gt"])
     built, read = rg.build_map(sequence), rg.read_map(written["map"])

@@ -91,9 +91,21 @@ std::vector<std::uint8_t> Decompress(const std::string& compression, const std::
     throw FileError(path, "a chunk of " + std::to_string(uncompressed_size) + " bytes uncompressed is past the " +
                               std::to_string(kMaxMcapChunkBytes >> 20) + " MiB limit");
   }
+  // A zstd frame states its content size: a chunk that disagrees is refused
+  // before its buffer is allocated.
+  if (compression == "zstd") {
+    const unsigned long long content = ZSTD_getFrameContentSize(data, size);
+    if (content == ZSTD_CONTENTSIZE_ERROR) throw FileError(path, "a zstd chunk is not a zstd frame");
+    if (content != ZSTD_CONTENTSIZE_UNKNOWN && content != uncompressed_size) {
+      throw FileError(path, "a zstd chunk's frame holds " + std::to_string(content) + " bytes, the chunk states " +
+                                std::to_string(uncompressed_size));
+    }
+  }
+  if (compression.empty() && size != uncompressed_size) {
+    throw FileError(path, "an uncompressed chunk's sizes disagree");
+  }
   std::vector<std::uint8_t> out(static_cast<std::size_t>(uncompressed_size));
   if (compression.empty()) {
-    if (size != uncompressed_size) throw FileError(path, "an uncompressed chunk's sizes disagree");
     std::copy(data, data + size, out.begin());
   } else if (compression == "zstd") {
     const std::size_t n = ZSTD_decompress(out.data(), out.size(), data, size);

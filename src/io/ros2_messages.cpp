@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <stdexcept>
 
 #include "radargauss/error.hpp"
 
@@ -174,6 +175,9 @@ const std::string kQuaternionDefinition =
 const std::string kVector3Definition =
     std::string(kRule) + "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z\n";
 const std::string kPointDefinition = std::string(kRule) + "MSG: geometry_msgs/Point\nfloat64 x\nfloat64 y\nfloat64 z\n";
+const std::string kPoseDefinition = std::string(kRule) +
+                                    "MSG: geometry_msgs/Pose\nPoint position\nQuaternion orientation\n" +
+                                    kPointDefinition + kQuaternionDefinition;
 
 }  // namespace
 
@@ -301,9 +305,67 @@ std::vector<std::uint8_t> EncodeRos2Imu(const Ros2Header& header, const ImuSampl
 std::vector<std::uint8_t> EncodeRos2PoseStamped(const Ros2Header& header, const SE3d& pose, CdrEncoding encoding) {
   CdrWriter cdr(encoding);
   cdr.Header(header);
+  const Eigen::Quaterniond& q = pose.rotation().quaternion();
+  cdr.Vector3(pose.translation());
+  for (const double c : {q.x(), q.y(), q.z(), q.w()}) cdr.Write(c);
+  return std::move(cdr.bytes());
+}
+
+namespace {
+
+void WritePose(CdrWriter& cdr, const SE3d& pose) {
   cdr.Vector3(pose.translation());
   const Eigen::Quaterniond& q = pose.rotation().quaternion();
   for (const double c : {q.x(), q.y(), q.z(), q.w()}) cdr.Write(c);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> EncodeRos2Path(const Ros2Header& header, const std::vector<double>& stamps,
+                                         const std::vector<SE3d>& poses, CdrEncoding encoding) {
+  if (stamps.size() != poses.size()) throw std::invalid_argument("EncodeRos2Path: stamps and poses differ in count");
+  CdrWriter cdr(encoding);
+  cdr.Header(header);
+  cdr.Write(std::uint32_t(poses.size()));
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    cdr.Header({stamps[k], header.frame_id});
+    WritePose(cdr, poses[k]);
+  }
+  return std::move(cdr.bytes());
+}
+
+std::vector<std::uint8_t> EncodeRos2Transform(const Ros2Header& header, const std::string& child, const SE3d& pose,
+                                              CdrEncoding encoding) {
+  CdrWriter cdr(encoding);
+  cdr.Write(std::uint32_t(1));
+  cdr.Header(header);
+  cdr.String(child);
+  WritePose(cdr, pose);  // Transform: translation, rotation
+  return std::move(cdr.bytes());
+}
+
+std::vector<std::uint8_t> EncodeRos2MarkerArray(const std::vector<Ros2Marker>& markers, CdrEncoding encoding) {
+  CdrWriter cdr(encoding);
+  cdr.Write(std::uint32_t(markers.size()));
+  for (const Ros2Marker& m : markers) {
+    cdr.Header(m.header);
+    cdr.String(m.ns);
+    cdr.Write(m.id);
+    cdr.Write(m.type);
+    cdr.Write(std::int32_t(0));  // ADD
+    WritePose(cdr, m.pose);
+    cdr.Vector3(m.scale);
+    for (int i = 0; i < 4; ++i) cdr.Write(m.color(i));
+    cdr.Write(std::int32_t(0));  // lifetime: forever
+    cdr.Write(std::uint32_t(0));
+    cdr.Write(std::uint8_t(0));  // frame_locked
+    cdr.Write(std::uint32_t(m.points.size()));
+    for (const Eigen::Vector3d& p : m.points) cdr.Vector3(p);
+    cdr.Write(std::uint32_t(0));  // colors
+    cdr.String("");               // text
+    cdr.String("");               // mesh_resource
+    cdr.Write(std::uint8_t(0));   // mesh_use_embedded_materials
+  }
   return std::move(cdr.bytes());
 }
 
@@ -321,9 +383,24 @@ const std::string& Ros2MessageDefinition(const std::string& type) {
        "geometry_msgs/Vector3 angular_velocity\nfloat64[9] angular_velocity_covariance\n"
        "geometry_msgs/Vector3 linear_acceleration\nfloat64[9] linear_acceleration_covariance\n" +
            kHeaderDefinition + kQuaternionDefinition + kVector3Definition},
-      {"geometry_msgs/msg/PoseStamped", "std_msgs/Header header\nPose pose\n" + kHeaderDefinition + kRule +
-                                            "MSG: geometry_msgs/Pose\nPoint position\nQuaternion orientation\n" +
-                                            kPointDefinition + kQuaternionDefinition},
+      {"geometry_msgs/msg/PoseStamped", "std_msgs/Header header\nPose pose\n" + kHeaderDefinition + kPoseDefinition},
+      {"nav_msgs/msg/Path", "std_msgs/Header header\ngeometry_msgs/PoseStamped[] poses\n" + kHeaderDefinition + kRule +
+                                "MSG: geometry_msgs/PoseStamped\nstd_msgs/Header header\nPose pose\n" +
+                                kPoseDefinition},
+      {"tf2_msgs/msg/TFMessage",
+       "geometry_msgs/TransformStamped[] transforms\n" + std::string(kRule) +
+           "MSG: geometry_msgs/TransformStamped\nstd_msgs/Header header\nstring child_frame_id\nTransform transform\n" +
+           kHeaderDefinition + kRule + "MSG: geometry_msgs/Transform\nVector3 translation\nQuaternion rotation\n" +
+           kVector3Definition + kQuaternionDefinition},
+      {"visualization_msgs/msg/MarkerArray",
+       "Marker[] markers\n" + std::string(kRule) +
+           "MSG: visualization_msgs/Marker\nstd_msgs/Header header\nstring ns\nint32 id\nint32 type\nint32 action\n"
+           "geometry_msgs/Pose pose\ngeometry_msgs/Vector3 scale\nstd_msgs/ColorRGBA color\n"
+           "builtin_interfaces/Duration lifetime\nbool frame_locked\ngeometry_msgs/Point[] points\n"
+           "std_msgs/ColorRGBA[] colors\nstring text\nstring mesh_resource\nbool mesh_use_embedded_materials\n" +
+           kHeaderDefinition + kPoseDefinition + kVector3Definition + kRule +
+           "MSG: std_msgs/ColorRGBA\nfloat32 r\nfloat32 g\nfloat32 b\nfloat32 a\n" + kRule +
+           "MSG: builtin_interfaces/Duration\nint32 sec\nuint32 nanosec\n"},
   };
   const auto found = definitions.find(type);
   if (found == definitions.end()) throw DataError("no message definition for " + type);

@@ -13,12 +13,14 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "radargauss/error.hpp"
 #include "radargauss/io/mcap.hpp"
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/run_mcap.hpp"
 #include "radargauss/simulator.hpp"
 #include "support/temp_dir.hpp"
 
@@ -458,6 +460,66 @@ TEST_F(Rosbag2Files, NothingIsLeftBehindWhenAWriteFails) {
   }  // not finished: nothing at `path`, no temporary beside it
   EXPECT_FALSE(std::filesystem::exists(path));
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir_), std::filesystem::directory_iterator()), 0);
+}
+
+// A run written for a viewer and read back by the MCAP reader: one pose, tf
+// and registered scan per scan, the path equal to the poses, the map's
+// means and one ellipsoid per Gaussian, the loops as one line list.
+TEST_F(Rosbag2Files, ARunForAViewerReadsBack) {
+  SimulationConfig config;
+  config.scans = 30;
+  const Sequence sequence = AsSequence(Simulate(config));
+  RunForViewer run;
+  for (const RadarScan& scan : sequence.scans) run.stamps.push_back(scan.timestamp);
+  run.poses = sequence.poses;
+  run.scans = sequence.scans;
+  for (int i = 0; i < 4; ++i) {
+    Gaussian g;
+    g.mean = Eigen::Vector3d(i, 2.0 * i, 0.5);
+    g.covariance = Eigen::Vector3d(0.5, 0.2, 0.1 + i).asDiagonal();
+    g.point_count = 10 + i;
+    run.map.gaussians.push_back(g);
+  }
+  run.loops.push_back({Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 0)});
+  WriteRunMcap(Path("run.mcap"), run);
+  McapReader reader(Path("run.mcap"));
+  std::map<std::string, std::size_t> counts;
+  for (const McapChannel& c : reader.channels()) counts[c.topic] = c.message_count;
+  EXPECT_EQ(counts["/radar/pose"], 30u);
+  EXPECT_EQ(counts["/tf"], 30u);
+  EXPECT_EQ(counts["/radar/registered"], 30u);
+  EXPECT_EQ(counts["/trajectory"], 1u);
+  EXPECT_EQ(counts["/map/ellipsoids"], 1u);
+  std::size_t scan = 0;
+  reader.ForEachMessage([&](const McapMessage& m) {
+    const std::string& topic = m.channel->topic;
+    if (topic == "/radar/pose") {
+      double stamp;
+      SE3d pose;
+      ASSERT_TRUE(DecodeRos2Pose(m.channel->schema_name, m.data, m.size, "m", "", stamp, pose));
+      EXPECT_EQ(stamp, run.stamps[scan]);
+      EXPECT_LT((pose.translation() - run.poses[scan].translation()).norm(), 1e-12);
+    } else if (topic == "/tf") {
+      double stamp;
+      SE3d pose;
+      ASSERT_TRUE(DecodeRos2Pose(m.channel->schema_name, m.data, m.size, "m", "radar", stamp, pose));
+      EXPECT_LT((pose.translation() - run.poses[scan].translation()).norm(), 1e-12);
+    } else if (topic == "/radar/registered") {
+      PointCloud2Data cloud;
+      const Ros2Header header = DecodeRos2PointCloud2(m.data, m.size, "m", cloud);
+      EXPECT_EQ(header.frame_id, "map");
+      const RadarScan registered = DecodePointCloud2(cloud, header.stamp, {}, "m");
+      ASSERT_EQ(registered.points.size(), run.scans[scan].points.size());
+      const Eigen::Vector3d expected = run.poses[scan] * run.scans[scan].points[0].position;
+      EXPECT_LT((registered.points[0].position - expected).norm(), 1e-12);
+      ++scan;
+    } else if (topic == "/map/gaussians") {
+      PointCloud2Data cloud;
+      DecodeRos2PointCloud2(m.data, m.size, "m", cloud);
+      EXPECT_EQ(cloud.width, 4u);
+    }
+  });
+  EXPECT_EQ(scan, 30u);
 }
 
 }  // namespace

@@ -58,6 +58,11 @@ expect_fail "no sequence at all" "radargauss: error: no sequence" -- "$tool" inf
 expect_fail "simulate without --out" "out" -- "$tool" simulate
 expect_fail "bad scan count" "scans" -- "$tool" simulate --out "$work/s" --scans -3
 expect_ok "simulate" "simulated 6 scans" -- "$tool" simulate --out "$work/seq" --scans 6 --seed 3
+expect_ok "convert to a ROS 2 bag" "wrote $work/seq.db3: 6 scans" -- \
+  "$tool" convert --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --out "$work/seq.db3"
+expect_ok "info on the ROS 2 bag" "/reference/pose .*geometry_msgs/msg/PoseStamped *6 messages" -- \
+  "$tool" info --bag "$work/seq.db3"
+expect_ok "info on the ROS 2 bag's scans" "scans: 6 read" -- "$tool" info --bag "$work/seq.db3" --topic /radar/points
 expect_ok "info on the simulation" "scans: 6 read, 6 matched" -- \
   "$tool" info --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt"
 expect_fail "simulate over an existing sequence" "already holds" -- \

@@ -303,5 +303,30 @@ touch "$work/a_file"
 expect_fail "odometry --out a file" "a_file: exists and is not a folder" -- "$tool" odometry "${seq[@]}" --out "$work/a_file"
 
 
+# ROS 2 bags (docs/design.md, "ROS 2 bags"): a bag of the sequence, then lies about it.
+"$tool" convert "${seq[@]}" --out "$work/seq.mcap" >/dev/null
+bag_bytes=$(stat -c %s "$work/seq.mcap")
+head -c $((bag_bytes - 100)) "$work/seq.mcap" >"$work/cut.mcap"
+expect_fail "odometry on a truncated .mcap" "cut.mcap: MCAP file is truncated" -- \
+  "$tool" odometry --bag "$work/cut.mcap" --topic /radar/points --out "$work/cut_run"
+[[ ! -e "$work/cut_run" ]] || { echo "FAIL: a failed odometry left its output folder"; failed=$((failed + 1)); }
+# The first chunk's uncompressed size (after magic, header record and the chunk's times) set to 10 GB.
+cp "$work/seq.mcap" "$work/huge.mcap"
+printf '\x00\x00\x00\x80\x02\x00\x00\x00' | dd of="$work/huge.mcap" bs=1 seek=$((8 + 31 + 9 + 16)) conv=notrunc 2>/dev/null
+expect_fail "a chunk that claims 10 GB" "MiB limit" -- "$tool" info --bag "$work/huge.mcap" --topic /radar/points
+/usr/bin/python3 -c "import sqlite3, sys; c = sqlite3.connect(sys.argv[1]); c.execute('create table notes(t)'); c.commit()" \
+  "$work/notes.db3"
+expect_fail "a sqlite file that is not a bag" "not a rosbag2 sqlite3 file" -- \
+  "$tool" info --bag "$work/notes.db3"
+mkdir -p "$work/escape"
+printf 'rosbag2_bagfile_information:\n  relative_file_paths: [../seq.mcap]\n' >"$work/escape/metadata.yaml"
+expect_fail "a rosbag2 folder that points outside itself" "not inside the bag's folder" -- \
+  "$tool" info --bag "$work/escape"
+expect_fail "convert to an unknown format" "say --format" -- "$tool" convert "${seq[@]}" --out "$work/seq.bag2"
+expect_fail "convert into a missing folder" "radargauss: error:" -- \
+  "$tool" convert "${seq[@]}" --out "$work/absent/seq.mcap"
+printf 'not a bag at all\n' >"$work/text.mcap"
+expect_fail "a text file named .mcap" "not a bag" -- "$tool" info --bag "$work/text.mcap"
+
 echo "hostile cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -47,6 +47,27 @@ std::vector<std::uint8_t> EncodeRos2Imu(const Ros2Header& header, const ImuSampl
 std::vector<std::uint8_t> EncodeRos2PoseStamped(const Ros2Header& header, const SE3d& pose,
                                                 CdrEncoding encoding = CdrEncoding::kXcdr1LittleEndian);
 
+// nav_msgs/msg/Path: the poses with their stamps, all in the header's frame.
+std::vector<std::uint8_t> EncodeRos2Path(const Ros2Header& header, const std::vector<double>& stamps,
+                                         const std::vector<SE3d>& poses,
+                                         CdrEncoding encoding = CdrEncoding::kXcdr1LittleEndian);
+// tf2_msgs/msg/TFMessage of one transform: `child` in the header's frame.
+std::vector<std::uint8_t> EncodeRos2Transform(const Ros2Header& header, const std::string& child, const SE3d& pose,
+                                              CdrEncoding encoding = CdrEncoding::kXcdr1LittleEndian);
+// One visualization_msgs/msg/Marker (the fields ROS 2 Humble has).
+struct Ros2Marker {
+  Ros2Header header;
+  std::string ns;
+  std::int32_t id = 0;
+  std::int32_t type = 2;  // 2 SPHERE, 5 LINE_LIST
+  SE3d pose;
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+  Eigen::Vector4f color = Eigen::Vector4f(1, 1, 1, 1);  // r g b a
+  std::vector<Eigen::Vector3d> points;
+};
+std::vector<std::uint8_t> EncodeRos2MarkerArray(const std::vector<Ros2Marker>& markers,
+                                                CdrEncoding encoding = CdrEncoding::kXcdr1LittleEndian);
+
 // The message definitions (ros2msg, dependencies appended as rosbag2 writes
 // them) that an MCAP schema carries.
 const std::string& Ros2MessageDefinition(const std::string& type);
