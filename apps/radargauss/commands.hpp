@@ -37,7 +37,7 @@ Subcommand AddRelocalize(CLI::App& parent);
 // The flags every subcommand that reads a sequence shares; the trajectory
 // that gives the scans their poses is `poses_flag` (refine: --poses).
 void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::string& poses_flag = "--gt",
-                        const std::string& poses_help = "Ground-truth trajectory (TUM)");
+                        const std::string& poses_help = "Ground-truth trajectory (TUM, or BAG:/topic[:child] of a ROS 2 bag)");
 
 // Throws DataError when a weight w > 0 needs RCS and no scan of the sequence
 // has it: before any map is built or scan matched.

@@ -105,7 +105,8 @@ int RunOdometry(const OdometrySettings& s) {
 Subcommand AddOdometry(CLI::App& parent) {
   auto s = std::make_shared<OdometrySettings>();
   CLI::App* app = parent.add_subcommand("odometry", "Radar odometry on a Gaussian-RCS map built on the way");
-  AddSequenceOptions(app, s->sequence, "--gt", "Reference trajectory (TUM), for the evaluation only");
+  AddSequenceOptions(app, s->sequence, "--gt",
+                     "Reference trajectory (TUM, or BAG:/topic[:child] of a ROS 2 bag), for the evaluation only");
   app->add_option("--out", s->out, "Output folder")->required();
   AddOdometryOptions(app, *s);
   return {app, [s] { return RunOdometry(*s); }};

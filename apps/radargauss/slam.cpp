@@ -83,7 +83,8 @@ int RunSlam(const SlamSettings& s) {
 Subcommand AddSlam(CLI::App& parent) {
   auto s = std::make_shared<SlamSettings>();
   CLI::App* app = parent.add_subcommand("slam", "Radar SLAM: odometry, loop closure, one map of the place");
-  AddSequenceOptions(app, s->odometry.sequence, "--gt", "Reference trajectory (TUM), for the evaluation only");
+  AddSequenceOptions(app, s->odometry.sequence, "--gt",
+                     "Reference trajectory (TUM, or BAG:/topic[:child] of a ROS 2 bag), for the evaluation only");
   app->add_option("--out", s->odometry.out, "Output folder")->required();
   AddTableOptions(app, SlamOptionTable(), s->slam);
   AddTableOptions(app, FalseLoopStudyOptionTable(), s->study);

@@ -17,11 +17,13 @@ Every function's help() lists its arguments; docs/python.md tells the rest.
 from ._radargauss import (DataError, GaussianMap, MatchResult, RadarInertialOdometry, RadarOdometry, RadarSlam,
                           Relocalizer, Scan, Sequence, build_map, compose,
                           evaluate, initial_errors, match, match_options, odometry_options, option_fields,
-                          pose_matrices, pose_matrix, read_imu, read_map, read_pcd, read_sequence, read_tum,
-                          relocalization_options, set_threads, simulate, slam_options, write_map, write_tum)
+                          pose_matrices, pose_matrix, read_bag_poses, read_bag_topics, read_imu, read_map, read_pcd,
+                          read_sequence, read_tum, relocalization_options, set_threads, simulate, slam_options,
+                          write_map, write_run_mcap, write_tum)
 from .sweep import Task, plan, run_task, sweep
 
 __all__ = ["DataError", "GaussianMap", "MatchResult", "RadarInertialOdometry", "RadarOdometry", "RadarSlam", "Relocalizer", "Scan", "Sequence", "build_map", "compose",
            "evaluate", "initial_errors", "match", "match_options", "odometry_options", "option_fields",
-           "pose_matrices", "pose_matrix", "read_imu", "read_map", "read_pcd", "read_sequence", "read_tum",
-           "relocalization_options", "set_threads", "simulate", "slam_options", "write_map", "write_tum", "Task", "plan", "run_task", "sweep"]
+           "pose_matrices", "pose_matrix", "read_bag_poses", "read_bag_topics", "read_imu", "read_map", "read_pcd",
+           "read_sequence", "read_tum", "relocalization_options", "set_threads", "simulate", "slam_options",
+           "write_map", "write_run_mcap", "write_tum", "Task", "plan", "run_task", "sweep"]

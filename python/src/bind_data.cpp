@@ -6,6 +6,8 @@
 
 #include "bindings.hpp"
 #include "radargauss/io/pcd.hpp"
+#include "radargauss/io/rosbag2.hpp"
+#include "radargauss/run_mcap.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/simulator.hpp"
 #include "radargauss/trajectory.hpp"
@@ -143,6 +145,66 @@ void BindTrajectories(py::module_& m) {
         return TrajectoryToArrays(trajectory);
       },
       py::arg("path"), "A TUM file as (stamps (N,), poses (N, 7) [x y z qx qy qz qw]).");
+  m.def(
+      "read_bag_topics",
+      [](const std::string& path) {
+        py::list topics;
+        for (const BagTopic& t : ListBagTopics(path)) {
+          py::dict d;
+          d["name"] = t.name;
+          d["type"] = t.type;
+          d["messages"] = t.messages;
+          d["first"] = t.first;
+          d["last"] = t.last;
+          topics.append(d);
+        }
+        return topics;
+      },
+      py::arg("path"),
+      "The topics of a bag of any kind (ROS1 .bag, ROS 2 .db3 or .mcap, rosbag2 folder): dicts of name, type, "
+      "messages and the first and last record time (s).");
+  m.def(
+      "read_bag_poses",
+      [](const std::string& path, const std::string& topic, const std::string& child_frame) {
+        Trajectory trajectory;
+        {
+          py::gil_scoped_release release;
+          trajectory = ReadBagPoses(path, topic, child_frame);
+        }
+        return TrajectoryToArrays(trajectory);
+      },
+      py::arg("path"), py::arg("topic"), py::arg("child_frame") = "",
+      "Poses of a ROS 2 bag's topic (PoseStamped, Odometry, TFMessage with child_frame, or the last Path) as "
+      "(stamps (N,), poses (N, 7)).");
+  m.def(
+      "write_run_mcap",
+      [](const std::string& path, const py::handle& stamps, const py::handle& poses, const py::object& map,
+         const py::object& reference_stamps, const py::object& reference, const py::object& scans,
+         double ellipsoid_sigma) {
+        RunForViewer run;
+        for (const StampedPose& p : TrajectoryFromArrays(stamps, poses, "poses")) {
+          run.stamps.push_back(p.time);
+          run.poses.push_back(p.pose);
+        }
+        if (!map.is_none()) run.map = map.cast<const PyMap&>().map();
+        if (!reference.is_none()) {
+          for (const StampedPose& p : TrajectoryFromArrays(reference_stamps, reference, "reference")) {
+            run.reference_stamps.push_back(p.time);
+            run.reference.push_back(p.pose);
+          }
+        }
+        if (!scans.is_none()) run.scans = scans.cast<std::vector<RadarScan>>();
+        RunMcapOptions options;
+        options.ellipsoid_sigma = ellipsoid_sigma;
+        py::gil_scoped_release release;
+        WriteRunMcap(path, run, options);
+      },
+      py::arg("path"), py::arg("stamps"), py::arg("poses"), py::arg("map") = py::none(),
+      py::arg("reference_stamps") = py::none(), py::arg("reference") = py::none(), py::arg("scans") = py::none(),
+      py::arg("ellipsoid_sigma") = 2.0,
+      "Writes a trajectory (stamps (N,), poses (N, 7) or (N, 4, 4): T_map_radar), and optionally a GaussianMap, a "
+      "reference and the scans (one per pose, registered by it) as an MCAP file a robotics viewer opens, as "
+      "`radargauss export` does.");
   m.def(
       "write_tum",
       [](const std::string& path, const py::handle& stamps, const py::handle& poses) {

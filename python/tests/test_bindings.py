@@ -85,6 +85,27 @@ def test_read_sequence_from_a_ros2_bag_equals_the_folder(cli, written, tmp_path,
         rg.read_sequence(bag=bag, topic="/absent")
 
 
+def test_a_run_written_for_a_viewer_reads_back(written, tmp_path):
+    sequence = rg.read_sequence(written["sequence"], gt=written["gt"])
+    stamps = np.array([scan.stamp for scan in sequence.scans])
+    poses = np.array(sequence.poses)
+    path = str(tmp_path / "run.mcap")
+    rg.write_run_mcap(path, stamps, poses, map=rg.read_map(written["map"]), scans=sequence.scans)
+    topics = {t["name"]: t for t in rg.read_bag_topics(path)}
+    assert topics["/radar/pose"]["messages"] == len(stamps)
+    assert topics["/radar/registered"]["type"] == "sensor_msgs/msg/PointCloud2"
+    assert topics["/map/ellipsoids"]["messages"] == 1
+    read_stamps, read_poses = rg.read_bag_poses(path, "/radar/pose")
+    assert np.array_equal(read_stamps, stamps)
+    assert np.allclose(read_poses[:, :3], poses[:, :3], atol=1e-12)
+    path_stamps, path_poses = rg.read_bag_poses(path, "/trajectory")  # the nav_msgs/Path
+    assert np.array_equal(path_stamps, stamps)
+    tf_stamps, _ = rg.read_bag_poses(path, "/tf", child_frame="radar")
+    assert np.array_equal(tf_stamps, stamps)
+    with pytest.raises(ValueError, match="fewer than 2 poses"):
+        rg.read_bag_poses(path, "/tf", child_frame="absent")
+
+
 def test_build_map_in_python_equals_build_map_of_the_cli(written):
     sequence = rg.read_sequence(written["sequence"], gt=written["gt"])
     built, read = rg.build_map(sequence), rg.read_map(written["map"])

@@ -61,4 +61,39 @@ std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string
   return samples;
 }
 
+Trajectory ReadBagPoses(const std::string& bag_path, const std::string& topic, const std::string& child_frame) {
+  if (DetectBagFormat(bag_path) == BagFormat::kRos1) {
+    throw FileError(bag_path, "reference poses are read from ROS 2 bags (convert a ROS1 bag's with a TUM file)");
+  }
+  std::vector<StampedPose> poses;
+  std::size_t index = 0;
+  ForEachRos2Message(bag_path, topic, [&](const Ros2Message& m) {
+    const std::string source = SourceOf(bag_path, m, index++);
+    if (IsRosType(*m.type, "nav_msgs", "Path")) {
+      std::vector<double> stamps;
+      std::vector<SE3d> path;
+      DecodeRos2Path(m.data, m.size, source, stamps, path);
+      poses.clear();
+      for (std::size_t k = 0; k < path.size(); ++k) poses.push_back({stamps[k], path[k]});
+      return;
+    }
+    double stamp = 0.0;
+    SE3d pose;
+    if (!DecodeRos2Pose(*m.type, m.data, m.size, source, child_frame, stamp, pose)) return;
+    if (stamp == 0.0) stamp = double(m.log_time) * 1e-9;
+    if (!poses.empty() && !(stamp > poses.back().time)) {
+      throw FileError(source, "stamp " + std::to_string(stamp) + " s is not after the previous pose's");
+    }
+    poses.push_back({stamp, pose});
+  });
+  if (poses.size() < 2) {
+    throw FileError(bag_path, "topic '" + Printable(topic) + "' holds fewer than 2 poses" +
+                                  (child_frame.empty() ? "" : " of child frame '" + Printable(child_frame) + "'"));
+  }
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    if (!(poses[k].time > poses[k - 1].time)) throw FileError(bag_path, "the path's stamps do not increase");
+  }
+  return Trajectory(std::move(poses));
+}
+
 }  // namespace radargauss

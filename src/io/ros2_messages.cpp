@@ -267,6 +267,20 @@ bool DecodeRos2Pose(const std::string& type, const std::uint8_t* data, std::size
                               ", not geometry_msgs/msg/PoseStamped, nav_msgs/msg/Odometry or tf2_msgs/msg/TFMessage");
 }
 
+Ros2Header DecodeRos2Path(const std::uint8_t* data, std::size_t size, const std::string& source,
+                          std::vector<double>& stamps, std::vector<SE3d>& poses) {
+  CdrReader cdr(data, size, source);
+  const Ros2Header header = cdr.Header();
+  const std::uint32_t n = cdr.Length(8 + 4 + 7 * 8);
+  stamps.clear();
+  poses.clear();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    stamps.push_back(cdr.Header().stamp);
+    poses.push_back(cdr.Pose());
+  }
+  return header;
+}
+
 std::vector<std::uint8_t> EncodeRos2PointCloud2(const Ros2Header& header, const PointCloud2Data& cloud,
                                                 CdrEncoding encoding) {
   CdrWriter cdr(encoding);

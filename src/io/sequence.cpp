@@ -11,6 +11,7 @@
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/read_file.hpp"
 #include "radargauss/io/rosbag.hpp"
+#include "radargauss/io/rosbag2.hpp"
 
 namespace radargauss {
 
@@ -35,6 +36,16 @@ SE3d SnailRadar20231213Extrinsic() {
 }
 
 Trajectory ReadRadarTrajectory(const std::string& ground_truth, const SE3d& extrinsic) {
+  // "BAG:/topic[:child_frame]": the poses of a ROS 2 bag's topic.
+  const std::size_t colon = ground_truth.find(":/");
+  std::error_code error;
+  if (colon != std::string::npos && !std::filesystem::exists(ground_truth, error)) {
+    const std::string topic_and_child = ground_truth.substr(colon + 1);
+    const std::size_t child = topic_and_child.find(':');
+    return ReadBagPoses(ground_truth.substr(0, colon), topic_and_child.substr(0, child),
+                        child == std::string::npos ? "" : topic_and_child.substr(child + 1))
+        .RightMultiplied(extrinsic);
+  }
   const Trajectory trajectory = ReadTum(ground_truth);
   if (trajectory.size() < 2) throw FileError(ground_truth, "needs at least 2 poses");
   return trajectory.RightMultiplied(extrinsic);

@@ -34,6 +34,10 @@ Ros2Header DecodeRos2Imu(const std::uint8_t* data, std::size_t size, const std::
 bool DecodeRos2Pose(const std::string& type, const std::uint8_t* data, std::size_t size, const std::string& source,
                     const std::string& child_frame, double& stamp, SE3d& pose);
 
+// nav_msgs/msg/Path: its poses with their stamps.
+Ros2Header DecodeRos2Path(const std::uint8_t* data, std::size_t size, const std::string& source,
+                          std::vector<double>& stamps, std::vector<SE3d>& poses);
+
 // Whether `type` ("sensor_msgs/msg/PointCloud2", or the ROS1 spelling
 // "sensor_msgs/PointCloud2") names `package`/`name`.
 bool IsRosType(const std::string& type, const std::string& package, const std::string& name);

@@ -42,6 +42,13 @@ void ForEachRos2Message(const std::string& path, const std::string& topic,
                         const std::function<void(const Ros2Message&)>& visit);
 std::vector<BagTopic> ListRos2Topics(const std::string& path);
 
+// Reference poses from a ROS 2 bag's `topic`: geometry_msgs/msg/PoseStamped
+// or nav_msgs/msg/Odometry (each message's pose at its stamp),
+// tf2_msgs/msg/TFMessage (the transforms whose child frame is
+// `child_frame`), or nav_msgs/msg/Path (the last message's poses). Stamps
+// that do not increase are refused; DataError names the message.
+Trajectory ReadBagPoses(const std::string& path, const std::string& topic, const std::string& child_frame = "");
+
 // Writes a ROS 2 bag file (an .mcap or a .db3, chosen by `format`)
 // atomically: nothing appears at `path` until Finish succeeds.
 class Ros2BagWriter {

@@ -24,7 +24,7 @@ struct SequenceOptions {
   std::string sequence_dir;  // (a) or (b)
   std::string bag;           // (c), with topic
   std::string topic;
-  std::string ground_truth;  // TUM file; empty: scans without poses
+  std::string ground_truth;  // TUM file, or BAG:/topic[:child_frame] of a ROS 2 bag; empty: scans without poses
   // "auto" (default): snail-20231213 when the ground-truth file name contains
   // "xt32" (Snail-Radar's utm50r_T_xt32.txt), else identity. Or a preset name
   // (identity, snail-20231213), or a file holding "x y z qx qy qz qw"
@@ -53,8 +53,9 @@ Sequence LoadSequence(const SequenceOptions& options);
 SE3d SnailRadar20231213Extrinsic();
 
 // A ground-truth TUM file as T_world_radar samples (times the extrinsic
-// T_gt_radar), as LoadSequence reads it; throws DataError for a bad file or
-// fewer than 2 poses.
+// T_gt_radar), as LoadSequence reads it; or "BAG:/topic[:child_frame]", the
+// poses of a ROS 2 bag's topic (ReadBagPoses). Throws DataError for a bad
+// file or fewer than 2 poses.
 Trajectory ReadRadarTrajectory(const std::string& ground_truth, const SE3d& extrinsic);
 // Resolves SequenceOptions::extrinsic; throws DataError for an unknown preset
 // or a malformed file.
