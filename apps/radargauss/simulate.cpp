@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/io/rosbag2.hpp"
 #include "radargauss/simulator.hpp"
 
 namespace radargauss::cli {
@@ -20,6 +21,7 @@ struct SimulateSettings {
   bool seed_given = false;
   int scans = 0;
   bool force = false;
+  std::string bag;  // --mcap: the sequence as a ROS 2 bag too
 };
 
 int RunSimulate(const SimulateSettings& s) {
@@ -32,15 +34,31 @@ int RunSimulate(const SimulateSettings& s) {
   if (!s.force && fs::exists(points, error) && !fs::is_empty(points, error)) {
     throw FileError(s.out, "already holds a sequence (use --force to overwrite)");
   }
+  const std::string extension = fs::path(s.bag).extension().string();
+  if (!s.bag.empty() && extension != ".mcap" && extension != ".db3") {
+    throw DataError("--mcap " + s.bag + ": name a .mcap or .db3 file");
+  }
+  if (!s.bag.empty()) CheckOutputFile(s.bag);
   StagedFolder folder(s.out);  // with --force, the new scans replace the old ones whole
   const SimulatedSequence sequence = Simulate(config);
   WriteSimulatedSequence(folder.path(), sequence);
+  if (!s.bag.empty()) {
+    // The scans as the folder gives them back, so that both inputs are the same sequence.
+    SequenceOptions written;
+    written.sequence_dir = folder.path();
+    WriteRos2Bag(s.bag, extension == ".mcap" ? BagFormat::kMcap : BagFormat::kSqlite3, LoadSequence(written).scans,
+                 sequence.imu, &sequence.ground_truth);
+  }
   folder.Commit();
   std::size_t detections = 0;
   for (const RadarScan& scan : sequence.scans) detections += scan.points.size();
   std::printf("simulated %zu scans, %zu detections (seed %u) into %s\n", sequence.scans.size(), detections, config.seed,
               s.out.c_str());
   std::printf("ground truth: %s/gt_radar_tum.txt (radar frame; use --extrinsic identity)\n", s.out.c_str());
+  if (!s.bag.empty()) {
+    std::printf("bag: %s (/radar/points, /reference/pose%s)\n", s.bag.c_str(),
+                sequence.imu.empty() ? "" : ", /imu/data");
+  }
   if (!sequence.imu.empty()) {
     std::printf("imu: %s/imu.txt (%zu samples at %g Hz), imu_extrinsic.txt (T_radar_imu), imu_biases.txt (the truth)\n",
                 s.out.c_str(), sequence.imu.size(), config.imu_rate_hz);
@@ -58,6 +76,7 @@ Subcommand AddSimulate(CLI::App& parent) {
   CLI::Option* seed = app->add_option("--seed", s->seed, "Random seed");
   app->add_option("--scans", s->scans, "Number of scans (overrides the config)")->check(Positive());
   app->add_flag("--force", s->force, "Overwrite an existing sequence in --out");
+  app->add_option("--mcap", s->bag, "Also write the sequence as a ROS 2 bag (.mcap, or .db3), as convert does");
   return {app, [s, seed] {
             s->seed_given = seed->count() > 0;
             return RunSimulate(*s);

@@ -369,6 +369,12 @@ def pose_matrices(poses: Any) -> numpy.ndarray:
 def pose_matrix(pose: Any) -> numpy.ndarray:
     """A pose [x y z qx qy qz qw] (or 4x4) as its 4x4 matrix."""
 
+def read_bag_poses(path: str, topic: str, child_frame: str = '') -> tuple:
+    """Poses of a ROS 2 bag's topic (PoseStamped, Odometry, TFMessage with child_frame, or the last Path) as (stamps (N,), poses (N, 7))."""
+
+def read_bag_topics(path: str) -> list:
+    """The topics of a bag of any kind (ROS1 .bag, ROS 2 .db3 or .mcap, rosbag2 folder): dicts of name, type, messages and the first and last record time (s)."""
+
 def read_imu(path: str) -> numpy.ndarray:
     """An IMU file (lines 'stamp wx wy wz ax ay az') as an (N, 7) array; DataError names the line"""
 
@@ -398,6 +404,9 @@ def slam_options(**options: Unpack[SlamOptions]) -> dict:
 
 def write_map(path: str, map: GaussianMap) -> None:
     """Writes a .rgm map file atomically."""
+
+def write_run_mcap(path: str, stamps: Any, poses: Any, map: Any = None, reference_stamps: Any = None, reference: Any = None, scans: Any = None, ellipsoid_sigma: float = 2.0) -> None:
+    """Writes a trajectory (stamps (N,), poses (N, 7) or (N, 4, 4): T_map_radar), and optionally a GaussianMap, a reference and the scans (one per pose, registered by it) as an MCAP file a robotics viewer opens, as `radargauss export` does."""
 
 def write_tum(path: str, stamps: Any, poses: Any) -> None:
     """Writes stamps (N,) and poses (N, 7) or (N, 4, 4) as a TUM file (9 decimals), atomically."""

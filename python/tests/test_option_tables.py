@@ -14,7 +14,7 @@ CLI = os.environ.get("RADARGAUSS_CLI")
 FLAG = re.compile(r"^\s+(--[a-z0-9-]+)(?: ([A-Z]+:(?:\{[^}]*\}|[\[(][^\])]*[\])])))?")
 # What each command reads and writes besides its options: the run's inputs and outputs.
 RUN_FLAGS = {"--help", "--sequence", "--gt", "--extrinsic", "--bag", "--topic", "--bin-layout", "--rcs-field",
-             "--doppler-field", "--doppler-sign", "--elevation-bias", "--out", "--first-scan", "--max-scans"}
+             "--doppler-field", "--doppler-sign", "--elevation-bias", "--out", "--first-scan", "--max-scans", "--mcap"}
 IMU_FLAGS = {"--imu", "--imu-extrinsic", "--imu-topic", "--imu-stamps", "--imu-rotation", "--imu-fusion"}
 # command, the option tables its flags come from, its own flags.
 COMMANDS = [("odometry", ("odometry", "radar_inertial"), {"--matcher"} | IMU_FLAGS),
