@@ -29,6 +29,16 @@ expect_fail() {
   fi
 }
 
+expect_same() {
+  local description=$1 a=$2 b=$3
+  if cmp -s "$a" "$b"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAIL: $description: $a and $b differ"
+  fi
+}
+
 expect_ok() {
   local description=$1 needle=$2
   shift 3

@@ -45,6 +45,16 @@ if [ "${2:-}" = bag ]; then
       "$tool" odometry --bag "$ti_bag" --topic /ti_mmwave/radar_scan_pcl --rcs-field none \
       --imu-topic /sensor_platform/imu --out "$work/ti_clock"
     [[ ! -e "$work/ti_clock" ]] || { echo "FAIL: a failed odometry left its output folder"; failed=$((failed + 1)); }
+    # Through a ROS 2 bag and back: the same trajectory, with the IMU too.
+    expect_ok "convert the TI bag to .mcap" "412 scans" -- \
+      "$tool" convert --bag "$ti_bag" --topic /ti_mmwave/radar_scan_pcl --imu-topic /sensor_platform/imu \
+      --imu-stamps record --out "$work/ti.mcap"
+    for input in ros1 mcap; do
+      if [ $input = ros1 ]; then bag=(--bag "$ti_bag" --topic /ti_mmwave/radar_scan_pcl --imu-topic /sensor_platform/imu \
+        --imu-stamps record); else bag=(--bag "$work/ti.mcap" --topic /radar/points --imu-topic /imu/data); fi
+      "$tool" odometry "${bag[@]}" --max-scans 120 --out "$work/ti_$input" >/dev/null
+    done
+    expect_same "TI odometry from its ROS1 bag and from the .mcap" "$work/ti_ros1/odometry.tum" "$work/ti_mcap/odometry.tum"
   else
     echo "skipped: the TI mmWave bag or ROS1 bag support is absent"; skipped=$((skipped + 1))
   fi
@@ -63,6 +73,16 @@ expect_ok "convert to a ROS 2 bag" "wrote $work/seq.db3: 6 scans" -- \
 expect_ok "info on the ROS 2 bag" "/reference/pose .*geometry_msgs/msg/PoseStamped *6 messages" -- \
   "$tool" info --bag "$work/seq.db3"
 expect_ok "info on the ROS 2 bag's scans" "scans: 6 read" -- "$tool" info --bag "$work/seq.db3" --topic /radar/points
+ntu="$(cd "$(dirname "$0")/../.." && pwd)/../shared/data/ntu4dradlm_loop1_eagle"
+if [[ -d "$ntu/points" ]]; then
+  "$tool" convert --sequence "$ntu/points" --gt "$ntu/gt_tum.txt" --extrinsic identity --out "$work/ntu.mcap" >/dev/null
+  ntu_config="$(cd "$(dirname "$0")/../.." && pwd)/configs/ntu_eagle_odometry.yaml"
+  "$tool" odometry --config "$ntu_config" --sequence "$ntu/points" --max-scans 150 --out "$work/ntu_pcd" >/dev/null
+  "$tool" odometry --config "$ntu_config" --bag "$work/ntu.mcap" --topic /radar/points --max-scans 150 \
+    --out "$work/ntu_mcap" >/dev/null
+  expect_same "NTU odometry from its PCD folder and from the .mcap" "$work/ntu_pcd/odometry.tum" \
+    "$work/ntu_mcap/odometry.tum"
+fi
 expect_ok "info on the simulation" "scans: 6 read, 6 matched" -- \
   "$tool" info --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt"
 expect_fail "simulate over an existing sequence" "already holds" -- \
