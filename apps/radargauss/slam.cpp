@@ -72,9 +72,13 @@ int RunSlam(const SlamSettings& s) {
       "recognition %.2f ms per keyframe (median); map of %zu Gaussians\n",
       sequence.scans.size(), summary.keyframes, summary.compared, summary.verified, summary.loops, summary.injected,
       summary.describe_ms + summary.search_ms, map.gaussians.size());
+  std::printf("per scan: median %.2f ms, p90 %.2f, p99 %.2f, max %.1f; the back end's p99 %.2f ms, max %.1f\n",
+              summary.total_median_ms, summary.total_p90_ms, summary.total_p99_ms, summary.total_max_ms,
+              summary.back_end_p99_ms, summary.back_end_max_ms);
   std::printf("%s", tables.c_str());
-  std::printf("wrote %s (slam.tum, keyframes.csv, loops.csv, slam.json%s, odometry/%s)\n", s.odometry.out.c_str(),
-              s.no_map ? "" : ", map.rgm, map.ply", reference ? ", evaluation.json, evaluation.md" : "");
+  std::printf("wrote %s (slam.tum, keyframes.csv, loops.csv, per_scan.csv, slam.json%s, odometry/%s)\n",
+              s.odometry.out.c_str(), s.no_map ? "" : ", map.rgm, map.ply",
+              reference ? ", evaluation.json, evaluation.md" : "");
   return 0;
 }
 

@@ -22,6 +22,12 @@ inline double Median(std::vector<double> values) {
   return MedianOfSorted(values);
 }
 
+// The value below which a share q of `sorted` (ascending, not empty) lies:
+// sorted[floor(q n)], the largest at q = 1.
+inline double PercentileOfSorted(const std::vector<double>& sorted, double q) {
+  return sorted[std::min(sorted.size() - 1, std::size_t(q * double(sorted.size())))];
+}
+
 // Mean, median, root mean square and maximum of a set of errors (all 0 for none).
 struct ErrorStatistics {
   double mean = 0.0, median = 0.0, rmse = 0.0, max = 0.0;

@@ -37,7 +37,7 @@ OdometrySummary Summarise(const RadarOdometry& odometry) {
   std::sort(times.begin(), times.end());
   if (!times.empty()) {
     s.median_ms = MedianOfSorted(times);
-    s.p90_ms = times[std::min(times.size() - 1, std::size_t(0.9 * double(times.size())))];
+    s.p90_ms = PercentileOfSorted(times, 0.9);
   }
   s.active_gaussians = odometry.map().gaussians();
   s.global_gaussians = odometry.map().global_gaussians();

@@ -88,15 +88,20 @@ void RadarSlam::UseImu(const RadarInertialOptions& options, const SE3d& radar_fr
 }
 
 const OdometryStep& RadarSlam::Register(const RadarScan& scan) {
+  const auto start = std::chrono::steady_clock::now();
   const std::size_t index = odometry_.steps().size();
   if (inertial_) inertial_->BeforeScan(odometry_, scan.timestamp);
   const OdometryStep& step = odometry_.Register(scan);
   if (inertial_) inertial_->AfterScan();
+  ScanTime time;
+  time.front_end_ms = MillisecondsSince(start);
+  const auto back_end = std::chrono::steady_clock::now();
   if (index > 0) path_ += (step.pose.translation() - odometry_.steps()[index - 1].pose.translation()).norm();
   if (!open_) {
     OpenKeyframe(index, step.pose, step.stamp);
   } else if (path_ - keyframes_.back().path >= options_.submap_distance) {
     CloseKeyframe();
+    time.closed_keyframe = true;
     OpenKeyframe(index, step.pose, step.stamp);
   }
   scan_keyframe_.push_back(keyframes_.size() - 1);
@@ -107,11 +112,18 @@ const OdometryStep& RadarSlam::Register(const RadarScan& scan) {
     point.doppler = 0.0;
     open_points_.push_back(point);
   }
+  time.back_end_ms = MillisecondsSince(back_end);
+  scan_times_.push_back(time);
   return step;
 }
 
 void RadarSlam::Finish() {
+  const auto start = std::chrono::steady_clock::now();
+  const bool closing = open_;
   if (open_) CloseKeyframe();
+  if (scan_times_.empty()) return;
+  scan_times_.back().back_end_ms += MillisecondsSince(start);
+  scan_times_.back().closed_keyframe = scan_times_.back().closed_keyframe || closing;
 }
 
 void RadarSlam::OpenKeyframe(std::size_t scan, const SE3d& pose, double stamp) {

@@ -43,6 +43,18 @@ void WriteLoops(std::ostream& out, const RadarSlam& slam) {
   }
 }
 
+// Each scan's time: whether a keyframe closed, the total, the front end and the back end.
+void WriteScanTimes(std::ostream& out, const RadarSlam& slam) {
+  out << "scan,stamp,closed_keyframe,total_ms,front_end_ms,back_end_ms\n" << std::setprecision(6);
+  const std::vector<OdometryStep>& steps = slam.odometry().steps();
+  const std::vector<ScanTime>& times = slam.scan_times();
+  for (std::size_t k = 0; k < times.size() && k < steps.size(); ++k) {
+    out << k << ',' << std::fixed << std::setprecision(9) << steps[k].stamp << std::defaultfloat << std::setprecision(6)
+        << ',' << (times[k].closed_keyframe ? 1 : 0) << ',' << times[k].total_ms() << ',' << times[k].front_end_ms
+        << ',' << times[k].back_end_ms << '\n';
+  }
+}
+
 }  // namespace
 
 GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& slam) {
@@ -80,6 +92,23 @@ SlamSummary Summarise(const RadarSlam& slam) {
   }
   s.describe_ms = Median(describe);
   s.search_ms = Median(search);
+  std::vector<double> total, back_end;
+  for (const ScanTime& t : slam.scan_times()) {
+    total.push_back(t.total_ms());
+    back_end.push_back(t.back_end_ms);
+  }
+  if (!total.empty()) {
+    std::sort(total.begin(), total.end());
+    std::sort(back_end.begin(), back_end.end());
+    s.total_median_ms = MedianOfSorted(total);
+    s.total_p90_ms = PercentileOfSorted(total, 0.9);
+    s.total_p99_ms = PercentileOfSorted(total, 0.99);
+    s.total_max_ms = total.back();
+    s.back_end_median_ms = MedianOfSorted(back_end);
+    s.back_end_p90_ms = PercentileOfSorted(back_end, 0.9);
+    s.back_end_p99_ms = PercentileOfSorted(back_end, 0.99);
+    s.back_end_max_ms = back_end.back();
+  }
   return s;
 }
 
@@ -92,11 +121,18 @@ void WriteSlam(const std::string& dir, const RadarSlam& slam) {
   WriteTum((out / "slam.tum").string(), slam.trajectory());
   WriteFileAtomically((out / "keyframes.csv").string(), [&](std::ostream& s) { WriteKeyframes(s, slam); });
   WriteFileAtomically((out / "loops.csv").string(), [&](std::ostream& s) { WriteLoops(s, slam); });
+  WriteFileAtomically((out / "per_scan.csv").string(), [&](std::ostream& s) { WriteScanTimes(s, slam); });
   const SlamSummary s = Summarise(slam);
-  const nlohmann::json summary = {{"keyframes", s.keyframes},           {"candidates_compared", s.compared},
-                                  {"candidates_verified", s.verified},  {"loops", s.loops},
-                                  {"injected_false_loops", s.injected}, {"describe_time_ms", s.describe_ms},
-                                  {"search_time_ms", s.search_ms}};
+  nlohmann::json summary = {{"keyframes", s.keyframes},           {"candidates_compared", s.compared},
+                            {"candidates_verified", s.verified},  {"loops", s.loops},
+                            {"injected_false_loops", s.injected}, {"describe_time_ms", s.describe_ms},
+                            {"search_time_ms", s.search_ms}};
+  summary["scan_time_ms"] = {
+      {"median", s.total_median_ms}, {"p90", s.total_p90_ms}, {"p99", s.total_p99_ms}, {"max", s.total_max_ms}};
+  summary["back_end_time_ms"] = {{"median", s.back_end_median_ms},
+                                 {"p90", s.back_end_p90_ms},
+                                 {"p99", s.back_end_p99_ms},
+                                 {"max", s.back_end_max_ms}};
   WriteFileAtomically((out / "slam.json").string(), [&](std::ostream& stream) { stream << summary.dump(2) << "\n"; });
 }
 

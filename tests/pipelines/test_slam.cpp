@@ -104,6 +104,28 @@ TEST(RadarSlam, ClosesTheYardsRevisitsWithoutAFalseLoop) {
   }
 }
 
+// Each scan's time, the front end and the back end apart: one per scan, the
+// back end's work on the scans that closed a keyframe (each keyframe once).
+TEST(RadarSlam, TimesEveryScanFrontAndBackEndApart) {
+  const RadarSlam& slam = YardSlam();
+  ASSERT_EQ(slam.scan_times().size(), slam.odometry().steps().size());
+  std::size_t closed = 0;
+  double closing_back_end = 0.0, other_back_end = 0.0;
+  for (const ScanTime& t : slam.scan_times()) {
+    EXPECT_GT(t.front_end_ms, 0.0);
+    EXPECT_GE(t.back_end_ms, 0.0);
+    EXPECT_DOUBLE_EQ(t.total_ms(), t.front_end_ms + t.back_end_ms);
+    closed += t.closed_keyframe;
+    (t.closed_keyframe ? closing_back_end : other_back_end) += t.back_end_ms;
+  }
+  EXPECT_EQ(closed, slam.keyframes().size());
+  EXPECT_GT(closing_back_end, other_back_end);  // describing and searching a place is the back end's work
+  const SlamSummary summary = Summarise(slam);
+  EXPECT_LE(summary.total_median_ms, summary.total_p90_ms);
+  EXPECT_LE(summary.total_p90_ms, summary.total_p99_ms);
+  EXPECT_LE(summary.total_p99_ms, summary.total_max_ms);
+}
+
 // The Radon descriptor's run with one thread everywhere (TBB and the graph)
 // against the default threads and two for the graph: the same loops and poses.
 TEST(RadarSlam, SameRunForAnyThreadCount) {

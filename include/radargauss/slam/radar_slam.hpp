@@ -84,6 +84,15 @@ struct Keyframe {
   double describe_ms = 0.0, search_ms = 0.0;  // place recognition's time
 };
 
+// One scan's time in Register (ms): the front end (the odometry, the IMU's
+// fusion) and the back end (closing a keyframe: its description, the place
+// search, verification and graph solves); Finish's goes to the last scan.
+struct ScanTime {
+  double front_end_ms = 0.0, back_end_ms = 0.0;
+  bool closed_keyframe = false;  // the back end described and searched a keyframe
+  double total_ms() const { return front_end_ms + back_end_ms; }
+};
+
 // A compared pair: the descriptor's verdict, then the verification's.
 struct LoopCandidate {
   int query = 0, candidate = 0;  // keyframes
@@ -110,6 +119,7 @@ class RadarSlam {
   const InertialFusion* inertial() const { return inertial_.get(); }  // null without UseImu
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   const std::vector<LoopCandidate>& candidates() const { return candidates_; }
+  const std::vector<ScanTime>& scan_times() const { return scan_times_; }
   const PoseGraph& graph() const { return graph_; }
   const SlamOptions& options() const { return options_; }
   std::size_t loops() const;  // accepted (injected false loops not counted)
@@ -137,6 +147,7 @@ class RadarSlam {
   VerificationTargets targets_;  // the last verified keyframes' verification maps
   std::vector<LoopCandidate> candidates_;
   std::vector<std::size_t> scan_keyframe_;  // per scan
+  std::vector<ScanTime> scan_times_;        // per scan
   std::vector<RadarPoint> open_points_;     // the open keyframe's submap so far
   double path_ = 0.0;
   bool open_ = false;
@@ -148,6 +159,9 @@ class RadarSlam {
 struct SlamSummary {
   std::size_t keyframes = 0, compared = 0, verified = 0, loops = 0, injected = 0;  // loops: accepted, not injected
   double describe_ms = 0.0, search_ms = 0.0;                                       // medians per keyframe
+  // Per scan (ScanTime): median, p90, p99 and maximum of the total and of the back end.
+  double total_median_ms = 0.0, total_p90_ms = 0.0, total_p99_ms = 0.0, total_max_ms = 0.0;
+  double back_end_median_ms = 0.0, back_end_p90_ms = 0.0, back_end_p99_ms = 0.0, back_end_max_ms = 0.0;
 };
 SlamSummary Summarise(const RadarSlam& slam);
 
@@ -158,7 +172,8 @@ SlamSummary Summarise(const RadarSlam& slam);
 GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& slam);
 
 // Writes slam.tum (each scan's optimised T_world_radar), keyframes.csv,
-// loops.csv and slam.json into `dir` (created), each file whole or not at all.
+// loops.csv, per_scan.csv (each scan's time: total, front end, back end) and
+// slam.json into `dir` (created), each file whole or not at all.
 void WriteSlam(const std::string& dir, const RadarSlam& slam);
 
 }  // namespace radargauss
