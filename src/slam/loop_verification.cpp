@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/slam/loop_verification.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -212,6 +214,34 @@ std::shared_ptr<const VerificationTarget> VerificationTargets::Get(int index, co
   kept_.emplace_front(index, target);
   if (kept_.size() > capacity_) kept_.pop_back();
   return target;
+}
+
+std::vector<std::shared_ptr<const VerificationTarget>> VerificationTargets::GetAll(
+    const std::vector<int>& indices, const std::vector<const std::vector<RadarPoint>*>& points,
+    const LoopVerificationOptions& options) {
+  std::vector<std::shared_ptr<const VerificationTarget>> built(indices.size());
+  std::vector<std::size_t> missing;
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    const bool kept = std::any_of(kept_.begin(), kept_.end(), [&](const auto& k) { return k.first == indices[i]; });
+    if (!kept) missing.push_back(i);
+  }
+  tbb::parallel_for(std::size_t(0), missing.size(), [&](std::size_t m) {
+    built[missing[m]] = std::make_shared<const VerificationTarget>(*points[missing[m]], options);
+  });
+  std::vector<std::shared_ptr<const VerificationTarget>> targets;
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    auto kept = std::find_if(kept_.begin(), kept_.end(), [&](const auto& k) { return k.first == indices[i]; });
+    if (kept != kept_.end()) {
+      kept_.splice(kept_.begin(), kept_, kept);
+    } else {
+      kept_.emplace_front(indices[i],
+                          built[i] ? built[i] : std::make_shared<const VerificationTarget>(*points[i], options));
+      ++built_;
+      if (kept_.size() > capacity_) kept_.pop_back();
+    }
+    targets.push_back(kept_.front().second);
+  }
+  return targets;
 }
 
 LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate, double yaw,

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/slam/radar_slam.hpp"
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -163,14 +166,24 @@ void RadarSlam::CloseKeyframe() {
   SearchLoops(int(keyframes_.size()) - 1);
 }
 
+// The ranked candidates in order, as one by one: the first close one that
+// verifies is accepted, those after it are not verified. Close candidates
+// are verified in waves of as many as there are threads (against the same
+// graph, which changes only on acceptance), so that the accepted loop and
+// every outcome are those of one thread; a wave may verify some that one
+// thread would not have reached.
 void RadarSlam::SearchLoops(int query) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<int> eligible;  // far enough back along the path
   for (int c = 0; c < query && keyframes_[query].path - keyframes_[c].path >= options_.min_loop_path; ++c) {
     eligible.push_back(c);
   }
+  const std::vector<PlaceMatch> ranked = places_.Rank(places_.place(std::size_t(query)), eligible);
+  std::vector<std::optional<LoopCandidate>> verified(ranked.size());
+  const std::size_t wave = std::size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
   bool accepted = false;
-  for (const PlaceMatch& match : places_.Rank(places_.place(std::size_t(query)), eligible)) {
+  for (std::size_t i = 0; i < ranked.size(); ++i) {
+    const PlaceMatch& match = ranked[i];
     LoopCandidate candidate;
     candidate.query = query;
     candidate.candidate = match.candidate;
@@ -183,7 +196,8 @@ void RadarSlam::SearchLoops(int query) {
       std::snprintf(reason, sizeof(reason), "descriptor distance %.3f", match.distance);
       candidate.check.reason = reason;
     } else {
-      candidate = Verify(query, match);
+      if (!verified[i]) VerifyWave(query, ranked, i, wave, verified);
+      candidate = *verified[i];
       if (candidate.check.accepted) {
         graph_.AddLoop(candidate.candidate, query, candidate.check.relative, candidate.check.sqrt_information);
         graph_.Optimize(options_.graph);
@@ -194,6 +208,25 @@ void RadarSlam::SearchLoops(int query) {
   }
   keyframes_[query].search_ms = MillisecondsSince(start);
   if (study_.rate > 0.0 && !eligible.empty()) InjectFalseLoop(query, eligible);
+}
+
+void RadarSlam::VerifyWave(int query, const std::vector<PlaceMatch>& ranked, std::size_t first, std::size_t wave,
+                           std::vector<std::optional<LoopCandidate>>& verified) {
+  std::vector<std::size_t> members;
+  std::vector<int> indices;
+  std::vector<const std::vector<RadarPoint>*> points;
+  for (std::size_t j = first; j < ranked.size() && members.size() < wave; ++j) {
+    if (!ranked[j].close) continue;
+    members.push_back(j);
+    indices.push_back(ranked[j].candidate);
+    points.push_back(&keyframes_[ranked[j].candidate].points);
+  }
+  const std::vector<std::shared_ptr<const VerificationTarget>> targets =
+      targets_.GetAll(indices, points, options_.verification);
+  std::vector<LoopCandidate> results(members.size());
+  tbb::parallel_for(std::size_t(0), members.size(),
+                    [&](std::size_t m) { results[m] = Verify(query, ranked[members[m]], *targets[m]); });
+  for (std::size_t m = 0; m < members.size(); ++m) verified[members[m]] = std::move(results[m]);
 }
 
 void RadarSlam::InjectFalseLoop(int query, const std::vector<int>& eligible) {
@@ -213,7 +246,7 @@ void RadarSlam::InjectFalseLoop(int query, const std::vector<int>& eligible) {
   candidates_.push_back(loop);
 }
 
-LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match) {
+LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match, const VerificationTarget& target) const {
   LoopCandidate result;
   result.query = query;
   result.candidate = match.candidate;
@@ -221,11 +254,9 @@ LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match) {
   result.verified = true;
   const SE3d expected = graph_.poses()[match.candidate].Inverse() * graph_.poses()[query];
   const double path = PathThroughGraph(match.candidate, query);
-  const std::shared_ptr<const VerificationTarget> target =
-      targets_.Get(match.candidate, keyframes_[match.candidate].points, options_.verification);
   for (const double yaw : match.yaws) {
     LoopCheck check =
-        VerifyLoop(keyframes_[query].points, *target, yaw, GraphPrior{expected, path}, options_.verification);
+        VerifyLoop(keyframes_[query].points, target, yaw, GraphPrior{expected, path}, options_.verification);
     if (check.accepted || yaw == match.yaws.front() || check.associated > result.check.associated) {
       result.check = std::move(check);
       result.yaw = yaw;

@@ -113,6 +113,11 @@ class VerificationTargets {
   // The target of candidate `index`, built from `points` when not kept.
   std::shared_ptr<const VerificationTarget> Get(int index, const std::vector<RadarPoint>& points,
                                                 const LoopVerificationOptions& options);
+  // The targets of `indices` as Get in that order would leave them (the
+  // same kept set and order), those not kept built in parallel (TBB).
+  std::vector<std::shared_ptr<const VerificationTarget>> GetAll(
+      const std::vector<int>& indices, const std::vector<const std::vector<RadarPoint>*>& points,
+      const LoopVerificationOptions& options);
   std::size_t built() const { return built_; }
 
  private:

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -132,7 +133,10 @@ class RadarSlam {
   void CloseKeyframe();
   void SearchLoops(int query);
   void InjectFalseLoop(int query, const std::vector<int>& eligible);
-  LoopCandidate Verify(int query, const PlaceMatch& match);
+  // Verifies the next `wave` close candidates of `ranked` from `first` on, in parallel.
+  void VerifyWave(int query, const std::vector<PlaceMatch>& ranked, std::size_t first, std::size_t wave,
+                  std::vector<std::optional<LoopCandidate>>& verified);
+  LoopCandidate Verify(int query, const PlaceMatch& match, const VerificationTarget& target) const;
   // The metres driven between two keyframes along the graph's odometry edges,
   // loop edges crossed for free: how far the graph's estimate may have drifted.
   double PathThroughGraph(int from, int to) const;
