@@ -22,6 +22,15 @@ void RequireType(const Ros2Message& m, const std::string& source, const char* pa
 
 }  // namespace
 
+void AppendBagImuSample(std::vector<ImuSample>& samples, const ImuSample& sample, const std::string& source) {
+  if (!sample.angular_velocity.allFinite()) throw FileError(source, "angular velocity is not finite");
+  if (!sample.specific_force.allFinite()) throw FileError(source, "linear acceleration is not finite");
+  if (!samples.empty() && !(sample.stamp > samples.back().stamp)) {
+    throw FileError(source, "stamp " + std::to_string(sample.stamp) + " s is not after the previous message's");
+  }
+  samples.push_back(sample);
+}
+
 std::vector<BagTopic> ListBagTopics(const std::string& bag_path) {
   if (DetectBagFormat(bag_path) == BagFormat::kRos1) return ListRos1BagTopics(bag_path);
   return ListRos2Topics(bag_path);
@@ -51,12 +60,7 @@ std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string
     ImuSample sample;
     const Ros2Header header = DecodeRos2Imu(m.data, m.size, source, sample);
     sample.stamp = record_time || header.stamp == 0.0 ? double(m.log_time) * 1e-9 : header.stamp;
-    if (!sample.angular_velocity.allFinite()) throw FileError(source, "angular velocity is not finite");
-    if (!sample.specific_force.allFinite()) throw FileError(source, "linear acceleration is not finite");
-    if (!samples.empty() && !(sample.stamp > samples.back().stamp)) {
-      throw FileError(source, "stamp " + std::to_string(sample.stamp) + " s is not after the previous message's");
-    }
-    samples.push_back(sample);
+    AppendBagImuSample(samples, sample, source);
   });
   return samples;
 }

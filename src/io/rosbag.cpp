@@ -117,12 +117,7 @@ std::vector<ImuSample> ReadRos1BagImu(const std::string& bag_path, const std::st
     sample.stamp = record_time || msg->header.stamp.isZero() ? message.getTime().toSec() : msg->header.stamp.toSec();
     sample.angular_velocity = {msg->angular_velocity.x, msg->angular_velocity.y, msg->angular_velocity.z};
     sample.specific_force = {msg->linear_acceleration.x, msg->linear_acceleration.y, msg->linear_acceleration.z};
-    if (!sample.angular_velocity.allFinite()) throw FileError(source, "angular velocity is not finite");
-    if (!sample.specific_force.allFinite()) throw FileError(source, "linear acceleration is not finite");
-    if (!samples.empty() && !(sample.stamp > samples.back().stamp)) {
-      throw FileError(source, "stamp " + std::to_string(sample.stamp) + " s is not after the previous message's");
-    }
-    samples.push_back(sample);
+    AppendBagImuSample(samples, sample, source);
   });
   return samples;
 }

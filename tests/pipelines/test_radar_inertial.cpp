@@ -95,17 +95,13 @@ TEST(RadarInertialOdometry, AnImuThatEndsEarlyIsRefused) {
 // roll, which only the turns show, within 1.5 deg; and the drift at most
 // 0.6x the radar's alone with the true mounting given.
 TEST(RadarInertialOdometry, CalibratesTheMountingClockOffsetAndElevationBias) {
-  SimulationConfig config;
+  SimulationConfig config =
+      LoadSimulationConfig(std::string(RADARGAUSS_SOURCE_DIR) + "/configs/synthetic_realistic.yaml");
   config.scans = 300;
   config.imu_rate_hz = 200.0;
   config.imu_clock_offset = 0.020;
-  config.elevation_bias_deg = 0.5;
-  config.elevation_noise_growth = 1.0;
-  config.mounting_roll_deg = 0.5;
-  config.mounting_pitch_deg = 1.5;
-  config.mounting_yaw_deg = -1.0;
-  config.rcs_swerling = 1;
-  config.multipath_probability = 0.2;
+  ASSERT_EQ(config.elevation_bias_deg, 0.5);
+  ASSERT_EQ(config.mounting_pitch_deg, 1.5);
   const SimulatedSequence s = Simulate(config);
   const Sequence sequence = AsSequence(s);
   OdometryOptions odometry;
@@ -116,7 +112,7 @@ TEST(RadarInertialOdometry, CalibratesTheMountingClockOffsetAndElevationBias) {
   options.window.vehicle_motion_std = 0.1;
   RadarInertialOdometry inertial(odometry, options, SE3d(), s.imu);
   OdometryOptions mounted = odometry;
-  mounted.mounting_deg = Eigen::Vector3d(0.5, 1.5, -1.0);
+  mounted.mounting_deg = Eigen::Vector3d(config.mounting_roll_deg, config.mounting_pitch_deg, config.mounting_yaw_deg);
   RadarOdometry radar(mounted);
   for (const RadarScan& scan : sequence.scans) {
     inertial.Register(scan);

@@ -72,6 +72,10 @@ std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::stri
 // another message type, non-finite values or stamps that do not increase.
 std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string& topic, bool record_time = false);
 
+// Appends a bag's IMU sample to `samples` after checking it: finite rates
+// and force, a stamp after the last one's; DataError naming `source` otherwise.
+void AppendBagImuSample(std::vector<ImuSample>& samples, const ImuSample& sample, const std::string& source);
+
 // The same three for ROS1 bags alone (src/io/rosbag.cpp, or its stand-in
 // without the library).
 std::vector<BagTopic> ListRos1BagTopics(const std::string& bag_path);
