@@ -129,6 +129,8 @@ class PlaceSearchOptions(TypedDict, total=False):
     verify_translation_floor_std: float  # 0.1
     verify_rotation_floor_std: float  # 0.5
     verify_kept_targets: int  # 64
+    verify_min_overlap: float  # 0.4
+    verify_budget: int  # 3
     verify_solver: str  # 'mh-gn'
     verify_loss: str  # 'trivial'
     verify_loss_scale: float  # 1.0

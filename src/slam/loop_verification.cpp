@@ -51,6 +51,12 @@ const OptionTable<LoopVerificationOptions>& LoopVerificationOptionTable() {
         RADARGAUSS_OPTION(O, "kept_targets", kept_targets)
             .In(1, 100000)
             .Help("candidates' verification maps kept, the last verified (each built once while kept)"),
+        RADARGAUSS_OPTION(O, "min_overlap", min_overlap)
+            .In(0.0, 1.0)
+            .Help("a close candidate overlapping less in bird's-eye view is refused before its match"),
+        RADARGAUSS_OPTION(O, "budget", budget)
+            .In(0, 100000)
+            .Help("Gaussian matches per keyframe, the best overlapping candidates first (0: all)"),
     };
     // The loop's match is geometric: its RCS rows are not options.
     AppendNested(t, MatchOptionTable(), +[](O & o) -> auto& { return o.match; }, "match", "",
@@ -214,6 +220,20 @@ std::shared_ptr<const VerificationTarget> VerificationTargets::Get(int index, co
   kept_.emplace_front(index, target);
   if (kept_.size() > capacity_) kept_.pop_back();
   return target;
+}
+
+double BirdsEyeOverlap(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate,
+                       const std::vector<double>& yaws, const LoopVerificationOptions& options) {
+  if (query.size() < kMinSubmapPoints || candidate.size() < kMinSubmapPoints) return 0.0;
+  const std::vector<Eigen::Vector3d> target = Positions(candidate);
+  double best = 0.0;
+  for (const double yaw : yaws) {
+    const SO3d rotation(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
+    std::vector<Eigen::Vector3d> turned = Positions(query);
+    for (Eigen::Vector3d& p : turned) p = rotation * p;
+    best = std::max(best, AlignBirdsEye(turned, target, options.bev_cell, options.bev_search).second);
+  }
+  return best;
 }
 
 std::vector<std::shared_ptr<const VerificationTarget>> VerificationTargets::GetAll(

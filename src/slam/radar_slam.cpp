@@ -166,12 +166,14 @@ void RadarSlam::CloseKeyframe() {
   SearchLoops(int(keyframes_.size()) - 1);
 }
 
-// The ranked candidates in order, as one by one: the first close one that
-// verifies is accepted, those after it are not verified. Close candidates
-// are verified in waves of as many as there are threads (against the same
-// graph, which changes only on acceptance), so that the accepted loop and
-// every outcome are those of one thread; a wave may verify some that one
-// thread would not have reached.
+// Cheapest checks first: the descriptor's distance (close or not), the
+// bird's-eye overlap (below verify_min_overlap: refused), then the Gaussian
+// match of the verify_budget best overlapping, in that order, as one thread
+// would: the first that verifies is accepted and those after it are not
+// matched. The matches run in waves of as many as there are threads
+// (against the same graph, which changes only on acceptance), so that the
+// accepted loop and every outcome are those of one thread; a wave may match
+// some that one thread would not have reached.
 void RadarSlam::SearchLoops(int query) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<int> eligible;  // far enough back along the path
@@ -179,54 +181,65 @@ void RadarSlam::SearchLoops(int query) {
     eligible.push_back(c);
   }
   const std::vector<PlaceMatch> ranked = places_.Rank(places_.place(std::size_t(query)), eligible);
-  std::vector<std::optional<LoopCandidate>> verified(ranked.size());
+  std::vector<LoopCandidate> outcomes(ranked.size());
+  std::vector<double> overlaps(ranked.size(), 0.0);
+  std::vector<std::size_t> to_match;  // close and overlapping, best overlap first
+  for (std::size_t i = 0; i < ranked.size(); ++i) {
+    LoopCandidate& c = outcomes[i];
+    c.query = query;
+    c.candidate = ranked[i].candidate;
+    c.distance = ranked[i].distance;
+    c.yaw = ranked[i].yaws.front();
+    char reason[64];
+    if (!ranked[i].close) {
+      std::snprintf(reason, sizeof(reason), "descriptor distance %.3f", ranked[i].distance);
+      c.check.reason = reason;
+      continue;
+    }
+    overlaps[i] = BirdsEyeOverlap(keyframes_[query].points, keyframes_[c.candidate].points, ranked[i].yaws,
+                                  options_.verification);
+    c.check.overlap = overlaps[i];
+    if (overlaps[i] < options_.verification.min_overlap) {
+      std::snprintf(reason, sizeof(reason), "bird's-eye overlap %.2f", overlaps[i]);
+      c.check.reason = reason;
+      continue;
+    }
+    to_match.push_back(i);
+  }
+  std::stable_sort(to_match.begin(), to_match.end(),
+                   [&](std::size_t a, std::size_t b) { return overlaps[a] > overlaps[b]; });
+  const std::size_t budget = options_.verification.budget;
+  for (std::size_t m = budget > 0 ? budget : to_match.size(); m < to_match.size(); ++m) {
+    outcomes[to_match[m]].check.reason = "past the verification budget";
+  }
+  if (budget > 0 && to_match.size() > budget) to_match.resize(budget);
   const std::size_t wave = std::size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
   bool accepted = false;
-  for (std::size_t i = 0; i < ranked.size(); ++i) {
-    const PlaceMatch& match = ranked[i];
-    LoopCandidate candidate;
-    candidate.query = query;
-    candidate.candidate = match.candidate;
-    candidate.distance = match.distance;
-    candidate.yaw = match.yaws.front();
-    char reason[64];
+  for (std::size_t m = 0; m < to_match.size(); m += wave) {
+    const std::vector<std::size_t> members(to_match.begin() + std::ptrdiff_t(m),
+                                           to_match.begin() + std::ptrdiff_t(std::min(to_match.size(), m + wave)));
     if (accepted) {
-      candidate.check.reason = "another candidate was accepted";
-    } else if (!match.close) {
-      std::snprintf(reason, sizeof(reason), "descriptor distance %.3f", match.distance);
-      candidate.check.reason = reason;
-    } else {
-      if (!verified[i]) VerifyWave(query, ranked, i, wave, verified);
-      candidate = *verified[i];
-      if (candidate.check.accepted) {
-        graph_.AddLoop(candidate.candidate, query, candidate.check.relative, candidate.check.sqrt_information);
+      for (const std::size_t i : members) outcomes[i].check.reason = "another candidate was accepted";
+      continue;
+    }
+    const std::vector<LoopCandidate> results = VerifyWave(query, ranked, members);
+    for (std::size_t k = 0; k < members.size(); ++k) {
+      LoopCandidate& c = outcomes[members[k]];
+      if (accepted) {
+        c.check.reason = "another candidate was accepted";
+        continue;
+      }
+      c = results[k];
+      if (c.check.accepted) {
+        graph_.AddLoop(c.candidate, query, c.check.relative, c.check.sqrt_information);
         graph_.Optimize(options_.graph);
         accepted = true;
       }
     }
-    candidates_.push_back(candidate);
   }
+  candidates_.insert(candidates_.end(), outcomes.begin(), outcomes.end());
   keyframes_[query].search_ms = MillisecondsSince(start);
   if (study_.rate > 0.0 && !eligible.empty()) InjectFalseLoop(query, eligible);
-}
-
-void RadarSlam::VerifyWave(int query, const std::vector<PlaceMatch>& ranked, std::size_t first, std::size_t wave,
-                           std::vector<std::optional<LoopCandidate>>& verified) {
-  std::vector<std::size_t> members;
-  std::vector<int> indices;
-  std::vector<const std::vector<RadarPoint>*> points;
-  for (std::size_t j = first; j < ranked.size() && members.size() < wave; ++j) {
-    if (!ranked[j].close) continue;
-    members.push_back(j);
-    indices.push_back(ranked[j].candidate);
-    points.push_back(&keyframes_[ranked[j].candidate].points);
-  }
-  const std::vector<std::shared_ptr<const VerificationTarget>> targets =
-      targets_.GetAll(indices, points, options_.verification);
-  std::vector<LoopCandidate> results(members.size());
-  tbb::parallel_for(std::size_t(0), members.size(),
-                    [&](std::size_t m) { results[m] = Verify(query, ranked[members[m]], *targets[m]); });
-  for (std::size_t m = 0; m < members.size(); ++m) verified[members[m]] = std::move(results[m]);
 }
 
 void RadarSlam::InjectFalseLoop(int query, const std::vector<int>& eligible) {
@@ -244,6 +257,22 @@ void RadarSlam::InjectFalseLoop(int query, const std::vector<int>& eligible) {
   graph_.AddLoop(loop.candidate, query, SE3d(), loop.check.sqrt_information);
   graph_.Optimize(options_.graph);
   candidates_.push_back(loop);
+}
+
+std::vector<LoopCandidate> RadarSlam::VerifyWave(int query, const std::vector<PlaceMatch>& ranked,
+                                                 const std::vector<std::size_t>& members) {
+  std::vector<int> indices;
+  std::vector<const std::vector<RadarPoint>*> points;
+  for (const std::size_t j : members) {
+    indices.push_back(ranked[j].candidate);
+    points.push_back(&keyframes_[ranked[j].candidate].points);
+  }
+  const std::vector<std::shared_ptr<const VerificationTarget>> targets =
+      targets_.GetAll(indices, points, options_.verification);
+  std::vector<LoopCandidate> results(members.size());
+  tbb::parallel_for(std::size_t(0), members.size(),
+                    [&](std::size_t m) { results[m] = Verify(query, ranked[members[m]], *targets[m]); });
+  return results;
 }
 
 LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match, const VerificationTarget& target) const {

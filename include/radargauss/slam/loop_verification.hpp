@@ -55,7 +55,17 @@ struct LoopVerificationOptions {
   // Candidates made ready for verification (VerificationTarget) that a
   // search keeps, the last verified: each is built once while it stays.
   std::size_t kept_targets = 64;
+  // Cheapest checks first (SLAM): a close candidate whose bird's-eye overlap
+  // is below min_overlap is refused without its Gaussian match, and of the
+  // rest the `budget` best overlapping are matched (0: all).
+  double min_overlap = 0.4;
+  std::size_t budget = 3;
 };
+
+// The best bird's-eye overlap of the query's points turned by any of `yaws`
+// with the candidate's (AlignBirdsEye): the cheap check before a match.
+double BirdsEyeOverlap(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate,
+                       const std::vector<double>& yaws, const LoopVerificationOptions& options);
 
 // Its options (options.hpp), the match's and the submaps' Gaussians' among
 // them; ValidateOptions throws std::invalid_argument naming the bad one.

@@ -133,9 +133,9 @@ class RadarSlam {
   void CloseKeyframe();
   void SearchLoops(int query);
   void InjectFalseLoop(int query, const std::vector<int>& eligible);
-  // Verifies the next `wave` close candidates of `ranked` from `first` on, in parallel.
-  void VerifyWave(int query, const std::vector<PlaceMatch>& ranked, std::size_t first, std::size_t wave,
-                  std::vector<std::optional<LoopCandidate>>& verified);
+  // The Gaussian matches of ranked[members], in parallel.
+  std::vector<LoopCandidate> VerifyWave(int query, const std::vector<PlaceMatch>& ranked,
+                                        const std::vector<std::size_t>& members);
   LoopCandidate Verify(int query, const PlaceMatch& match, const VerificationTarget& target) const;
   // The metres driven between two keyframes along the graph's odometry edges,
   // loop edges crossed for free: how far the graph's estimate may have drifted.
