@@ -25,13 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::uint64_t Nanoseconds(double stamp) {
-  std::int32_t sec;
-  std::uint32_t nanosec;
-  SplitStamp(stamp, sec, nanosec);
-  return std::uint64_t(sec) * 1000000000u + nanosec;
-}
-
 // A cloud of one row from columns of doubles, named.
 PointCloud2Data CloudOf(const std::vector<std::string>& names, const std::vector<std::vector<double>>& columns) {
   PointCloud2Data cloud;
@@ -83,7 +76,7 @@ void WriteRunMcap(const std::string& path, const RunForViewer& run, const RunMca
         const std::uint16_t registered =
             run.scans.empty() ? 0 : topic("/radar/registered", "sensor_msgs/msg/PointCloud2");
         for (std::size_t k = 0; k < run.poses.size(); ++k) {
-          const std::uint64_t at = Nanoseconds(run.stamps[k]);
+          const std::uint64_t at = std::uint64_t(StampNanoseconds(run.stamps[k]));
           writer.Write(pose, at, at, EncodeRos2PoseStamped({run.stamps[k], "map"}, run.poses[k]));
           writer.Write(tf, at, at, EncodeRos2Transform({run.stamps[k], "map"}, "radar", run.poses[k]));
           if (run.scans.empty()) continue;
@@ -93,7 +86,7 @@ void WriteRunMcap(const std::string& path, const RunForViewer& run, const RunMca
         }
         // Once, at the end: the paths, the map and the loops.
         const double end = run.stamps.empty() ? 0.0 : run.stamps.back();
-        const std::uint64_t at = Nanoseconds(end);
+        const std::uint64_t at = std::uint64_t(StampNanoseconds(end));
         writer.Write(topic("/trajectory", "nav_msgs/msg/Path"), at, at,
                      EncodeRos2Path({end, "map"}, run.stamps, run.poses));
         if (!run.reference.empty()) {

@@ -196,6 +196,13 @@ void SplitStamp(double stamp, std::int32_t& sec, std::uint32_t& nanosec) {
   nanosec = std::uint32_t(ns);
 }
 
+std::int64_t StampNanoseconds(double stamp) {
+  std::int32_t sec;
+  std::uint32_t nanosec;
+  SplitStamp(stamp, sec, nanosec);
+  return std::int64_t(sec) * 1000000000 + nanosec;
+}
+
 bool IsRosType(const std::string& type, const std::string& package, const std::string& name) {
   return type == package + "/msg/" + name || type == package + "/" + name;
 }

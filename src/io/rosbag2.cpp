@@ -162,6 +162,18 @@ FolderPlan ReadFolder(const std::string& folder) {
   return plan;
 }
 
+// One file's count and span of a topic added to the listing of a bag's files.
+void AddToListing(std::map<std::string, BagTopic>& listing, const std::string& name, const std::string& type,
+                  std::size_t messages, std::pair<double, double> span) {
+  BagTopic& t = listing[name];
+  t.name = name;
+  t.type = type;
+  if (messages == 0) return;
+  t.first = t.messages == 0 ? span.first : std::min(t.first, span.first);
+  t.last = std::max(t.last, span.second);
+  t.messages += messages;
+}
+
 void ForEachInFile(const std::string& path, const std::string& topic, bool message_compression,
                    const std::function<void(const Ros2Message&)>& visit, std::map<std::string, BagTopic>* listing) {
   const BagFormat format = DetectBagFormat(path);
@@ -177,11 +189,18 @@ void ForEachInFile(const std::string& path, const std::string& topic, bool messa
   if (format == BagFormat::kMcap) {
     McapReader reader(path);
     if (listing != nullptr) {
+      // Names, types and counts from the reader (the summary's when there is
+      // one); the time spans from one pass over the messages.
+      std::map<std::string, std::pair<double, double>> spans;
+      reader.ForEachMessage([&](const McapMessage& m) {
+        const double t = double(m.log_time) * 1e-9;
+        auto [it, fresh] = spans.try_emplace(m.channel->topic, t, t);
+        if (!fresh) it->second = {std::min(it->second.first, t), std::max(it->second.second, t)};
+      });
       for (const McapChannel& channel : reader.channels()) {
-        BagTopic& t = (*listing)[channel.topic];
-        t.name = channel.topic;
-        t.type = channel.schema_name;
-        t.messages += channel.message_count;
+        const auto span = spans.find(channel.topic);
+        AddToListing(*listing, channel.topic, channel.schema_name, channel.message_count,
+                     span == spans.end() ? std::make_pair(0.0, 0.0) : span->second);
       }
       return;
     }
@@ -209,15 +228,13 @@ void ForEachInFile(const std::string& path, const std::string& topic, bool messa
     std::map<std::int64_t, std::array<std::int64_t, 3>> by_topic;
     while (counts.Step()) by_topic[counts.Int(0)] = {counts.Int(1), counts.Int(2), counts.Int(3)};
     for (const SqliteTopic& t : topics) {
-      BagTopic& entry = (*listing)[t.name];
-      entry.name = t.name;
-      entry.type = t.type;
       const auto found = by_topic.find(t.id);
-      if (found == by_topic.end()) continue;
-      const double first = double(found->second[1]) * 1e-9, last = double(found->second[2]) * 1e-9;
-      entry.first = entry.messages == 0 ? first : std::min(entry.first, first);
-      entry.last = std::max(entry.last, last);
-      entry.messages += std::size_t(found->second[0]);
+      if (found == by_topic.end()) {
+        AddToListing(*listing, t.name, t.type, 0, {0.0, 0.0});
+      } else {
+        AddToListing(*listing, t.name, t.type, std::size_t(found->second[0]),
+                     {double(found->second[1]) * 1e-9, double(found->second[2]) * 1e-9});
+      }
     }
     return;
   }
@@ -283,33 +300,7 @@ void ForEachRos2Message(const std::string& path, const std::string& topic,
 std::vector<BagTopic> ListRos2Topics(const std::string& path) {
   const FolderPlan plan = PlanOf(path);
   std::map<std::string, BagTopic> topics;
-  for (const std::string& file : plan.files) {
-    if (DetectBagFormat(file) == BagFormat::kMcap) {
-      // The counts from the summary; the times from one pass over the messages.
-      std::map<std::string, BagTopic> counted;
-      ForEachInFile(file, "", false, nullptr, &counted);
-      std::map<std::string, std::pair<double, double>> spans;
-      McapReader reader(file);
-      reader.ForEachMessage([&](const McapMessage& m) {
-        const double t = double(m.log_time) * 1e-9;
-        auto [it, fresh] = spans.try_emplace(m.channel->topic, t, t);
-        if (!fresh) it->second = {std::min(it->second.first, t), std::max(it->second.second, t)};
-      });
-      for (auto& [name, entry] : counted) {
-        BagTopic& t = topics[name];
-        const bool first = t.messages == 0;
-        t.name = name;
-        t.type = entry.type;
-        if (spans.count(name)) {
-          t.first = first ? spans[name].first : std::min(t.first, spans[name].first);
-          t.last = std::max(t.last, spans[name].second);
-        }
-        t.messages += entry.messages;
-      }
-    } else {
-      ForEachInFile(file, "", false, nullptr, &topics);
-    }
-  }
+  for (const std::string& file : plan.files) ForEachInFile(file, "", false, nullptr, &topics);
   std::vector<BagTopic> result;
   for (auto& entry : topics) result.push_back(entry.second);
   return result;
@@ -421,17 +412,6 @@ void Ros2BagWriter::Finish() {
   w.finished = true;
 }
 
-namespace {
-
-std::int64_t Nanoseconds(double stamp) {
-  std::int32_t sec;
-  std::uint32_t nanosec;
-  SplitStamp(stamp, sec, nanosec);
-  return std::int64_t(sec) * 1000000000 + nanosec;
-}
-
-}  // namespace
-
 void WriteRos2Bag(const std::string& path, BagFormat format, const std::vector<RadarScan>& scans,
                   const std::vector<ImuSample>& imu, const Trajectory* reference, const BagExportOptions& options) {
   Ros2BagWriter writer(path, format, options.mcap);
@@ -443,12 +423,12 @@ void WriteRos2Bag(const std::string& path, BagFormat format, const std::vector<R
   const auto write_imu_until = [&](double stamp) {
     for (; next_imu < imu.size() && imu[next_imu].stamp <= stamp; ++next_imu) {
       const ImuSample& sample = imu[next_imu];
-      writer.Write(imu_topic, Nanoseconds(sample.stamp), EncodeRos2Imu({sample.stamp, options.imu_frame}, sample));
+      writer.Write(imu_topic, StampNanoseconds(sample.stamp), EncodeRos2Imu({sample.stamp, options.imu_frame}, sample));
     }
   };
   for (const RadarScan& scan : scans) {
     write_imu_until(scan.timestamp);
-    const std::int64_t at = Nanoseconds(scan.timestamp);
+    const std::int64_t at = StampNanoseconds(scan.timestamp);
     writer.Write(scan_topic, at, EncodeRos2PointCloud2({scan.timestamp, options.radar_frame}, EncodePointCloud2(scan)));
     const std::optional<SE3d> pose = reference ? reference->Interpolate(scan.timestamp) : std::nullopt;
     if (pose) writer.Write(pose_topic, at, EncodeRos2PoseStamped({scan.timestamp, options.world_frame}, *pose));
