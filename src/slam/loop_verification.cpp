@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 
 #include <Eigen/Cholesky>
@@ -57,6 +58,11 @@ const OptionTable<LoopVerificationOptions>& LoopVerificationOptionTable() {
         RADARGAUSS_OPTION(O, "budget", budget)
             .In(0, 100000)
             .Help("Gaussian matches per keyframe, the best overlapping candidates first (0: all)"),
+        RADARGAUSS_OPTION(O, "start_margin", start_margin)
+            .AtLeast(0.0)
+            .Unit("m")
+            .Help("a start farther from the graph than its bound plus this is refused before its match"),
+        RADARGAUSS_OPTION(O, "start_margin_deg", start_margin_deg).AtLeast(0.0).Unit("deg").Help("the same, turned"),
     };
     // The loop's match is geometric: its RCS rows are not options.
     AppendNested(t, MatchOptionTable(), +[](O & o) -> auto& { return o.match; }, "match", "",
@@ -222,18 +228,36 @@ std::shared_ptr<const VerificationTarget> VerificationTargets::Get(int index, co
   return target;
 }
 
-double BirdsEyeOverlap(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate,
-                       const std::vector<double>& yaws, const LoopVerificationOptions& options) {
-  if (query.size() < kMinSubmapPoints || candidate.size() < kMinSubmapPoints) return 0.0;
+SE3d BirdsEyeStart::pose() const {
+  return SE3d(SO3d(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()))),
+              Eigen::Vector3d(shift.x(), shift.y(), 0.0));
+}
+
+std::vector<BirdsEyeStart> BirdsEyeStarts(const std::vector<RadarPoint>& query,
+                                          const std::vector<RadarPoint>& candidate, const std::vector<double>& yaws,
+                                          const LoopVerificationOptions& options) {
+  std::vector<BirdsEyeStart> starts(yaws.size());
+  for (std::size_t i = 0; i < yaws.size(); ++i) starts[i].yaw = yaws[i];
+  if (query.size() < kMinSubmapPoints || candidate.size() < kMinSubmapPoints) return starts;
   const std::vector<Eigen::Vector3d> target = Positions(candidate);
-  double best = 0.0;
-  for (const double yaw : yaws) {
-    const SO3d rotation(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
+  for (BirdsEyeStart& start : starts) {
+    const SO3d rotation(Eigen::Quaterniond(Eigen::AngleAxisd(start.yaw, Eigen::Vector3d::UnitZ())));
     std::vector<Eigen::Vector3d> turned = Positions(query);
     for (Eigen::Vector3d& p : turned) p = rotation * p;
-    best = std::max(best, AlignBirdsEye(turned, target, options.bev_cell, options.bev_search).second);
+    std::tie(start.shift, start.overlap) = AlignBirdsEye(turned, target, options.bev_cell, options.bev_search);
   }
-  return best;
+  return starts;
+}
+
+GraphCorrection CorrectGraph(const SE3d& relative, const GraphPrior& prior, const LoopVerificationOptions& options,
+                             double margin, double margin_deg) {
+  const SE3d correction = prior.expected.Inverse() * relative;
+  GraphCorrection c;
+  c.translation = correction.translation().norm();
+  c.rotation_deg = correction.rotation().Log().norm() * 180.0 / M_PI;
+  c.consistent = c.translation <= std::max(options.min_drift, options.drift * prior.path) + margin &&
+                 c.rotation_deg <= std::max(options.min_drift_deg, options.drift_deg * prior.path) + margin_deg;
+  return c;
 }
 
 std::vector<std::shared_ptr<const VerificationTarget>> VerificationTargets::GetAll(
@@ -277,12 +301,14 @@ LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const VerificationTar
     check.reason = "submap too small";
     return check;
   }
-  const SO3d rotation(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
+  BirdsEyeStart start;
+  start.yaw = yaw;
   std::vector<Eigen::Vector3d> turned = Positions(query);
-  for (Eigen::Vector3d& p : turned) p = rotation * p;
-  const auto [shift, overlap] = AlignBirdsEye(turned, candidate.points(), options.bev_cell, options.bev_search);
-  check.overlap = overlap;
-  const SE3d initial(rotation, Eigen::Vector3d(shift.x(), shift.y(), 0.0));
+  for (Eigen::Vector3d& p : turned) p = start.pose().rotation() * p;
+  std::tie(start.shift, start.overlap) =
+      AlignBirdsEye(turned, candidate.points(), options.bev_cell, options.bev_search);
+  check.overlap = start.overlap;
+  const SE3d initial = start.pose();
 
   RadarScan scan;
   scan.points = query;
@@ -290,10 +316,11 @@ LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const VerificationTar
   check.relative = match.pose;
   check.associated = double(match.n_geo) / query.size();
   check.cost = match.final_cost;
+  GraphCorrection correction;
   if (prior) {
-    const SE3d correction = prior->expected.Inverse() * match.pose;
-    check.correction = correction.translation().norm();
-    check.correction_deg = correction.rotation().Log().norm() * 180.0 / M_PI;
+    correction = CorrectGraph(match.pose, *prior, options);
+    check.correction = correction.translation;
+    check.correction_deg = correction.rotation_deg;
   }
   char detail[96];
   if (!match.converged) {
@@ -309,8 +336,7 @@ LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const VerificationTar
     std::snprintf(detail, sizeof(detail), "degenerate: std %.3f m, %.3f deg", check.translation_std,
                   check.rotation_std_deg);
     check.reason = detail;
-  } else if (prior && (check.correction > std::max(options.min_drift, options.drift * prior->path) ||
-                       check.correction_deg > std::max(options.min_drift_deg, options.drift_deg * prior->path))) {
+  } else if (prior && !correction.consistent) {
     std::snprintf(detail, sizeof(detail), "inconsistent with the graph: %.1f m, %.1f deg", check.correction,
                   check.correction_deg);
     check.reason = detail;

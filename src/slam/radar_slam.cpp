@@ -166,8 +166,10 @@ void RadarSlam::CloseKeyframe() {
   SearchLoops(int(keyframes_.size()) - 1);
 }
 
-// Cheapest checks first: the descriptor's distance (close or not), the
-// bird's-eye overlap (below verify_min_overlap: refused), then the Gaussian
+// Cheapest checks first: the descriptor's distance (close or not), each
+// yaw's bird's-eye start against the graph (farther than the consistency
+// bound plus verify_start_margin: refused), the best consistent start's
+// overlap (below verify_min_overlap: refused), then the Gaussian
 // match of the verify_budget best overlapping, in that order, as one thread
 // would: the first that verifies is accepted and those after it are not
 // matched. The matches run in waves of as many as there are threads
@@ -180,26 +182,49 @@ void RadarSlam::SearchLoops(int query) {
   for (int c = 0; c < query && keyframes_[query].path - keyframes_[c].path >= options_.min_loop_path; ++c) {
     eligible.push_back(c);
   }
-  const std::vector<PlaceMatch> ranked = places_.Rank(places_.place(std::size_t(query)), eligible);
+  std::vector<PlaceMatch> ranked = places_.Rank(places_.place(std::size_t(query)), eligible);
+  const std::vector<double> paths = PathsThroughGraph(query);
+  const LoopVerificationOptions& verification = options_.verification;
   std::vector<LoopCandidate> outcomes(ranked.size());
   std::vector<double> overlaps(ranked.size(), 0.0);
-  std::vector<std::size_t> to_match;  // close and overlapping, best overlap first
+  std::vector<std::size_t> to_match;  // close, consistent and overlapping, best overlap first
   for (std::size_t i = 0; i < ranked.size(); ++i) {
     LoopCandidate& c = outcomes[i];
     c.query = query;
     c.candidate = ranked[i].candidate;
     c.distance = ranked[i].distance;
     c.yaw = ranked[i].yaws.front();
-    char reason[64];
+    char reason[80];
     if (!ranked[i].close) {
       std::snprintf(reason, sizeof(reason), "descriptor distance %.3f", ranked[i].distance);
       c.check.reason = reason;
       continue;
     }
-    overlaps[i] = BirdsEyeOverlap(keyframes_[query].points, keyframes_[c.candidate].points, ranked[i].yaws,
-                                  options_.verification);
+    // The yaws whose start may end consistent with the graph, and their best overlap.
+    const GraphPrior prior = PriorOf(c.candidate, query, paths);
+    const std::vector<BirdsEyeStart> starts =
+        BirdsEyeStarts(keyframes_[query].points, keyframes_[c.candidate].points, ranked[i].yaws, verification);
+    std::vector<double> yaws;
+    for (const BirdsEyeStart& start : starts) {
+      if (!CorrectGraph(start.pose(), prior, verification, verification.start_margin, verification.start_margin_deg)
+               .consistent) {
+        continue;
+      }
+      yaws.push_back(start.yaw);
+      overlaps[i] = std::max(overlaps[i], start.overlap);
+    }
     c.check.overlap = overlaps[i];
-    if (overlaps[i] < options_.verification.min_overlap) {
+    if (yaws.empty()) {
+      const GraphCorrection off = CorrectGraph(starts.front().pose(), prior, verification);
+      c.check.correction = off.translation;
+      c.check.correction_deg = off.rotation_deg;
+      std::snprintf(reason, sizeof(reason), "start inconsistent with the graph: %.1f m, %.1f deg", off.translation,
+                    off.rotation_deg);
+      c.check.reason = reason;
+      continue;
+    }
+    ranked[i].yaws = std::move(yaws);
+    if (overlaps[i] < verification.min_overlap) {
       std::snprintf(reason, sizeof(reason), "bird's-eye overlap %.2f", overlaps[i]);
       c.check.reason = reason;
       continue;
@@ -222,7 +247,7 @@ void RadarSlam::SearchLoops(int query) {
       for (const std::size_t i : members) outcomes[i].check.reason = "another candidate was accepted";
       continue;
     }
-    const std::vector<LoopCandidate> results = VerifyWave(query, ranked, members);
+    const std::vector<LoopCandidate> results = VerifyWave(query, ranked, members, paths);
     for (std::size_t k = 0; k < members.size(); ++k) {
       LoopCandidate& c = outcomes[members[k]];
       if (accepted) {
@@ -260,7 +285,8 @@ void RadarSlam::InjectFalseLoop(int query, const std::vector<int>& eligible) {
 }
 
 std::vector<LoopCandidate> RadarSlam::VerifyWave(int query, const std::vector<PlaceMatch>& ranked,
-                                                 const std::vector<std::size_t>& members) {
+                                                 const std::vector<std::size_t>& members,
+                                                 const std::vector<double>& paths) {
   std::vector<int> indices;
   std::vector<const std::vector<RadarPoint>*> points;
   for (const std::size_t j : members) {
@@ -270,22 +296,26 @@ std::vector<LoopCandidate> RadarSlam::VerifyWave(int query, const std::vector<Pl
   const std::vector<std::shared_ptr<const VerificationTarget>> targets =
       targets_.GetAll(indices, points, options_.verification);
   std::vector<LoopCandidate> results(members.size());
-  tbb::parallel_for(std::size_t(0), members.size(),
-                    [&](std::size_t m) { results[m] = Verify(query, ranked[members[m]], *targets[m]); });
+  tbb::parallel_for(std::size_t(0), members.size(), [&](std::size_t m) {
+    const PlaceMatch& match = ranked[members[m]];
+    results[m] = Verify(query, match, *targets[m], PriorOf(match.candidate, query, paths));
+  });
   return results;
 }
 
-LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match, const VerificationTarget& target) const {
+GraphPrior RadarSlam::PriorOf(int candidate, int query, const std::vector<double>& paths) const {
+  return {graph_.poses()[candidate].Inverse() * graph_.poses()[query], paths[candidate]};
+}
+
+LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match, const VerificationTarget& target,
+                                const GraphPrior& prior) const {
   LoopCandidate result;
   result.query = query;
   result.candidate = match.candidate;
   result.distance = match.distance;
   result.verified = true;
-  const SE3d expected = graph_.poses()[match.candidate].Inverse() * graph_.poses()[query];
-  const double path = PathThroughGraph(match.candidate, query);
   for (const double yaw : match.yaws) {
-    LoopCheck check =
-        VerifyLoop(keyframes_[query].points, target, yaw, GraphPrior{expected, path}, options_.verification);
+    LoopCheck check = VerifyLoop(keyframes_[query].points, target, yaw, prior, options_.verification);
     if (check.accepted || yaw == match.yaws.front() || check.associated > result.check.associated) {
       result.check = std::move(check);
       result.yaw = yaw;
@@ -295,7 +325,7 @@ LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match, const Verifi
   return result;
 }
 
-double RadarSlam::PathThroughGraph(int from, int to) const {
+std::vector<double> RadarSlam::PathsThroughGraph(int from) const {
   // Dijkstra over the keyframes: odometry edges weigh the metres driven, loop edges nothing.
   std::vector<std::vector<int>> loops(keyframes_.size());
   for (const PoseGraphEdge& edge : graph_.edges()) {
@@ -312,7 +342,6 @@ double RadarSlam::PathThroughGraph(int from, int to) const {
     const double d = queue.top().first;
     const int k = queue.top().second;
     queue.pop();
-    if (k == to) return d;
     if (d > distance[k]) continue;
     const auto relax = [&](int next, double weight) {
       if (d + weight < distance[next]) queue.emplace(distance[next] = d + weight, next);
@@ -321,7 +350,7 @@ double RadarSlam::PathThroughGraph(int from, int to) const {
     if (k + 1 < int(keyframes_.size())) relax(k + 1, keyframes_[k + 1].path - keyframes_[k].path);
     for (const int next : loops[k]) relax(next, 0.0);
   }
-  return distance[to];
+  return distance;
 }
 
 std::size_t RadarSlam::loops() const {

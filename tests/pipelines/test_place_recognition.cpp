@@ -202,5 +202,43 @@ TEST(LoopVerification, RecoversAPlantedLoopAndRefusesAnotherPlace) {
   EXPECT_NE(inconsistent.reason.find("inconsistent"), std::string::npos) << inconsistent.reason;
 }
 
+// The bound of consistency by hand: max(min_drift, drift * path) metres and
+// max(min_drift_deg, drift_deg * path) degrees, plus a margin; and the
+// bird's-eye starts of a planted loop: the one at the true yaw lands on the
+// planted shift and is consistent with a graph that has it there, and the
+// other (half a turn off) is not, however wide the margin in metres.
+TEST(LoopVerification, StartsAndTheirConsistencyWithTheGraph) {
+  LoopVerificationOptions options;  // 5 m or 0.05 m per m, 10 deg or 0.05 deg per m
+  const SE3d expected(SO3d(), Eigen::Vector3d(1.0, 2.0, 0.0));
+  const auto moved = [&](double dx, double yaw_deg) {
+    return expected * SE3d(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, yaw_deg * M_PI / 180.0)), Eigen::Vector3d(dx, 0, 0));
+  };
+  GraphCorrection c = CorrectGraph(moved(4.9, 9.9), GraphPrior{expected, 20.0}, options);
+  EXPECT_NEAR(c.translation, 4.9, 1e-12);
+  EXPECT_NEAR(c.rotation_deg, 9.9, 1e-9);
+  EXPECT_TRUE(c.consistent);
+  EXPECT_FALSE(CorrectGraph(moved(5.1, 0.0), GraphPrior{expected, 20.0}, options).consistent);
+  EXPECT_FALSE(CorrectGraph(moved(0.0, 10.1), GraphPrior{expected, 20.0}, options).consistent);
+  EXPECT_TRUE(CorrectGraph(moved(5.1, 0.0), GraphPrior{expected, 20.0}, options, 0.2).consistent);
+  EXPECT_TRUE(CorrectGraph(moved(11.9, 0.0), GraphPrior{expected, 240.0}, options).consistent);  // 0.05 * 240 = 12
+  EXPECT_FALSE(CorrectGraph(moved(12.1, 0.0), GraphPrior{expected, 240.0}, options).consistent);
+  EXPECT_TRUE(CorrectGraph(moved(0.0, 11.9), GraphPrior{expected, 240.0}, options).consistent);
+
+  const std::vector<RadarPoint> place = RandomPlace(7);
+  const double yaw = 25.0 * M_PI / 180.0;
+  const Eigen::Vector3d shift(3.0, -2.0, 0.0);
+  const SE3d planted(SO3d(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()))), shift);
+  const std::vector<BirdsEyeStart> starts =
+      BirdsEyeStarts(SeenFrom(place, yaw, shift, 5), place, {yaw, yaw - M_PI}, options);
+  ASSERT_EQ(starts.size(), 2u);
+  EXPECT_EQ(starts[0].yaw, yaw);
+  EXPECT_LE((starts[0].shift - shift.head<2>()).norm(), options.bev_cell * std::sqrt(2.0));
+  EXPECT_GT(starts[0].overlap, starts[1].overlap);
+  const GraphPrior prior{planted, 20.0};
+  EXPECT_TRUE(CorrectGraph(starts[0].pose(), prior, options).consistent);
+  EXPECT_FALSE(CorrectGraph(starts[1].pose(), prior, options, 1000.0, options.start_margin_deg).consistent);
+  EXPECT_EQ(BirdsEyeStarts({}, place, {yaw}, options)[0].overlap, 0.0);
+}
+
 }  // namespace
 }  // namespace radargauss

@@ -60,12 +60,27 @@ struct LoopVerificationOptions {
   // rest the `budget` best overlapping are matched (0: all).
   double min_overlap = 0.4;
   std::size_t budget = 3;
+  // A start (the descriptor's yaw, the bird's-eye shift) farther from the
+  // graph's estimate than the consistency bound plus these cannot end
+  // consistent: it is refused before its match.
+  double start_margin = 10.0;  // m
+  double start_margin_deg = 20.0;
 };
 
-// The best bird's-eye overlap of the query's points turned by any of `yaws`
-// with the candidate's (AlignBirdsEye): the cheap check before a match.
-double BirdsEyeOverlap(const std::vector<RadarPoint>& query, const std::vector<RadarPoint>& candidate,
-                       const std::vector<double>& yaws, const LoopVerificationOptions& options);
+// Where a match starts: the query turned by a descriptor's yaw and shifted
+// to its best bird's-eye overlap with the candidate (AlignBirdsEye).
+struct BirdsEyeStart {
+  double yaw = 0.0;  // rad
+  Eigen::Vector2d shift = Eigen::Vector2d::Zero();
+  double overlap = 0.0;  // share of the query's cells on the candidate's
+  SE3d pose() const;     // candidate frame from query frame
+};
+
+// The start at each of `yaws`, in their order: the cheap check before a
+// match (all overlaps 0 for a submap too small to verify).
+std::vector<BirdsEyeStart> BirdsEyeStarts(const std::vector<RadarPoint>& query,
+                                          const std::vector<RadarPoint>& candidate, const std::vector<double>& yaws,
+                                          const LoopVerificationOptions& options);
 
 // Its options (options.hpp), the match's and the submaps' Gaussians' among
 // them; ValidateOptions throws std::invalid_argument naming the bad one.
@@ -98,6 +113,16 @@ struct GraphPrior {
   SE3d expected;
   double path = 0.0;
 };
+
+// How far `relative` moves the query from the graph's estimate (m, deg), and
+// whether that is within the consistency bound (drift, min_drift, ...) plus
+// a margin.
+struct GraphCorrection {
+  double translation = 0.0, rotation_deg = 0.0;
+  bool consistent = false;
+};
+GraphCorrection CorrectGraph(const SE3d& relative, const GraphPrior& prior, const LoopVerificationOptions& options,
+                             double margin = 0.0, double margin_deg = 0.0);
 
 // A candidate submap made ready for verification once: its points, the
 // matching map of its Gaussians (none for a submap too small to verify) and

@@ -135,11 +135,14 @@ class RadarSlam {
   void InjectFalseLoop(int query, const std::vector<int>& eligible);
   // The Gaussian matches of ranked[members], in parallel.
   std::vector<LoopCandidate> VerifyWave(int query, const std::vector<PlaceMatch>& ranked,
-                                        const std::vector<std::size_t>& members);
-  LoopCandidate Verify(int query, const PlaceMatch& match, const VerificationTarget& target) const;
-  // The metres driven between two keyframes along the graph's odometry edges,
-  // loop edges crossed for free: how far the graph's estimate may have drifted.
-  double PathThroughGraph(int from, int to) const;
+                                        const std::vector<std::size_t>& members, const std::vector<double>& paths);
+  LoopCandidate Verify(int query, const PlaceMatch& match, const VerificationTarget& target,
+                       const GraphPrior& prior) const;
+  // The metres driven from keyframe `from` to each keyframe along the graph's
+  // odometry edges, loop edges crossed for free: how far the graph's estimate
+  // may have drifted.
+  std::vector<double> PathsThroughGraph(int from) const;
+  GraphPrior PriorOf(int candidate, int query, const std::vector<double>& paths) const;
 
   SlamOptions options_;
   FalseLoopStudy study_;
