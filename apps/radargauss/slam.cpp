@@ -75,6 +75,9 @@ int RunSlam(const SlamSettings& s) {
   std::printf("per scan: median %.2f ms, p90 %.2f, p99 %.2f, max %.1f; the back end's p99 %.2f ms, max %.1f\n",
               summary.total_median_ms, summary.total_p90_ms, summary.total_p99_ms, summary.total_max_ms,
               summary.back_end_p99_ms, summary.back_end_max_ms);
+  std::printf("back end (%s): per keyframe median %.2f ms, p99 %.2f, max %.1f\n",
+              summary.asynchronous ? "beside the odometry" : "in each scan's time", summary.keyframe_median_ms,
+              summary.keyframe_p99_ms, summary.keyframe_max_ms);
   std::printf("%s", tables.c_str());
   std::printf("wrote %s (slam.tum, keyframes.csv, loops.csv, per_scan.csv, slam.json%s, odometry/%s)\n",
               s.odometry.out.c_str(), s.no_map ? "" : ", map.rgm, map.ply",

@@ -131,6 +131,8 @@ class PlaceSearchOptions(TypedDict, total=False):
     verify_kept_targets: int  # 64
     verify_min_overlap: float  # 0.4
     verify_budget: int  # 3
+    verify_start_margin: float  # 10.0
+    verify_start_margin_deg: float  # 20.0
     verify_solver: str  # 'mh-gn'
     verify_loss: str  # 'trivial'
     verify_loss_scale: float  # 1.0
@@ -180,6 +182,7 @@ class SlamOptions(OdometryOptions, PlaceSearchOptions, total=False):
     odometry_drift: float  # 0.02
     odometry_rotation_std: float  # 0.1
     odometry_drift_deg: float  # 0.02
+    asynchronous_back_end: bool  # True
     loop_rejection: str  # 'graduated'
     loop_loss: str  # 'geman-mcclure'
     loop_loss_scale: float  # 3.0

@@ -210,7 +210,9 @@ VerificationTarget::VerificationTarget(const std::vector<RadarPoint>& candidate,
     : points_(Positions(candidate)), matcher_(MakeScanMatcher(options.match)) {
   ValidateOptions(options);
   if (points_.size() >= kMinSubmapPoints) {
-    map_ = std::make_unique<const MatchingMap>(GaussianMap{BuildGaussians(points_, options.gaussians), {}});
+    GaussianMap map;
+    map.gaussians = BuildGaussians(points_, options.gaussians);
+    map_ = std::make_unique<const MatchingMap>(std::move(map));
   }
 }
 

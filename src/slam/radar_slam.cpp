@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/slam/radar_slam.hpp"
 
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -11,6 +12,8 @@
 #include <limits>
 #include <queue>
 #include <stdexcept>
+
+#include "radargauss/serial_worker.hpp"
 
 namespace radargauss {
 
@@ -48,6 +51,8 @@ const OptionTable<SlamOptions>& SlamOptionTable() {
             .AtLeast(0.0)
             .Unit("deg per m")
             .Help("and its growth"),
+        RADARGAUSS_OPTION(O, "asynchronous_back_end", asynchronous_back_end)
+            .Help("with more than one thread, the back end runs beside the odometry (the same results)"),
     };
     AppendPlaceSearchRows(t);
     AppendNested(
@@ -83,7 +88,13 @@ RadarSlam::RadarSlam(const SlamOptions& options, const FalseLoopStudy& study)
       false_loops_(study.seed) {
   ValidateOptions(options_);
   CheckOptions(FalseLoopStudyOptionTable(), study_);
+  const std::size_t threads =
+      std::min<std::size_t>(std::size_t(std::max(1, tbb::this_task_arena::max_concurrency())),
+                            tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  if (options_.asynchronous_back_end && threads > 1) worker_ = std::make_unique<SerialWorker>();
 }
+
+RadarSlam::~RadarSlam() = default;
 
 void RadarSlam::UseImu(const RadarInertialOptions& options, const SE3d& radar_from_imu, std::vector<ImuSample> imu) {
   inertial_ = std::make_unique<InertialFusion>(options, radar_from_imu, std::move(imu));
@@ -102,13 +113,13 @@ const OdometryStep& RadarSlam::Register(const RadarScan& scan) {
   if (index > 0) path_ += (step.pose.translation() - odometry_.steps()[index - 1].pose.translation()).norm();
   if (!open_) {
     OpenKeyframe(index, step.pose, step.stamp);
-  } else if (path_ - keyframes_.back().path >= options_.submap_distance) {
+  } else if (path_ - open_keyframe_.path >= options_.submap_distance) {
     CloseKeyframe();
     time.closed_keyframe = true;
     OpenKeyframe(index, step.pose, step.stamp);
   }
-  scan_keyframe_.push_back(keyframes_.size() - 1);
-  const SE3d keyframe_from_scan = keyframes_.back().odometry_pose.Inverse() * step.pose;
+  scan_keyframe_.push_back(opened_ - 1);
+  const SE3d keyframe_from_scan = open_keyframe_.odometry_pose.Inverse() * step.pose;
   for (const std::size_t i : odometry_.last_static_points()) {
     RadarPoint point = scan.points[i];
     point.position = keyframe_from_scan * point.position;
@@ -124,25 +135,68 @@ void RadarSlam::Finish() {
   const auto start = std::chrono::steady_clock::now();
   const bool closing = open_;
   if (open_) CloseKeyframe();
+  Wait();
   if (scan_times_.empty()) return;
   scan_times_.back().back_end_ms += MillisecondsSince(start);
   scan_times_.back().closed_keyframe = scan_times_.back().closed_keyframe || closing;
 }
 
 void RadarSlam::OpenKeyframe(std::size_t scan, const SE3d& pose, double stamp) {
-  Keyframe keyframe;
-  keyframe.scan = scan;
-  keyframe.stamp = stamp;
-  keyframe.odometry_pose = pose;
-  keyframe.path = path_;
+  open_keyframe_ = Keyframe();
+  open_keyframe_.scan = scan;
+  open_keyframe_.stamp = stamp;
+  open_keyframe_.odometry_pose = pose;
+  open_keyframe_.path = path_;
+  ++opened_;
+  ToBackEnd([this, keyframe = open_keyframe_] { AddKeyframe(keyframe); });
+  open_points_.clear();
+  open_ = true;
+}
+
+void RadarSlam::CloseKeyframe() {
+  ToBackEnd([this, submap = std::move(open_points_)]() mutable { DescribeAndSearch(std::move(submap)); });
+  open_points_.clear();
+  open_ = false;
+}
+
+void RadarSlam::ToBackEnd(std::function<void()> work) {
+  if (worker_) {
+    worker_->Post(std::move(work));
+  } else {
+    work();
+  }
+}
+
+void RadarSlam::Wait() const {
+  if (worker_) worker_->Wait();
+}
+
+const std::vector<Keyframe>& RadarSlam::keyframes() const {
+  Wait();
+  return keyframes_;
+}
+
+const std::vector<LoopCandidate>& RadarSlam::candidates() const {
+  Wait();
+  return candidates_;
+}
+
+const PoseGraph& RadarSlam::graph() const {
+  Wait();
+  return graph_;
+}
+
+// The keyframe's graph node at the previous node's optimised pose times the
+// odometry between them, and their odometry edge.
+void RadarSlam::AddKeyframe(Keyframe keyframe) {
   if (keyframes_.empty()) {
-    graph_.AddKeyframe(pose);
+    graph_.AddKeyframe(keyframe.odometry_pose);
   } else {
     const Keyframe& last = keyframes_.back();
-    const SE3d measured = last.odometry_pose.Inverse() * pose;
+    const SE3d measured = last.odometry_pose.Inverse() * keyframe.odometry_pose;
     const int from = int(keyframes_.size()) - 1;
     const int to = graph_.AddKeyframe(graph_.poses()[from] * measured);
-    const double driven = path_ - last.path;
+    const double driven = keyframe.path - last.path;
     const double translation_std = options_.odometry_translation_std + options_.odometry_drift * driven;
     const double rotation_std =
         (options_.odometry_rotation_std_deg + options_.odometry_drift_deg * driven) * M_PI / 180.0;
@@ -151,18 +205,14 @@ void RadarSlam::OpenKeyframe(std::size_t scan, const SE3d& pose, double stamp) {
     graph_.AddOdometry(from, to, measured, weights.asDiagonal());
   }
   keyframes_.push_back(std::move(keyframe));
-  open_points_.clear();
-  open_ = true;
 }
 
-void RadarSlam::CloseKeyframe() {
+void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap) {
   const auto start = std::chrono::steady_clock::now();
   Keyframe& keyframe = keyframes_.back();
-  keyframe.points = DownsampleSubmap(open_points_, options_.place_recognition.submap_voxel);
-  open_points_.clear();
+  keyframe.points = DownsampleSubmap(submap, options_.place_recognition.submap_voxel);
   places_.Add(places_.Describe(keyframe.points));
   keyframe.describe_ms = MillisecondsSince(start);
-  open_ = false;
   SearchLoops(int(keyframes_.size()) - 1);
 }
 
@@ -354,11 +404,13 @@ std::vector<double> RadarSlam::PathsThroughGraph(int from) const {
 }
 
 std::size_t RadarSlam::loops() const {
+  Wait();
   return std::size_t(std::count_if(candidates_.begin(), candidates_.end(),
                                    [](const LoopCandidate& c) { return c.check.accepted && !c.injected; }));
 }
 
 std::vector<SE3d> RadarSlam::Poses() const {
+  Wait();
   std::vector<SE3d> poses;
   const std::vector<OdometryStep>& steps = odometry_.steps();
   poses.reserve(steps.size());

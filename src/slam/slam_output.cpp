@@ -85,13 +85,21 @@ SlamSummary Summarise(const RadarSlam& slam) {
     s.loops += c.check.accepted && !c.injected;
     s.injected += c.injected;
   }
-  std::vector<double> describe, search;
+  std::vector<double> describe, search, keyframe_ms;
   for (const Keyframe& keyframe : slam.keyframes()) {
     describe.push_back(keyframe.describe_ms);
     search.push_back(keyframe.search_ms);
+    keyframe_ms.push_back(keyframe.back_end_ms());
   }
   s.describe_ms = Median(describe);
   s.search_ms = Median(search);
+  s.asynchronous = slam.asynchronous();
+  if (!keyframe_ms.empty()) {
+    std::sort(keyframe_ms.begin(), keyframe_ms.end());
+    s.keyframe_median_ms = MedianOfSorted(keyframe_ms);
+    s.keyframe_p99_ms = PercentileOfSorted(keyframe_ms, 0.99);
+    s.keyframe_max_ms = keyframe_ms.back();
+  }
   std::vector<double> total, back_end;
   for (const ScanTime& t : slam.scan_times()) {
     total.push_back(t.total_ms());
@@ -133,6 +141,9 @@ void WriteSlam(const std::string& dir, const RadarSlam& slam) {
                                  {"p90", s.back_end_p90_ms},
                                  {"p99", s.back_end_p99_ms},
                                  {"max", s.back_end_max_ms}};
+  summary["asynchronous_back_end"] = s.asynchronous;
+  summary["keyframe_back_end_ms"] = {
+      {"median", s.keyframe_median_ms}, {"p99", s.keyframe_p99_ms}, {"max", s.keyframe_max_ms}};
   WriteFileAtomically((out / "slam.json").string(), [&](std::ostream& stream) { stream << summary.dump(2) << "\n"; });
 }
 

@@ -6,7 +6,10 @@
 // the yaw-invariant key farther back than min_loop_path are compared and
 // verified (slam/loop_verification.hpp), and an accepted loop enters the
 // pose graph, which is optimised again from its current estimate. Each scan
-// follows its keyframe.
+// follows its keyframe. With more than one thread the back end (all of the
+// above but the odometry) runs beside the odometry on its own thread, in the
+// keyframes' order: nothing of it feeds back into the odometry, so the
+// results are those of one thread.
 //
 //   RadarSlam slam(options);
 //   for (const RadarScan& scan : sequence.scans) slam.Register(scan);
@@ -16,6 +19,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <random>
@@ -42,6 +46,8 @@ struct SlamOptions {
   double odometry_drift = 0.02;            // m per m
   double odometry_rotation_std_deg = 0.1;
   double odometry_drift_deg = 0.02;  // deg per m
+  // With more than one thread, the back end on its own thread (same results).
+  bool asynchronous_back_end = true;
 };
 
 // Robustness studies, apart from what a user sets: after each keyframe's
@@ -83,11 +89,13 @@ struct Keyframe {
   double path = 0.0;                          // m driven to it
   std::vector<RadarPoint> points;             // its submap, in its frame (closed keyframes)
   double describe_ms = 0.0, search_ms = 0.0;  // place recognition's time
+  double back_end_ms() const { return describe_ms + search_ms; }
 };
 
 // One scan's time in Register (ms): the front end (the odometry, the IMU's
 // fusion) and the back end (closing a keyframe: its description, the place
-// search, verification and graph solves); Finish's goes to the last scan.
+// search, verification and graph solves; only handing it over when the back
+// end is asynchronous); Finish's goes to the last scan.
 struct ScanTime {
   double front_end_ms = 0.0, back_end_ms = 0.0;
   bool closed_keyframe = false;  // the back end described and searched a keyframe
@@ -104,24 +112,34 @@ struct LoopCandidate {
   LoopCheck check;               // check.accepted: in the graph
 };
 
+class SerialWorker;
+
 class RadarSlam {
  public:
   explicit RadarSlam(const SlamOptions& options = {}, const FalseLoopStudy& study = {});
+  ~RadarSlam();
+  RadarSlam(const RadarSlam&) = delete;  // the back end's thread holds `this`
+  RadarSlam& operator=(const RadarSlam&) = delete;
 
   // From the next scan on, the odometry is radar-inertial (odometry/radar_inertial.hpp):
   // the IMU's samples on the scans' clock, T_radar_imu, the window's options.
   void UseImu(const RadarInertialOptions& options, const SE3d& radar_from_imu, std::vector<ImuSample> imu);
   // As RadarOdometry::Register; a keyframe that closes is described and searched.
   const OdometryStep& Register(const RadarScan& scan);
-  // Closes the last keyframe (described and searched).
+  // Closes the last keyframe (described and searched) and waits for the back end.
   void Finish();
+  // Whether the back end runs on its own thread (asynchronous_back_end and
+  // more than one thread allowed when constructed).
+  bool asynchronous() const { return worker_ != nullptr; }
 
   const RadarOdometry& odometry() const { return odometry_; }
   const InertialFusion* inertial() const { return inertial_.get(); }  // null without UseImu
-  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
-  const std::vector<LoopCandidate>& candidates() const { return candidates_; }
+  // The back end's state: each waits until the keyframes handed over so far
+  // are done; what they return holds until the next Register or Finish.
+  const std::vector<Keyframe>& keyframes() const;
+  const std::vector<LoopCandidate>& candidates() const;
+  const PoseGraph& graph() const;
   const std::vector<ScanTime>& scan_times() const { return scan_times_; }
-  const PoseGraph& graph() const { return graph_; }
   const SlamOptions& options() const { return options_; }
   std::size_t loops() const;  // accepted (injected false loops not counted)
   // T_world_radar of every scan: its keyframe's optimised pose times the odometry since.
@@ -129,8 +147,14 @@ class RadarSlam {
   Trajectory trajectory() const;
 
  private:
+  // The front end's side: what the back end is handed, in order.
   void OpenKeyframe(std::size_t scan, const SE3d& pose, double stamp);
   void CloseKeyframe();
+  void ToBackEnd(std::function<void()> work);
+  void Wait() const;  // rethrows what the back end threw
+  // The back end's side.
+  void AddKeyframe(Keyframe keyframe);
+  void DescribeAndSearch(std::vector<RadarPoint> submap);
   void SearchLoops(int query);
   void InjectFalseLoop(int query, const std::vector<int>& eligible);
   // The Gaussian matches of ranked[members], in parallel.
@@ -146,19 +170,24 @@ class RadarSlam {
 
   SlamOptions options_;
   FalseLoopStudy study_;
+  // The front end.
   RadarOdometry odometry_;
   std::unique_ptr<InertialFusion> inertial_;
+  std::vector<std::size_t> scan_keyframe_;  // per scan
+  std::vector<ScanTime> scan_times_;        // per scan
+  Keyframe open_keyframe_;                  // the open keyframe (no points)
+  std::vector<RadarPoint> open_points_;     // its submap so far
+  std::size_t opened_ = 0;                  // keyframes opened
+  double path_ = 0.0;
+  bool open_ = false;
+  // The back end.
   PoseGraph graph_;
   std::vector<Keyframe> keyframes_;
   PlaceDatabase places_;         // a place per closed keyframe
   VerificationTargets targets_;  // the last verified keyframes' verification maps
   std::vector<LoopCandidate> candidates_;
-  std::vector<std::size_t> scan_keyframe_;  // per scan
-  std::vector<ScanTime> scan_times_;        // per scan
-  std::vector<RadarPoint> open_points_;     // the open keyframe's submap so far
-  double path_ = 0.0;
-  bool open_ = false;
   std::mt19937 false_loops_;
+  std::unique_ptr<SerialWorker> worker_;  // the back end's thread; null: in Register
 };
 
 // Keyframe and loop counts, place recognition's time per keyframe (median),
@@ -166,6 +195,9 @@ class RadarSlam {
 struct SlamSummary {
   std::size_t keyframes = 0, compared = 0, verified = 0, loops = 0, injected = 0;  // loops: accepted, not injected
   double describe_ms = 0.0, search_ms = 0.0;                                       // medians per keyframe
+  // Per keyframe, the back end's work (description and search): median, p99 and maximum.
+  double keyframe_median_ms = 0.0, keyframe_p99_ms = 0.0, keyframe_max_ms = 0.0;
+  bool asynchronous = false;
   // Per scan (ScanTime): median, p90, p99 and maximum of the total and of the back end.
   double total_median_ms = 0.0, total_p90_ms = 0.0, total_p99_ms = 0.0, total_max_ms = 0.0;
   double back_end_median_ms = 0.0, back_end_p90_ms = 0.0, back_end_p99_ms = 0.0, back_end_max_ms = 0.0;
