@@ -97,6 +97,7 @@ ceres::Solver::Options SolverOptions(const PoseGraphOptions& options) {
   solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
   solver_options.num_threads = options.threads;
   solver_options.logging_type = ceres::SILENT;
   // From the chordal start, in the basin, nearly Gauss-Newton: Ceres's first
@@ -128,6 +129,9 @@ const OptionTable<PoseGraphOptions>& PoseGraphOptionTable() {
       RADARGAUSS_CHOICE(O, "graph_jacobians", jacobians, JacobianModeNames(), JacobianModeFromString)
           .Help("pose graph: closed-form Jacobians or Jets"),
       RADARGAUSS_OPTION(O, "graph_max_iterations", max_iterations).AtLeast(1).Help("pose graph: iterations per solve"),
+      RADARGAUSS_OPTION(O, "graph_function_tolerance", function_tolerance)
+          .In(1e-16, 0.1)
+          .Help("pose graph: a solve stops when the cost changes by less than this share"),
       RADARGAUSS_OPTION(O, "graph_threads", threads).In(1, 1024).Help("pose graph: Ceres's threads"),
   };
   return table;
@@ -174,6 +178,8 @@ struct PoseGraph::Problem {
   std::unique_ptr<ceres::Problem> problem;
   std::vector<ceres::ResidualBlockId> loop_blocks;
   std::vector<ceres::LossFunctionWrapper*> loop_losses;  // owned by the problem
+  std::vector<std::size_t> loops;                        // the loop of each block (loop_weights' index)
+  std::vector<bool> used;                                // per keyframe: in the problem
 
   // |r|^2 of each loop edge at the current parameters, without its loss.
   std::vector<double> LoopSquaredNorms() const {
@@ -188,7 +194,7 @@ struct PoseGraph::Problem {
   }
 };
 
-std::unique_ptr<PoseGraph::Problem> PoseGraph::Build(const PoseGraphOptions& options) {
+std::unique_ptr<PoseGraph::Problem> PoseGraph::Build(const PoseGraphOptions& options, int first_free) {
   auto graph = std::make_unique<Problem>();
   const std::size_t n = poses_.size();
   for (std::size_t k = 0; k < n; ++k) {
@@ -199,12 +205,27 @@ std::unique_ptr<PoseGraph::Problem> PoseGraph::Build(const PoseGraphOptions& opt
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   graph->problem = std::make_unique<ceres::Problem>(problem_options);
   ceres::Problem& problem = *graph->problem;
-  for (std::size_t k = 0; k < n; ++k) {
+  // The free keyframes in order, a held one when an edge reaches it (constant).
+  graph->used.assign(n, false);
+  const auto use = [&](std::size_t k) {
+    if (graph->used[k]) return;
+    graph->used[k] = true;
     problem.AddParameterBlock(graph->rotations[k].data(), 4, &graph->so3);
     problem.AddParameterBlock(graph->translations[k].data(), 3);
-  }
+    if (k < std::size_t(first_free)) {
+      problem.SetParameterBlockConstant(graph->rotations[k].data());
+      problem.SetParameterBlockConstant(graph->translations[k].data());
+    }
+  };
+  for (std::size_t k = std::size_t(first_free); k < n; ++k) use(k);
   std::size_t loop = 0;
   for (const PoseGraphEdge& edge : edges_) {
+    if (std::max(edge.from, edge.to) < first_free) {
+      loop += edge.loop;
+      continue;
+    }
+    use(std::size_t(edge.from));
+    use(std::size_t(edge.to));
     std::vector<double*> blocks = {graph->rotations[edge.from].data(), graph->translations[edge.from].data(),
                                    graph->rotations[edge.to].data(), graph->translations[edge.to].data()};
     ceres::CostFunction* cost = EdgeCost(edge, options.jacobians);
@@ -226,10 +247,13 @@ std::unique_ptr<PoseGraph::Problem> PoseGraph::Build(const PoseGraphOptions& opt
       graph->loop_losses.push_back(loss);
       graph->loop_blocks.push_back(problem.AddResidualBlock(cost, loss, blocks));
     }
+    graph->loops.push_back(loop);
     ++loop;
   }
-  problem.SetParameterBlockConstant(graph->rotations[0].data());  // the gauge
-  problem.SetParameterBlockConstant(graph->translations[0].data());
+  if (graph->used[0]) {  // the gauge
+    problem.SetParameterBlockConstant(graph->rotations[0].data());
+    problem.SetParameterBlockConstant(graph->translations[0].data());
+  }
   return graph;
 }
 
@@ -244,8 +268,9 @@ void PoseGraph::Graduate(Problem& graph, const PoseGraphOptions& options, PoseGr
   while (true) {
     for (std::size_t l = 0; l < norms.size(); ++l) {
       const double weight = mu * a2 / (norms[l] + mu * a2);
-      loop_weights_[l] = weight * weight;
-      graph.loop_losses[l]->Reset(new ceres::ScaledLoss(nullptr, loop_weights_[l], ceres::TAKE_OWNERSHIP),
+      double& loop_weight = loop_weights_[graph.loops[l]];
+      loop_weight = weight * weight;
+      graph.loop_losses[l]->Reset(new ceres::ScaledLoss(nullptr, loop_weight, ceres::TAKE_OWNERSHIP),
                                   ceres::TAKE_OWNERSHIP);
     }
     ceres::Solver::Summary round;
@@ -260,17 +285,25 @@ void PoseGraph::Graduate(Problem& graph, const PoseGraphOptions& options, PoseGr
   }
 }
 
-PoseGraphSummary PoseGraph::Optimize(const PoseGraphOptions& options) {
+PoseGraphSummary PoseGraph::Optimize(const PoseGraphOptions& options) { return Optimize(options, 0); }
+
+PoseGraphSummary PoseGraph::Optimize(const PoseGraphOptions& options, int first_free) {
   CheckOptions(PoseGraphOptionTable(), options);
+  if (first_free < 0 || first_free > int(poses_.size())) {
+    throw std::invalid_argument("the first free keyframe must be one of the graph's");
+  }
+  if (first_free > 0 && options.initialization == GraphInitialization::kChordal) {
+    throw std::invalid_argument("a chordal start solves the whole graph");
+  }
   const auto start = std::chrono::steady_clock::now();
   PoseGraphSummary summary;
-  if (poses_.empty()) {
+  if (poses_.empty() || first_free == int(poses_.size())) {
     summary.converged = true;
-    summary.message = "no keyframes";
+    summary.message = "no free keyframe";
     return summary;
   }
   if (options.initialization == GraphInitialization::kChordal) poses_ = ChordalInitialization(poses_, edges_);
-  const std::unique_ptr<Problem> graph = Build(options);
+  const std::unique_ptr<Problem> graph = Build(options, first_free);
   ceres::Solver::Summary first;  // kGraduated: the quadratic solution it starts from
   ceres::Solve(SolverOptions(options), graph->problem.get(), &first);
   summary.converged = first.termination_type == ceres::CONVERGENCE;
@@ -280,7 +313,7 @@ PoseGraphSummary PoseGraph::Optimize(const PoseGraphOptions& options) {
   summary.message = first.message;
   if (options.loop_rejection == LoopRejection::kGraduated) Graduate(*graph, options, summary);
 
-  for (std::size_t k = 0; k < poses_.size(); ++k) {
+  for (std::size_t k = std::size_t(first_free); k < poses_.size(); ++k) {
     poses_[k] = SE3d(SO3d::FromXyzw(graph->rotations[k].data()), graph->translations[k]);
   }
   if (options.loop_rejection != LoopRejection::kGraduated) {
@@ -289,7 +322,8 @@ PoseGraphSummary PoseGraph::Optimize(const PoseGraphOptions& options) {
     for (std::size_t l = 0; l < norms.size(); ++l) {
       double rho[3] = {0.0, 1.0, 0.0};
       if (loss) loss->Evaluate(norms[l], rho);
-      loop_weights_[l] = options.loop_rejection == LoopRejection::kSwitchable ? switches_[l] : rho[1];
+      const std::size_t loop = graph->loops[l];
+      loop_weights_[loop] = options.loop_rejection == LoopRejection::kSwitchable ? switches_[loop] : rho[1];
     }
   }
   summary.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -15,6 +15,7 @@
 #include "radargauss/error.hpp"
 #include "radargauss/experiment.hpp"
 #include "radargauss/map/map_file.hpp"
+#include "radargauss/map/map_tiles.hpp"
 #include "radargauss/progress.hpp"
 #include "radargauss/solvers/factory.hpp"
 #ifdef RADARGAUSS_HAVE_PCL
@@ -33,7 +34,7 @@ std::vector<GaussianMap> MapsToMatch(const Sequence& sequence, LocalizeSettings&
     if (!s.incidences.empty() || !s.degrees.empty()) {
       throw DataError("--incidences/--degrees need the map built here (drop --map)");
     }
-    maps.push_back(ReadMap(s.map_path));
+    maps.push_back(ReadMapOrTiles(s.map_path));
     degrees = {s.build.map.rcs.max_degree};
     return maps;
   }

@@ -136,7 +136,7 @@ radargauss::MatchOptions LocalizeSettings::Configuration(const std::string& solv
 void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
   AddSequenceOptions(app, s.sequence);
   AddMapBuildOptions(app, s.build);
-  app->add_option("--map", s.map_path, "Map file (.rgm); without it the map is built from the sequence");
+  app->add_option("--map", s.map_path, "Map file (.rgm) or folder of map tiles; without it the map is built from the sequence");
   app->add_option("--out", s.out, "Results folder")->required();
   app->add_option("--shard", s.shard,
                   "I/N: match the I-th of N equal parts of the scans and write shard.json too; "

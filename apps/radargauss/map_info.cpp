@@ -7,13 +7,14 @@
 
 #include "commands.hpp"
 #include "radargauss/map/map_file.hpp"
+#include "radargauss/map/map_tiles.hpp"
 
 namespace radargauss::cli {
 
 namespace {
 
 int RunMapInfo(const std::string& path) {
-  const GaussianMap map = ReadMap(path);
+  const GaussianMap map = ReadMapOrTiles(path);
   std::array<std::size_t, kMaxShDegree + 1> histogram{};
   std::size_t with_model = 0, members = 0;
   double rmse = 0.0;

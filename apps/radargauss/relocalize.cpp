@@ -16,6 +16,7 @@
 #include "radargauss/error.hpp"
 #include "radargauss/evaluation.hpp"
 #include "radargauss/map/map_file.hpp"
+#include "radargauss/map/map_tiles.hpp"
 #include "radargauss/progress.hpp"
 #include "radargauss/slam/relocalization.hpp"
 
@@ -60,7 +61,7 @@ void WriteCandidates(std::ostream& out, const Relocalizer& relocalizer) {
 int RunRelocalize(const RelocalizeSettings& s) {
   const RelocalizationOptions& options = s.relocalization;
   ValidateOptions(options);
-  GaussianMap map = ReadMap(s.map);
+  GaussianMap map = ReadMapOrTiles(s.map);
   if (map.places.empty()) {
     throw FileError(s.map, "the map has no places to relocalise against (build it with radargauss slam)");
   }
@@ -115,7 +116,7 @@ int RunRelocalize(const RelocalizeSettings& s) {
 Subcommand AddRelocalize(CLI::App& parent) {
   auto s = std::make_shared<RelocalizeSettings>();
   CLI::App* app = parent.add_subcommand("relocalize", "Locate a sequence in a SLAM map without an initial pose");
-  app->add_option("--map", s->map, "Map of radargauss slam (.rgm with places)")->required();
+  app->add_option("--map", s->map, "Map of radargauss slam (.rgm with places, or its folder of map tiles)")->required();
   AddSequenceOptions(app, s->odometry.sequence, "--gt",
                      "Reference trajectory (TUM, map frame), for the evaluation only");
   app->add_option("--out", s->odometry.out, "Output folder")->required();

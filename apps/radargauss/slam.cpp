@@ -9,10 +9,12 @@
 
 #include "commands.hpp"
 #include "odometry_settings.hpp"
+#include "option_flags.hpp"
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/evaluation.hpp"
 #include "radargauss/map/map_file.hpp"
+#include "radargauss/map/map_tiles.hpp"
 #include "radargauss/progress.hpp"
 #include "radargauss/slam/radar_slam.hpp"
 
@@ -25,6 +27,7 @@ struct SlamSettings {
   SlamOptions slam;
   FalseLoopStudy study;
   bool no_map = false;
+  double map_tiles = 0.0;  // m; 0: no tiles
 };
 
 int RunSlam(const SlamSettings& s) {
@@ -33,7 +36,8 @@ int RunSlam(const SlamSettings& s) {
   RunInputs inputs = LoadRunInputs(s.odometry, options.odometry.match.matching.w_rcs);
   const Sequence& sequence = inputs.sequence;
   const std::optional<Trajectory>& reference = inputs.reference;
-  StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "odometry", "map.rgm", "map.ply"});
+  if (s.map_tiles > 0.0 && s.no_map) throw DataError("--map-tiles writes the map: drop --no-map");
+  StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "odometry", "map.rgm", "map.ply", "map_tiles"});
   RadarSlam slam(options, s.study);
   const ImuInput imu = ImuOf(s.odometry);  // before the run: a bad IMU leaves nothing behind
   if (!imu.samples.empty()) {
@@ -57,6 +61,7 @@ int RunSlam(const SlamSettings& s) {
   if (!s.no_map) {
     WriteMap((std::filesystem::path(out) / "map.rgm").string(), map);
     ExportPly((std::filesystem::path(out) / "map.ply").string(), map);
+    if (s.map_tiles > 0.0) WriteMapTiles((std::filesystem::path(out) / "map_tiles").string(), map, s.map_tiles);
   }
   std::string tables;
   if (reference) {
@@ -79,8 +84,8 @@ int RunSlam(const SlamSettings& s) {
               summary.asynchronous ? "beside the odometry" : "in each scan's time", summary.keyframe_median_ms,
               summary.keyframe_p99_ms, summary.keyframe_max_ms);
   std::printf("%s", tables.c_str());
-  std::printf("wrote %s (slam.tum, keyframes.csv, loops.csv, per_scan.csv, slam.json%s, odometry/%s)\n",
-              s.odometry.out.c_str(), s.no_map ? "" : ", map.rgm, map.ply",
+  std::printf("wrote %s (slam.tum, keyframes.csv, loops.csv, per_scan.csv, slam.json%s%s, odometry/%s)\n",
+              s.odometry.out.c_str(), s.no_map ? "" : ", map.rgm, map.ply", s.map_tiles > 0.0 ? ", map_tiles/" : "",
               reference ? ", evaluation.json, evaluation.md" : "");
   return 0;
 }
@@ -99,6 +104,10 @@ Subcommand AddSlam(CLI::App& parent) {
   AddTableOptions(app, RadarInertialOptionTable(), s->odometry.inertial);
   AddRunOptions(app, s->odometry);
   app->add_flag("--no-map", s->no_map, "Write no map of the place (trajectories and loops only)");
+  app->add_option("--map-tiles", s->map_tiles,
+                  "Also write the map as square tiles of this many metres (map_tiles/, for relocalize and localize)")
+      ->check(CLI::NonNegativeNumber)
+      ->group(HelpGroup(OptionGroup::kTuning));  // --help-all
   return {app, [s] { return RunSlam(*s); }};
 }
 

@@ -183,6 +183,7 @@ class SlamOptions(OdometryOptions, PlaceSearchOptions, total=False):
     odometry_rotation_std: float  # 0.1
     odometry_drift_deg: float  # 0.02
     asynchronous_back_end: bool  # True
+    local_solve_margin: float  # 100.0
     loop_rejection: str  # 'graduated'
     loop_loss: str  # 'geman-mcclure'
     loop_loss_scale: float  # 3.0
@@ -191,6 +192,7 @@ class SlamOptions(OdometryOptions, PlaceSearchOptions, total=False):
     graph_initialization: str  # 'current'
     graph_jacobians: str  # 'analytic'
     graph_max_iterations: int  # 100
+    graph_function_tolerance: float  # 1e-06
     graph_threads: int  # 1
 
 class RelocalizationOptions(OdometryOptions, PlaceSearchOptions, total=False):

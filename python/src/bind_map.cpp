@@ -5,6 +5,7 @@
 #include "bindings.hpp"
 #include "radargauss/map/builder.hpp"
 #include "radargauss/map/map_file.hpp"
+#include "radargauss/map/map_tiles.hpp"
 #include "radargauss/map/pipeline.hpp"
 #include "radargauss/radargauss.hpp"
 
@@ -135,7 +136,7 @@ void BindMap(py::module_& m) {
       "The map of `radargauss build-map`: from a Sequence with poses, or from a list of Scans and their poses "
       "T_world_radar (4x4 or [x y z qx qy qz qw]). builder: kmeans or voxel; incidence: offset, view or none.");
   m.def(
-      "read_map", [](const std::string& path) { return std::make_shared<PyMap>(ReadMap(path)); }, py::arg("path"),
+      "read_map", [](const std::string& path) { return std::make_shared<PyMap>(ReadMapOrTiles(path)); }, py::arg("path"),
       "Reads a .rgm map file (validated: docs/design.md, \"Bounds on input\").");
   m.def(
       "write_map", [](const std::string& path, const PyMap& map) { WriteMap(path, map.map()); }, py::arg("path"),

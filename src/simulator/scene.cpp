@@ -204,12 +204,20 @@ Scene Nearby(const Scene& scene, const Eigen::Vector3d& position, double range) 
   return nearby;
 }
 
-Box MovingCarBox(const MovingCar& car, const LoopPath& path, double time) {
+Box MovingCarBox(const MovingCar& car, const LoopPath& path, double time, double ego_arc) {
   Eigen::Vector2d p;
   double heading = 0.0;
   bool straight = false;
-  path.At(car.s0 + car.direction * car.speed * time, p, heading, straight);
-  const Eigen::Vector2d centre = p + car.lane_offset * LoopPath::Left(heading);
+  const double arc = car.s0 + car.direction * car.speed * time;
+  path.At(arc, p, heading, straight);
+  double lane = car.lane_offset;
+  if (car.lane_offset == 0.0 && car.direction > 0.0) {
+    // Within 15 m of the ego (along the path, either side) in the next lane, beyond 23 m in the ego's.
+    constexpr double kPassingLane = 3.5, kReach = 15.0, kRamp = 8.0;
+    const double apart = std::abs(std::remainder(arc - ego_arc, path.Perimeter()));
+    lane = kPassingLane * std::clamp((kReach + kRamp - apart) / kRamp, 0.0, 1.0);
+  }
+  const Eigen::Vector2d centre = p + lane * LoopPath::Left(heading);
   const Eigen::Vector2d velocity = car.direction * car.speed * Eigen::Vector2d(std::cos(heading), std::sin(heading));
   return {Eigen::Vector3d(centre.x(), centre.y(), kCarHalfExtent.z()),
           kCarHalfExtent,
@@ -220,13 +228,15 @@ Box MovingCarBox(const MovingCar& car, const LoopPath& path, double time) {
           true};
 }
 
+double EgoArc(const SimulationConfig& config, double time) { return 5.0 + config.start_offset + config.speed * time; }
+
 // Sensor pose and world velocity at a time.
 void SensorState(const SimulationConfig& config, const LoopPath& path, double time, SE3d& pose,
                  Eigen::Vector3d& velocity_world) {
   Eigen::Vector2d p;
   double heading = 0.0;
   bool straight = false;
-  path.At(5.0 + config.start_offset + config.speed * time, p, heading, straight);
+  path.At(EgoArc(config, time), p, heading, straight);
   const double roll = config.attitude_wobble_deg * kDeg * std::sin(2.0 * M_PI * 0.5 * time);
   const double pitch = config.attitude_wobble_deg * kDeg * std::sin(2.0 * M_PI * 0.3 * time + 1.0);
   const Eigen::Matrix3d rotation =

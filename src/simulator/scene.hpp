@@ -111,8 +111,13 @@ Scene BuildScene(const SimulationConfig& config, const LoopPath& path, std::mt19
 // neighbourhood, not the length of the loop.
 Scene Nearby(const Scene& scene, const Eigen::Vector3d& position, double range);
 
-// A moving car's box at `time` (s since the start).
-Box MovingCarBox(const MovingCar& car, const LoopPath& path, double time);
+// A moving car's box at `time` (s since the start), the ego at `ego_arc`
+// metres along the path: a car in the ego's lane that comes within reach of
+// it (a faster car lapping the ego on a long drive) passes in the next lane.
+Box MovingCarBox(const MovingCar& car, const LoopPath& path, double time, double ego_arc);
+
+// The ego's metres along the path at `time`.
+double EgoArc(const SimulationConfig& config, double time);
 
 // Sensor pose and world velocity at `time`.
 void SensorState(const SimulationConfig& config, const LoopPath& path, double time, SE3d& pose,

@@ -269,7 +269,7 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
     state.velocity_radar = state.R.transpose() * velocity_world;
     state.moving.clear();
     for (const simulation::MovingCar& car : scene.moving_cars) {
-      state.moving.push_back(MovingCarBox(car, path, time.since_start));
+      state.moving.push_back(MovingCarBox(car, path, time.since_start, simulation::EgoArc(config, time.since_start)));
     }
     const Scene nearby = Nearby(scene, state.pose.translation(), config.max_range);
     RadarScan scan;

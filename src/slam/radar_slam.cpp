@@ -53,6 +53,10 @@ const OptionTable<SlamOptions>& SlamOptionTable() {
             .Help("and its growth"),
         RADARGAUSS_OPTION(O, "asynchronous_back_end", asynchronous_back_end)
             .Help("with more than one thread, the back end runs beside the odometry (the same results)"),
+        RADARGAUSS_OPTION(O, "local_solve_margin", local_solve_margin)
+            .AtLeast(0.0)
+            .Unit("m")
+            .Help("a loop re-solves the keyframes within its path through the graph plus this (0: the whole graph)"),
     };
     AppendPlaceSearchRows(t);
     AppendNested(
@@ -135,6 +139,10 @@ void RadarSlam::Finish() {
   const auto start = std::chrono::steady_clock::now();
   const bool closing = open_;
   if (open_) CloseKeyframe();
+  ToBackEnd([this] {
+    if (whole_solve_due_) graph_.Optimize(options_.graph);
+    whole_solve_due_ = false;
+  });
   Wait();
   if (scan_times_.empty()) return;
   scan_times_.back().back_end_ms += MillisecondsSince(start);
@@ -307,7 +315,7 @@ void RadarSlam::SearchLoops(int query) {
       c = results[k];
       if (c.check.accepted) {
         graph_.AddLoop(c.candidate, query, c.check.relative, c.check.sqrt_information);
-        graph_.Optimize(options_.graph);
+        SolveAfterLoop(query, paths[std::size_t(c.candidate)]);
         accepted = true;
       }
     }
@@ -315,6 +323,23 @@ void RadarSlam::SearchLoops(int query) {
   candidates_.insert(candidates_.end(), outcomes.begin(), outcomes.end());
   keyframes_[query].search_ms = MillisecondsSince(start);
   if (study_.rate > 0.0 && !eligible.empty()) InjectFalseLoop(query, eligible);
+}
+
+// The loop corrects the drift of the `path` metres it closes: the keyframes
+// driven within that plus the margin move, the rest stays for Finish's
+// whole solve (docs/design.md, "SLAM").
+void RadarSlam::SolveAfterLoop(int query, double path) {
+  int first_free = 0;
+  if (options_.local_solve_margin > 0.0) {
+    const double reach = path + options_.local_solve_margin;
+    first_free = query;
+    while (first_free > 0 &&
+           keyframes_[std::size_t(query)].path - keyframes_[std::size_t(first_free - 1)].path <= reach) {
+      --first_free;
+    }
+  }
+  graph_.Optimize(options_.graph, first_free);
+  whole_solve_due_ = whole_solve_due_ || first_free > 0;
 }
 
 void RadarSlam::InjectFalseLoop(int query, const std::vector<int>& eligible) {
@@ -407,6 +432,11 @@ std::size_t RadarSlam::loops() const {
   Wait();
   return std::size_t(std::count_if(candidates_.begin(), candidates_.end(),
                                    [](const LoopCandidate& c) { return c.check.accepted && !c.injected; }));
+}
+
+std::size_t RadarSlam::verification_targets_built() const {
+  Wait();
+  return targets_.built();
 }
 
 std::vector<SE3d> RadarSlam::Poses() const {

@@ -7,12 +7,17 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
 #include <memory>
 
 #include "radargauss/evaluation.hpp"
 #include "radargauss/simulator.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/map/map_tiles.hpp"
 #include "radargauss/slam/radar_slam.hpp"
 #include "radargauss/slam/relocalization.hpp"
 
@@ -252,6 +257,48 @@ TEST(Relocalizer, FindsASecondRunInTheSlamMapAndRefusesAnotherYard) {
   GaussianMap without_places = map;
   without_places.places.clear();
   EXPECT_THROW(Relocalizer(without_places, options), DataError);
+}
+
+// The map file and the map written as tiles of 40 m, read back whole,
+// relocalise the second run alike to the bit.
+TEST(Relocalizer, TheMapAsTilesRelocalisesTheSame) {
+  const std::string dir = std::filesystem::temp_directory_path() / ("radargauss_tiles_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  WriteMap(dir + "/map.rgm", BuildPlaceMap(Yard().scans, YardSlam()));
+  const GaussianMap map = ReadMapOrTiles(dir + "/map.rgm");
+  WriteMapTiles(dir + "/tiles", map, 40.0);
+  const GaussianMap tiled = ReadMapOrTiles(dir + "/tiles");
+  std::filesystem::remove_all(dir);
+  RelocalizationOptions options;
+  options.place_recognition = YardOptions().place_recognition;
+  Relocalizer a(map, options), b(tiled, options);
+  for (const RadarScan& scan : SecondRun(true).scans) {
+    const RelocalizationStep sa = a.Register(scan), sb = b.Register(scan);
+    ASSERT_EQ(sa.fixed, sb.fixed);
+    ASSERT_EQ(sa.pose.translation(), sb.pose.translation());
+    ASSERT_EQ(sa.pose.rotation().quaternion().coeffs(), sb.pose.rotation().quaternion().coeffs());
+  }
+  ASSERT_TRUE(a.first_fix().has_value());
+  EXPECT_EQ(a.first_fix(), b.first_fix());
+}
+
+// Verification targets kept between searches (the default) or built anew for
+// every candidate (one kept): the same loops and poses, fewer builds.
+TEST(RadarSlam, KeptVerificationTargetsChangeNothing) {
+  SlamOptions rebuilt = YardOptions();
+  rebuilt.verification.kept_targets = 1;
+  const std::unique_ptr<RadarSlam> a = RunYard(rebuilt);
+  const RadarSlam& b = YardSlam();
+  ASSERT_GT(b.loops(), 0u);
+  EXPECT_EQ(a->loops(), b.loops());
+  EXPECT_GT(a->verification_targets_built(), b.verification_targets_built());
+  const std::vector<SE3d> pa = a->Poses(), pb = b.Poses();
+  ASSERT_EQ(pa.size(), pb.size());
+  for (std::size_t s = 0; s < pa.size(); ++s) {
+    ASSERT_EQ(pa[s].translation(), pb[s].translation()) << s;
+    ASSERT_EQ(pa[s].rotation().quaternion().coeffs(), pb[s].rotation().quaternion().coeffs()) << s;
+  }
 }
 
 TEST(RadarSlam, RefusesBadOptions) {

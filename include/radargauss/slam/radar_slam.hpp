@@ -48,6 +48,10 @@ struct SlamOptions {
   double odometry_drift_deg = 0.02;  // deg per m
   // With more than one thread, the back end on its own thread (same results).
   bool asynchronous_back_end = true;
+  // An accepted loop re-solves the keyframes driven within its path through
+  // the graph plus this margin of the query, the rest held; Finish solves
+  // the whole graph. 0: every solve is of the whole graph.
+  double local_solve_margin = 100.0;  // m
 };
 
 // Robustness studies, apart from what a user sets: after each keyframe's
@@ -142,6 +146,8 @@ class RadarSlam {
   const std::vector<ScanTime>& scan_times() const { return scan_times_; }
   const SlamOptions& options() const { return options_; }
   std::size_t loops() const;  // accepted (injected false loops not counted)
+  // Verification targets built (each kept one is reused: verify_kept_targets).
+  std::size_t verification_targets_built() const;
   // T_world_radar of every scan: its keyframe's optimised pose times the odometry since.
   std::vector<SE3d> Poses() const;
   Trajectory trajectory() const;
@@ -155,6 +161,8 @@ class RadarSlam {
   // The back end's side.
   void AddKeyframe(Keyframe keyframe);
   void DescribeAndSearch(std::vector<RadarPoint> submap);
+  // After a loop whose path through the graph was `path` metres.
+  void SolveAfterLoop(int query, double path);
   void SearchLoops(int query);
   void InjectFalseLoop(int query, const std::vector<int>& eligible);
   // The Gaussian matches of ranked[members], in parallel.
@@ -187,6 +195,7 @@ class RadarSlam {
   VerificationTargets targets_;  // the last verified keyframes' verification maps
   std::vector<LoopCandidate> candidates_;
   std::mt19937 false_loops_;
+  bool whole_solve_due_ = false;          // a local solve since the last whole one
   std::unique_ptr<SerialWorker> worker_;  // the back end's thread; null: in Register
 };
 

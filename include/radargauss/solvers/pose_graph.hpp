@@ -55,6 +55,8 @@ struct PoseGraphOptions {
   GraphInitialization initialization = GraphInitialization::kCurrent;
   JacobianMode jacobians = JacobianMode::kAnalytic;
   int max_iterations = 100;  // per solve
+  // Levenberg-Marquardt stops when the cost changes by less than this share.
+  double function_tolerance = 1e-6;
   int threads = 1;
 };
 
@@ -91,6 +93,10 @@ class PoseGraph {
 
   // From the current estimate; the poses become the optimum.
   PoseGraphSummary Optimize(const PoseGraphOptions& options);
+  // The same over the keyframes from `first_free` on, those before held where
+  // they are: only the edges that reach a free keyframe enter, and only their
+  // loops' weights change. The cost of the part a loop changes, not the map's.
+  PoseGraphSummary Optimize(const PoseGraphOptions& options, int first_free);
 
   const std::vector<SE3d>& poses() const { return poses_; }
   const std::vector<PoseGraphEdge>& edges() const { return edges_; }
@@ -101,7 +107,7 @@ class PoseGraph {
 
  private:
   struct Problem;
-  std::unique_ptr<Problem> Build(const PoseGraphOptions& options);
+  std::unique_ptr<Problem> Build(const PoseGraphOptions& options, int first_free);
   void Graduate(Problem& graph, const PoseGraphOptions& options, PoseGraphSummary& summary);
   void Check(int from, int to, const SE3d& measured, const Eigen::Matrix<double, 6, 6>& sqrt_information) const;
 

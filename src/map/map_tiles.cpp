@@ -1,0 +1,210 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/map/map_tiles.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "radargauss/atomic_file.hpp"
+#include "radargauss/error.hpp"
+#include "radargauss/io/read_file.hpp"
+#include "radargauss/map/map_file.hpp"
+#include "radargauss/voxel_grid.hpp"
+
+namespace radargauss {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using TileKey = std::pair<std::int64_t, std::int64_t>;
+
+constexpr const char* kIndexName = "tiles.json";
+constexpr const char* kFormat = "radargauss map tiles";
+
+TileKey TileOf(const Eigen::Vector3d& position, double tile_size) {
+  return {FloorToInt(position.x() / tile_size), FloorToInt(position.y() / tile_size)};
+}
+
+std::string TileFile(const TileKey& key) {
+  return "tile_" + std::to_string(key.first) + "_" + std::to_string(key.second) + ".rgm";
+}
+
+// The index as read and checked against itself.
+struct TileIndex {
+  double tile_size = 0.0;
+  IncidenceModel incidence = IncidenceModel::kOffset;
+  std::size_t gaussians = 0, places = 0;
+  std::vector<TileKey> keys;
+  std::vector<std::string> files;
+  std::vector<std::size_t> tile_gaussians;
+  std::vector<std::vector<std::size_t>> tile_places;
+  std::vector<std::pair<std::size_t, std::size_t>> order;  // (tile, count) runs
+};
+
+TileIndex ReadIndex(const std::string& dir) {
+  const std::string path = (fs::path(dir) / kIndexName).string();
+  const std::string text = ReadFileBytes(path, "map tiles index");
+  TileIndex index;
+  try {
+    const Json json = Json::parse(text);
+    if (json.at("format").get<std::string>() != kFormat) throw FileError(path, "not an index of map tiles");
+    if (json.at("version").get<int>() != kMapTilesVersion) {
+      throw FileError(path, "version " + json.at("version").dump() + " (this build reads " +
+                                std::to_string(kMapTilesVersion) + ")");
+    }
+    index.tile_size = json.at("tile_size").get<double>();
+    if (!(index.tile_size > 0.0) || !std::isfinite(index.tile_size)) throw FileError(path, "tile_size not above 0");
+    try {
+      index.incidence = IncidenceModelFromString(json.at("incidence").get<std::string>());
+    } catch (const std::invalid_argument& e) {
+      throw FileError(path, e.what());
+    }
+    index.gaussians = json.at("gaussians").get<std::size_t>();
+    index.places = json.at("places").get<std::size_t>();
+    std::vector<int> place_seen(index.places, 0);
+    for (const Json& tile : json.at("tiles")) {
+      index.keys.emplace_back(tile.at("x").get<std::int64_t>(), tile.at("y").get<std::int64_t>());
+      const std::string file = tile.at("file").get<std::string>();
+      if (file != TileFile(index.keys.back())) throw FileError(path, "tile file '" + Printable(file) + "' unexpected");
+      index.files.push_back(file);
+      index.tile_gaussians.push_back(tile.at("gaussians").get<std::size_t>());
+      index.tile_places.push_back(tile.at("places").get<std::vector<std::size_t>>());
+      for (const std::size_t p : index.tile_places.back()) {
+        if (p >= index.places || place_seen[p]++) throw FileError(path, "place " + std::to_string(p) + " misplaced");
+      }
+    }
+    if (std::count(place_seen.begin(), place_seen.end(), 0) > 0) throw FileError(path, "a place in no tile");
+    std::vector<std::size_t> in_runs(index.keys.size(), 0);
+    std::size_t total = 0;
+    for (const Json& run : json.at("order")) {
+      const auto tile = run.at(0).get<std::size_t>();
+      const auto count = run.at(1).get<std::size_t>();
+      if (tile >= index.keys.size() || count == 0) throw FileError(path, "order names no tile");
+      in_runs[tile] += count;
+      total += count;
+      index.order.emplace_back(tile, count);
+    }
+    if (total != index.gaussians || in_runs != index.tile_gaussians) {
+      throw FileError(path, "the tiles' Gaussian counts do not add up");
+    }
+  } catch (const Json::exception& e) {
+    throw FileError(path, std::string("malformed index: ") + e.what());
+  }
+  return index;
+}
+
+// The map of the chosen tiles (all: every one), Gaussians and places in the map's order.
+GaussianMap ReadTiles(const std::string& dir, const TileIndex& index, const std::vector<bool>& chosen) {
+  std::vector<GaussianMap> tiles(index.keys.size());
+  GaussianMap map;
+  map.incidence = index.incidence;
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    if (!chosen[t]) continue;
+    const std::string path = (fs::path(dir) / index.files[t]).string();
+    tiles[t] = ReadMap(path);
+    if (tiles[t].gaussians.size() != index.tile_gaussians[t] || tiles[t].places.size() != index.tile_places[t].size()) {
+      throw FileError(path, "holds other counts than " + std::string(kIndexName) + " says");
+    }
+    if (tiles[t].incidence != map.incidence) throw FileError(path, "another incidence model than the index's");
+  }
+  std::vector<std::size_t> next(tiles.size(), 0);
+  for (const auto& [tile, count] : index.order) {
+    if (chosen[tile]) {
+      const auto begin = tiles[tile].gaussians.begin() + std::ptrdiff_t(next[tile]);
+      map.gaussians.insert(map.gaussians.end(), begin, begin + std::ptrdiff_t(count));
+    }
+    next[tile] += count;
+  }
+  std::vector<std::pair<std::size_t, MapPlace*>> places;  // by their index in the map
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    if (!chosen[t]) continue;
+    for (std::size_t k = 0; k < index.tile_places[t].size(); ++k) {
+      places.emplace_back(index.tile_places[t][k], &tiles[t].places[k]);
+    }
+  }
+  std::sort(places.begin(), places.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& place : places) map.places.push_back(std::move(*place.second));
+  return map;
+}
+
+}  // namespace
+
+void WriteMapTiles(const std::string& dir, const GaussianMap& map, double tile_size) {
+  if (!(tile_size > 0.0) || !std::isfinite(tile_size)) throw std::invalid_argument("tile_size must be above 0");
+  std::error_code error;
+  fs::create_directories(dir, error);
+  if (error) throw FileError(dir, "cannot create the folder of map tiles: " + error.message());
+  if (!fs::is_empty(dir, error)) throw FileError(dir, "the folder of map tiles must be empty");
+  std::map<TileKey, GaussianMap> tiles;
+  std::map<TileKey, std::vector<std::size_t>> tile_places;
+  std::vector<TileKey> gaussian_tiles;
+  for (const Gaussian& g : map.gaussians) {
+    gaussian_tiles.push_back(TileOf(g.mean, tile_size));
+    tiles[gaussian_tiles.back()].gaussians.push_back(g);
+  }
+  for (std::size_t p = 0; p < map.places.size(); ++p) {
+    const TileKey key = TileOf(map.places[p].pose.translation(), tile_size);
+    tiles[key].places.push_back(map.places[p]);
+    tile_places[key].push_back(p);
+  }
+  Json index = {{"format", kFormat},
+                {"version", kMapTilesVersion},
+                {"tile_size", tile_size},
+                {"incidence", ToString(map.incidence)},
+                {"gaussians", map.gaussians.size()},
+                {"places", map.places.size()},
+                {"tiles", Json::array()},
+                {"order", Json::array()}};
+  std::map<TileKey, std::size_t> number;
+  for (auto& [key, tile] : tiles) {
+    tile.incidence = map.incidence;
+    number[key] = number.size();
+    WriteMap((fs::path(dir) / TileFile(key)).string(), tile);
+    index["tiles"].push_back({{"x", key.first},
+                              {"y", key.second},
+                              {"file", TileFile(key)},
+                              {"gaussians", tile.gaussians.size()},
+                              {"places", tile_places[key]}});
+  }
+  for (std::size_t i = 0; i < gaussian_tiles.size();) {
+    std::size_t j = i;
+    while (j < gaussian_tiles.size() && gaussian_tiles[j] == gaussian_tiles[i]) ++j;
+    index["order"].push_back({number[gaussian_tiles[i]], j - i});
+    i = j;
+  }
+  WriteFileAtomically((fs::path(dir) / kIndexName).string(), [&](std::ostream& out) { out << index.dump() << "\n"; });
+}
+
+bool IsMapTiles(const std::string& path) {
+  std::error_code error;
+  return fs::is_directory(path, error) && fs::exists(fs::path(path) / kIndexName, error);
+}
+
+GaussianMap ReadMapTiles(const std::string& dir) {
+  const TileIndex index = ReadIndex(dir);
+  return ReadTiles(dir, index, std::vector<bool>(index.keys.size(), true));
+}
+
+GaussianMap ReadMapOrTiles(const std::string& path) { return IsMapTiles(path) ? ReadMapTiles(path) : ReadMap(path); }
+
+GaussianMap ReadMapTiles(const std::string& dir, const Eigen::Vector2d& center, double radius) {
+  const TileIndex index = ReadIndex(dir);
+  std::vector<bool> chosen(index.keys.size(), false);
+  for (std::size_t t = 0; t < index.keys.size(); ++t) {
+    // The tile's square against the disc: the nearest point of the square within the radius.
+    const Eigen::Vector2d low(double(index.keys[t].first) * index.tile_size,
+                              double(index.keys[t].second) * index.tile_size);
+    const Eigen::Vector2d nearest = center.cwiseMax(low).cwiseMin(low + Eigen::Vector2d::Constant(index.tile_size));
+    chosen[t] = (nearest - center).norm() <= radius;
+  }
+  return ReadTiles(dir, index, chosen);
+}
+
+}  // namespace radargauss
