@@ -178,6 +178,7 @@ class PlaceSearchOptions(TypedDict, total=False):
 class SlamOptions(OdometryOptions, PlaceSearchOptions, total=False):
     """option_fields("slam")"""
     min_loop_path: float  # 150.0
+    loop_spacing: float  # 0.0
     odometry_translation_std: float  # 0.05
     odometry_drift: float  # 0.02
     odometry_rotation_std: float  # 0.1

@@ -38,6 +38,10 @@ const OptionTable<SlamOptions>& SlamOptionTable() {
             .AtLeast(0.0)
             .Unit("m")
             .Help("metres driven between a loop's keyframes at least"),
+        RADARGAUSS_OPTION(O, "loop_spacing", loop_spacing)
+            .AtLeast(0.0)
+            .Unit("m")
+            .Help("after an accepted loop, keyframes within this many metres are not searched (0: every one)"),
         RADARGAUSS_OPTION(O, "odometry_translation_std", odometry_translation_std)
             .Above(0.0)
             .Unit("m")
@@ -236,6 +240,10 @@ void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap) {
 // some that one thread would not have reached.
 void RadarSlam::SearchLoops(int query) {
   const auto start = std::chrono::steady_clock::now();
+  if (last_loop_path_ >= 0.0 && options_.loop_spacing > 0.0 &&
+      keyframes_[std::size_t(query)].path - last_loop_path_ < options_.loop_spacing) {
+    return;
+  }
   std::vector<int> eligible;  // far enough back along the path
   for (int c = 0; c < query && keyframes_[query].path - keyframes_[c].path >= options_.min_loop_path; ++c) {
     eligible.push_back(c);
@@ -316,6 +324,7 @@ void RadarSlam::SearchLoops(int query) {
       if (c.check.accepted) {
         graph_.AddLoop(c.candidate, query, c.check.relative, c.check.sqrt_information);
         SolveAfterLoop(query, paths[std::size_t(c.candidate)]);
+        last_loop_path_ = keyframes_[std::size_t(query)].path;
         accepted = true;
       }
     }

@@ -283,6 +283,24 @@ TEST(Relocalizer, TheMapAsTilesRelocalisesTheSame) {
   EXPECT_EQ(a.first_fix(), b.first_fix());
 }
 
+// With a loop spacing of 25 m, no accepted loop's query lies within 25 m
+// driven after the previous one's, and the revisits are still closed.
+TEST(RadarSlam, LoopSpacingLeavesTheKeyframesAfterALoopUnsearched) {
+  SlamOptions options = YardOptions();
+  options.loop_spacing = 25.0;
+  const std::unique_ptr<RadarSlam> spaced = RunYard(options);
+  ASSERT_GT(spaced->loops(), 0u);
+  EXPECT_LT(spaced->loops(), YardSlam().loops());
+  int last = -1;  // the last accepted loop's query
+  for (const LoopCandidate& c : spaced->candidates()) {
+    if (last >= 0 && c.query != last) {
+      EXPECT_GE(spaced->keyframes()[std::size_t(c.query)].path - spaced->keyframes()[std::size_t(last)].path, 25.0)
+          << "keyframe " << c.query << " searched";
+    }
+    if (c.check.accepted) last = c.query;
+  }
+}
+
 // Verification targets kept between searches (the default) or built anew for
 // every candidate (one kept): the same loops and poses, fewer builds.
 TEST(RadarSlam, KeptVerificationTargetsChangeNothing) {

@@ -39,6 +39,9 @@ struct SlamOptions {
   double submap_distance = 10.0;  // m driven per keyframe
   PlaceRecognitionOptions place_recognition;
   double min_loop_path = 150.0;  // m driven between a loop's keyframes (the active map closes shorter ones)
+  // After an accepted loop, the keyframes closed within this many metres
+  // driven are not searched: the loop has just corrected them. 0: every one.
+  double loop_spacing = 0.0;  // m
   LoopVerificationOptions verification;
   PoseGraphOptions graph;
   // The odometry edges' stds: floor plus drift per metre driven between keyframes.
@@ -196,6 +199,7 @@ class RadarSlam {
   std::vector<LoopCandidate> candidates_;
   std::mt19937 false_loops_;
   bool whole_solve_due_ = false;          // a local solve since the last whole one
+  double last_loop_path_ = -1.0;          // m driven to the last accepted loop's query (-1: none)
   std::unique_ptr<SerialWorker> worker_;  // the back end's thread; null: in Register
 };
 
