@@ -18,7 +18,10 @@ cores: wall time, its ratio to one thread's, the per-scan p99, the back
 end's p99 per keyframe, and whether the trajectory equals one thread's.
 
     scripts/scale_table.py [--tool build/release/bin/radargauss] [--work /tmp/scale_table] [--laps 1,2,4,10]
-                           [--threads 1,2,4,0] [--tables 1,2]
+                           [--threads 1,2,4,0] [--tables 1,2] [--slam-flags "--loop-spacing 25"]
+
+--slam-flags are added to every slam run (its outputs then go to folders
+named after them).
 """
 import argparse
 import csv
@@ -63,9 +66,9 @@ def drive(tool, work, laps):
     return out
 
 
-def slam(tool, sequence, out, threads):
+def slam(tool, sequence, out, threads, flags):
     command = [tool, "--threads", str(threads), "slam", "--sequence", sequence, "--gt",
-               os.path.join(sequence, "gt_radar_tum.txt"), "--out", out]
+               os.path.join(sequence, "gt_radar_tum.txt"), "--out", out] + flags
     start = time.perf_counter()
     memory = peak_mb(command)
     wall = time.perf_counter() - start
@@ -95,7 +98,10 @@ def main():
     parser.add_argument("--laps", default="1,2,4,10")
     parser.add_argument("--threads", default="1,2,4,0")
     parser.add_argument("--tables", default="1,2")
+    parser.add_argument("--slam-flags", default="")
     args = parser.parse_args()
+    flags = args.slam_flags.split()
+    suffix = "".join(f.strip("-").replace("-", "_") + "_" for f in flags)
     tables = args.tables.split(",")
     if "1" in tables:
         print("| laps | scans | wall s | ms per scan | median ms | p99 ms | first lap mean / p99 ms | last tenth "
@@ -104,7 +110,7 @@ def main():
         print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         for laps in [int(n) for n in args.laps.split(",")]:
             sequence = drive(args.tool, args.work, laps)
-            r = slam(args.tool, sequence, os.path.join(args.work, f"slam_{laps}"), 1)
+            r = slam(args.tool, sequence, os.path.join(args.work, f"slam_{suffix}{laps}"), 1, flags)
             print(f"| {laps} | {r['scans']} | {r['wall']:.1f} | {1000 * r['wall'] / r['scans']:.2f} | "
                   f"{r['median']:.2f} | {r['p99']:.1f} | {r['first_mean']:.2f} / {r['first_p99']:.1f} | "
                   f"{r['last_mean']:.2f} / {r['last_p99']:.1f} | "
@@ -119,8 +125,8 @@ def main():
         sequence = drive(args.tool, args.work, 2)
         reference = None
         for threads in [int(n) for n in args.threads.split(",")]:
-            out = os.path.join(args.work, f"threads_{threads}")
-            r = slam(args.tool, sequence, out, threads)
+            out = os.path.join(args.work, f"threads_{suffix}{threads}")
+            r = slam(args.tool, sequence, out, threads, flags)
             if reference is None:
                 reference = (r["wall"], out)
             same = filecmp.cmp(os.path.join(reference[1], "slam.tum"), os.path.join(out, "slam.tum"), shallow=False)
