@@ -57,6 +57,15 @@ const OptionTable<SlamOptions>& SlamOptionTable() {
             .Help("and its growth"),
         RADARGAUSS_OPTION(O, "asynchronous_back_end", asynchronous_back_end)
             .Help("with more than one thread, the back end runs beside the odometry (the same results)"),
+        RADARGAUSS_OPTION(O, "place_merge_distance", place_merge_distance)
+            .AtLeast(0.0)
+            .Unit("m")
+            .Help(
+                "a keyframe this near a place of the map already (and turned less than the angle) adds none (0: all)"),
+        RADARGAUSS_OPTION(O, "place_merge_angle", place_merge_angle_deg)
+            .In(0.0, 180.0)
+            .Unit("deg")
+            .Help("the same, turned"),
         RADARGAUSS_OPTION(O, "local_solve_margin", local_solve_margin)
             .AtLeast(0.0)
             .Unit("m")

@@ -70,8 +70,16 @@ GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& 
   MapGeometry geometry = BuildMapGeometry(scans, poses, options);
   FitRcsModels(geometry.map, geometry.cloud, geometry.association, options.rcs);  // as BuildMap
   GaussianMap map = std::move(geometry.map);
+  const SlamOptions& o = slam.options();
+  const double merge_angle = o.place_merge_angle_deg * M_PI / 180.0;
   for (std::size_t k = 0; k < slam.keyframes().size(); ++k) {
-    map.places.push_back({slam.graph().poses()[k], slam.keyframes()[k].points});
+    const SE3d& pose = slam.graph().poses()[k];
+    const bool revisit =
+        o.place_merge_distance > 0.0 && std::any_of(map.places.begin(), map.places.end(), [&](const MapPlace& place) {
+          return (place.pose.translation() - pose.translation()).norm() <= o.place_merge_distance &&
+                 (place.pose.rotation().Inverse() * pose.rotation()).Log().norm() <= merge_angle;
+        });
+    if (!revisit) map.places.push_back({pose, slam.keyframes()[k].points});
   }
   return map;
 }

@@ -170,6 +170,22 @@ expect_ok "relocalize says when nothing verifies" "relocalize: no fix" -- \
   --max-scan-context-distance 0 --out "$work/relocalized"
 [[ -s "$work/relocalized/per_scan.csv" && ! -s "$work/relocalized/relocalization.tum" ]] ||
   { echo "FAIL: relocalize without a fix wrote no per_scan.csv or a pose"; failed=1; }
+# The map as tiles: map-info and relocalize read the folder as they read the file.
+expect_ok "slam writes the map as tiles" "map_tiles/" -- \
+  "$tool" slam --sequence "$work/seq10" --submap-distance 2 --map-tiles 20 --out "$work/slam_tiles"
+[[ -s "$work/slam_tiles/map_tiles/tiles.json" ]] || { echo "FAIL: slam --map-tiles wrote no tiles.json"; failed=1; }
+if [[ "$("$tool" map-info "$work/slam_tiles/map.rgm" | tail -n +2)" != \
+      "$("$tool" map-info "$work/slam_tiles/map_tiles" | tail -n +2)" ]]; then
+  echo "FAIL: map-info of the tiles differs from the map file's"; failed=1
+fi
+"$tool" relocalize --map "$work/slam_tiles/map_tiles" --sequence "$work/seq10" --submap-distance 2 \
+  --out "$work/relocalized_tiles" >/dev/null
+"$tool" relocalize --map "$work/slam_tiles/map.rgm" --sequence "$work/seq10" --submap-distance 2 \
+  --out "$work/relocalized_file" >/dev/null
+cmp -s "$work/relocalized_tiles/per_scan.csv" "$work/relocalized_file/per_scan.csv" ||
+  { echo "FAIL: relocalize in the tiles differs from relocalize in the map file"; failed=1; }
+expect_fail "--map-tiles needs the map" "drop --no-map" -- \
+  "$tool" slam --sequence "$work/seq10" --map-tiles 20 --no-map --out "$work/slam_no_map_tiles"
 # The evaluation in memory (odometry --gt) and from the files (evaluate) agree
 # field by field, here on the straight drive whose positions lie on a line.
 "$tool" simulate --out "$work/straight" --scans 120 --seed 3 >/dev/null

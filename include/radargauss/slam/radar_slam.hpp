@@ -55,6 +55,11 @@ struct SlamOptions {
   // the graph plus this margin of the query, the rest held; Finish solves
   // the whole graph. 0: every solve is of the whole graph.
   double local_solve_margin = 100.0;  // m
+  // The map of the place keeps a keyframe as a place unless a place already
+  // kept lies within this many metres and degrees of its optimised pose: a
+  // revisit adds no place. 0: every keyframe is a place.
+  double place_merge_distance = 6.0;  // m
+  double place_merge_angle_deg = 45.0;
 };
 
 // Robustness studies, apart from what a user sets: after each keyframe's
@@ -219,7 +224,8 @@ SlamSummary Summarise(const RadarSlam& slam);
 
 // The map of the place: build-map's estimator (the odometry map's Gaussian
 // and RCS options, its Doppler filter) over every scan at its optimised pose,
-// with the keyframes as places at their optimised poses. `scans` are the ones
+// with the keyframes as places at their optimised poses, a revisit merged
+// into the place already there (place_merge_distance). `scans` are the ones
 // registered, in order.
 GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& slam);
 
