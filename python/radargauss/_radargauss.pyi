@@ -184,7 +184,7 @@ class SlamOptions(OdometryOptions, PlaceSearchOptions, total=False):
     odometry_rotation_std: float  # 0.1
     odometry_drift_deg: float  # 0.02
     asynchronous_back_end: bool  # True
-    place_merge_distance: float  # 6.0
+    place_merge_distance: float  # 0.0
     place_merge_angle: float  # 45.0
     local_solve_margin: float  # 100.0
     loop_rejection: str  # 'graduated'

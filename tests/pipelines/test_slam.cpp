@@ -48,6 +48,7 @@ SlamOptions YardOptions() {
   options.min_loop_path = 100.0;
   options.place_recognition.candidates = 20;
   options.place_recognition.max_scan_context_distance = 0.6;
+  options.place_merge_distance = 6.0;  // a revisit adds no place
   return options;
 }
 

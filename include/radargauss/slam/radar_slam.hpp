@@ -57,8 +57,8 @@ struct SlamOptions {
   double local_solve_margin = 100.0;  // m
   // The map of the place keeps a keyframe as a place unless a place already
   // kept lies within this many metres and degrees of its optimised pose: a
-  // revisit adds no place. 0: every keyframe is a place.
-  double place_merge_distance = 6.0;  // m
+  // revisit adds no place. 0 (the default): every keyframe is a place.
+  double place_merge_distance = 0.0;  // m
   double place_merge_angle_deg = 45.0;
 };
 
