@@ -235,6 +235,22 @@ SE3d BirdsEyeStart::pose() const {
               Eigen::Vector3d(shift.x(), shift.y(), 0.0));
 }
 
+namespace {
+
+// The start at one yaw: the query turned (once, not per point) and aligned to the target's cells.
+BirdsEyeStart StartAt(const std::vector<RadarPoint>& query, const std::vector<Eigen::Vector3d>& target, double yaw,
+                      const LoopVerificationOptions& options) {
+  BirdsEyeStart start;
+  start.yaw = yaw;
+  const SO3d rotation = start.pose().rotation();
+  std::vector<Eigen::Vector3d> turned = Positions(query);
+  for (Eigen::Vector3d& p : turned) p = rotation * p;
+  std::tie(start.shift, start.overlap) = AlignBirdsEye(turned, target, options.bev_cell, options.bev_search);
+  return start;
+}
+
+}  // namespace
+
 std::vector<BirdsEyeStart> BirdsEyeStarts(const std::vector<RadarPoint>& query,
                                           const std::vector<RadarPoint>& candidate, const std::vector<double>& yaws,
                                           const LoopVerificationOptions& options) {
@@ -242,12 +258,7 @@ std::vector<BirdsEyeStart> BirdsEyeStarts(const std::vector<RadarPoint>& query,
   for (std::size_t i = 0; i < yaws.size(); ++i) starts[i].yaw = yaws[i];
   if (query.size() < kMinSubmapPoints || candidate.size() < kMinSubmapPoints) return starts;
   const std::vector<Eigen::Vector3d> target = Positions(candidate);
-  for (BirdsEyeStart& start : starts) {
-    const SO3d rotation(Eigen::Quaterniond(Eigen::AngleAxisd(start.yaw, Eigen::Vector3d::UnitZ())));
-    std::vector<Eigen::Vector3d> turned = Positions(query);
-    for (Eigen::Vector3d& p : turned) p = rotation * p;
-    std::tie(start.shift, start.overlap) = AlignBirdsEye(turned, target, options.bev_cell, options.bev_search);
-  }
+  for (BirdsEyeStart& start : starts) start = StartAt(query, target, start.yaw, options);
   return starts;
 }
 
@@ -303,12 +314,7 @@ LoopCheck VerifyLoop(const std::vector<RadarPoint>& query, const VerificationTar
     check.reason = "submap too small";
     return check;
   }
-  BirdsEyeStart start;
-  start.yaw = yaw;
-  std::vector<Eigen::Vector3d> turned = Positions(query);
-  for (Eigen::Vector3d& p : turned) p = start.pose().rotation() * p;
-  std::tie(start.shift, start.overlap) =
-      AlignBirdsEye(turned, candidate.points(), options.bev_cell, options.bev_search);
+  const BirdsEyeStart start = StartAt(query, candidate.points(), yaw, options);
   check.overlap = start.overlap;
   const SE3d initial = start.pose();
 
