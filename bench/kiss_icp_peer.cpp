@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // kiss-icp's C++ core (kiss_icp::pipeline::KissICP) on a radargauss
-// sequence, one thread, for the odometry comparison of bench/RESULTS.md:
+// sequence, one thread unless told, for the odometry comparison of
+// bench/RESULTS.md (scripts/peer_table.py):
 // every point of each scan, no deskewing; writes the radar poses (TUM) and
 // each RegisterFrame's time. Built by scripts/kiss_icp_peer.sh, not by CMake
 // (kiss-icp, Sophus and robin-map are not Debian packages).
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <exception>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,11 +32,14 @@ void WriteTumLine(std::ofstream& out, double stamp, const Sophus::SE3d& pose) {
 }  // namespace
 
 int main(int argc, char** argv) try {
-  if (argc < 4 || argc > 6) {
-    std::fprintf(stderr, "usage: kiss_icp_peer SEQUENCE_DIR OUT.tum TIMES.csv [voxel_m=1] [max_range_m=100]\n");
+  if (argc < 4 || argc > 7) {
+    std::fprintf(stderr,
+                 "usage: kiss_icp_peer SEQUENCE_DIR OUT.tum TIMES.csv [voxel_m=1] [max_range_m=100] [threads=1]\n");
     return 2;
   }
-  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const int threads = argc > 6 ? std::stoi(argv[6]) : 1;
+  if (threads < 1) throw std::invalid_argument("threads must be >= 1");
+  const tbb::global_control thread_limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
   radargauss::SequenceOptions options;
   options.sequence_dir = argv[1];
   const radargauss::Sequence sequence = radargauss::LoadSequence(options);
@@ -42,7 +47,7 @@ int main(int argc, char** argv) try {
   config.voxel_size = argc > 4 ? std::stod(argv[4]) : 1.0;
   config.max_range = argc > 5 ? std::stod(argv[5]) : 100.0;
   config.deskew = false;
-  config.max_num_threads = 1;
+  config.max_num_threads = threads;
   kiss_icp::pipeline::KissICP kiss(config);
   std::ofstream tum(argv[2]), times(argv[3]);
   if (!tum || !times) throw std::runtime_error("cannot write " + std::string(argv[2]) + " or " + argv[3]);

@@ -2,8 +2,9 @@
 // The map build against small_gicp's VGICP target on the same static cloud
 // (bench/RESULTS.md, "Gaussian-RCS map"): radargauss's Gaussians (k-means +
 // hard EM), the default MatchingMap and the RCS fit, against small_gicp's
-// downsampling (0.25 m), k-d tree, covariances (20 neighbours) and Gaussian
-// voxel map (1 m), one thread each. Built by scripts/small_gicp_peer.sh,
+// defaults (preprocess_points, RegistrationSetting): downsampling (0.25 m),
+// k-d tree, covariances (10 neighbours) and Gaussian voxel map (1 m), one
+// thread each. Built by scripts/small_gicp_peer.sh,
 // not by CMake (small_gicp is not a Debian package).
 #include <tbb/global_control.h>
 
@@ -65,7 +66,7 @@ int main(int argc, char** argv) try {
   const auto tree = std::make_shared<small_gicp::KdTree<small_gicp::PointCloud>>(downsampled);
   const double kdtree = SecondsSince(start);
   start = std::chrono::steady_clock::now();
-  small_gicp::estimate_covariances(*downsampled, *tree, 20);
+  small_gicp::estimate_covariances(*downsampled, *tree, 10);
   const double covariances = SecondsSince(start);
   start = std::chrono::steady_clock::now();
   small_gicp::GaussianVoxelMap voxels(1.0);

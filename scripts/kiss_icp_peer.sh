@@ -21,6 +21,6 @@ ln -sfn "$kiss/pipeline" "$include/kiss_icp/pipeline"
 g++ -std=c++17 -O3 -DNDEBUG -DSOPHUS_USE_BASIC_LOGGING -I"$include" -I"$2" -I"$3/include" -I/usr/include/eigen3 \
   -I"$root/include" "$root/bench/kiss_icp_peer.cpp" "$kiss"/core/*.cpp "$kiss/pipeline/KissICP.cpp" \
   "$root/build/release/libradargauss.a" -lrosbag_storage -lroslz4 -lroscpp_serialization -lrostime -lcpp_common \
-  -lconsole_bridge -lboost_filesystem -lboost_regex -lbz2 -llz4 -ltbb -lz -llzf -lyaml-cpp -lpthread \
+  -lconsole_bridge -lboost_filesystem -lboost_regex -lbz2 -llz4 -ltbb -lz -llzf -lyaml-cpp -lsqlite3 -lzstd -lpthread \
   -o "$root/build/kiss_icp_peer"
 echo "built $root/build/kiss_icp_peer"

@@ -15,5 +15,5 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 g++ -std=c++17 -O3 -DNDEBUG -I"$1/include" -I/usr/include/eigen3 -I"$root/include" \
   "$root/bench/small_gicp_target_peer.cpp" "$root/build/release/libradargauss.a" \
   -lrosbag_storage -lroslz4 -lroscpp_serialization -lrostime -lcpp_common -lconsole_bridge -lboost_filesystem \
-  -lboost_regex -lbz2 -llz4 -ltbb -lz -llzf -lyaml-cpp -lpthread -o "$root/build/small_gicp_target_peer"
+  -lboost_regex -lbz2 -llz4 -ltbb -lz -llzf -lyaml-cpp -lsqlite3 -lzstd -lpthread -o "$root/build/small_gicp_target_peer"
 echo "built $root/build/small_gicp_target_peer"
