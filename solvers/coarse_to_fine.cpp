@@ -68,10 +68,11 @@ void CoarseToFine::Begin(const Stage& stage) {
   stage_scan_ = stage.finest || !reduce_ ? &scan_ : &coarse_scan_;
   gate_ = stage.finest ? options_.gate : map_.coarse_gate();
   if (stage.full_cost && geometric_first_ && KeepsAssociation(true, correspondences_.pose, result_.pose, options_)) {
-    AddRcsTerms(scan_, map_, correspondences_);  // eq. 2 on the geometric stage's last association (same level)
+    AddRcsTerms(scan_, map_, correspondences_,
+                options_.rcs_terms);  // eq. 2 on the geometric stage's last association (same level)
   } else {
-    correspondences_ =
-        FindCorrespondences(*stage_scan_, map_, stage.level, result_.pose, gate_, stage.options.w_rcs > 0.0);
+    correspondences_ = FindCorrespondences(*stage_scan_, map_, stage.level, result_.pose, gate_,
+                                           stage.options.w_rcs > 0.0, options_.rcs_terms);
   }
   evaluated_.known = false;
 }
@@ -80,8 +81,8 @@ bool CoarseToFine::Associate(const Stage& stage, int iteration) {
   if (iteration == 1) {
     Begin(stage);
   } else if (!KeepsAssociation(stage.finest, correspondences_.pose, result_.pose, options_)) {
-    correspondences_ =
-        FindCorrespondences(*stage_scan_, map_, stage.level, result_.pose, gate_, stage.options.w_rcs > 0.0);
+    correspondences_ = FindCorrespondences(*stage_scan_, map_, stage.level, result_.pose, gate_,
+                                           stage.options.w_rcs > 0.0, options_.rcs_terms);
     evaluated_.known = false;
   }
   if (!CheckCorrespondences(*stage_scan_, correspondences_, stage.options, result_.reason)) return false;
@@ -108,9 +109,10 @@ void CoarseToFine::FinishCounts(ScanMatchingResult& result) const {
   const ScanPriors& priors = priors_;
   const Correspondences& c = correspondences_;
   const bool last_is_final = KeepsAssociation(c.index == &map.index(), c.pose, result.pose, options);
-  const Correspondences final_c =
-      last_is_final ? c
-                    : FindCorrespondences(scan_, map, map.levels() - 1, result.pose, options.gate, options.w_rcs > 0.0);
+  const Correspondences final_c = last_is_final
+                                      ? c
+                                      : FindCorrespondences(scan_, map, map.levels() - 1, result.pose, options.gate,
+                                                            options.w_rcs > 0.0, options.rcs_terms);
   result.n_geo = final_c.geometric.size();
   result.n_rcs = final_c.rcs.size();
   // On the exact map the steps' options are these (w_rcs is the requested w there).

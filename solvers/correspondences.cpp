@@ -21,7 +21,7 @@ std::vector<int> AssociateScan(const RadarScan& scan, const GaussianIndex& index
 }
 
 Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level, const SE3d& pose,
-                                    double gate, bool with_rcs) {
+                                    double gate, bool with_rcs, const RcsTermOptions& rcs_terms) {
   Correspondences out;
   out.index = &map.level(level);
   out.pose = pose;
@@ -32,13 +32,17 @@ Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& ma
       out.geometric.push_back({scan.points[k].position, std::uint32_t(associations[k]), std::uint32_t(k)});
     }
   }
-  if (with_rcs) AddRcsTerms(scan, map, out);
+  if (with_rcs) AddRcsTerms(scan, map, out, rcs_terms);
   return out;
 }
 
-void AddRcsTerms(const RadarScan& scan, const MatchingMap& map, Correspondences& c) {
+void AddRcsTerms(const RadarScan& scan, const MatchingMap& map, Correspondences& c, const RcsTermOptions& rcs_terms) {
   c.rcs.clear();
   if (!scan.has_rcs) return;
+  const double shape = SwerlingShape(rcs_terms.likelihood);
+  const double expected_spread =
+      rcs_terms.expected_spread_db > 0.0 ? rcs_terms.expected_spread_db : RcsLikelihoodSpreadDb(rcs_terms.likelihood);
+  constexpr double kNepersPerDb = 0.23025850929940458;  // ln(10) / 10
   c.rcs.reserve(c.geometric.size());
   const Eigen::Matrix3d Rt = c.pose.rotation().Matrix().transpose();
   const std::vector<Gaussian>& gaussians = map.map().gaussians;
@@ -64,6 +68,17 @@ void AddRcsTerms(const RadarScan& scan, const MatchingMap& map, Correspondences&
     term.incidence = map.map().incidence;
     term.facing = FacingSign(u);
     term.gaussian = pair.gaussian;
+    if (shape > 0.0) {  // z = ln(sigma / mean) from the decibel residual (rcs_likelihood.hpp)
+      term.shape = shape;
+      term.log_scale = kNepersPerDb * gaussian.rcs.scale;
+      term.log_offset = -kNepersPerDb * gaussian.rcs.mean_offset_db;
+    }
+    if (rcs_terms.confidence) {
+      const double confidence =
+          RcsConfidence(gaussian.rcs.spread_db, gaussian.rcs.degree, gaussian.rcs.inliers, expected_spread);
+      if (!(confidence > 0.0)) continue;  // says nothing: no residual
+      term.weight = std::sqrt(confidence);
+    }
     c.rcs.push_back(term);
   }
 }

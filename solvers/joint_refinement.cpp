@@ -240,7 +240,7 @@ JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans, const s
     std::size_t points = 0, associated = 0;
     for (std::size_t k = 0; k < scans.size(); ++k) {
       const Correspondences c = FindCorrespondences(scans[k], matching, 0, blocks.Pose(k), options.matching.gate,
-                                                    options.matching.w_rcs > 0.0);
+                                                    options.matching.w_rcs > 0.0, options.matching.rcs_terms);
       points += scans[k].points.size();
       associated += c.geometric.size();
       problem.AddScan(k, c);

@@ -37,7 +37,15 @@ const OptionTable<ScanMatchingOptions>& ScanMatchingOptionTable() {
       RADARGAUSS_OPTION(O, "loss_scale", geometric_loss.scale).Above(0.0).Help("its scale a"),
       RADARGAUSS_CHOICE(O, "rcs_loss", rcs_loss.type, LossNames(), LossTypeFromString)
           .Help("robust loss of the RCS term (the paper: cauchy)"),
-      RADARGAUSS_OPTION(O, "rcs_loss_scale", rcs_loss.scale).Above(0.0).Unit("dB").Help("its scale a"),
+      RADARGAUSS_OPTION(O, "rcs_loss_scale", rcs_loss.scale).Above(0.0).Help("its scale a"),
+      RADARGAUSS_CHOICE(O, "rcs_likelihood", rcs_terms.likelihood, RcsLikelihoodNames(), RcsLikelihoodFromString)
+          .Help("the RCS residual: decibel (the paper), swerling1 or swerling3 (fluctuating RCS)"),
+      RADARGAUSS_OPTION(O, "rcs_confidence", rcs_terms.confidence)
+          .Help("weigh each RCS term by its Gaussian's fit (spread and members)"),
+      RADARGAUSS_OPTION(O, "rcs_expected_spread", rcs_terms.expected_spread_db)
+          .AtLeast(0.0)
+          .Unit("dB")
+          .Help("the spread the confidence expects (0: the likelihood's own)"),
       RADARGAUSS_CHOICE(O, "rcs_translation", rcs_translation, RcsTranslationNames(), RcsTranslationFromString)
           .Help("the RCS term on the rotation alone (the paper) or on the full pose"),
       RADARGAUSS_CHOICE(O, "jacobians", jacobians, JacobianModeNames(), JacobianModeFromString)

@@ -13,6 +13,9 @@ class MatchOptions(TypedDict, total=False):
     loss_scale: float  # 1.0
     rcs_loss: str  # 'cauchy'
     rcs_loss_scale: float  # 1.0
+    rcs_likelihood: str  # 'decibel'
+    rcs_confidence: bool  # False
+    rcs_expected_spread: float  # 0.0
     rcs_translation: str  # 'rotation-only'
     jacobians: str  # 'analytic'
     gate: float  # 3.0
@@ -91,6 +94,7 @@ class OdometryOptions(MatchOptions, total=False):
     rcs_adaptive: bool  # True
     incidence: str  # 'offset'
     rcs_rank_threshold: float  # 0.01
+    rcs_min_explained: float  # 0.0
     coarse_levels: str  # 'merged'
     coarse_sigmas: list[float]  # [0.25]
     index_cell: float  # 1.0
@@ -136,6 +140,9 @@ class PlaceSearchOptions(TypedDict, total=False):
     verify_solver: str  # 'mh-gn'
     verify_loss: str  # 'trivial'
     verify_loss_scale: float  # 1.0
+    verify_rcs_likelihood: str  # 'decibel'
+    verify_rcs_confidence: bool  # False
+    verify_rcs_expected_spread: float  # 0.0
     verify_jacobians: str  # 'analytic'
     verify_gate: float  # 3.0
     verify_max_iterations: int  # 30
@@ -226,9 +233,13 @@ class GaussianMap:
     @property
     def rcs_degrees(self) -> Any: ...
     @property
+    def rcs_explained(self) -> Any: ...
+    @property
     def rcs_medians(self) -> Any: ...
     @property
     def rcs_scales(self) -> Any: ...
+    @property
+    def rcs_spreads(self) -> Any: ...
 
 class MatchResult:
     """The outcome of one scan match."""

@@ -87,7 +87,25 @@ void BindMapClass(py::module_& m) {
               return std::copy(g.rcs.coefficients.begin(), g.rcs.coefficients.end(), p);
             });
           },
-          "(K, 16) real SH coefficients of the normalised RCS, zero beyond each model's degree");
+          "(K, 16) real SH coefficients of the normalised RCS, zero beyond each model's degree")
+      .def_property_readonly(
+          "rcs_spreads",
+          [](const PyMap& m) {
+            return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
+              *p = g.rcs.spread_db;
+              return p + 1;
+            });
+          },
+          "std (dB) of each RCS fit's residuals, its coefficients' degrees of freedom taken out")
+      .def_property_readonly(
+          "rcs_explained",
+          [](const PyMap& m) {
+            return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
+              *p = g.rcs.explained;
+              return p + 1;
+            });
+          },
+          "share of each Gaussian's RCS variance its model's view explains (adjusted R^2, in [0, 1])");
 }
 
 MapOptions BuildOptions(const std::string& builder, double points_per_gaussian, double min_std,
@@ -136,8 +154,8 @@ void BindMap(py::module_& m) {
       "The map of `radargauss build-map`: from a Sequence with poses, or from a list of Scans and their poses "
       "T_world_radar (4x4 or [x y z qx qy qz qw]). builder: kmeans or voxel; incidence: offset, view or none.");
   m.def(
-      "read_map", [](const std::string& path) { return std::make_shared<PyMap>(ReadMapOrTiles(path)); }, py::arg("path"),
-      "Reads a .rgm map file (validated: docs/design.md, \"Bounds on input\").");
+      "read_map", [](const std::string& path) { return std::make_shared<PyMap>(ReadMapOrTiles(path)); },
+      py::arg("path"), "Reads a .rgm map file (validated: docs/design.md, \"Bounds on input\").");
   m.def(
       "write_map", [](const std::string& path, const PyMap& map) { WriteMap(path, map.map()); }, py::arg("path"),
       py::arg("map"), "Writes a .rgm map file atomically.");

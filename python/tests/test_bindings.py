@@ -40,22 +40,25 @@ def parse_map(path):
     (the layout of include/radargauss/map/map_file.hpp)."""
     data = open(path, "rb").read()
     count = struct.unpack_from("<Q", data, 16)[0]
-    means, covariances, coefficients = [], [], []
+    means, covariances, coefficients, statistics = [], [], [], []
     for k in range(count):
-        record = struct.unpack_from("<3d6dIiddd I16d", data, 24 + k * 236)
+        record = struct.unpack_from("<3d6dIiddd I16d3d", data, 24 + k * 260)
         means.append(record[0:3])
         xx, xy, xz, yy, yz, zz = record[3:9]
         covariances.append([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
         coefficients.append(record[15:31])
-    return np.array(means), np.array(covariances), np.array(coefficients)
+        statistics.append(record[31:33])
+    return np.array(means), np.array(covariances), np.array(coefficients), np.array(statistics)
 
 
 def test_map_arrays_equal_the_file(written, tmp_path):
     world = rg.read_map(written["map"])
-    means, covariances, coefficients = parse_map(written["map"])
+    means, covariances, coefficients, statistics = parse_map(written["map"])
     assert len(world) == len(means) > 100
     assert np.array_equal(world.means, means) and np.array_equal(world.covariances, covariances)
     assert np.array_equal(world.rcs_coefficients, coefficients)
+    assert np.array_equal(world.rcs_spreads, statistics[:, 0]) and np.array_equal(world.rcs_explained, statistics[:, 1])
+    assert world.rcs_spreads.max() > 0 and 0 <= world.rcs_explained.min() <= world.rcs_explained.max() <= 1
     copy = str(tmp_path / "copy.rgm")
     rg.write_map(copy, world)
     assert open(copy, "rb").read() == open(written["map"], "rb").read()

@@ -115,6 +115,15 @@ RcsModel RcsStatistics::Solve(const RcsFitOptions& options) const {
         const double residual = sum_y_squared - 2.0 * c.dot(rhs.head(count)) + c.dot(block * c);
         model.fit_rmse = std::sqrt(std::max(residual, 0.0) / double(inliers));
         model.inliers = std::uint32_t(inliers);
+        // Sum of (y - mean y)^2: Y_0 is the constant kC0, so sum y = rhs_0 / kC0.
+        const double sum_y = rhs[0] / sh_constants::kC0;
+        SetRcsFitSpread(model, residual, sum_y_squared - sum_y * sum_y / double(inliers), inliers, count);
+        // Without the members: the offset of a log-normal spread, sigma^2 ln(10) / 20 dB.
+        model.mean_offset_db = model.spread_db * model.spread_db * std::log(10.0) / 20.0;
+        if (degree > 0 && model.explained < options.min_explained) {
+          degree = 1;
+          continue;
+        }
         return model;
       }
     }

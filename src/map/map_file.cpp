@@ -25,7 +25,8 @@ namespace {
 
 constexpr char kMagic[8] = {'R', 'G', 'A', 'U', 'S', 'M', 'A', 'P'};
 constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8;
-constexpr std::size_t kGaussianBytes = 3 * 8 + 6 * 8 + 4 + 4 + 3 * 8 + 4 + 16 * 8;
+constexpr std::size_t kGaussianBytesV2 = 3 * 8 + 6 * 8 + 4 + 4 + 3 * 8 + 4 + 16 * 8;
+constexpr std::size_t kGaussianBytes = kGaussianBytesV2 + 3 * 8;  // and the fit's statistics
 
 template <typename T>
 void Put(std::string& out, T value) {
@@ -83,6 +84,9 @@ void WriteMap(const std::string& path, const GaussianMap& map) {
     Put<double>(bytes, g.rcs.fit_rmse);
     Put<std::uint32_t>(bytes, g.rcs.inliers);
     for (const double c : g.rcs.coefficients) Put<double>(bytes, c);
+    Put<double>(bytes, g.rcs.spread_db);
+    Put<double>(bytes, g.rcs.explained);
+    Put<double>(bytes, g.rcs.mean_offset_db);
   }
   Put<std::uint64_t>(bytes, map.places.size());
   for (const MapPlace& place : map.places) {
@@ -117,9 +121,13 @@ void ValidateGaussian(const Gaussian& g, const Fail& fail) {
   if (g.rcs.degree < -1 || g.rcs.degree > kMaxShDegree) throw fail("SH degree out of range");
   const bool rcs_finite =
       std::isfinite(g.rcs.median) && std::isfinite(g.rcs.scale) && std::isfinite(g.rcs.fit_rmse) &&
+      std::isfinite(g.rcs.spread_db) && std::isfinite(g.rcs.mean_offset_db) &&
       std::all_of(g.rcs.coefficients.begin(), g.rcs.coefficients.end(), [](double c) { return std::isfinite(c); });
   if (!rcs_finite) throw fail("non-finite RCS model");
   if (g.rcs.degree >= 0 && !(g.rcs.scale > 0.0)) throw fail("RCS model with scale <= 0");
+  if (!(g.rcs.spread_db >= 0.0) || !(g.rcs.explained >= 0.0 && g.rcs.explained <= 1.0)) {
+    throw fail("RCS fit statistics out of range (spread < 0 dB or explained share outside [0, 1])");
+  }
 }
 
 // The places section, which must end at `end` (the CRC).
@@ -175,7 +183,7 @@ GaussianMap ReadMap(const std::string& path) {
   Reader reader(bytes);
   reader.Get<std::uint64_t>();  // magic
   const std::uint32_t version = reader.Get<std::uint32_t>();
-  if (version != 1 && version != kMapFileVersion) {
+  if (version < 1 || version > kMapFileVersion) {
     throw FileError(path, "map version " + std::to_string(version) + ", this build reads versions 1 to " +
                               std::to_string(kMapFileVersion) + " (rebuild the map)");
   }
@@ -184,9 +192,10 @@ GaussianMap ReadMap(const std::string& path) {
   reader.Get<std::uint16_t>();
   const std::uint64_t count = reader.Get<std::uint64_t>();
   const std::size_t places_bytes = version == 1 ? 0 : 8;  // at least the place count
-  if (count > (bytes.size() - kHeaderBytes) / kGaussianBytes ||
-      (version == 1 && bytes.size() != kHeaderBytes + count * kGaussianBytes + 4) ||
-      bytes.size() < kHeaderBytes + count * kGaussianBytes + places_bytes + 4) {
+  const std::size_t gaussian_bytes = version < 3 ? kGaussianBytesV2 : kGaussianBytes;
+  if (count > (bytes.size() - kHeaderBytes) / gaussian_bytes ||
+      (version == 1 && bytes.size() != kHeaderBytes + count * gaussian_bytes + 4) ||
+      bytes.size() < kHeaderBytes + count * gaussian_bytes + places_bytes + 4) {
     throw FileError(path, "truncated or oversized: " + std::to_string(bytes.size()) + " bytes for " +
                               std::to_string(count) + " Gaussians");
   }
@@ -212,6 +221,13 @@ GaussianMap ReadMap(const std::string& path) {
     g.rcs.fit_rmse = reader.Get<double>();
     g.rcs.inliers = reader.Get<std::uint32_t>();
     for (double& c : g.rcs.coefficients) c = reader.Get<double>();
+    if (version >= 3) {
+      g.rcs.spread_db = reader.Get<double>();
+      g.rcs.explained = reader.Get<double>();
+      g.rcs.mean_offset_db = reader.Get<double>();
+    } else {  // no statistics: the fit's rmse in dB, view-dependent (docs/design.md, "RCS confidence")
+      g.rcs.spread_db = g.rcs.fit_rmse * g.rcs.scale;
+    }
     const auto fail = [&](const std::string& what) {
       return FileError(path, "Gaussian " + std::to_string(k) + ": " + what);
     };

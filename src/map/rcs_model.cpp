@@ -23,6 +23,9 @@ const OptionTable<RcsFitOptions>& RcsFitOptionTable() {
           .In(0.0, 1.0)
           .Above(0.0)
           .Help("relative pivot threshold of the fit"),
+      RADARGAUSS_OPTION(O, "rcs_min_explained", min_explained)
+          .In(0.0, 1.0)
+          .Help("a model whose view explains less of its RCS variance (adjusted R^2) is constant"),
   };
   return table;
 }
@@ -35,6 +38,18 @@ RcsNormalisation NormaliseRcs(std::vector<double> rcs) {
   result.scale = std::min(result.median - rcs.front(), rcs.back() - result.median);
   result.valid = result.scale > 0.0;
   return result;
+}
+
+void SetRcsFitSpread(RcsModel& model, double residual_sq, double total_sq, std::size_t inliers, int coefficients) {
+  const double n = double(inliers), p = double(coefficients);
+  if (n > p) {
+    model.spread_db = model.scale * std::sqrt(std::max(residual_sq, 0.0) / (n - p));
+    const double adjusted = total_sq > 0.0 ? 1.0 - (residual_sq / (n - p)) / (total_sq / (n - 1.0)) : 0.0;
+    model.explained = std::clamp(adjusted, 0.0, 1.0);
+  } else {
+    model.spread_db = model.scale;
+    model.explained = 0.0;
+  }
 }
 
 RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::vector<double>& rcs,
@@ -75,6 +90,19 @@ RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::
         for (int j = 0; j < count; ++j) model.coefficients[j] = c[j];
         model.fit_rmse = std::sqrt((A * c - y).squaredNorm() / n);
         model.inliers = std::uint32_t(n);
+        const Eigen::VectorXd fitted = A * c;
+        SetRcsFitSpread(model, (fitted - y).squaredNorm(), (y.array() - y.mean()).square().sum(), std::size_t(n),
+                        count);
+        // 10 log10 of the mean of 10^((rcs - prediction) / 10): the inliers'
+        // linear mean over the model's dB value.
+        double linear_sum = 0.0;
+        for (int k = 0; k < n; ++k) linear_sum += std::pow(10.0, model.scale * (y[k] - fitted[k]) / 10.0);
+        model.mean_offset_db = 10.0 * std::log10(linear_sum / n);
+        // Not view-dependent beyond its noise: the constant model instead.
+        if (degree > 0 && model.explained < options.min_explained) {
+          degree = 1;
+          continue;
+        }
         return model;
       }
     }

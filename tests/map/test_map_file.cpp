@@ -48,6 +48,9 @@ GaussianMap ExampleMap() {
     g.rcs.scale = 1.0 + std::abs(normal(rng));
     g.rcs.fit_rmse = 0.1;
     g.rcs.inliers = 9;
+    g.rcs.spread_db = 0.5 + std::abs(normal(rng));
+    g.rcs.explained = 0.1 * double(i % 10);
+    g.rcs.mean_offset_db = normal(rng);
     for (int j = 0; j < ShCoefficientCount(g.rcs.degree); ++j) g.rcs.coefficients[j] = normal(rng);
   }
   return map;
@@ -56,6 +59,31 @@ GaussianMap ExampleMap() {
 std::string ReadBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+void AppendCrc(std::string& bytes) {
+  const std::uint32_t crc =
+      std::uint32_t(crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), uInt(bytes.size())));
+  bytes.append(reinterpret_cast<const char*>(&crc), 4);
+}
+
+// The bytes of an older version of a current file, laid out by hand from
+// map_file.hpp: version 2 without the fit statistics (24 bytes at the end of
+// each Gaussian), version 1 without the places section either.
+std::string OlderVersion(const std::string& current, int version) {
+  constexpr std::size_t kHeader = 24, kGaussianV2 = 236, kStatistics = 24;
+  std::uint64_t count;
+  std::memcpy(&count, current.data() + 16, 8);
+  std::string out = current.substr(0, kHeader);
+  out[8] = char(version);
+  for (std::uint64_t k = 0; k < count; ++k)
+    out += current.substr(kHeader + k * (kGaussianV2 + kStatistics), kGaussianV2);
+  if (version == 2) {
+    const std::size_t places = kHeader + count * (kGaussianV2 + kStatistics);
+    out += current.substr(places, current.size() - 4 - places);
+  }
+  AppendCrc(out);
+  return out;
 }
 
 TEST_F(MapFiles, RoundTripIsBitExact) {
@@ -69,6 +97,9 @@ TEST_F(MapFiles, RoundTripIsBitExact) {
     EXPECT_EQ(read.gaussians[i].covariance, map.gaussians[i].covariance);
     EXPECT_EQ(read.gaussians[i].rcs.coefficients, map.gaussians[i].rcs.coefficients);
     EXPECT_EQ(read.gaussians[i].rcs.degree, map.gaussians[i].rcs.degree);
+    EXPECT_EQ(read.gaussians[i].rcs.spread_db, map.gaussians[i].rcs.spread_db);
+    EXPECT_EQ(read.gaussians[i].rcs.explained, map.gaussians[i].rcs.explained);
+    EXPECT_EQ(read.gaussians[i].rcs.mean_offset_db, map.gaussians[i].rcs.mean_offset_db);
   }
   WriteMap(Path("b.rgm"), read);
   EXPECT_EQ(ReadBytes(Path("a.rgm")), ReadBytes(Path("b.rgm")));
@@ -94,14 +125,19 @@ TEST_F(MapFiles, CorruptFilesGiveClearErrors) {
   expect_error(good.substr(0, 10), "too short");
   std::string version = good;
   version[8] = 7;
-  expect_error(version, "map version 7, this build reads versions 1 to 2");
+  expect_error(version, "map version 7, this build reads versions 1 to 3");
+  GaussianMap unexplained = ExampleMap();
+  unexplained.gaussians[1].rcs.explained = 1.5;
+  WriteMap(Path("unexplained.rgm"), unexplained);
+  expect_error(ReadBytes(Path("unexplained.rgm")), "Gaussian 1: RCS fit statistics out of range");
   expect_error("PLY?" + good, "bad magic");
   EXPECT_THROW(ReadMap(Path("absent.rgm")), DataError);
 }
 
-// A SLAM map's places: poses bit-exact, points in float32; a version-1 file
-// (no places section) still reads; a truncated places section is an error.
-TEST_F(MapFiles, PlacesRoundTripAndVersionOneStillReads) {
+// A SLAM map's places: poses bit-exact, points in float32; version-1 (no
+// places section) and version-2 (no fit statistics) files still read; a
+// truncated places section is an error.
+TEST_F(MapFiles, PlacesRoundTripAndVersionsOneAndTwoStillRead) {
   GaussianMap map = ExampleMap();
   std::mt19937 rng(3);
   std::normal_distribution<double> normal;
@@ -134,23 +170,27 @@ TEST_F(MapFiles, PlacesRoundTripAndVersionOneStillReads) {
       EXPECT_EQ(read.places[k].points[i].rcs, double(float(map.places[k].points[i].rcs)));
     }
   }
-  // Version 1: the same Gaussians without the place count, its own CRC.
-  WriteMap(Path("plain.rgm"), ExampleMap());
-  std::string v1 = ReadBytes(Path("plain.rgm"));
-  v1.erase(v1.size() - 12);  // the place count (0) and the CRC
-  v1[8] = 1;
-  const uLong crc = crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(v1.data()), uInt(v1.size()));
-  const std::uint32_t crc32_value = std::uint32_t(crc);
-  v1.append(reinterpret_cast<const char*>(&crc32_value), 4);
-  const GaussianMap old = ReadMap(WriteFile("v1.rgm", v1));
-  EXPECT_EQ(old.gaussians.size(), map.gaussians.size());
-  EXPECT_TRUE(old.places.empty());
+  // Versions 1 and 2: the same Gaussians and places (version 2), and for
+  // the fit statistics the fit's rmse in dB, explained 1 and offset 0.
+  for (const int version : {1, 2}) {
+    const GaussianMap old = ReadMap(WriteFile("old.rgm", OlderVersion(ReadBytes(Path("places.rgm")), version)));
+    ASSERT_EQ(old.gaussians.size(), map.gaussians.size());
+    EXPECT_EQ(old.places.size(), version == 1 ? 0u : 3u);
+    for (std::size_t i = 0; i < map.gaussians.size(); ++i) {
+      const RcsModel& a = old.gaussians[i].rcs;
+      const RcsModel& b = map.gaussians[i].rcs;
+      EXPECT_EQ(old.gaussians[i].mean, map.gaussians[i].mean);
+      EXPECT_EQ(a.coefficients, b.coefficients);
+      EXPECT_EQ(a.inliers, b.inliers);
+      EXPECT_EQ(a.spread_db, b.fit_rmse * b.scale);
+      EXPECT_EQ(a.explained, 1.0);
+      EXPECT_EQ(a.mean_offset_db, 0.0);
+    }
+  }
   // The places file cut inside its last point, with a CRC that matches the cut.
   std::string cut = ReadBytes(Path("places.rgm"));
   cut.erase(cut.size() - 4 - 8);
-  const std::uint32_t cut_crc =
-      std::uint32_t(crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(cut.data()), uInt(cut.size())));
-  cut.append(reinterpret_cast<const char*>(&cut_crc), 4);
+  AppendCrc(cut);
   try {
     ReadMap(WriteFile("cut.rgm", cut));
     ADD_FAILURE() << "accepted a truncated places section";

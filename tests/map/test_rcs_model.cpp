@@ -119,6 +119,42 @@ TEST(RcsModelFit, RmseMatchesNoiseLevel) {
   EXPECT_NEAR(model.fit_rmse * model.scale, noise, 0.1 * noise);
 }
 
+// The fit's statistics (docs/design.md, "RCS confidence") on planted data:
+// a view law with 1 dB of noise gives a 1 dB spread and a view that explains
+// most of the variance; noise alone explains nothing and, with
+// min_explained, gets the constant model; a law without noise has no spread
+// and no offset to its linear mean.
+TEST(RcsModelFit, StatisticsOfPlantedFits) {
+  std::mt19937 rng(23);
+  std::normal_distribution<double> coefficient(0.0, 0.3), noise(0.0, 1.0);
+  std::array<double, 16> planted{};
+  for (double& c : planted) c = coefficient(rng);
+  const std::vector<Eigen::Vector3d> directions = FacingDirections(3000, rng);
+  std::vector<double> law, noisy, pure_noise;
+  for (const Eigen::Vector3d& d : directions) {
+    law.push_back(10.0 + 10.0 * EvaluateSh<3>(planted.data(), d));
+    noisy.push_back(law.back() + noise(rng));
+    pure_noise.push_back(10.0 + noise(rng));
+  }
+  const RcsModel exact = FitRcsModel(directions, law);
+  ASSERT_EQ(exact.degree, 3);
+  EXPECT_LT(exact.spread_db, 1e-9);
+  EXPECT_NEAR(exact.explained, 1.0, 1e-12);
+  EXPECT_NEAR(exact.mean_offset_db, 0.0, 1e-9);
+  const RcsModel fitted = FitRcsModel(directions, noisy);
+  ASSERT_EQ(fitted.degree, 3);
+  EXPECT_NEAR(fitted.spread_db, 1.0, 0.08);
+  EXPECT_GT(fitted.explained, 0.8);
+  // Gaussian dB noise of 1 dB: a linear mean sigma^2 ln(10) / 20 = 0.115 dB above.
+  EXPECT_NEAR(fitted.mean_offset_db, std::log(10.0) / 20.0, 0.03);
+  const RcsModel noise_only = FitRcsModel(directions, pure_noise);
+  EXPECT_LT(noise_only.explained, 0.02);
+  RcsFitOptions constant_below;
+  constant_below.min_explained = 0.1;
+  EXPECT_EQ(FitRcsModel(directions, pure_noise, constant_below).degree, 0);
+  EXPECT_EQ(FitRcsModel(directions, noisy, constant_below).degree, 3);
+}
+
 TEST(RcsModelFit, CoplanarDirectionsLowerTheDegree) {
   // Directions on one great circle span only 2L + 1 of the (L + 1)^2 functions.
   std::vector<Eigen::Vector3d> directions;

@@ -137,6 +137,8 @@ TEST(RcsStatistics, NormalEquationsEqualTheBatchSumsAndSolveAsFitRcsModel) {
   for (int j = 0; j < RcsStatistics::kSize; ++j)
     EXPECT_NEAR(model.coefficients[j], expected.coefficients[j], 1e-8) << j;
   EXPECT_NEAR(model.fit_rmse, expected.fit_rmse, 1e-9);
+  EXPECT_NEAR(model.spread_db, expected.spread_db, 1e-8);
+  EXPECT_NEAR(model.explained, expected.explained, 1e-9);
 }
 
 TEST(KullbackLeibler, HandComputedCases) {

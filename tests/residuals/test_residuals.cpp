@@ -23,6 +23,7 @@
 #include "radargauss/simulator.hpp"
 #include "radargauss/residuals/geometric_residual.hpp"
 #include "radargauss/residuals/loss.hpp"
+#include "radargauss/residuals/rcs_likelihood.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
 #include "radargauss/solvers/ceres_solver.hpp"
 #include "radargauss/solvers/factory.hpp"
@@ -143,8 +144,164 @@ TEST_P(JacobianTest, RcsCoefficientBlocksAnalyticAutodiffNumeric) {
   }
 }
 
+// The Swerling likelihoods and the confidence weight (rcs_likelihood.hpp)
+// on every form of the RCS residual: the value is w g_k(a r + b) of the
+// paper's residual r, computed here by hand, and the analytic Jacobians
+// equal autodiff and central differences, on both sides of the series'
+// threshold at z = 1e-3.
+TEST_P(JacobianTest, RcsLikelihoodsAnalyticAutodiffNumeric) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (int trial = 0; trial < 24; ++trial) {
+    RcsTerm term = RandomRcsTerm(rng, GetParam());
+    term.degree = trial % (kMaxShDegree + 1);
+    term.measurement = 2.0 * uniform(rng) - 1.0;
+    Eigen::Vector4d q = SO3d::Exp(0.5 * RandomUnitVector(rng)).quaternion().coeffs();
+    Eigen::Vector3d t = RandomUnitVector(rng);
+    const Eigen::Vector3d mean_radar = Eigen::Map<const Eigen::Quaterniond>(q.data()).conjugate() * (term.mean - t);
+    term.facing = FacingSign(IncidenceVector(term.incidence, term.point_radar, mean_radar));
+    double d_norm = 0.0;
+    const Eigen::Vector3d d = RcsDirection<double>(term, mean_radar, d_norm);
+    const double decibel = term.measurement - EvaluateSh(term.degree, term.coefficients.data(), d);
+    term.shape = trial % 2 == 0 ? 1.0 : 2.0;
+    term.log_scale = 0.2302585 * (2.0 + 6.0 * uniform(rng));  // scales of 2-8 dB
+    term.weight = 0.3 + 0.7 * uniform(rng);
+    // z: well away from 0, then just inside and just outside the series.
+    const double z = trial < 8 ? 3.0 * (uniform(rng) - 0.5) : (trial < 16 ? 5e-4 : -2e-3);
+    term.log_offset = z - term.log_scale * decibel;
+    const double k = term.shape;
+    const double by_hand = term.weight * (z < 0 ? -1.0 : 1.0) * std::sqrt(2.0 * k * (std::exp(z) - z - 1.0));
+    const RcsCostFunction analytic(term);
+    const std::unique_ptr<ceres::CostFunction> autodiff(RcsResidual::Create(term));
+    std::vector<Eigen::MatrixXd> ja, jd;
+    std::vector<double*> blocks = {q.data(), t.data()};
+    const Eigen::VectorXd ra = EvaluateWithJacobians(analytic, blocks, ja);
+    EXPECT_NEAR(ra[0], by_hand, 1e-9 * std::max(1.0, std::abs(by_hand))) << "trial " << trial;
+    EXPECT_NEAR(EvaluateWithJacobians(*autodiff, blocks, jd)[0], ra[0], 1e-12);
+    for (int b = 0; b < 2; ++b) {
+      EXPECT_LT(Relative(ja[b], jd[b]), 1e-8) << "block " << b << " trial " << trial;
+      EXPECT_LT(Relative(ja[b], NumericBlockJacobian(analytic, blocks, b)), 1e-5) << "block " << b;
+    }
+    const RcsRotationCostFunction analytic_rotation(term, t);
+    const std::unique_ptr<ceres::CostFunction> autodiff_rotation(RcsRotationResidual::Create(term, t));
+    blocks = {q.data()};
+    EvaluateWithJacobians(analytic_rotation, blocks, ja);
+    EvaluateWithJacobians(*autodiff_rotation, blocks, jd);
+    EXPECT_LT(Relative(ja[0], jd[0]), 1e-8);
+    EXPECT_LT(Relative(ja[0], NumericBlockJacobian(analytic_rotation, blocks, 0)), 1e-5);
+    Eigen::VectorXd c(ShCoefficientCount(term.degree));
+    for (int i = 0; i < c.size(); ++i) c[i] = term.coefficients[i];
+    for (const bool full : {false, true}) {
+      const RcsCoefficientCostFunction analytic_c(term, t, full);
+      const std::unique_ptr<ceres::CostFunction> autodiff_c(RcsCoefficientResidual::Create(term, t, full));
+      blocks = {q.data(), c.data()};
+      if (full) blocks.push_back(t.data());
+      EXPECT_NEAR(EvaluateWithJacobians(analytic_c, blocks, ja)[0], by_hand, 1e-9 * std::max(1.0, std::abs(by_hand)));
+      EvaluateWithJacobians(*autodiff_c, blocks, jd);
+      for (std::size_t b = 0; b < blocks.size(); ++b) {
+        EXPECT_LT(Relative(ja[b], jd[b]), 1e-8) << "block " << b << " trial " << trial;
+        EXPECT_LT(Relative(ja[b], NumericBlockJacobian(analytic_c, blocks, int(b))), 1e-5) << "block " << b;
+      }
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(BothIncidenceModels, JacobianTest,
                          ::testing::Values(IncidenceModel::kOffset, IncidenceModel::kView));
+
+// g_k(z)^2 / 2 is the Gamma(k) negative log-likelihood k (e^z - z - 1), its
+// derivative is continuous across the series' threshold, and it is
+// sqrt(k) at 0.
+TEST(RcsLikelihoods, SwerlingResidualIsTheNegativeLogLikelihood) {
+  for (const double k : {1.0, 2.0}) {
+    for (const double z : {-4.0, -0.7, -2e-3, -1e-3, -3e-4, 0.0, 2e-4, 9.99e-4, 1e-3, 0.4, 3.0}) {
+      const double r = SwerlingResidual(k, z);
+      EXPECT_NEAR(0.5 * r * r, k * (std::exp(z) - z - 1.0), 1e-15 + 1e-12 * r * r) << z;
+      EXPECT_TRUE(z == 0.0 ? r == 0.0 : (r > 0.0) == (z > 0.0)) << z;
+      const double h = 1e-6;
+      const double numeric = (SwerlingResidual(k, z + h) - SwerlingResidual(k, z - h)) / (2.0 * h);
+      EXPECT_NEAR(SwerlingResidualDerivative(k, z), numeric, 1e-6) << z;
+    }
+    EXPECT_NEAR(SwerlingResidualDerivative(k, 0.0), std::sqrt(k), 1e-15);
+  }
+}
+
+// Over a planted Swerling sample (linear RCS Gamma(k, mean / k)), the
+// likelihood's maximum lies at the planted mean (it is the sample's linear
+// mean), while the decibel residual's lies at the mean of the dB, 2.5 dB
+// (k = 1) or 1.2 dB (k = 2) below it.
+TEST(RcsLikelihoods, MaximumOverAPlantedSwerlingSampleIsThePlantedMean) {
+  const double planted_db = 10.0;
+  for (const RcsLikelihood likelihood : {RcsLikelihood::kSwerling1, RcsLikelihood::kSwerling3}) {
+    const double k = SwerlingShape(likelihood);
+    std::mt19937 rng(static_cast<unsigned>(k));
+    std::gamma_distribution<double> gamma(k, 1.0 / k);
+    std::vector<double> db;
+    double linear_sum = 0.0;
+    for (int i = 0; i < 100000; ++i) {
+      const double sigma = std::pow(10.0, planted_db / 10.0) * gamma(rng);
+      linear_sum += sigma;
+      db.push_back(10.0 * std::log10(sigma));
+    }
+    const double sample_mean_db = 10.0 * std::log10(linear_sum / double(db.size()));
+    // The argmin of a cost over the mean (dB): a 0.05 dB grid, then 0.002 dB around its best.
+    const auto argmin = [&](const auto& cost) {
+      double best_m = 0.0, best = std::numeric_limits<double>::infinity();
+      for (double m = planted_db - 4.0; m <= planted_db + 2.0; m += 0.05) {
+        if (const double f = cost(m); f < best) best = f, best_m = m;
+      }
+      const double coarse = best_m;
+      for (double m = coarse - 0.06; m <= coarse + 0.06; m += 0.002) {
+        if (const double f = cost(m); f < best) best = f, best_m = m;
+      }
+      return best_m;
+    };
+    const double best_db = argmin([&](double m) {
+      double nll = 0.0;
+      for (const double x : db) {
+        const double r = SwerlingResidual(k, 0.23025850929940458 * (x - m));
+        nll += 0.5 * r * r;
+      }
+      return nll;
+    });
+    const double best_decibel_db = argmin([&](double m) {
+      double squares = 0.0;
+      for (const double x : db) squares += (x - m) * (x - m);
+      return squares;
+    });
+    EXPECT_NEAR(best_db, sample_mean_db, 0.006) << ToString(likelihood);
+    EXPECT_NEAR(best_db, planted_db, 0.06) << ToString(likelihood);
+    // E[10 log10 X] for X ~ Gamma(k, 1/k): 10 / ln(10) (psi(k) - ln k).
+    const double log_bias_db = k == 1.0 ? -2.5068 : -1.1742;
+    EXPECT_NEAR(best_decibel_db, planted_db + log_bias_db, 0.06) << ToString(likelihood);
+    // The likelihood's own spread: the std of 10 log10 X.
+    double mean = 0.0, variance = 0.0;
+    for (const double x : db) mean += x / double(db.size());
+    for (const double x : db) variance += (x - mean) * (x - mean) / double(db.size());
+    EXPECT_NEAR(std::sqrt(variance), RcsLikelihoodSpreadDb(likelihood), 0.05) << ToString(likelihood);
+  }
+}
+
+// The confidence: 1 while the predictive variance is within the expected,
+// then the ratio, by hand; falls as the spread grows (to zero) and as the
+// members become fewer; zero without a model.
+TEST(RcsLikelihoods, ConfidenceGoesToZeroAsTheSpreadGrows) {
+  EXPECT_EQ(RcsConfidence(1.0, 3, 100, 3.0), 1.0);
+  // 3 members, constant model, 6 dB: 9 / (36 (1 + 1/3)) = 0.1875.
+  EXPECT_NEAR(RcsConfidence(6.0, 0, 3, 3.0), 0.1875, 1e-15);
+  double previous = 1.0;
+  for (double spread = 3.0; spread < 1e4; spread *= 1.5) {
+    const double confidence = RcsConfidence(spread, 2, 20, 3.0);
+    EXPECT_LT(confidence, previous) << spread;
+    EXPECT_GT(confidence, 0.0);
+    previous = confidence;
+  }
+  EXPECT_LT(previous, 1e-6);
+  EXPECT_LT(RcsConfidence(6.0, 3, 17, 3.0), RcsConfidence(6.0, 3, 170, 3.0));
+  EXPECT_EQ(RcsConfidence(6.0, -1, 17, 3.0), 0.0);
+  EXPECT_THROW(RcsLikelihoodFromString("swerling2"), std::invalid_argument);
+  EXPECT_EQ(RcsLikelihoodFromString(ToString(RcsLikelihood::kSwerling3)), RcsLikelihood::kSwerling3);
+}
 
 // The Doppler velocity term: analytic twin against autodiff and central
 // differences; zero where the translation is the previous pose plus

@@ -134,8 +134,8 @@ expect_fail "a data set's root as the sequence" "did you mean $work/dataset/poin
   "$tool" info --sequence "$work/dataset"
 expect_fail "localize with a bad weight" "w-rcs" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --w-rcs 1.5 --out "$work/r2"
-expect_fail "localize with a map of another version" "map version 3" -- \
-  bash -c "cp '$work/seq.rgm' '$work/v3.rgm' && printf '\\x03' | dd of='$work/v3.rgm' bs=1 seek=8 conv=notrunc 2>/dev/null && '$tool' localize --sequence '$work/seq' --gt '$work/seq/gt_radar_tum.txt' --map '$work/v3.rgm' --out '$work/r3'"
+expect_fail "localize with a map of another version" "map version 4" -- \
+  bash -c "cp '$work/seq.rgm' '$work/v4.rgm' && printf '\\x04' | dd of='$work/v4.rgm' bs=1 seek=8 conv=notrunc 2>/dev/null && '$tool' localize --sequence '$work/seq' --gt '$work/seq/gt_radar_tum.txt' --map '$work/v4.rgm' --out '$work/r3'"
 expect_fail "localize --map with --degrees" "drop --map" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" --degrees 1 --out "$work/r4"
 "$tool" simulate --out "$work/seq10" --scans 10 >/dev/null

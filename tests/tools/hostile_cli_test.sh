@@ -231,7 +231,7 @@ expect_fail "slam on scans without points" "hollow: every one of the 4 scans has
 import struct, sys, zlib
 data = open(sys.argv[1], "rb").read()
 count = struct.unpack_from("<Q", data, 16)[0]
-body = data[:16] + struct.pack("<Q", 0) + data[24 + 236 * count:-4]
+body = data[:16] + struct.pack("<Q", 0) + data[24 + 260 * count:-4]
 open(sys.argv[2], "wb").write(body + struct.pack("<I", zlib.crc32(body)))
 PY
 expect_fail "relocalize on a map without Gaussians" "placesonly.rgm: the map has no Gaussians to match against" -- \

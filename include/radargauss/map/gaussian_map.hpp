@@ -39,6 +39,14 @@ struct RcsModel {
   std::array<double, ShCoefficientCount(kMaxShDegree)> coefficients{};
   double fit_rmse = 0.0;  // normalised units, over the inliers
   std::uint32_t inliers = 0;
+  // The fit's statistics over its inliers (docs/design.md, "RCS confidence"):
+  // the residuals' std in dB with the fitted coefficients' degrees of freedom
+  // taken out; the share of the RCS variance the view explains (adjusted
+  // R^2, in [0, 1]); and the dB from the model's value to the members'
+  // linear mean, which the Swerling likelihoods take as the mean.
+  double spread_db = 0.0;
+  double explained = 1.0;
+  double mean_offset_db = 0.0;
 
   bool valid() const { return degree >= 0; }
   // The normalised measurement of a raw RCS value.

@@ -1,15 +1,17 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Gaussian-RCS map files.
 //
-// .rgm, version 2, little-endian:
+// .rgm, version 3, little-endian:
 //   "RGAUSMAP" | u32 version | u8 incidence model | 3 zero bytes | u64 count |
 //   count x { f64 mean[3] | f64 covariance[6] (xx xy xz yy yz zz) |
 //             u32 point_count | i32 sh_degree (-1: no model) | f64 rcs_median |
-//             f64 rcs_scale | f64 fit_rmse | u32 inliers | f64 coefficients[16] } |
+//             f64 rcs_scale | f64 fit_rmse | u32 inliers | f64 coefficients[16] |
+//             f64 spread_db | f64 explained | f64 mean_offset_db } |
 //   u64 places | places x { f64 q[4] (x y z w) | f64 t[3] | u64 n |
 //                           n x { f32 x y z rcs } } |
 //   u32 CRC32 (zlib) of everything before it.
-// Version 1 (no places section) is still read.
+// Versions 1 (no places section) and 2 (no fit statistics: spread_db from
+// fit_rmse, explained 1, mean_offset_db 0) are still read.
 // Written to a temporary file and renamed: never a half-written map.
 //
 // PLY export in the 3D Gaussian Splatting layout (binary little-endian
@@ -29,7 +31,7 @@
 
 namespace radargauss {
 
-inline constexpr std::uint32_t kMapFileVersion = 2;
+inline constexpr std::uint32_t kMapFileVersion = 3;
 
 // What ReadMap accepts of a Gaussian (docs/design.md, "Bounds on input"):
 // every mean coordinate within kMaxMapCoordinate of the origin (UTM

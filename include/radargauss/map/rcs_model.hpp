@@ -10,7 +10,8 @@
 // minimum-norm solution, ill-determined directions truncated. When the
 // inliers are too few (fewer than (L+1)^2) or A's numerical rank is below
 // half of (L+1)^2 for degree L, the degree is lowered (adaptive) or the
-// Gaussian gets no model.
+// Gaussian gets no model. A fit that explains less of its inliers' variance
+// than min_explained is replaced by the constant model.
 #pragma once
 
 #include <array>
@@ -55,9 +56,17 @@ struct RcsFitOptions {
   // largest count as rank loss and their directions are truncated, instead of
   // fitting huge coefficients that explode off the sampled directions.
   double rank_threshold = 1e-2;
+  // A fit whose view explains less than this share of its inliers' RCS
+  // variance (RcsModel::explained) gets the constant model (degree 0).
+  double min_explained = 0.0;
 };
 // Its options (options.hpp).
 const OptionTable<RcsFitOptions>& RcsFitOptionTable();
+
+// Sets a fit's spread_db and explained (RcsModel) from its inliers'
+// squared residual and their squared deviation from their mean, both
+// normalised, for `coefficients` fitted coefficients.
+void SetRcsFitSpread(RcsModel& model, double residual_sq, double total_sq, std::size_t inliers, int coefficients);
 
 // Fits one model from the members' incidence directions and raw RCS.
 RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::vector<double>& rcs,

@@ -17,6 +17,9 @@
 //   RcsCoefficientResidual  either of these plus the Gaussian's coefficients
 //                           as a block (joint refinement).
 // Each has an analytic twin (ceres::CostFunction) sharing LineariseRcs.
+// Every form takes the term's likelihood (rcs_likelihood.hpp) and weight:
+//   r = w_c g_k(a r_rcs + b),  g_0 the identity (the paper's residual),
+// with w_c the square root of the Gaussian's confidence.
 #pragma once
 
 #include <array>
@@ -33,6 +36,7 @@
 
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/map/rcs_model.hpp"
+#include "radargauss/residuals/rcs_likelihood.hpp"
 #include "radargauss/sh.hpp"
 #include "radargauss/residuals/quaternion_jacobians.hpp"
 
@@ -48,7 +52,28 @@ struct RcsTerm {
   IncidenceModel incidence = IncidenceModel::kOffset;
   double facing = 1.0;         // s: FacingSign(u) at the association's pose
   std::uint32_t gaussian = 0;  // index in the map (for joint refinement)
+  // The likelihood (rcs_likelihood.hpp): Gamma shape k (0: decibel) and
+  // z = log_scale r_rcs + log_offset; the residual's weight w_c.
+  double shape = 0.0;
+  double log_scale = 1.0;
+  double log_offset = 0.0;
+  double weight = 1.0;
 };
+
+// The term's residual from the decibel one: w_c g_k(a r + b) (the identity
+// times w_c for the decibel likelihood).
+template <typename T>
+T RcsLikelihoodResidual(const RcsTerm& term, const T& decibel) {
+  if (term.shape == 0.0) return term.weight * decibel;
+  return term.weight * SwerlingResidual(term.shape, T(term.log_scale * decibel + term.log_offset));
+}
+
+// d/d(decibel residual) of RcsLikelihoodResidual at `decibel`.
+inline double RcsLikelihoodChain(const RcsTerm& term, double decibel) {
+  if (term.shape == 0.0) return term.weight;
+  return term.weight * term.log_scale *
+         SwerlingResidualDerivative(term.shape, term.log_scale * decibel + term.log_offset);
+}
 
 // d = s u / |u| for the Gaussian centre mu_r in the radar frame; writes |u|.
 template <typename T>
@@ -64,7 +89,8 @@ Eigen::Matrix<T, 3, 1> RcsDirection(const RcsTerm& term, const Eigen::Matrix<T, 
 template <typename T, typename CoefficientT>
 T RcsResidualAt(const RcsTerm& term, const Eigen::Matrix<T, 3, 1>& mean_radar, const CoefficientT* coefficients) {
   T norm = T(0.0);
-  return T(term.measurement) - EvaluateSh<T>(term.degree, coefficients, RcsDirection<T>(term, mean_radar, norm));
+  return RcsLikelihoodResidual<T>(
+      term, T(term.measurement) - EvaluateSh<T>(term.degree, coefficients, RcsDirection<T>(term, mean_radar, norm)));
 }
 
 // The same for a rotation quaternion and a translation: mu_r = R^T (mu - t).
@@ -134,13 +160,16 @@ class RcsRotationResidual {
 //   dr/du = -(c^T dY/dd) s (I - d d^T) / |u|,
 //   u = p_r - mu_r (offset) or -mu_r (view), so du/dq = -d(R^T a)/dq and
 //   du/dt = R^T, with a = mu - t.
+// The likelihood's chain factor dr/dr_rcs (RcsLikelihoodChain) multiplies
+// dr/du, and dr/dc = -chain Y(d).
 struct RcsLinearisation {
   double residual = 0.0;
   Eigen::RowVector3d dr_du = Eigen::RowVector3d::Zero();
+  double chain = 1.0;
 };
 
 // With coefficients c from a parameter block (joint refinement), else the
-// term's; writes Y(d) = -dr/dc to `basis_out` when given.
+// term's; writes Y(d) to `basis_out` when given (dr/dc = -chain Y(d)).
 inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d& mean_radar, const double* coefficients,
                                      double* basis_out = nullptr) {
   double norm = 0.0;
@@ -148,8 +177,10 @@ inline RcsLinearisation LineariseRcs(const RcsTerm& term, const Eigen::Vector3d&
   const Eigen::Vector3d d = RcsDirection<double>(term, mean_radar, norm);
   Eigen::Vector3d c_dY;
   const double prediction = EvaluateShWithGradient(term.degree, coefficients, d, c_dY, basis_out);
-  out.residual = term.measurement - prediction;
-  out.dr_du = -(term.facing / norm) * (c_dY - c_dY.dot(d) * d).transpose();  // c_dY^T (I - d d^T)
+  const double decibel = term.measurement - prediction;
+  out.residual = RcsLikelihoodResidual(term, decibel);
+  out.chain = RcsLikelihoodChain(term, decibel);
+  out.dr_du = -(out.chain * term.facing / norm) * (c_dY - c_dY.dot(d) * d).transpose();  // c_dY^T (I - d d^T)
   return out;
 }
 
@@ -168,7 +199,7 @@ inline bool EvaluateRcsTerm(const RcsTerm& term, const double* rotation, const E
     return true;
   }
   const Eigen::Map<const Eigen::Quaterniond> q(rotation);
-  // coefficient_jacobian, when asked for, receives Y(d); dr/dc = -Y(d).
+  // coefficient_jacobian, when asked for, receives Y(d); dr/dc = -chain Y(d).
   const RcsLinearisation lin = LineariseRcs(term, q.conjugate() * (term.mean - t), coefficients, coefficient_jacobian);
   residual[0] = lin.residual;
   if (rotation_jacobian != nullptr) {
@@ -176,7 +207,7 @@ inline bool EvaluateRcsTerm(const RcsTerm& term, const double* rotation, const E
     J = InverseRotatePointJacobianLeft(-lin.dr_du, rotation, term.mean - t);
   }
   if (coefficient_jacobian != nullptr) {
-    for (int i = 0; i < ShCoefficientCount(term.degree); ++i) coefficient_jacobian[i] = -coefficient_jacobian[i];
+    for (int i = 0; i < ShCoefficientCount(term.degree); ++i) coefficient_jacobian[i] *= -lin.chain;
   }
   if (translation_jacobian != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 1, 3>> J(translation_jacobian);

@@ -38,15 +38,16 @@ std::vector<int> AssociateScan(const RadarScan& scan, const GaussianIndex& index
 
 // Associates every point at `pose` with the Gaussians of `level`
 // (smallest Mahalanobis^2 within the gate); RCS terms too when `with_rcs`
-// (and the scan has RCS).
+// (and the scan has RCS), made as `rcs_terms` says.
 Correspondences FindCorrespondences(const RadarScan& scan, const MatchingMap& map, std::size_t level, const SE3d& pose,
-                                    double gate, bool with_rcs);
+                                    double gate, bool with_rcs, const RcsTermOptions& rcs_terms = {});
 
 // Replaces the RCS terms of `correspondences` (made from `scan`) by those of
 // their geometric pairs, at the pose they were made at: what
 // FindCorrespondences gives with_rcs, without associating again (when the
 // scan has RCS).
-void AddRcsTerms(const RadarScan& scan, const MatchingMap& map, Correspondences& correspondences);
+void AddRcsTerms(const RadarScan& scan, const MatchingMap& map, Correspondences& correspondences,
+                 const RcsTermOptions& rcs_terms = {});
 
 // f of eq. 2 for fixed correspondences at `pose`, plus the terms of
 // `priors`. RCS residuals take the translation of the correspondences when

@@ -21,6 +21,7 @@
 #include "radargauss/options.hpp"
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/residuals/priors.hpp"
+#include "radargauss/residuals/rcs_likelihood.hpp"
 #include "radargauss/types.hpp"
 
 namespace radargauss {
@@ -40,6 +41,7 @@ struct ScanMatchingOptions {
   double w_rcs = 0.0;  // eq. 2's w, in [0, 1]
   LossConfig geometric_loss{LossType::kTrivial, 1.0};
   LossConfig rcs_loss{LossType::kCauchy, 1.0};  // the paper: Cauchy
+  RcsTermOptions rcs_terms;                     // the RCS likelihood and confidence
   RcsTranslation rcs_translation = RcsTranslation::kRotationOnly;
   JacobianMode jacobians = JacobianMode::kAnalytic;
   double gate = 3.0;           // tau: association gate (Mahalanobis distance)
