@@ -54,4 +54,36 @@ double RcsConfidence(double spread_db, int degree, unsigned inliers, double expe
   return predictive <= expected ? 1.0 : expected / predictive;
 }
 
+RcsMapSummary SummariseRcs(const GaussianMap& map, const RcsTermOptions& options) {
+  const double expected =
+      options.expected_spread_db > 0.0 ? options.expected_spread_db : RcsLikelihoodSpreadDb(options.likelihood);
+  RcsMapSummary summary;
+  std::vector<double> spreads, explained;
+  double confidence_sum = 0.0, information_sum = 0.0;
+  for (const Gaussian& g : map.gaussians) {
+    if (!g.rcs.valid()) continue;
+    spreads.push_back(g.rcs.spread_db);
+    explained.push_back(g.rcs.explained);
+    const double confidence = RcsConfidence(g.rcs.spread_db, g.rcs.degree, g.rcs.inliers, expected);
+    confidence_sum += confidence;
+    information_sum += confidence * double(ShCoefficientCount(g.rcs.degree) - 1) /
+                       double(ShCoefficientCount(kMaxShDegree) - 1);
+  }
+  summary.models = spreads.size();
+  if (summary.models == 0) return summary;
+  const auto median = [](std::vector<double>& values) {
+    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
+    return values[values.size() / 2];
+  };
+  summary.median_spread_db = median(spreads);
+  summary.median_explained = median(explained);
+  summary.mean_confidence = confidence_sum / double(summary.models);
+  summary.view_information = information_sum / double(summary.models);
+  return summary;
+}
+
+double RcsWeightFromMap(const RcsMapSummary& summary) {
+  return std::min(kMaxChosenRcsWeight, kRcsWeightPerInformation * summary.view_information);
+}
+
 }  // namespace radargauss

@@ -104,7 +104,7 @@ std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const 
   std::vector<ConfigurationRun> runs;
   std::vector<Eigen::Vector3d> map_cloud;  // the PCL peers' target
   ProgressBar bar;
-  const std::size_t total = maps.size() * s.solvers.size() * s.losses.size() * s.w_rcs.size();
+  const std::size_t total = maps.size() * s.solvers.size() * s.losses.size() * (s.w_rcs.size() + s.w_rcs_from_map);
   std::size_t done = 0;
   for (std::size_t m = 0; m < maps.size(); ++m) {
     const MatchingMap matching(maps[m], s.MatchingOptions());
@@ -117,10 +117,10 @@ std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const 
         continue;
       }
       for (const std::string& loss : s.losses) {
-        for (const double w : s.w_rcs) {
+        for (const auto& [w, from_map] : s.Weights(maps[m])) {
           const auto matcher = MakeScanMatcher(s.Configuration(solver, w, loss));
-          const std::string name = solver + "-w" + FormatWeight(w) + "-" + loss + "-" + ToString(maps[m].incidence) +
-                                   "-L" + std::to_string(degrees[m]);
+          const std::string name = solver + (from_map ? "-wmap" : "-w") + FormatWeight(w) + "-" + loss + "-" +
+                                   ToString(maps[m].incidence) + "-L" + std::to_string(degrees[m]);
           bar.Update("localize", done, total);
           runs.push_back(RunConfiguration(name, w, *matcher, matching, e.scans, e.references, e.errors, e.first_scan));
           ++done;

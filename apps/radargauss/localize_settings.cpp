@@ -59,6 +59,17 @@ void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--rcs-loss-scale", s.rcs_loss_scale, "Scale of the RCS loss")
       ->check(Positive())
       ->capture_default_str();
+  app->add_option("--rcs-likelihood", s.rcs_likelihood,
+                  "RCS residual: decibel (the paper), swerling1 or swerling3 (fluctuating RCS)")
+      ->check(CLI::IsMember(RcsLikelihoodNames()))
+      ->capture_default_str();
+  app->add_flag("--rcs-confidence", s.rcs_confidence, "Weigh each RCS term by its Gaussian's fit (spread and members)");
+  app->add_option("--rcs-expected-spread", s.rcs_expected_spread,
+                  "The spread (dB) the confidence expects (0: the likelihood's own)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  app->add_flag("--w-rcs-from-map", s.w_rcs_from_map,
+                "Also match with each map's data-chosen w_rcs (configuration gn-wmap...)");
   app->add_option("--incidences", s.incidences, "Incidence models to sweep (map built here)")
       ->delimiter(',')
       ->check(CLI::IsMember(IncidenceModelNames()));
@@ -112,6 +123,21 @@ const SequenceOptions& LocalizeSettings::CheckedSequenceOptions() const {
 
 void LocalizeSettings::CheckAgainst(const Sequence& sequence) const { CheckRcsWeights(sequence, w_rcs); }
 
+RcsTermOptions LocalizeSettings::RcsTerms() const {
+  RcsTermOptions options;
+  options.likelihood = RcsLikelihoodFromString(rcs_likelihood);
+  options.confidence = rcs_confidence;
+  options.expected_spread_db = rcs_expected_spread;
+  return options;
+}
+
+std::vector<std::pair<double, bool>> LocalizeSettings::Weights(const GaussianMap& map) const {
+  std::vector<std::pair<double, bool>> weights;
+  for (const double w : w_rcs) weights.emplace_back(w, false);
+  if (w_rcs_from_map) weights.emplace_back(RcsWeightFromMap(SummariseRcs(map, RcsTerms())), true);
+  return weights;
+}
+
 MatchingMapOptions LocalizeSettings::MatchingOptions() const {
   MatchingMapOptions options;
   options.coarse = CoarseLevelsFromString(coarse_levels);
@@ -126,6 +152,7 @@ radargauss::MatchOptions LocalizeSettings::Configuration(const std::string& solv
   options.matching.w_rcs = w;
   options.matching.geometric_loss = {LossTypeFromString(loss), loss_scale};
   options.matching.rcs_loss = {LossTypeFromString(rcs_loss), rcs_loss_scale};
+  options.matching.rcs_terms = RcsTerms();
   options.matching.coarse_voxel_per_sigma = coarse_voxel;
   options.matching.coarse_points = coarse_points;
   options.matching.geometric_first = geometric_first;
@@ -136,7 +163,8 @@ radargauss::MatchOptions LocalizeSettings::Configuration(const std::string& solv
 void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
   AddSequenceOptions(app, s.sequence);
   AddMapBuildOptions(app, s.build);
-  app->add_option("--map", s.map_path, "Map file (.rgm) or folder of map tiles; without it the map is built from the sequence");
+  app->add_option("--map", s.map_path,
+                  "Map file (.rgm) or folder of map tiles; without it the map is built from the sequence");
   app->add_option("--out", s.out, "Results folder")->required();
   app->add_option("--shard", s.shard,
                   "I/N: match the I-th of N equal parts of the scans and write shard.json too; "

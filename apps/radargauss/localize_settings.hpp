@@ -3,9 +3,12 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
+#include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/residuals/rcs_likelihood.hpp"
 #include "radargauss/solvers/factory.hpp"
 #include "radargauss/solvers/scan_matcher.hpp"
 
@@ -22,6 +25,10 @@ struct LocalizeSettings {
   std::vector<std::string> incidences;
   std::vector<int> degrees;
   std::string rcs_loss = "cauchy";
+  std::string rcs_likelihood = ToString(RcsLikelihood::kDecibel);
+  bool rcs_confidence = false;
+  double rcs_expected_spread = 0.0;  // dB; 0: the likelihood's own
+  bool w_rcs_from_map = false;       // add each map's data-chosen weight (RcsWeightFromMap) to the sweep
   double loss_scale = 1.0;
   double rcs_loss_scale = 1.0;
   double max_translation = 2.0;
@@ -44,6 +51,10 @@ struct LocalizeSettings {
   // w > 0 on scans without RCS), before any map is built.
   void CheckAgainst(const Sequence& sequence) const;
   MatchingMapOptions MatchingOptions() const;
+  RcsTermOptions RcsTerms() const;
+  // The weights of the sweep for `map`: --w-rcs and, with --w-rcs-from-map,
+  // the map's own (flagged true).
+  std::vector<std::pair<double, bool>> Weights(const GaussianMap& map) const;
   // The options of one configuration: solver, weight w and geometric loss.
   radargauss::MatchOptions Configuration(const std::string& solver, double w, const std::string& loss) const;
 };

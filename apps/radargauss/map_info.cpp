@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/map_tiles.hpp"
+#include "radargauss/residuals/rcs_likelihood.hpp"
 
 namespace radargauss::cli {
 
@@ -40,6 +41,17 @@ int RunMapInfo(const std::string& path) {
   std::printf("sh degree histogram: none %zu", n - with_model);
   for (int d = 0; d <= kMaxShDegree; ++d) std::printf(", %d: %zu", d, histogram[d]);
   std::printf("\nmean fit RMSE (normalised): %.4f\n", with_model ? rmse / double(with_model) : 0.0);
+  for (const RcsLikelihood likelihood : {RcsLikelihood::kDecibel, RcsLikelihood::kSwerling1}) {
+    RcsTermOptions options;
+    options.likelihood = likelihood;
+    const RcsMapSummary rcs = SummariseRcs(map, options);
+    if (likelihood == RcsLikelihood::kDecibel) {
+      std::printf("rcs fits: median spread %.2f dB, median explained share %.3f\n", rcs.median_spread_db,
+                  rcs.median_explained);
+    }
+    std::printf("rcs confidence (%s): mean %.3f, view information %.3f, chosen w_rcs %.3f\n",
+                ToString(likelihood).c_str(), rcs.mean_confidence, rcs.view_information, RcsWeightFromMap(rcs));
+  }
   if (n) {
     std::printf("extent: x %.2f..%.2f, y %.2f..%.2f, z %.2f..%.2f m\n", lo.x(), hi.x(), lo.y(), hi.y(), lo.z(), hi.z());
   }

@@ -146,6 +146,18 @@ GaussianMap FitRcsModelsOf(const MapGeometry& geometry, const MapBuildSettings& 
         "degree), %zu without; mean fit RMSE %.4f\n",
         ToString(incidence).c_str(), degree, rcs.adaptive ? "adaptive" : "fixed", stats.with_model,
         stats.lowered_degree, stats.no_model, stats.mean_fit_rmse);
+    if (stats.member_spread >= 0.0) {
+      std::printf("rcs across frames (members' std, median over Gaussians of >= %zu): %.2f dB; by range",
+                  RcsFitStats::kSpreadMinMembers, stats.member_spread);
+      for (std::size_t b = 0; b < RcsFitStats::kRangeBins.size(); ++b) {
+        std::printf(" %g+ m %.2f", RcsFitStats::kRangeBins[b], stats.member_spread_by_range[b]);
+      }
+      std::printf("; by |azimuth|");
+      for (std::size_t b = 0; b < RcsFitStats::kAzimuthBins.size(); ++b) {
+        std::printf(" %g+ deg %.2f", RcsFitStats::kAzimuthBins[b], stats.member_spread_by_azimuth[b]);
+      }
+      std::printf("\n");
+    }
   }
   return map;
 }

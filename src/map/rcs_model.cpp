@@ -112,6 +112,39 @@ RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::
   return model;
 }
 
+namespace {
+
+double MedianOf(std::vector<double> values) {
+  if (values.empty()) return -1.0;
+  std::sort(values.begin(), values.end());
+  return MedianOfSorted(values);
+}
+
+// The bin of `value` among lower edges `edges`.
+template <std::size_t N>
+std::size_t BinOf(const std::array<double, N>& edges, double value) {
+  std::size_t bin = 0;
+  while (bin + 1 < N && value >= edges[bin + 1]) ++bin;
+  return bin;
+}
+
+void SetMemberSpreads(const std::vector<Eigen::Vector3d>& spreads, RcsFitStats& stats) {
+  std::array<std::vector<double>, 4> by_range;
+  std::array<std::vector<double>, 3> by_azimuth;
+  std::vector<double> all;
+  for (const Eigen::Vector3d& s : spreads) {
+    if (std::isnan(s.x())) continue;
+    all.push_back(s.x());
+    by_range[BinOf(RcsFitStats::kRangeBins, s.y())].push_back(s.x());
+    by_azimuth[BinOf(RcsFitStats::kAzimuthBins, s.z())].push_back(s.x());
+  }
+  stats.member_spread = MedianOf(all);
+  for (std::size_t b = 0; b < by_range.size(); ++b) stats.member_spread_by_range[b] = MedianOf(by_range[b]);
+  for (std::size_t b = 0; b < by_azimuth.size(); ++b) stats.member_spread_by_azimuth[b] = MedianOf(by_azimuth[b]);
+}
+
+}  // namespace
+
 RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud, const std::vector<int>& association,
                          const RcsFitOptions& options) {
   map.incidence = options.incidence;
@@ -127,10 +160,13 @@ RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud, const std::vec
   for (std::size_t i = 0; i < association.size(); ++i) {
     if (association[i] >= 0) members[fill[association[i]]++] = std::uint32_t(i);
   }
+  // Per Gaussian: its members' RCS std, mean range and mean |azimuth| (NaN: too few members).
+  std::vector<Eigen::Vector3d> member_spreads(n_gaussians, Eigen::Vector3d::Constant(std::nan("")));
   tbb::parallel_for(std::size_t(0), n_gaussians, [&](std::size_t g) {
     Gaussian& gaussian = map.gaussians[g];
     std::vector<Eigen::Vector3d> directions;
     std::vector<double> rcs;
+    double range_sum = 0.0, azimuth_sum = 0.0;
     for (std::uint32_t k = offsets[g]; k < offsets[g + 1]; ++k) {
       const std::uint32_t i = members[k];
       const SE3d& pose = cloud.poses[cloud.scan[i]];
@@ -141,6 +177,15 @@ RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud, const std::vec
       if (u.squaredNorm() < 1e-18) continue;  // no direction: skip the member
       directions.push_back(FacingSign(u) * u.normalized());
       rcs.push_back(cloud.rcs[i]);
+      range_sum += point_radar.norm();
+      azimuth_sum += std::abs(std::atan2(point_radar.y(), point_radar.x())) * 180.0 / 3.14159265358979323846;
+    }
+    if (cloud.has_rcs && rcs.size() >= RcsFitStats::kSpreadMinMembers) {
+      const double n = double(rcs.size());
+      double mean = 0.0, square = 0.0;
+      for (const double x : rcs) mean += x / n;
+      for (const double x : rcs) square += (x - mean) * (x - mean);
+      member_spreads[g] = Eigen::Vector3d(std::sqrt(square / (n - 1.0)), range_sum / n, azimuth_sum / n);
     }
     gaussian.rcs = cloud.has_rcs ? FitRcsModel(directions, rcs, options) : RcsModel{};
   });
@@ -158,6 +203,7 @@ RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud, const std::vec
     rmse_sum += g.rcs.fit_rmse;
   }
   stats.mean_fit_rmse = stats.with_model ? rmse_sum / double(stats.with_model) : 0.0;
+  SetMemberSpreads(member_spreads, stats);
   return stats;
 }
 

@@ -198,5 +198,45 @@ TEST(RcsModelFit, SimulatedSequenceCoverage) {
   }
 }
 
+// How a target's RCS varies across frames (RcsFitStats), by hand: two
+// Gaussians of four members, one 10 m ahead with RCS {0, 2, 4, 6} (std
+// sqrt(20/3)), one about 37 m out at 20 deg with {1, 1, 1, 5} (std 2); a
+// third of three members is too few to count.
+TEST(RcsModelFit, MemberSpreadsByRangeAndAzimuthByHand) {
+  MapCloud cloud;
+  cloud.has_rcs = true;
+  cloud.poses = {SE3d()};
+  std::vector<int> association;
+  const auto add = [&](const Eigen::Vector3d& at, const std::vector<double>& rcs, int gaussian) {
+    for (std::size_t k = 0; k < rcs.size(); ++k) {
+      cloud.points.push_back(at + 0.05 * Eigen::Vector3d(double(k + 1), double(k % 2), 0.0));  // not at the mean
+      cloud.rcs.push_back(rcs[k]);
+      cloud.scan.push_back(0);
+      association.push_back(gaussian);
+    }
+  };
+  const double azimuth = 20.0 * M_PI / 180.0;
+  const Eigen::Vector3d far(35.0 * std::cos(azimuth), 35.0 * std::sin(azimuth), 0.0);
+  add(Eigen::Vector3d(10.0, 0.0, 0.0), {0.0, 2.0, 4.0, 6.0}, 0);
+  add(far, {1.0, 1.0, 1.0, 5.0}, 1);
+  add(Eigen::Vector3d(5.0, -60.0, 0.0), {0.0, 9.0, 3.0}, 2);
+  GaussianMap map;
+  for (const Eigen::Vector3d& mean : {Eigen::Vector3d(10.0, 0.0, 0.0), far, Eigen::Vector3d(5.0, -60.0, 0.0)}) {
+    Gaussian g;
+    g.mean = mean;
+    map.gaussians.push_back(g);
+  }
+  const RcsFitStats stats = FitRcsModels(map, cloud, association);
+  const double near_std = std::sqrt(20.0 / 3.0);
+  EXPECT_NEAR(stats.member_spread, 0.5 * (near_std + 2.0), 1e-12);
+  EXPECT_NEAR(stats.member_spread_by_range[0], near_std, 1e-12);
+  EXPECT_NEAR(stats.member_spread_by_range[1], 2.0, 1e-12);
+  EXPECT_EQ(stats.member_spread_by_range[2], -1.0);
+  EXPECT_EQ(stats.member_spread_by_range[3], -1.0);
+  EXPECT_NEAR(stats.member_spread_by_azimuth[0], near_std, 1e-12);
+  EXPECT_NEAR(stats.member_spread_by_azimuth[1], 2.0, 1e-12);
+  EXPECT_EQ(stats.member_spread_by_azimuth[2], -1.0);
+}
+
 }  // namespace
 }  // namespace radargauss

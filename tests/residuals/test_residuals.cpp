@@ -303,6 +303,41 @@ TEST(RcsLikelihoods, ConfidenceGoesToZeroAsTheSpreadGrows) {
   EXPECT_EQ(RcsLikelihoodFromString(ToString(RcsLikelihood::kSwerling3)), RcsLikelihood::kSwerling3);
 }
 
+// The map's view information and its weight, by hand: a degree-3 model of
+// full confidence counts 15/15, a degree-1 one 3/15, a constant one 0, a
+// Gaussian without a model nothing.
+TEST(RcsLikelihoods, WeightFromTheMapByHand) {
+  GaussianMap map;
+  const auto add = [&](int degree, double spread_db, std::uint32_t inliers) {
+    Gaussian g;
+    g.rcs.degree = degree;
+    g.rcs.scale = 1.0;
+    g.rcs.spread_db = spread_db;
+    g.rcs.inliers = inliers;
+    g.rcs.explained = 0.5;
+    map.gaussians.push_back(g);
+  };
+  add(1, 0.5, 400);  // confidence 1
+  add(0, 0.5, 400);
+  add(-1, 0.0, 0);
+  RcsTermOptions options;  // decibel: expected spread 2 dB
+  RcsMapSummary summary = SummariseRcs(map, options);
+  EXPECT_EQ(summary.models, 2u);
+  EXPECT_NEAR(summary.view_information, 0.5 * 3.0 / 15.0, 1e-15);
+  EXPECT_NEAR(summary.mean_confidence, 1.0, 1e-15);
+  EXPECT_NEAR(RcsWeightFromMap(summary), kRcsWeightPerInformation * 0.1, 1e-15);
+  // A degree-3 model whose spread is 4x the expected: confidence 1 / (16 (1 + 16/400)).
+  add(3, 8.0, 400);
+  summary = SummariseRcs(map, options);
+  const double confidence = 1.0 / (16.0 * (1.0 + 16.0 / 400.0));
+  EXPECT_NEAR(summary.view_information, (0.2 + confidence) / 3.0, 1e-15);
+  EXPECT_NEAR(summary.median_spread_db, 0.5, 1e-15);
+  // Every model of degree 3 at full confidence: capped at kMaxChosenRcsWeight.
+  for (Gaussian& g : map.gaussians) g.rcs.degree = 3, g.rcs.spread_db = 0.1;
+  EXPECT_EQ(RcsWeightFromMap(SummariseRcs(map, options)), kMaxChosenRcsWeight);
+  EXPECT_EQ(RcsWeightFromMap(SummariseRcs(GaussianMap{}, options)), 0.0);
+}
+
 // The Doppler velocity term: analytic twin against autodiff and central
 // differences; zero where the translation is the previous pose plus
 // R_prev v dt; W^T W is the inverse of S dt^2 + Q.

@@ -108,6 +108,13 @@ expect_ok "localize with merged coarse levels" "configurations" -- \
 expect_ok "localize with the losses' curvature" "configurations" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --w-rcs 0.25 --solver gn --loss-curvature --out "$work/results_curvature"
+expect_ok "localize with a Swerling likelihood and the map's own weight" "gn-wmap" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0 --rcs-likelihood swerling3 --rcs-confidence --w-rcs-from-map --out "$work/results_swerling"
+expect_fail "localize with an unknown RCS likelihood" "rcs-likelihood" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --rcs-likelihood swerling2 --out "$work/results_bad"
+expect_ok "map-info: the RCS fits' statistics and chosen weight" "chosen w_rcs" -- "$tool" map-info "$work/seq.rgm"
 expect_fail "localize with unknown coarse levels" "coarse-levels" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --coarse-levels blurred --out "$work/r5"

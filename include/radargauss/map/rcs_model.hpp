@@ -79,6 +79,16 @@ struct RcsFitStats {
   std::size_t no_model = 0;
   std::array<std::size_t, kMaxShDegree + 1> degree_histogram{};
   double mean_fit_rmse = 0.0;  // over the Gaussians with a model
+  // How a target's RCS varies across frames: the median over the Gaussians
+  // of at least kSpreadMinMembers members of their members' RCS std (dB,
+  // every member), binned by the members' mean range and mean |azimuth|
+  // (docs/design.md, "RCS statistics"); -1 for an empty bin.
+  static constexpr std::size_t kSpreadMinMembers = 4;
+  static constexpr std::array<double, 4> kRangeBins{0.0, 20.0, 40.0, 70.0};  // m, lower edges
+  static constexpr std::array<double, 3> kAzimuthBins{0.0, 15.0, 30.0};      // deg, lower edges
+  std::array<double, 4> member_spread_by_range{-1.0, -1.0, -1.0, -1.0};
+  std::array<double, 3> member_spread_by_azimuth{-1.0, -1.0, -1.0};
+  double member_spread = -1.0;  // over all bins
 };
 
 // Fits the RCS model of every Gaussian of `map` from the cloud points

@@ -17,8 +17,11 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 #include <string>
 #include <vector>
+
+#include "radargauss/map/gaussian_map.hpp"
 
 namespace radargauss {
 
@@ -76,5 +79,26 @@ inline double SwerlingResidualDerivative(double k, double z) {
   }
   return k * std::expm1(z) / SwerlingResidual(k, z);
 }
+
+// What a map's RCS models know, over the Gaussians with a model
+// (docs/design.md, "The RCS weight from the map").
+struct RcsMapSummary {
+  std::size_t models = 0;
+  double median_spread_db = 0.0;
+  double median_explained = 0.0;
+  double mean_confidence = 0.0;  // RcsConfidence with the likelihood's spread
+  // The mean over the models of confidence x (p - 1) / 15, p = (L + 1)^2:
+  // the view-dependent coefficients the members support, as a share of a
+  // degree-3 model's, weighed by how far the fit can be trusted; in [0, 1].
+  double view_information = 0.0;
+};
+RcsMapSummary SummariseRcs(const GaussianMap& map, const RcsTermOptions& options);
+
+// The data-chosen w_rcs of eq. 2: kRcsWeightPerInformation times the map's
+// view information, at most kMaxChosenRcsWeight (docs/design.md, "The RCS
+// weight from the map").
+inline constexpr double kRcsWeightPerInformation = 1.5;
+inline constexpr double kMaxChosenRcsWeight = 0.75;
+double RcsWeightFromMap(const RcsMapSummary& summary);
 
 }  // namespace radargauss
