@@ -114,9 +114,15 @@ RcsTerm BenchmarkTerm(IncidenceModel incidence) {
   return term;
 }
 
+// Args: incidence model, Gamma shape k of the likelihood (0: decibel).
 template <typename Kind>
 void BM_RcsResidualRotationOnly(benchmark::State& state) {
-  const RcsTerm term = BenchmarkTerm(IncidenceModel(state.range(0)));
+  RcsTerm term = BenchmarkTerm(IncidenceModel(state.range(0)));
+  term.shape = double(state.range(1));
+  if (term.shape > 0.0) {  // a Gaussian of scale 4 dB and offset 1 dB (rcs_likelihood.hpp)
+    term.log_scale = 0.2302585 * 4.0;
+    term.log_offset = -0.2302585;
+  }
   const Eigen::Vector3d t(1.0, 2.0, 0.5);
   const auto cost = MakeCost<Kind, RcsRotationCostFunction, RcsRotationResidual>(term, t);
   Eigen::Vector4d q = SO3d::Exp(Eigen::Vector3d(0.1, -0.2, 0.3)).quaternion().coeffs();
@@ -127,10 +133,10 @@ void BM_RcsResidualRotationOnly(benchmark::State& state) {
     cost->Evaluate(parameters, &residual, jacobians);
     benchmark::DoNotOptimize(j0[0]);
   }
-  state.SetLabel(ToString(term.incidence) + ", degree 3");
+  state.SetLabel(ToString(term.incidence) + ", degree 3" + (term.shape > 0.0 ? ", swerling1" : ""));
 }
-BENCHMARK_TEMPLATE(BM_RcsResidualRotationOnly, Analytic)->Arg(0)->Arg(1);
-BENCHMARK_TEMPLATE(BM_RcsResidualRotationOnly, AutoDiff)->Arg(0)->Arg(1);
+BENCHMARK_TEMPLATE(BM_RcsResidualRotationOnly, Analytic)->Args({0, 0})->Args({1, 0})->Args({0, 1});
+BENCHMARK_TEMPLATE(BM_RcsResidualRotationOnly, AutoDiff)->Args({0, 0})->Args({1, 0})->Args({0, 1});
 
 // Joint refinement's RCS block: rotation-only, the 16 coefficients a block.
 template <typename Kind>
