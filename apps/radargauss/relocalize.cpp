@@ -18,6 +18,7 @@
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/map_tiles.hpp"
 #include "radargauss/progress.hpp"
+#include "radargauss/residuals/rcs_likelihood.hpp"
 #include "radargauss/slam/relocalization.hpp"
 
 namespace radargauss::cli {
@@ -28,6 +29,7 @@ struct RelocalizeSettings {
   OdometrySettings odometry;
   std::string map;
   RelocalizationOptions relocalization;
+  bool w_rcs_from_map = false;  // w_rcs chosen from the map's RCS fits (RcsWeightFromMap)
 };
 
 void WritePerScan(std::ostream& out, const Relocalizer& relocalizer) {
@@ -59,14 +61,19 @@ void WriteCandidates(std::ostream& out, const Relocalizer& relocalizer) {
 }
 
 int RunRelocalize(const RelocalizeSettings& s) {
-  const RelocalizationOptions& options = s.relocalization;
+  RelocalizationOptions options = s.relocalization;
   ValidateOptions(options);
   GaussianMap map = ReadMapOrTiles(s.map);
+  ScanMatchingOptions& matching = options.odometry.match.matching;
+  if (s.w_rcs_from_map) {
+    matching.w_rcs = RcsWeightFromMap(SummariseRcs(map, matching.rcs_terms));
+    std::printf("relocalize: w_rcs %.3f from the map's RCS fits\n", matching.w_rcs);
+  }
   if (map.places.empty()) {
     throw FileError(s.map, "the map has no places to relocalise against (build it with radargauss slam)");
   }
   if (map.gaussians.empty()) throw FileError(s.map, "the map has no Gaussians to match against");
-  RunInputs inputs = LoadRunInputs(s.odometry, options.odometry.match.matching.w_rcs);
+  RunInputs inputs = LoadRunInputs(s.odometry, matching.w_rcs);
   const Sequence& sequence = inputs.sequence;
   const std::optional<Trajectory>& reference = inputs.reference;
   StagedFolder folder = RunFolder(s.odometry, {"relocalization.tum"});
@@ -121,6 +128,10 @@ Subcommand AddRelocalize(CLI::App& parent) {
                      "Reference trajectory (TUM, map frame), for the evaluation only");
   app->add_option("--out", s->odometry.out, "Output folder")->required();
   AddTableOptions(app, RelocalizationOptionTable(), s->relocalization);
+  app->add_flag("--w-rcs-from-map", s->w_rcs_from_map,
+                "Eq. 2's w_rcs chosen from the map's RCS fits instead of --w-rcs (docs/design.md)")
+      ->excludes(app->get_option("--w-rcs"))
+      ->group(HelpGroup(OptionGroup::kTuning));
   AddRunOptions(app, s->odometry);
   return {app, [s] { return RunRelocalize(*s); }};
 }

@@ -19,7 +19,7 @@ IMU_FLAGS = {"--imu", "--imu-extrinsic", "--imu-topic", "--imu-stamps", "--imu-r
 # command, the option tables its flags come from, its own flags.
 COMMANDS = [("odometry", ("odometry", "radar_inertial"), {"--matcher"} | IMU_FLAGS),
             ("slam", ("slam", "radar_inertial"), {"--no-map", "--map-tiles", "--false-loop-rate", "--false-loop-seed"} | IMU_FLAGS),
-            ("relocalize", ("relocalization",), {"--map"})]
+            ("relocalize", ("relocalization",), {"--map", "--w-rcs-from-map"})]
 
 pytestmark = pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool")
 

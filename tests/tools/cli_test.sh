@@ -177,6 +177,12 @@ expect_ok "relocalize says when nothing verifies" "relocalize: no fix" -- \
   --max-scan-context-distance 0 --out "$work/relocalized"
 [[ -s "$work/relocalized/per_scan.csv" && ! -s "$work/relocalized/relocalization.tum" ]] ||
   { echo "FAIL: relocalize without a fix wrote no per_scan.csv or a pose"; failed=1; }
+expect_ok "relocalize with the map's own w_rcs" "w_rcs [0-9.]* from the map's RCS fits" -- \
+  "$tool" relocalize --map "$work/slam/map.rgm" --sequence "$work/seq10" --submap-distance 2 \
+  --w-rcs-from-map --rcs-likelihood swerling1 --out "$work/relocalized_w"
+expect_fail "relocalize with both --w-rcs and --w-rcs-from-map" "excludes" -- \
+  "$tool" relocalize --map "$work/slam/map.rgm" --sequence "$work/seq10" --w-rcs 0.25 --w-rcs-from-map \
+  --out "$work/relocalized_x"
 # The map as tiles: map-info and relocalize read the folder as they read the file.
 expect_ok "slam writes the map as tiles" "map_tiles/" -- \
   "$tool" slam --sequence "$work/seq10" --submap-distance 2 --map-tiles 20 --out "$work/slam_tiles"
