@@ -8,6 +8,7 @@
 #include "radargauss/map/map_tiles.hpp"
 #include "radargauss/map/pipeline.hpp"
 #include "radargauss/radargauss.hpp"
+#include "radargauss/residuals/rcs_likelihood.hpp"
 
 namespace radargauss::python {
 
@@ -105,7 +106,26 @@ void BindMapClass(py::module_& m) {
               return p + 1;
             });
           },
-          "share of each Gaussian's RCS variance its model's view explains (adjusted R^2, in [0, 1])");
+          "share of each Gaussian's RCS variance its model's view explains (adjusted R^2, in [0, 1])")
+      .def_property_readonly(
+          "rcs_inliers",
+          [](const PyMap& m) {
+            return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
+              *p = g.rcs.inliers;
+              return p + 1;
+            });
+          },
+          "members each RCS model was fitted to (its inliers)")
+      .def(
+          "rcs_weight",
+          [](const PyMap& m, const std::string& likelihood, double expected_spread) {
+            RcsTermOptions options;
+            options.likelihood = RcsLikelihoodFromString(likelihood);
+            options.expected_spread_db = expected_spread;
+            return RcsWeightFromMap(SummariseRcs(m.map(), options));
+          },
+          py::arg("likelihood") = "decibel", py::arg("expected_spread") = 0.0,
+          "eq. 2's w_rcs chosen from the map's RCS fits (localize --w-rcs-from-map; docs/design.md)");
 }
 
 MapOptions BuildOptions(const std::string& builder, double points_per_gaussian, double min_std,

@@ -51,6 +51,25 @@ def parse_map(path):
     return np.array(means), np.array(covariances), np.array(coefficients), np.array(statistics)
 
 
+def test_rcs_weight_from_the_map_by_numpy(written):
+    """The map's own w_rcs, recomputed from its arrays as docs/design.md
+    states it: 1.5 x the mean over the models of confidence x (p - 1) / 15,
+    confidence min(1, s_e^2 / (spread^2 (1 + p / n))), at most 0.75."""
+    world = rg.read_map(written["map"])
+    models = world.rcs_degrees >= 0
+    p = (world.rcs_degrees[models] + 1) ** 2
+    n = world.rcs_inliers[models]
+    spread = world.rcs_spreads[models]
+    for likelihood, expected in (("decibel", 2.0), ("swerling1", 10 / np.log(10) * np.pi / np.sqrt(6))):
+        predictive = spread ** 2 * (1 + p / n)
+        confidence = np.where(predictive <= expected ** 2, 1.0, expected ** 2 / predictive)
+        information = np.mean(confidence * (p - 1) / 15)
+        assert world.rcs_weight(likelihood) == pytest.approx(min(0.75, 1.5 * information), rel=1e-12)
+    assert 0 < world.rcs_weight("decibel") < world.rcs_weight("swerling1") <= 0.75
+    with pytest.raises(ValueError):
+        world.rcs_weight("swerling2")
+
+
 def test_map_arrays_equal_the_file(written, tmp_path):
     world = rg.read_map(written["map"])
     means, covariances, coefficients, statistics = parse_map(written["map"])
