@@ -2,9 +2,11 @@
 #include "radargauss/residuals/rcs_likelihood.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "radargauss/names.hpp"
 #include "radargauss/sh.hpp"
+#include "radargauss/stats.hpp"
 
 namespace radargauss {
 
@@ -17,7 +19,6 @@ const NamedValue<RcsLikelihood> kRcsLikelihoodNames[] = {
 };
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kDbPerNeper = 4.342944819032518;  // 10 / ln(10)
 
 }  // namespace
 
@@ -37,13 +38,17 @@ double RcsLikelihoodSpreadDb(RcsLikelihood likelihood) {
   // pi^2 / 6 for k = 1, pi^2 / 6 - 1 for k = 2.
   switch (likelihood) {
     case RcsLikelihood::kSwerling1:
-      return kDbPerNeper * std::sqrt(kPi * kPi / 6.0);
+      return std::sqrt(kPi * kPi / 6.0) / kNepersPerDecibel;
     case RcsLikelihood::kSwerling3:
-      return kDbPerNeper * std::sqrt(kPi * kPi / 6.0 - 1.0);
+      return std::sqrt(kPi * kPi / 6.0 - 1.0) / kNepersPerDecibel;
     case RcsLikelihood::kDecibel:
       break;
   }
   return 2.0;
+}
+
+double ExpectedSpreadDb(const RcsTermOptions& options) {
+  return options.expected_spread_db > 0.0 ? options.expected_spread_db : RcsLikelihoodSpreadDb(options.likelihood);
 }
 
 double RcsConfidence(double spread_db, int degree, unsigned inliers, double expected_spread_db) {
@@ -55,8 +60,7 @@ double RcsConfidence(double spread_db, int degree, unsigned inliers, double expe
 }
 
 RcsMapSummary SummariseRcs(const GaussianMap& map, const RcsTermOptions& options) {
-  const double expected =
-      options.expected_spread_db > 0.0 ? options.expected_spread_db : RcsLikelihoodSpreadDb(options.likelihood);
+  const double expected = ExpectedSpreadDb(options);
   RcsMapSummary summary;
   std::vector<double> spreads, explained;
   double confidence_sum = 0.0, information_sum = 0.0;
@@ -66,17 +70,13 @@ RcsMapSummary SummariseRcs(const GaussianMap& map, const RcsTermOptions& options
     explained.push_back(g.rcs.explained);
     const double confidence = RcsConfidence(g.rcs.spread_db, g.rcs.degree, g.rcs.inliers, expected);
     confidence_sum += confidence;
-    information_sum += confidence * double(ShCoefficientCount(g.rcs.degree) - 1) /
-                       double(ShCoefficientCount(kMaxShDegree) - 1);
+    information_sum +=
+        confidence * double(ShCoefficientCount(g.rcs.degree) - 1) / double(ShCoefficientCount(kMaxShDegree) - 1);
   }
   summary.models = spreads.size();
   if (summary.models == 0) return summary;
-  const auto median = [](std::vector<double>& values) {
-    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
-    return values[values.size() / 2];
-  };
-  summary.median_spread_db = median(spreads);
-  summary.median_explained = median(explained);
+  summary.median_spread_db = Median(std::move(spreads));
+  summary.median_explained = Median(std::move(explained));
   summary.mean_confidence = confidence_sum / double(summary.models);
   summary.view_information = information_sum / double(summary.models);
   return summary;

@@ -40,9 +40,7 @@ void AddRcsTerms(const RadarScan& scan, const MatchingMap& map, Correspondences&
   c.rcs.clear();
   if (!scan.has_rcs) return;
   const double shape = SwerlingShape(rcs_terms.likelihood);
-  const double expected_spread =
-      rcs_terms.expected_spread_db > 0.0 ? rcs_terms.expected_spread_db : RcsLikelihoodSpreadDb(rcs_terms.likelihood);
-  constexpr double kNepersPerDb = 0.23025850929940458;  // ln(10) / 10
+  const double expected_spread = ExpectedSpreadDb(rcs_terms);
   c.rcs.reserve(c.geometric.size());
   const Eigen::Matrix3d Rt = c.pose.rotation().Matrix().transpose();
   const std::vector<Gaussian>& gaussians = map.map().gaussians;
@@ -70,8 +68,8 @@ void AddRcsTerms(const RadarScan& scan, const MatchingMap& map, Correspondences&
     term.gaussian = pair.gaussian;
     if (shape > 0.0) {  // z = ln(sigma / mean) from the decibel residual (rcs_likelihood.hpp)
       term.shape = shape;
-      term.log_scale = kNepersPerDb * gaussian.rcs.scale;
-      term.log_offset = -kNepersPerDb * gaussian.rcs.mean_offset_db;
+      term.log_scale = kNepersPerDecibel * gaussian.rcs.scale;
+      term.log_offset = -kNepersPerDecibel * gaussian.rcs.mean_offset_db;
     }
     if (rcs_terms.confidence) {
       const double confidence =

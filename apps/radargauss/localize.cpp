@@ -108,6 +108,7 @@ std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const 
   std::size_t done = 0;
   for (std::size_t m = 0; m < maps.size(); ++m) {
     const MatchingMap matching(maps[m], s.MatchingOptions());
+    const std::vector<std::pair<double, bool>> weights = s.Weights(maps[m]);
     for (const std::string& solver : s.solvers) {
       if (solver.rfind("pcl-", 0) == 0) {
         if (m > 0) continue;  // the peers do not use the RCS models: once
@@ -117,7 +118,7 @@ std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const 
         continue;
       }
       for (const std::string& loss : s.losses) {
-        for (const auto& [w, from_map] : s.Weights(maps[m])) {
+        for (const auto& [w, from_map] : weights) {
           const auto matcher = MakeScanMatcher(s.Configuration(solver, w, loss));
           const std::string name = solver + (from_map ? "-wmap" : "-w") + FormatWeight(w) + "-" + loss + "-" +
                                    ToString(maps[m].incidence) + "-L" + std::to_string(degrees[m]);

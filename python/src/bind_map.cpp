@@ -29,6 +29,15 @@ Array PerGaussian(const GaussianMap& map, std::vector<py::ssize_t> shape, const 
   return out;
 }
 
+// A (K,) array of one number of every Gaussian, `value(g)`.
+template <typename Value>
+Array EachGaussian(const PyMap& m, const Value& value) {
+  return PerGaussian(m.map(), {}, [&](const Gaussian& g, double* p) {
+    *p = double(value(g));
+    return p + 1;
+  });
+}
+
 void BindMapClass(py::module_& m) {
   py::class_<PyMap, std::shared_ptr<PyMap>>(m, "GaussianMap",
                                             "A Gaussian-RCS map; every array is a copy (the Gaussians are "
@@ -50,36 +59,16 @@ void BindMapClass(py::module_& m) {
                                  return p;
                                });
                              })
-      .def_property_readonly("point_counts",
-                             [](const PyMap& m) {
-                               return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
-                                 *p = g.point_count;
-                                 return p + 1;
-                               });
-                             })
       .def_property_readonly(
-          "rcs_degrees",
-          [](const PyMap& m) {
-            return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
-              *p = g.rcs.degree;
-              return p + 1;
-            });
-          },
+          "point_counts",
+          [](const PyMap& m) { return EachGaussian(m, [](const Gaussian& g) { return g.point_count; }); })
+      .def_property_readonly(
+          "rcs_degrees", [](const PyMap& m) { return EachGaussian(m, [](const Gaussian& g) { return g.rcs.degree; }); },
           "SH degree of each RCS model, -1 where a Gaussian has none")
-      .def_property_readonly("rcs_medians",
-                             [](const PyMap& m) {
-                               return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
-                                 *p = g.rcs.median;
-                                 return p + 1;
-                               });
-                             })
-      .def_property_readonly("rcs_scales",
-                             [](const PyMap& m) {
-                               return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
-                                 *p = g.rcs.scale;
-                                 return p + 1;
-                               });
-                             })
+      .def_property_readonly(
+          "rcs_medians", [](const PyMap& m) { return EachGaussian(m, [](const Gaussian& g) { return g.rcs.median; }); })
+      .def_property_readonly(
+          "rcs_scales", [](const PyMap& m) { return EachGaussian(m, [](const Gaussian& g) { return g.rcs.scale; }); })
       .def_property_readonly(
           "rcs_coefficients",
           [](const PyMap& m) {
@@ -91,30 +80,15 @@ void BindMapClass(py::module_& m) {
           "(K, 16) real SH coefficients of the normalised RCS, zero beyond each model's degree")
       .def_property_readonly(
           "rcs_spreads",
-          [](const PyMap& m) {
-            return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
-              *p = g.rcs.spread_db;
-              return p + 1;
-            });
-          },
+          [](const PyMap& m) { return EachGaussian(m, [](const Gaussian& g) { return g.rcs.spread_db; }); },
           "std (dB) of each RCS fit's residuals, its coefficients' degrees of freedom taken out")
       .def_property_readonly(
           "rcs_explained",
-          [](const PyMap& m) {
-            return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
-              *p = g.rcs.explained;
-              return p + 1;
-            });
-          },
+          [](const PyMap& m) { return EachGaussian(m, [](const Gaussian& g) { return g.rcs.explained; }); },
           "share of each Gaussian's RCS variance its model's view explains (adjusted R^2, in [0, 1])")
       .def_property_readonly(
           "rcs_inliers",
-          [](const PyMap& m) {
-            return PerGaussian(m.map(), {}, [](const Gaussian& g, double* p) {
-              *p = g.rcs.inliers;
-              return p + 1;
-            });
-          },
+          [](const PyMap& m) { return EachGaussian(m, [](const Gaussian& g) { return g.rcs.inliers; }); },
           "members each RCS model was fitted to (its inliers)")
       .def(
           "rcs_weight",

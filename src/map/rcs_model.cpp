@@ -88,9 +88,9 @@ RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::
         model.degree = degree;
         model.coefficients.fill(0.0);
         for (int j = 0; j < count; ++j) model.coefficients[j] = c[j];
-        model.fit_rmse = std::sqrt((A * c - y).squaredNorm() / n);
-        model.inliers = std::uint32_t(n);
         const Eigen::VectorXd fitted = A * c;
+        model.fit_rmse = std::sqrt((fitted - y).squaredNorm() / n);
+        model.inliers = std::uint32_t(n);
         SetRcsFitSpread(model, (fitted - y).squaredNorm(), (y.array() - y.mean()).square().sum(), std::size_t(n),
                         count);
         // 10 log10 of the mean of 10^((rcs - prediction) / 10): the inliers'
@@ -114,11 +114,8 @@ RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::
 
 namespace {
 
-double MedianOf(std::vector<double> values) {
-  if (values.empty()) return -1.0;
-  std::sort(values.begin(), values.end());
-  return MedianOfSorted(values);
-}
+// -1 for an empty bin (RcsFitStats).
+double MedianOf(std::vector<double> values) { return values.empty() ? -1.0 : Median(std::move(values)); }
 
 // The bin of `value` among lower edges `edges`.
 template <std::size_t N>
@@ -178,7 +175,7 @@ RcsFitStats FitRcsModels(GaussianMap& map, const MapCloud& cloud, const std::vec
       directions.push_back(FacingSign(u) * u.normalized());
       rcs.push_back(cloud.rcs[i]);
       range_sum += point_radar.norm();
-      azimuth_sum += std::abs(std::atan2(point_radar.y(), point_radar.x())) * 180.0 / 3.14159265358979323846;
+      azimuth_sum += std::abs(std::atan2(point_radar.y(), point_radar.x())) * 180.0 / M_PI;
     }
     if (cloud.has_rcs && rcs.size() >= RcsFitStats::kSpreadMinMembers) {
       const double n = double(rcs.size());

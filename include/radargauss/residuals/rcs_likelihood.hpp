@@ -46,10 +46,17 @@ struct RcsTermOptions {
   double expected_spread_db = 0.0;
 };
 
+// ln(10) / 10: nepers (natural-log units) per decibel.
+inline constexpr double kNepersPerDecibel = 0.23025850929940458;
+
 // The std (dB) of a measurement about its mean under the likelihood: for
 // Gamma(k) fluctuation, 10 / ln(10) sqrt(psi_1(k)) (5.57 dB for k = 1, 3.49
 // dB for k = 2); for the decibel residual, 2 dB.
 double RcsLikelihoodSpreadDb(RcsLikelihood likelihood);
+
+// The spread the confidence expects: options.expected_spread_db, or the
+// likelihood's own when that is 0.
+double ExpectedSpreadDb(const RcsTermOptions& options);
 
 // A Gaussian's confidence in [0, 1]: the expected variance over the
 // predictive variance of a new measurement about the fitted model,
