@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -19,6 +20,7 @@
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/map/map_file.hpp"
+#include "radargauss/map/map_tiles.hpp"
 #include "radargauss/simulator.hpp"
 #include "radargauss/slam/place_recognition.hpp"
 #include "radargauss/trajectory.hpp"
@@ -208,12 +210,41 @@ void ShardJson(const std::uint8_t* data, std::size_t size) {
 
 }  // namespace
 
+// The tiles the map_tiles target's index refers to: three Gaussians, two in
+// tile (0, 0) and one in (1, 0) at 100 m, written once per process
+// (scripts/fuzz_seeds.py writes their true index as the seed).
+std::string TilesFolder() {
+  static const std::string folder = [] {
+    const std::string dir = InputPath("tiles");
+    std::filesystem::remove_all(dir);
+    GaussianMap map;
+    for (const double x : {10.0, 150.0, 20.0}) {
+      Gaussian g;
+      g.mean = Eigen::Vector3d(x, 5.0, 0.0);
+      map.gaussians.push_back(g);
+    }
+    WriteMapTiles(dir, map, 100.0);
+    return dir;
+  }();
+  return folder;
+}
+
+// A tiles.json over TilesFolder's tiles, read whole and by neighbourhood.
+void MapTiles(const std::uint8_t* data, std::size_t size) {
+  const std::string dir = TilesFolder();
+  WriteInput(data, size, "index.json");
+  std::filesystem::copy_file(InputPath("index.json"), dir + "/tiles.json",
+                             std::filesystem::copy_options::overwrite_existing);
+  Expecting([&] { ReadMapTiles(dir); });
+  Expecting([&] { ReadMapTiles(dir, Eigen::Vector2d(120.0, 0.0), 30.0); });
+}
+
 const std::vector<Target>& Targets() {
   static const std::vector<Target> targets = {
       {"pcd", Pcd},          {"kitti_bin", KittiBin},      {"tum", Tum},
       {"map_file", MapFile}, {"pointcloud2", PointCloud2}, {"simulator_yaml", SimulatorYaml},
       {"cli_yaml", CliYaml}, {"shard_json", ShardJson},    {"map_places", MapPlaces},
-      {"mcap", Mcap},        {"cdr", Cdr}};
+      {"mcap", Mcap},        {"cdr", Cdr},                 {"map_tiles", MapTiles}};
   return targets;
 }
 

@@ -2,6 +2,9 @@
 #include "radargauss/residuals/rcs_likelihood.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "radargauss/names.hpp"
@@ -60,6 +63,10 @@ double RcsConfidence(double spread_db, int degree, unsigned inliers, double expe
 }
 
 RcsMapSummary SummariseRcs(const GaussianMap& map, const RcsTermOptions& options) {
+  if (!(options.expected_spread_db >= 0.0) || !std::isfinite(options.expected_spread_db)) {
+    throw std::invalid_argument("expected_spread must be a finite number >= 0 (dB), not " +
+                                std::to_string(options.expected_spread_db));
+  }
   const double expected = ExpectedSpreadDb(options);
   RcsMapSummary summary;
   std::vector<double> spreads, explained;

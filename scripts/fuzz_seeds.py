@@ -230,6 +230,19 @@ def shard_json_seeds(rng):
         yield f"shard_{index}_of_{count}.json", json.dumps(shard).encode()
 
 
+def map_tiles_seeds(rng):
+    """The true index of the tiles the map_tiles entry point writes (three
+    Gaussians at x = 10, 150, 20 m in 100 m tiles), and one with a place list."""
+    import json
+    tiles = [{"x": 0, "y": 0, "file": "tile_0_0.rgm", "gaussians": 2, "places": []},
+             {"x": 1, "y": 0, "file": "tile_1_0.rgm", "gaussians": 1, "places": []}]
+    index = {"format": "radargauss map tiles", "gaussians": 3, "incidence": "offset", "order": [[0, 1], [1, 1], [0, 1]],
+             "places": 0, "tile_size": 100.0, "tiles": tiles, "version": 1}
+    yield "true.json", json.dumps(index).encode()
+    index["order"] = [[0, 2], [1, 1]]
+    yield "reordered.json", json.dumps(index, indent=1).encode()
+
+
 def files(*patterns):
     for path in sorted(p for pattern in patterns for p in glob.glob(os.path.join(ROOT, pattern))):
         with open(path, "rb") as f:
@@ -245,7 +258,7 @@ def main():
         "pointcloud2": pointcloud2_seeds(rng), "simulator_yaml": files("configs/synthetic_world.yaml", "configs/synthetic_long_drive.yaml"),
         "cli_yaml": files("configs/*_localize.yaml", "configs/*_odometry.yaml"),
         "shard_json": shard_json_seeds(rng), "map_places": map_places_seeds(rng),
-        "mcap": mcap_seeds(rng), "cdr": cdr_seeds(rng),
+        "mcap": mcap_seeds(rng), "cdr": cdr_seeds(rng), "map_tiles": map_tiles_seeds(rng),
     }
     for target, items in seeds.items():
         folder = os.path.join(sys.argv[1], target)

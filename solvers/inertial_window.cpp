@@ -105,6 +105,7 @@ struct InertialWindow::Impl {
   Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
   double clock_offset[1] = {0.0};    // t_d: the block
   double clock_linearisation = 0.0;  // t_0: where the samples were read
+  bool clock_held = false;           // held at a bound since the last solve: every term read again
   double elevation_bias[1] = {0.0};  // b: the block
   std::shared_ptr<MarginalizationPrior> prior;
 
@@ -146,6 +147,31 @@ struct InertialWindow::Impl {
     if (options.estimate_clock_offset) blocks.push_back(clock_offset);
     if (options.estimate_elevation_bias) blocks.push_back(elevation_bias);
     return blocks;
+  }
+
+  // Before a state at `stamp` is added: an offset at which its IMU interval
+  // would pass the IMU's last sample is held at the largest the data covers
+  // (when that is within its bounds; otherwise the interval is refused as
+  // the data's fault), and the next Solve reads every term again at it.
+  void HoldClockOffsetFor(double stamp) {
+    const double lowest = std::max(-kMaxClockOffset, imu.front().stamp - nodes.front().stamp);
+    const double highest = std::min(kMaxClockOffset, imu.back().stamp - stamp);
+    if (std::max(clock_offset[0], clock_linearisation) <= highest || highest < lowest) return;
+    clock_offset[0] = std::min(clock_offset[0], highest);
+    clock_linearisation = std::min(clock_linearisation, highest);
+    clock_held = true;
+  }
+
+  // The clock offset put back within [-kMaxClockOffset, kMaxClockOffset] and
+  // within what the IMU's samples cover at the window's ends (so that every
+  // term can be integrated again at it); whether it had left them.
+  bool HoldClockOffsetInBounds() {
+    const double lowest = std::max(-kMaxClockOffset, imu.front().stamp - nodes.front().stamp);
+    const double highest = std::min(kMaxClockOffset, imu.back().stamp - nodes.back().stamp);
+    double& offset = clock_offset[0];
+    if (lowest > highest || (offset >= lowest && offset <= highest)) return false;
+    offset = std::clamp(offset, lowest, highest);
+    return true;
   }
 
   // Every term of the window in `problem`; the ids of those on the oldest state in `oldest_terms`.
@@ -285,6 +311,7 @@ void InertialWindow::AddState(double stamp) {
     throw DataError("state at " + std::to_string(stamp) + " s does not follow the one at " +
                     std::to_string(last.stamp) + " s");
   }
+  if (options_.estimate_clock_offset) impl_->HoldClockOffsetFor(stamp);
   const double t0 = impl_->clock_linearisation;
   const ImuPreintegration between = Preintegrate(impl_->imu, last.stamp + t0, stamp + t0, last.Bias(), options_.noise);
   // The prediction (imu_preintegration.hpp's model) is the new state's start.
@@ -367,7 +394,7 @@ WindowSolveSummary InertialWindow::Solve() {
   // A clock offset moved past kClockRelinearisation: every term read again
   // at it (the terms' first-order move d stays small).
   const double t0 = impl_->clock_offset[0];
-  const bool clock_moved = std::abs(t0 - impl_->clock_linearisation) > kClockRelinearisation;
+  const bool clock_moved = std::abs(t0 - impl_->clock_linearisation) > kClockRelinearisation || impl_->clock_held;
   if (clock_moved) {
     impl_->clock_linearisation = t0;
     for (Node& node : nodes) impl_->MakeRadarTerms(node);
@@ -390,6 +417,8 @@ WindowSolveSummary InertialWindow::Solve() {
           ? SolveWithGaussNewton(problem, impl_->VariableBlocks(options_), options_.max_iterations)
           : SolveWithCeres(problem, options_);
   summary.reintegrated = reintegrated;
+  const bool held_after = options_.estimate_clock_offset && impl_->HoldClockOffsetInBounds();
+  summary.clock_offset_held = std::exchange(impl_->clock_held, false) || held_after;
   summary.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "radargauss/error.hpp"
+#include "radargauss/io/read_file.hpp"
 
 namespace radargauss {
 
@@ -33,11 +34,16 @@ const std::string kMark = ".radargauss-tmp.";
 
 std::string TemporaryOf(const std::string& path) { return path + kMark + std::to_string(::getpid()); }
 
+// The mark the bag writer's temporaries had before they took kMark; such
+// files of ended processes are removed as well.
+const std::string kOldBagMark = ".radargauss-partial.";
+
 // Whether `name` is a temporary of a process that has ended.
 bool IsStaleTemporary(const std::string& name) {
-  const std::size_t mark = name.rfind(kMark);
-  if (mark == std::string::npos || mark + kMark.size() == name.size()) return false;
-  const std::string digits = name.substr(mark + kMark.size());
+  std::size_t mark = name.rfind(kMark), mark_size = kMark.size();
+  if (mark == std::string::npos) mark = name.rfind(kOldBagMark), mark_size = kOldBagMark.size();
+  if (mark == std::string::npos || mark + mark_size == name.size()) return false;
+  const std::string digits = name.substr(mark + mark_size);
   if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) return false;
   const pid_t pid = pid_t(std::stol(digits));
   return pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH;
@@ -107,17 +113,63 @@ fs::path FolderPath(const std::string& target) {
   return path;
 }
 
+// Creates and removes `probe` (a temporary name beside an output): whether
+// the output's folder takes a new file, tried rather than inferred from its
+// mode (/proc, a read-only mount, a full inode table).
+void TryCreating(const std::string& probe, const std::string& output) {
+  const int fd = ::open(probe.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    if (errno == EEXIST) return;  // this process is writing it now
+    throw FileError(output, std::string("cannot be written: ") + std::strerror(errno));
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
+// Whether `path` (a file, or a folder and everything in it) holds a file this run has read.
+bool HoldsProtectedInput(const fs::path& path) {
+  std::error_code error;
+  if (!fs::is_directory(fs::symlink_status(path, error))) return IsProtectedInput(path.string());
+  for (fs::recursive_directory_iterator it(path, error), end; !error && it != end; it.increment(error)) {
+    if (IsProtectedInput(it->path().string())) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 void CheckOutputFile(const std::string& path) {
+  if (path.empty()) throw DataError("an output file needs a name");
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
   if (fs::exists(status) && !fs::is_regular_file(status)) {
     throw FileError(path, fs::is_directory(status) ? "is a folder, not a file to write"
                                                    : "is not a regular file (a device or FIFO?); refused as an output");
   }
+  if (IsProtectedInput(path)) throw FileError(path, "is read by this run; an output never replaces an input");
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty() && !fs::is_directory(parent, error)) throw FileError(path, "its folder does not exist");
+  TryCreating(TemporaryOf(path), path);
+}
+
+void CheckOutputFolder(const std::string& path) {
+  const fs::path target = FolderPath(path);
+  std::error_code error;
+  if (fs::exists(target, error) && !fs::is_directory(target, error)) {
+    throw FileError(path, "exists and is not a folder; refused as an output folder");
+  }
+  fs::path existing = target;
+  while (!fs::exists(existing, error) && existing.has_parent_path() && existing != existing.parent_path()) {
+    existing = existing.parent_path();
+  }
+  if (!fs::is_directory(existing, error)) throw FileError(path, existing.string() + " is not a folder");
+  TryCreating((existing / ("probe" + kMark + std::to_string(::getpid()))).string(), path);
+}
+
+std::string TemporaryFileFor(const std::string& path) {
+  CheckOutputFile(path);
+  RemoveStaleTemporaries(fs::path(path).parent_path());
+  return TemporaryOf(path);
 }
 
 StagedFolder::StagedFolder(const std::string& target, std::vector<std::string> superseded)
@@ -158,6 +210,15 @@ void StagedFolder::Commit() {
     }
     committed_ = true;
     return;
+  }
+  // What the new results replace (a name both hold) or drop (superseded) may not be a file this run read.
+  for (const fs::directory_entry& entry : fs::directory_iterator(target_)) {
+    const std::string name = entry.path().filename().string();
+    const bool replaced = fs::exists(fs::symlink_status(fs::path(staging_) / name, error)) ||
+                          std::find(superseded_.begin(), superseded_.end(), name) != superseded_.end();
+    if (replaced && HoldsProtectedInput(entry.path())) {
+      throw FileError(entry.path().string(), "is read by this run; its results never replace an input");
+    }
   }
   CarryOver(target_, staging_, superseded_);
   KeepAttributes(target_, staging_);

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <random>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
@@ -19,6 +21,14 @@ namespace radargauss {
 
 std::vector<SE3d> InitialErrors(std::size_t scans, double max_translation, double max_rotation_deg,
                                 std::uint32_t seed) {
+  if (scans > kMaxInitialErrors) {
+    throw std::invalid_argument("InitialErrors: " + std::to_string(scans) + " scans is past " +
+                                std::to_string(kMaxInitialErrors));
+  }
+  if (!(max_translation >= 0.0) || !std::isfinite(max_translation) || !(max_rotation_deg >= 0.0) ||
+      !std::isfinite(max_rotation_deg)) {
+    throw std::invalid_argument("InitialErrors: the largest translation and rotation must be finite and >= 0");
+  }
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> normal;

@@ -2,6 +2,7 @@
 #include "radargauss/options.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -147,14 +148,7 @@ OptionValue OptionSpec::Parse(const std::vector<std::string>& words) const {
   OptionValue value;
   switch (kind) {
     case OptionKind::kFlag: {
-      const std::string& w = words[0];
-      if (w == "true" || w == "1" || w == "on" || w == "yes") {
-        value = true;
-      } else if (w == "false" || w == "0" || w == "off" || w == "no" || w == "-1") {
-        value = false;
-      } else {
-        throw std::invalid_argument(w + " is not true or false");
-      }
+      value = ParseFlagWord(words[0]);
       break;
     }
     case OptionKind::kInteger: {
@@ -188,6 +182,14 @@ OptionValue OptionSpec::Parse(const std::vector<std::string>& words) const {
   const std::string why = Check(value);
   if (!why.empty()) throw std::invalid_argument(FormatOptionValue(value) + " " + why);
   return value;
+}
+
+bool ParseFlagWord(const std::string& word) {
+  std::string lower = word;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (lower == "true" || lower == "1" || lower == "on" || lower == "yes") return true;
+  if (lower == "false" || lower == "0" || lower == "off" || lower == "no") return false;
+  throw std::invalid_argument("'" + word + "' is not one of true/false, 1/0, on/off, yes/no");
 }
 
 namespace option_detail {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -63,6 +64,10 @@ void WriteRunMcap(const std::string& path, const RunForViewer& run, const RunMca
   if (run.stamps.size() != run.poses.size() || run.reference_stamps.size() != run.reference.size() ||
       (!run.scans.empty() && run.scans.size() != run.poses.size())) {
     throw std::invalid_argument("WriteRunMcap: stamps, poses and scans differ in count");
+  }
+  if (!(options.ellipsoid_sigma > 0.0) || !(options.ellipsoid_sigma <= kMaxEllipsoidSigma)) {
+    throw std::invalid_argument("WriteRunMcap: ellipsoid_sigma must be in (0, " + std::to_string(int(kMaxEllipsoidSigma)) +
+                                "], not " + std::to_string(options.ellipsoid_sigma));
   }
   WriteFileAtomically(
       path,
@@ -134,57 +139,61 @@ void WriteRunMcap(const std::string& path, const RunForViewer& run, const RunMca
 
 namespace {
 
-// The rows of a CSV file with a header, as maps from column name to text.
-std::vector<std::map<std::string, std::string>> ReadCsv(const std::string& path) {
-  std::istringstream in(ReadFileBytes(path, "CSV file", std::size_t(1) << 30));
-  std::string line;
-  std::vector<std::string> columns;
-  std::vector<std::map<std::string, std::string>> rows;
-  const auto split = [](const std::string& text) {
-    std::vector<std::string> cells;
-    std::string cell;
-    bool quoted = false;
-    for (const char c : text) {
-      if (c == '"') {
-        quoted = !quoted;
-      } else if (c == ',' && !quoted) {
-        cells.push_back(cell);
-        cell.clear();
-      } else {
-        cell += c;
-      }
+// The cells of one CSV line (quotes group commas).
+std::vector<std::string> SplitCsvLine(const std::string& text) {
+  std::vector<std::string> cells;
+  std::string cell;
+  bool quoted = false;
+  for (const char c : text) {
+    if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      cells.push_back(cell);
+      cell.clear();
+    } else {
+      cell += c;
     }
-    cells.push_back(cell);
-    return cells;
-  };
-  std::size_t number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (columns.empty()) {
-      columns = split(line);
-      continue;
-    }
-    const std::vector<std::string> cells = split(line);
-    if (cells.size() != columns.size())
-      throw FileError(path, number, "expected " + std::to_string(columns.size()) + " columns");
-    std::map<std::string, std::string> row;
-    for (std::size_t i = 0; i < cells.size(); ++i) row[columns[i]] = cells[i];
-    rows.push_back(row);
   }
-  return rows;
+  cells.push_back(cell);
+  return cells;
 }
 
-double Number(const std::map<std::string, std::string>& row, const std::string& column, const std::string& path) {
-  const auto found = row.find(column);
-  if (found == row.end()) throw FileError(path, "no column '" + column + "'");
-  try {
-    std::size_t used = 0;
-    const double value = std::stod(found->second, &used);
-    if (used != found->second.size() || !std::isfinite(value)) throw std::invalid_argument("");
-    return value;
-  } catch (const std::exception&) {
-    throw FileError(path, "column '" + column + "' holds '" + Printable(found->second) + "', not a number");
+// The columns `names` of a CSV file with a header, as numbers, read line by
+// line into one vector per column: a file of millions of rows costs its
+// numbers, not a map per row.
+std::vector<std::vector<double>> ReadCsvColumns(const std::string& path, const std::vector<std::string>& names) {
+  const std::string bytes = ReadFileBytes(path, "CSV file", std::size_t(1) << 30);
+  std::vector<std::size_t> wanted;
+  std::size_t columns = 0, number = 0;
+  std::vector<std::vector<double>> values(names.size());
+  for (std::size_t begin = 0; begin < bytes.size();) {
+    std::size_t end = bytes.find('\n', begin);
+    if (end == std::string::npos) end = bytes.size();
+    const std::vector<std::string> cells = SplitCsvLine(bytes.substr(begin, end - begin));
+    begin = end + 1;
+    ++number;
+    if (number == 1) {
+      columns = cells.size();
+      for (const std::string& name : names) {
+        const auto found = std::find(cells.begin(), cells.end(), name);
+        if (found == cells.end()) throw FileError(path, "no column '" + name + "'");
+        wanted.push_back(std::size_t(found - cells.begin()));
+      }
+      continue;
+    }
+    if (cells.size() != columns) throw FileError(path, number, "expected " + std::to_string(columns) + " columns");
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      const std::string& cell = cells[wanted[c]];
+      char* after = nullptr;
+      const double value = cell.empty() ? NAN : std::strtod(cell.c_str(), &after);
+      if (cell.empty() || *after != '\0' || !std::isfinite(value)) {
+        throw FileError(path, number, "column '" + names[c] + "' holds '" + Printable(cell) + "', not a number");
+      }
+      values[c].push_back(value);
+    }
   }
+  if (number == 0) throw FileError(path, "no header");
+  return values;
 }
 
 }  // namespace
@@ -210,8 +219,7 @@ RunForViewer ReadRunFolder(const std::string& folder) {
   if (fs::exists(dir / "map.rgm", error)) run.map = ReadMap((dir / "map.rgm").string());
   if (fs::exists(dir / "loops.csv", error) && fs::exists(dir / "keyframes.csv", error)) {
     const std::string keyframes_path = (dir / "keyframes.csv").string(), loops_path = (dir / "loops.csv").string();
-    std::vector<double> keyframe_stamps;
-    for (const auto& row : ReadCsv(keyframes_path)) keyframe_stamps.push_back(Number(row, "stamp", keyframes_path));
+    const std::vector<double> keyframe_stamps = ReadCsvColumns(keyframes_path, {"stamp"})[0];
     const auto position = [&](double index) -> Eigen::Vector3d {
       if (!(index >= 0.0) || index >= double(keyframe_stamps.size())) {
         throw FileError(loops_path, "a loop names keyframe " + std::to_string(index) + ", which keyframes.csv lacks");
@@ -220,10 +228,9 @@ RunForViewer ReadRunFolder(const std::string& folder) {
       if (!pose) throw FileError(loops_path, "a loop's keyframe lies outside the trajectory");
       return pose->translation();
     };
-    for (const auto& row : ReadCsv(loops_path)) {
-      if (Number(row, "accepted", loops_path) == 0.0) continue;
-      run.loops.emplace_back(position(Number(row, "query", loops_path)),
-                             position(Number(row, "candidate", loops_path)));
+    const std::vector<std::vector<double>> loops = ReadCsvColumns(loops_path, {"accepted", "query", "candidate"});
+    for (std::size_t k = 0; k < loops[0].size(); ++k) {
+      if (loops[0][k] != 0.0) run.loops.emplace_back(position(loops[1][k]), position(loops[2][k]));
     }
   }
   return run;

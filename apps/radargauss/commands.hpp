@@ -39,6 +39,13 @@ Subcommand AddRelocalize(CLI::App& parent);
 void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::string& poses_flag = "--gt",
                         const std::string& poses_help = "Ground-truth trajectory (TUM, or BAG:/topic[:child] of a ROS 2 bag)");
 
+// Before a run: every output of `command` (--out, --mcap, --ply) can be
+// written, no two name the same path, and none is a file or
+// folder the command reads (its other flags, `config_path`); DataError
+// naming the flags otherwise. What a folder holds is checked as it is
+// written (read_file.hpp, ProtectInputs).
+void CheckRunPaths(const CLI::App& command, const std::string& config_path);
+
 // Throws DataError when a weight w > 0 needs RCS and no scan of the sequence
 // has it: before any map is built or scan matched.
 void CheckRcsWeights(const Sequence& sequence, const std::vector<double>& weights);

@@ -6,9 +6,11 @@
 #include <optional>
 
 #include "commands.hpp"
+#include "option_flags.hpp"
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/imu.hpp"
+#include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/io/rosbag2.hpp"
 
 namespace radargauss::cli {
@@ -45,6 +47,10 @@ int RunConvert(ConvertSettings s) {
                                                      : McapCompression::kZstd;
   s.bag.mcap.chunked = !s.unchunked;
   CheckOutputFile(s.out);
+  // The topics written, checked before anything is read.
+  CheckBagTopics({{"--scan-topic", s.bag.scan_topic},
+                  {"--imu-topic-out", s.bag.imu_topic},
+                  {"--pose-topic", s.bag.pose_topic}});
   // Every scan, the reference (when given) at those within its span.
   SequenceOptions scans_only = s.sequence;
   scans_only.ground_truth.clear();
@@ -58,6 +64,21 @@ int RunConvert(ConvertSettings s) {
                                      : !s.imu_topic.empty()
                                          ? ReadBagImu(s.sequence.bag, s.imu_topic, s.imu_stamps == "record")
                                          : std::vector<ImuSample>{};
+  // Stamps ROS cannot hold, named by their files before the bag is begun.
+  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
+    if (!FitsRosTime(sequence.scans[k].timestamp)) {
+      const std::string source = k < sequence.scan_sources.size() ? sequence.scan_sources[k] : s.sequence.bag;
+      throw FileError(source, "stamp " + std::to_string(sequence.scans[k].timestamp) +
+                                  " s does not fit ROS's time (0 to 2^31 s since 1970)");
+    }
+  }
+  for (const ImuSample& sample : imu) {
+    if (!FitsRosTime(sample.stamp)) {
+      throw FileError(s.imu.empty() ? s.sequence.bag + ":" + s.imu_topic : s.imu,
+                      "IMU stamp " + std::to_string(sample.stamp) +
+                          " s does not fit ROS's time (0 to 2^31 s since 1970; seconds expected)");
+    }
+  }
   WriteRos2Bag(s.out, format, sequence.scans, imu, reference ? &*reference : nullptr, s.bag);
   std::printf("wrote %s: %zu scans on %s%s%s\n", s.out.c_str(), sequence.scans.size(), s.bag.scan_topic.c_str(),
               imu.empty() ? "" : (", " + std::to_string(imu.size()) + " IMU samples on " + s.bag.imu_topic).c_str(),
@@ -82,7 +103,7 @@ Subcommand AddConvert(CLI::App& parent) {
   app->add_option("--compression", s->compression, "MCAP chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
       ->capture_default_str();
-  app->add_flag("--unchunked", s->unchunked, "MCAP without chunks (no compression, no message indexes)");
+  AddBoolFlag(app, "--unchunked", s->unchunked, "MCAP without chunks (no compression, no message indexes)");
   app->add_option("--scan-topic", s->bag.scan_topic, "Topic of the scans")->capture_default_str();
   app->add_option("--imu-topic-out", s->bag.imu_topic, "Topic of the IMU")->capture_default_str();
   app->add_option("--pose-topic", s->bag.pose_topic, "Topic of the reference poses")->capture_default_str();

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss export: a results folder as an MCAP file a robotics viewer opens.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -7,6 +8,7 @@
 #include "commands.hpp"
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
+#include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/run_mcap.hpp"
 
 namespace radargauss::cli {
@@ -14,6 +16,13 @@ namespace radargauss::cli {
 void WriteRunForViewer(const std::string& run_folder, const std::vector<RadarScan>& scans,
                        const std::optional<Trajectory>& reference, const std::string& mcap) {
   RunForViewer run = ReadRunFolder(run_folder);
+  const auto fits = [](const std::vector<double>& stamps) { return std::all_of(stamps.begin(), stamps.end(), FitsRosTime); };
+  if (!fits(run.stamps)) throw FileError(run_folder, "its trajectory holds a stamp outside ROS's time (0 to 2^31 s)");
+  if (reference) {
+    for (const StampedPose& p : *reference) {
+      if (!FitsRosTime(p.time)) throw DataError("--gt: a stamp " + std::to_string(p.time) + " s outside ROS's time");
+    }
+  }
   if (!scans.empty()) {
     // Each pose's scan by stamp (the TUM file holds 9 decimals); a pose without one shows none.
     std::size_t next = 0;

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "localize_settings.hpp"
+#include "option_flags.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -63,12 +64,12 @@ void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
                   "RCS residual: decibel (the paper), swerling1 or swerling3 (fluctuating RCS)")
       ->check(CLI::IsMember(RcsLikelihoodNames()))
       ->capture_default_str();
-  app->add_flag("--rcs-confidence", s.rcs_confidence, "Weigh each RCS term by its Gaussian's fit (spread and members)");
+  AddBoolFlag(app, "--rcs-confidence", s.rcs_confidence, "Weigh each RCS term by its Gaussian's fit (spread and members)");
   app->add_option("--rcs-expected-spread", s.rcs_expected_spread,
                   "The spread (dB) the confidence expects (0: the likelihood's own)")
       ->check(NonNegative())
       ->capture_default_str();
-  app->add_flag("--w-rcs-from-map", s.w_rcs_from_map,
+  AddBoolFlag(app, "--w-rcs-from-map", s.w_rcs_from_map,
                 "Also match with each map's data-chosen w_rcs (configuration gn-wmap...)");
   app->add_option("--incidences", s.incidences, "Incidence models to sweep (map built here)")
       ->delimiter(',')
@@ -108,10 +109,12 @@ void AddCoarseOptions(CLI::App* app, LocalizeSettings& s) {
                   "Association gate on the coarse levels (Mahalanobis; smaller: faster, less reach)")
       ->check(Positive())
       ->capture_default_str();
-  app->add_flag("--loss-curvature", s.loss_curvature,
+  AddBoolFlag(app, "--loss-curvature", s.loss_curvature,
                 "Own GN: the robust losses' curvature in the Hessian instead of IRLS weights alone");
-  app->add_flag("--geometric-first,!--no-geometric-first", s.geometric_first,
-                "With 0 < w < 1: the exact map's geometric term alone first, then eq. 2 (default on)");
+  AddBoolFlag(app, "--geometric-first", s.geometric_first,
+              "With 0 < w < 1: the exact map's geometric term alone first, then eq. 2 (default on)");
+  AddBoolFlag(
+      app, "--no-geometric-first", [&s](bool on) { s.geometric_first = !on; }, "--geometric-first=false");
 }
 
 }  // namespace

@@ -110,8 +110,11 @@ int main(int argc, char** argv) {
         std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
   }
   try {
+    radargauss::ProtectInputs();
     for (const Subcommand& command : subcommands) {
-      if (command.app->parsed()) return command.run();
+      if (!command.app->parsed()) continue;
+      CheckRunPaths(*command.app, config_path);
+      return command.run();
     }
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "radargauss: error: out of memory (an input larger than this machine can hold?)\n");

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss odometry: radar odometry on a map the run builds itself
 // (docs/design.md, "Odometry"), evaluated against a reference when one is given.
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -27,9 +28,18 @@ void PrintSummary(const OdometrySummary& summary) {
       summary.global_gaussians);
 }
 
+// The IMU samples dropped before use, when any were.
+void PrintScreening(const ImuScreening& screening) {
+  if (screening.beyond_range + screening.spikes == 0) return;
+  std::printf("imu: dropped %zu samples beyond the IMU's range (--imu-gyro-range, --imu-accel-range) and %zu "
+              "isolated spikes\n",
+              screening.beyond_range, screening.spikes);
+}
+
 // The window's last estimate: the tilt of the odometry's world against
 // gravity, the biases, and its cost per scan.
 void PrintInertial(const RadarInertialOdometry& inertial) {
+  PrintScreening(inertial.screening());
   const auto& states = inertial.states();
   if (states.empty() || !states.back()) {
     std::printf("inertial: the window never started (no Doppler velocity)\n");
@@ -43,6 +53,14 @@ void PrintInertial(const RadarInertialOdometry& inertial) {
       tilt.x(), tilt.y(), last.bias.gyro.x(), last.bias.gyro.y(), last.bias.gyro.z(), last.bias.accel.x(),
       last.bias.accel.y(), last.bias.accel.z());
   const RadarInertialOptions& o = inertial.options();
+  const std::size_t held = std::size_t(std::count_if(inertial.solves().begin(), inertial.solves().end(),
+                                                     [](const WindowSolveSummary& w) { return w.clock_offset_held; }));
+  if (held > 0) {
+    std::fprintf(stderr,
+                 "radargauss: warning: the clock offset's estimate reached its bound (+-%g s, or the IMU's data) in "
+                 "%zu of %zu solves and was held there: the clocks may disagree by more than a window calibrates\n",
+                 kMaxClockOffset, held, inertial.solves().size());
+  }
   if (o.window.estimate_clock_offset) {
     std::printf("inertial: clock offset estimated: %.2f ms (the IMU's stamps minus the radar's)\n",
                 inertial.window().clock_offset() * 1e3);
@@ -74,7 +92,11 @@ int RunOdometry(const OdometrySettings& s) {
     RegisterScans(sequence, "odometry", [&](const RadarScan& scan) { inertial->Register(scan); });
   } else {
     radar_only.emplace(options, MatcherOf(s.matcher));
-    if (!imu.samples.empty()) radar_only->AddGyro(GyroOf(imu));
+    if (!imu.samples.empty()) {
+      ImuInput screened = imu;
+      PrintScreening(ScreenImuSamples(screened.samples, s.inertial.window.noise));
+      radar_only->AddGyro(GyroOf(screened));
+    }
     RegisterScans(sequence, "odometry", [&](const RadarScan& scan) { radar_only->Register(scan); });
   }
   const RadarOdometry& odometry = inertial ? inertial->odometry() : *radar_only;

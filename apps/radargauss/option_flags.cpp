@@ -25,6 +25,28 @@ void CheckAfterParse(CLI::App* app, std::function<void()> check) {
   });
 }
 
+CLI::Option* AddBoolFlag(CLI::App* app, const std::string& name, std::function<void(bool)> set,
+                         const std::string& help) {
+  CLI::Option* flag = app->add_option(
+      name,
+      [name, set](const CLI::results_t& words) {
+        try {
+          set(ParseFlagWord(words.empty() ? std::string("true") : words.back()));
+        } catch (const std::invalid_argument& e) {
+          throw CLI::ValidationError(name, e.what());
+        }
+        return true;
+      },
+      help);
+  // No value but with '=' (a flag), the last of several given wins.
+  flag->expected(0)->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  return flag;
+}
+
+CLI::Option* AddBoolFlag(CLI::App* app, const std::string& name, bool& target, const std::string& help) {
+  return AddBoolFlag(app, name, [&target](bool on) { target = on; }, help);
+}
+
 void ShowEveryOption(bool show) { show_every_option = show; }
 bool ShowingEveryOption() { return show_every_option; }
 

@@ -37,6 +37,13 @@ class GroupedHelp : public CLI::Formatter {
 // order); a std::invalid_argument becomes a ValidationError.
 void CheckAfterParse(CLI::App* app, std::function<void()> check);
 
+// A flag that is on when given alone and takes one word with '=' (YAML: a
+// value): true/false, 1/0, on/off, yes/no (ParseFlagWord); any other word
+// is a ValidationError naming the flag. `set` gets the flag's value.
+CLI::Option* AddBoolFlag(CLI::App* app, const std::string& name, std::function<void(bool)> set,
+                         const std::string& help);
+CLI::Option* AddBoolFlag(CLI::App* app, const std::string& name, bool& target, const std::string& help);
+
 // "Std of the velocity term's floor Q (m); at least --x".
 std::string HelpText(const OptionSpec& option);
 
@@ -48,8 +55,8 @@ void AddTableOptions(CLI::App* app, const OptionTable<Options>& table, Options& 
     const Option<Options>* option = &entry;  // the tables are static
     CLI::Option* flag = nullptr;
     if (option->kind == OptionKind::kFlag) {
-      flag = app->add_flag_function(
-          option->Flag(), [&options, option](std::int64_t count) { option->set(options, OptionValue(count > 0)); },
+      flag = AddBoolFlag(
+          app, option->Flag(), [&options, option](bool on) { option->set(options, OptionValue(on)); },
           HelpText(*option));
     } else {
       flag = app->add_option(

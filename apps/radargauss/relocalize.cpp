@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "option_flags.hpp"
 #include "odometry_settings.hpp"
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
@@ -128,7 +129,7 @@ Subcommand AddRelocalize(CLI::App& parent) {
                      "Reference trajectory (TUM, map frame), for the evaluation only");
   app->add_option("--out", s->odometry.out, "Output folder")->required();
   AddTableOptions(app, RelocalizationOptionTable(), s->relocalization);
-  app->add_flag("--w-rcs-from-map", s->w_rcs_from_map,
+  AddBoolFlag(app, "--w-rcs-from-map", s->w_rcs_from_map,
                 "Eq. 2's w_rcs chosen from the map's RCS fits instead of --w-rcs (docs/design.md)")
       ->excludes(app->get_option("--w-rcs"))
       ->group(HelpGroup(OptionGroup::kTuning));

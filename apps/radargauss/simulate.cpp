@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "option_flags.hpp"
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/rosbag2.hpp"
@@ -75,7 +76,7 @@ Subcommand AddSimulate(CLI::App& parent) {
   app->add_option("--config", s->config, "YAML parameters (see configs/synthetic_world.yaml)");
   CLI::Option* seed = app->add_option("--seed", s->seed, "Random seed");
   app->add_option("--scans", s->scans, "Number of scans (overrides the config)")->check(Positive());
-  app->add_flag("--force", s->force, "Overwrite an existing sequence in --out");
+  AddBoolFlag(app, "--force", s->force, "Overwrite an existing sequence in --out");
   app->add_option("--mcap", s->bag, "Also write the sequence as a ROS 2 bag (.mcap, or .db3), as convert does");
   return {app, [s, seed] {
             s->seed_given = seed->count() > 0;

@@ -103,10 +103,10 @@ Subcommand AddSlam(CLI::App& parent) {
   AddImuOptions(app, s->odometry);
   AddTableOptions(app, RadarInertialOptionTable(), s->odometry.inertial);
   AddRunOptions(app, s->odometry);
-  app->add_flag("--no-map", s->no_map, "Write no map of the place (trajectories and loops only)");
+  AddBoolFlag(app, "--no-map", s->no_map, "Write no map of the place (trajectories and loops only)");
   app->add_option("--map-tiles", s->map_tiles,
                   "Also write the map as square tiles of this many metres (map_tiles/, for relocalize and localize)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->group(HelpGroup(OptionGroup::kTuning));  // --help-all
   return {app, [s] { return RunSlam(*s); }};
 }

@@ -21,9 +21,23 @@ namespace radargauss {
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write, bool binary = false);
 
 // Throws DataError naming `path` unless a file could be written there: its
-// folder exists and `path` names a regular file or nothing. Lets a command
-// that writes two files check both before writing either.
+// folder exists, a file can be created in it (tried), `path` names a
+// regular file or nothing, and not a file this run has read
+// (read_file.hpp, ProtectInputs). Lets a command that writes two files
+// check both before writing either.
 void CheckOutputFile(const std::string& path);
+
+// Throws DataError naming `path` unless a results folder could be made
+// there: the nearest folder on its path that exists takes a new entry
+// (tried), and `path` names a folder or nothing.
+void CheckOutputFolder(const std::string& path);
+
+// The temporary name a writer that cannot go through WriteFileAtomically (a
+// sqlite3 database, a file written over a whole run) writes `path` under,
+// to rename it over `path` when complete: "<path>.radargauss-tmp.<pid>",
+// after CheckOutputFile(path); the temporaries beside it of processes that
+// have ended (killed during a write) are removed first.
+std::string TemporaryFileFor(const std::string& path);
 
 // A results folder written whole: a command writes into path(), a staging
 // folder beside the target, and Commit() puts it in place with one rename

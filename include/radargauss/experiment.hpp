@@ -18,7 +18,12 @@
 
 namespace radargauss {
 
+// The most initial errors one call makes: ten million scans.
+constexpr std::size_t kMaxInitialErrors = 10000000;
+
 // The seeded initial errors: one perturbation per scan, X_initial = X_ref * E.
+// Throws std::invalid_argument past kMaxInitialErrors scans or for a
+// negative or non-finite largest error.
 std::vector<SE3d> InitialErrors(std::size_t scans, double max_translation, double max_rotation_deg, std::uint32_t seed);
 
 // Translation (m) and rotation (deg) error of an estimate.

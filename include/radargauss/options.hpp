@@ -63,6 +63,10 @@ struct OptionSpec {
   OptionValue Parse(const std::vector<std::string>& words) const;
 };
 
+// A flag's word as the command line and YAML give it: true/false, 1/0,
+// on/off, yes/no in any case; std::invalid_argument for any other.
+bool ParseFlagWord(const std::string& word);
+
 template <typename Options>
 struct Option : OptionSpec {
   std::function<OptionValue(const Options&)> get;

@@ -31,6 +31,9 @@ struct RunForViewer {
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> loops;  // the two keyframes' positions
 };
 
+// An ellipsoid drawn beyond this many standard deviations says nothing.
+constexpr double kMaxEllipsoidSigma = 10.0;
+
 struct RunMcapOptions {
   double ellipsoid_sigma = 2.0;        // an ellipsoid's semi-axes: this many standard deviations
   std::size_t max_ellipsoids = 50000;  // the most populated Gaussians beyond this are left out

@@ -186,7 +186,13 @@ void BindTrajectories(py::module_& m) {
           run.stamps.push_back(p.time);
           run.poses.push_back(p.pose);
         }
-        if (!map.is_none()) run.map = map.cast<const PyMap&>().map();
+        if (!map.is_none()) {
+          if (!py::isinstance<PyMap>(map)) {
+            throw py::type_error("map must be a GaussianMap or None, not " +
+                                 std::string(py::str(map.get_type().attr("__name__"))));
+          }
+          run.map = map.cast<const PyMap&>().map();
+        }
         if (!reference.is_none()) {
           for (const StampedPose& p : TrajectoryFromArrays(reference_stamps, reference, "reference")) {
             run.reference_stamps.push_back(p.time);

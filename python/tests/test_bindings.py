@@ -7,6 +7,7 @@ import re
 import struct
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -327,3 +328,27 @@ def test_radar_inertial_odometry(cli, tmp_path):
         rg.RadarInertialOdometry(imu, window_size=1)
     with pytest.raises(ValueError, match="imu"):
         rg.RadarInertialOdometry(imu[:, :6])
+
+
+def test_hostile_arguments_are_refused_as_the_cli_refuses_them(written, tmp_path):
+    """The values the command line refuses are refused here too, at once and naming the argument."""
+    sequence = rg.read_sequence(written["sequence"], gt=written["gt"])
+    stamps = np.array([scan.stamp for scan in sequence.scans])
+    poses = np.array(sequence.poses)
+    world = rg.read_map(written["map"])
+    path = str(tmp_path / "run.mcap")
+    for sigma in (float("nan"), -1.0, 0.0, float("inf"), 11.0):
+        with pytest.raises(ValueError, match="ellipsoid_sigma"):
+            rg.write_run_mcap(path, stamps, poses, map=world, ellipsoid_sigma=sigma)
+    with pytest.raises(TypeError, match="map must be a GaussianMap or None, not str"):
+        rg.write_run_mcap(path, stamps, poses, map="not a map")
+    assert not os.path.exists(path)
+    for spread in (-1.0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="expected_spread"):
+            world.rcs_weight("decibel", spread)
+    with pytest.raises(ValueError, match="has no sample"):
+        rg.RadarInertialOdometry(np.zeros((0, 7)))
+    started = time.monotonic()
+    with pytest.raises(ValueError, match="past 10000000"):
+        rg.initial_errors(10 ** 12)
+    assert time.monotonic() - started < 5.0

@@ -25,6 +25,8 @@ void RequireType(const Ros2Message& m, const std::string& source, const char* pa
 void AppendBagImuSample(std::vector<ImuSample>& samples, const ImuSample& sample, const std::string& source) {
   if (!sample.angular_velocity.allFinite()) throw FileError(source, "angular velocity is not finite");
   if (!sample.specific_force.allFinite()) throw FileError(source, "linear acceleration is not finite");
+  const std::string fault = ImuSampleFault(sample);
+  if (!fault.empty()) throw FileError(source, fault);
   if (!samples.empty() && !(sample.stamp > samples.back().stamp)) {
     throw FileError(source, "stamp " + std::to_string(sample.stamp) + " s is not after the previous message's");
   }
@@ -73,6 +75,11 @@ Trajectory ReadBagPoses(const std::string& bag_path, const std::string& topic, c
   std::size_t index = 0;
   ForEachRos2Message(bag_path, topic, [&](const Ros2Message& m) {
     const std::string source = SourceOf(bag_path, m, index++);
+    if (child_frame.empty() && IsRosType(*m.type, "tf2_msgs", "TFMessage")) {
+      throw FileError(bag_path, "topic '" + Printable(topic) +
+                                    "' holds transforms (tf2_msgs/TFMessage): name the child frame, BAG:" + topic +
+                                    ":child_frame");
+    }
     if (IsRosType(*m.type, "nav_msgs", "Path")) {
       std::vector<double> stamps;
       std::vector<SE3d> path;

@@ -1,14 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/io/mcap.hpp"
 
-#include <lz4frame.h>
-#include <zstd.h>
-
 #include <algorithm>
 #include <cstring>
 #include <tuple>
 #include <utility>
 
+#include "decompress.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/mcap_records.hpp"
 #include "radargauss/io/read_file.hpp"
@@ -58,59 +56,20 @@ class Cursor {
   const char* record_;
 };
 
-// The decompressed records of a chunk, `size` bytes exactly.
+// The decompressed records of a chunk, `uncompressed_size` bytes exactly
+// (streamed: a size the chunk states and its data do not hold is refused
+// before it is allocated).
 std::vector<std::uint8_t> Decompress(const std::string& compression, const std::uint8_t* data, std::size_t size,
                                      std::uint64_t uncompressed_size, const std::string& path) {
-  if (uncompressed_size > kMaxMcapChunkBytes) {
-    throw FileError(path, "a chunk of " + std::to_string(uncompressed_size) + " bytes uncompressed is past the " +
-                              std::to_string(kMaxMcapChunkBytes >> 20) + " MiB limit");
-  }
-  // A zstd frame states its content size: a chunk that disagrees is refused
-  // before its buffer is allocated.
-  if (compression == "zstd") {
-    const unsigned long long content = ZSTD_getFrameContentSize(data, size);
-    if (content == ZSTD_CONTENTSIZE_ERROR) throw FileError(path, "a zstd chunk is not a zstd frame");
-    if (content != ZSTD_CONTENTSIZE_UNKNOWN && content != uncompressed_size) {
-      throw FileError(path, "a zstd chunk's frame holds " + std::to_string(content) + " bytes, the chunk states " +
-                                std::to_string(uncompressed_size));
-    }
-  }
-  if (compression.empty() && size != uncompressed_size) {
-    throw FileError(path, "an uncompressed chunk's sizes disagree");
-  }
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(uncompressed_size));
   if (compression.empty()) {
-    std::copy(data, data + size, out.begin());
-  } else if (compression == "zstd") {
-    const std::size_t n = ZSTD_decompress(out.data(), out.size(), data, size);
-    if (ZSTD_isError(n) || n != out.size()) {
-      throw FileError(path, std::string("a zstd chunk does not decompress to its size: ") +
-                                (ZSTD_isError(n) ? ZSTD_getErrorName(n) : "size differs"));
-    }
-  } else if (compression == "lz4") {
-    LZ4F_dctx* context = nullptr;
-    if (LZ4F_isError(LZ4F_createDecompressionContext(&context, LZ4F_VERSION))) {
-      throw FileError(path, "cannot start lz4 decompression");
-    }
-    std::size_t written = 0, read = 0;
-    std::size_t status = 1;
-    while (status != 0 && read < size) {
-      std::size_t out_size = out.size() - written;
-      std::size_t in_size = size - read;
-      status = LZ4F_decompress(context, out.data() + written, &out_size, data + read, &in_size, nullptr);
-      if (LZ4F_isError(status)) break;
-      written += out_size;
-      read += in_size;
-      if (out_size == 0 && in_size == 0) break;  // no progress: the output is full
-    }
-    LZ4F_freeDecompressionContext(context);
-    if (LZ4F_isError(status) || status != 0 || written != out.size()) {
-      throw FileError(path, "an lz4 chunk does not decompress to its size");
-    }
-  } else {
+    if (size != uncompressed_size) throw FileError(path, "an uncompressed chunk's sizes disagree");
+    return std::vector<std::uint8_t>(data, data + size);
+  }
+  if (compression != "zstd" && compression != "lz4") {
     throw FileError(path, "chunk compression '" + Printable(compression) + "' is not zstd, lz4 or none");
   }
-  return out;
+  return DecompressFrame(compression == "zstd" ? Codec::kZstd : Codec::kLz4, data, size, uncompressed_size,
+                         kMaxMcapChunkBytes, path, "a " + compression + " chunk");
 }
 
 }  // namespace

@@ -1,9 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/io/read_file.hpp"
 
+#include <sys/stat.h>
+
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <mutex>
+#include <set>
+#include <utility>
 
 #include "radargauss/error.hpp"
 
@@ -30,7 +36,24 @@ const char* TypeName(fs::file_type type) {
   }
 }
 
+// The files read since ProtectInputs(), by device and inode.
+std::atomic<bool> protecting{false};
+std::mutex protected_mutex;
+std::set<std::pair<dev_t, ino_t>>& ProtectedFiles() {
+  static std::set<std::pair<dev_t, ino_t>> files;
+  return files;
+}
+
 }  // namespace
+
+void ProtectInputs() { protecting = true; }
+
+bool IsProtectedInput(const std::string& path) {
+  struct stat status {};
+  if (!protecting || ::stat(path.c_str(), &status) != 0) return false;
+  const std::lock_guard<std::mutex> lock(protected_mutex);
+  return ProtectedFiles().count({status.st_dev, status.st_ino}) > 0;
+}
 
 void CheckRegularInputFile(const std::string& path, const std::string& what) {
   std::error_code error;
@@ -38,6 +61,11 @@ void CheckRegularInputFile(const std::string& path, const std::string& what) {
   if (!fs::exists(status)) throw FileError(path, "cannot open " + what + " (no such file)");
   if (!fs::is_regular_file(status))
     throw FileError(path, std::string("is ") + TypeName(status.type()) + ", not a " + what);
+  struct stat file {};
+  if (protecting && ::stat(path.c_str(), &file) == 0) {
+    const std::lock_guard<std::mutex> lock(protected_mutex);
+    ProtectedFiles().insert({file.st_dev, file.st_ino});
+  }
 }
 
 std::string ReadFileBytes(const std::string& path, const std::string& what, std::size_t max_bytes) {

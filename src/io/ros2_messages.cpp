@@ -63,6 +63,8 @@ class CdrReader {
     std::string s(reinterpret_cast<const char*>(data_ + pos_), n);
     pos_ += n;
     if (!s.empty() && s.back() == '\0') s.pop_back();
+    // A CDR string ends at its one NUL: one inside would cut every name and message short.
+    if (s.find('\0') != std::string::npos) throw FileError(source_, "a string holds a NUL byte before its end");
     return s;
   }
   // A sequence's length, checked against the bytes left at `element_bytes` each.
@@ -181,8 +183,10 @@ const std::string kPoseDefinition = std::string(kRule) +
 
 }  // namespace
 
+bool FitsRosTime(double stamp) { return std::isfinite(stamp) && stamp >= 0.0 && stamp < 2147483648.0; }
+
 void SplitStamp(double stamp, std::int32_t& sec, std::uint32_t& nanosec) {
-  if (!std::isfinite(stamp) || stamp < 0.0 || stamp >= 2147483648.0) {
+  if (!FitsRosTime(stamp)) {
     throw DataError("stamp " + std::to_string(stamp) + " s does not fit ROS's time");
   }
   const double whole = std::floor(stamp);

@@ -6,6 +6,7 @@
 #include <zstd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <array>
 #include <cstdio>
 #include <cstring>
@@ -15,6 +16,7 @@
 #include <map>
 #include <optional>
 
+#include "decompress.hpp"
 #include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/read_file.hpp"
@@ -113,17 +115,15 @@ std::vector<SqliteTopic> SqliteTopics(Database& db, const std::string& path) {
 }
 
 // Per-message zstd compression (rosbag2's compression_mode MESSAGE), undone
-// into `out` with the same bound as an MCAP chunk.
+// into `out` with the same bound as an MCAP chunk; a frame may leave its
+// size out (streamed up to the bound).
 void DecompressMessage(const std::uint8_t* data, std::size_t size, const std::string& source,
                        std::vector<std::uint8_t>& out) {
   const unsigned long long content = ZSTD_getFrameContentSize(data, size);
-  if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN) {
-    throw FileError(source, "a message is not a zstd frame with its size");
-  }
-  if (content > kMaxMcapChunkBytes) throw FileError(source, "a message decompresses past the 1 GiB limit");
-  out.resize(std::size_t(content));
-  const std::size_t n = ZSTD_decompress(out.data(), out.size(), data, size);
-  if (ZSTD_isError(n) || n != out.size()) throw FileError(source, "a zstd message does not decompress to its size");
+  if (content == ZSTD_CONTENTSIZE_ERROR) throw FileError(source, "a message is not a zstd frame");
+  const std::optional<std::uint64_t> stated =
+      content == ZSTD_CONTENTSIZE_UNKNOWN ? std::nullopt : std::optional<std::uint64_t>(content);
+  out = DecompressFrame(Codec::kZstd, data, size, stated, kMaxMcapChunkBytes, source, "a zstd message");
 }
 
 struct FolderPlan {
@@ -151,12 +151,24 @@ FolderPlan ReadFolder(const std::string& folder) {
   }
   const YAML::Node paths = info["relative_file_paths"];
   if (!paths || !paths.IsSequence() || paths.size() == 0) throw FileError(metadata, "no relative_file_paths");
+  // Each file inside the folder once: by its path with links resolved (a
+  // link out of the folder is outside it; "b..0.db3" is a name, not a way up).
+  std::error_code error;
+  const fs::path inside = fs::weakly_canonical(fs::absolute(folder), error);
+  std::vector<fs::path> seen;
   for (const YAML::Node& entry : paths) {
     if (!entry.IsScalar()) throw FileError(metadata, "relative_file_paths holds a non-string");
     const std::string name = entry.as<std::string>();
-    if (name.empty() || fs::path(name).is_absolute() || name.find("..") != std::string::npos) {
+    const fs::path resolved = fs::weakly_canonical(inside / name, error);
+    const fs::path relative = resolved.lexically_relative(inside);
+    if (name.empty() || fs::path(name).is_absolute() || error || relative.empty() || *relative.begin() == ".." ||
+        relative == ".") {
       throw FileError(metadata, "file '" + Printable(name) + "' is not inside the bag's folder");
     }
+    if (std::find(seen.begin(), seen.end(), resolved) != seen.end()) {
+      throw FileError(metadata, "file '" + Printable(name) + "' is listed twice in relative_file_paths");
+    }
+    seen.push_back(resolved);
     plan.files.push_back((fs::path(folder) / name).string());
   }
   return plan;
@@ -326,10 +338,9 @@ Ros2BagWriter::Ros2BagWriter(const std::string& path, BagFormat format, const Mc
   if (format != BagFormat::kMcap && format != BagFormat::kSqlite3) {
     throw std::invalid_argument("Ros2BagWriter writes .mcap or .db3 files");
   }
-  CheckOutputFile(path);
   Impl& w = *impl_;
   w.path = path;
-  w.temporary = path + ".radargauss-partial." + std::to_string(::getpid());
+  w.temporary = TemporaryFileFor(path);
   w.format = format;
   w.mcap_options = mcap;
   std::remove(w.temporary.c_str());
@@ -412,8 +423,46 @@ void Ros2BagWriter::Finish() {
   w.finished = true;
 }
 
+std::string TopicNameFault(const std::string& name) {
+  if (name.empty()) return "is empty";
+  if (name[0] != '/') return "does not start with '/'";
+  for (std::size_t i = 1; i <= name.size(); ++i) {
+    const bool part_starts = name[i - 1] == '/';
+    if (i == name.size()) return part_starts ? "ends in '/'" : "";
+    const unsigned char c = static_cast<unsigned char>(name[i]);
+    if (part_starts && (c == '/' || std::isdigit(c))) return "has a part that is empty or starts with a digit";
+    if (c != '/' && c != '_' && !std::isalnum(c)) return "holds '" + Printable(std::string(1, char(c))) + "'";
+  }
+  return "";
+}
+
+void CheckBagTopics(const std::vector<std::pair<std::string, std::string>>& topics) {
+  for (std::size_t i = 0; i < topics.size(); ++i) {
+    const std::string fault = TopicNameFault(topics[i].second);
+    if (!fault.empty()) throw DataError(topics[i].first + " '" + Printable(topics[i].second) + "' " + fault);
+    for (std::size_t j = 0; j < i; ++j) {
+      if (topics[i].second == topics[j].second) {
+        throw DataError(topics[j].first + " and " + topics[i].first + " are both " + topics[i].second);
+      }
+    }
+  }
+}
+
 void WriteRos2Bag(const std::string& path, BagFormat format, const std::vector<RadarScan>& scans,
                   const std::vector<ImuSample>& imu, const Trajectory* reference, const BagExportOptions& options) {
+  // Everything checked before the bag is begun: a refused bag leaves no file.
+  std::vector<std::pair<std::string, std::string>> topics = {{"scan topic", options.scan_topic}};
+  if (!imu.empty()) topics.emplace_back("IMU topic", options.imu_topic);
+  if (reference) topics.emplace_back("pose topic", options.pose_topic);
+  CheckBagTopics(topics);
+  const auto check_stamp = [](double stamp, const std::string& what) {
+    if (!FitsRosTime(stamp)) {
+      throw DataError(what + ": stamp " + std::to_string(stamp) +
+                      " s does not fit ROS's time (0 to 2^31 s since 1970; seconds expected)");
+    }
+  };
+  for (std::size_t k = 0; k < scans.size(); ++k) check_stamp(scans[k].timestamp, "scan " + std::to_string(k));
+  for (std::size_t k = 0; k < imu.size(); ++k) check_stamp(imu[k].stamp, "IMU sample " + std::to_string(k));
   Ros2BagWriter writer(path, format, options.mcap);
   const int scan_topic = writer.AddTopic(options.scan_topic, "sensor_msgs/msg/PointCloud2");
   const int imu_topic = imu.empty() ? 0 : writer.AddTopic(options.imu_topic, "sensor_msgs/msg/Imu");

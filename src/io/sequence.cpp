@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <sstream>
 
@@ -40,6 +41,7 @@ Trajectory ReadRadarTrajectory(const std::string& ground_truth, const SE3d& extr
   const std::size_t colon = ground_truth.find(":/");
   std::error_code error;
   if (colon != std::string::npos && !std::filesystem::exists(ground_truth, error)) {
+    if (colon == 0) throw DataError("'" + Printable(ground_truth) + "': no bag before ':/' (BAG:/topic[:child_frame])");
     const std::string topic_and_child = ground_truth.substr(colon + 1);
     const std::size_t child = topic_and_child.find(':');
     return ReadBagPoses(ground_truth.substr(0, colon), topic_and_child.substr(0, child),
@@ -73,13 +75,18 @@ SE3d ReadExtrinsicFile(const std::string& path) {
     if (first == std::string::npos || line[first] == '#') continue;
     std::istringstream tokens(line);
     double v[7];
+    std::string word;
     for (double& value : v) {
-      if (!(tokens >> value)) throw FileError(path, "extrinsic needs 'x y z qx qy qz qw'");
+      if (!(tokens >> word)) throw FileError(path, "extrinsic needs 'x y z qx qy qz qw'");
+      char* end = nullptr;
+      value = std::strtod(word.c_str(), &end);
+      if (*end != '\0') throw FileError(path, "extrinsic holds '" + Printable(word) + "', not a number");
+      if (!std::isfinite(value)) throw FileError(path, "extrinsic holds " + word + ", a value that is not finite");
     }
-    std::string rest;
-    if (tokens >> rest) throw FileError(path, "extrinsic needs exactly 7 numbers");
-    if (!std::all_of(v, v + 7, [](double x) { return std::isfinite(x); })) {
-      throw FileError(path, "extrinsic holds a value that is not finite");
+    if (tokens >> word) throw FileError(path, "extrinsic needs exactly 7 numbers");
+    if (Eigen::Vector3d(v[0], v[1], v[2]).norm() > kMaxLeverArm) {
+      throw FileError(path, "extrinsic's translation is past " + std::to_string(int(kMaxLeverArm)) +
+                                " m (a sensor's mounting on its vehicle)");
     }
     const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
     if (std::abs(q.norm() - 1.0) > kTumQuaternionNormTolerance) {
@@ -191,6 +198,7 @@ Sequence LoadSequence(const SequenceOptions& options) {
   }
 
   if (options.ground_truth.empty()) {
+    ResolveExtrinsic(options.extrinsic, "");  // a file given is checked though no reference uses it
     sequence.scans = std::move(scans);
     sequence.scan_sources = std::move(sources);
     return sequence;

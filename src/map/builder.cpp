@@ -12,6 +12,7 @@
 
 #include <Eigen/LU>
 
+#include "radargauss/map/map_file.hpp"
 #include "radargauss/map/matching_map.hpp"
 #include "radargauss/names.hpp"
 
@@ -219,7 +220,10 @@ const OptionTable<GaussianMapOptions>& GaussianMapOptionTable() {
           .Help("K = round(N_downsampled / this) (about 4 for ARS548, 16 for Oculii Eagle)"),
       RADARGAUSS_OPTION(O, "kmeans_iterations", kmeans_iterations).AtLeast(1).Help("Lloyd iterations per bisection"),
       RADARGAUSS_OPTION(O, "em_iterations", em_iterations).AtLeast(0).Help("hard-EM rounds"),
-      RADARGAUSS_OPTION(O, "min_std", min_std).Above(0.0).Unit("m").Help("minimum principal std of a Gaussian"),
+      RADARGAUSS_OPTION(O, "min_std", min_std)
+          .In(kMinMapStd, kMaxMapStd)
+          .Unit("m")
+          .Help("minimum principal std of a Gaussian"),
       RADARGAUSS_OPTION(O, "map_seed", seed).Help("seed of the bisecting k-means"),
       RADARGAUSS_OPTION(O, "ndt_voxel", ndt_voxel).Above(0.0).Unit("m").Help("voxel edge of the voxel builder"),
       RADARGAUSS_OPTION(O, "ndt_min_points", ndt_min_points)

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -42,18 +44,59 @@ struct TileIndex {
   IncidenceModel incidence = IncidenceModel::kOffset;
   std::size_t gaussians = 0, places = 0;
   std::vector<TileKey> keys;
-  std::vector<std::string> files;
   std::vector<std::size_t> tile_gaussians;
   std::vector<std::vector<std::size_t>> tile_places;
   std::vector<std::pair<std::size_t, std::size_t>> order;  // (tile, count) runs
 };
 
+// a + b, refused when the sum passes 2^64 (a count of an index that lies).
+std::size_t CheckedSum(std::size_t a, std::size_t b, const std::string& path, const std::string& what) {
+  if (b > std::numeric_limits<std::size_t>::max() - a) throw FileError(path, what + " add up past 2^64");
+  return a + b;
+}
+
+// One entry of "tiles", checked as it is parsed: its file named as its key
+// says, listed once, and present (so that a missing tile is named at once).
+void TakeTile(const Json& tile, const std::string& dir, const std::string& path, std::set<TileKey>& seen,
+              TileIndex& index) {
+  const TileKey key(tile.at("x").get<std::int64_t>(), tile.at("y").get<std::int64_t>());
+  const std::string file = tile.at("file").get<std::string>();
+  if (file != TileFile(key)) throw FileError(path, "tile file '" + Printable(file) + "' unexpected");
+  if (!seen.insert(key).second) throw FileError(path, "tile " + file + " listed twice");
+  std::error_code error;
+  if (!fs::is_regular_file(fs::path(dir) / file, error)) {
+    throw FileError((fs::path(dir) / file).string(), "cannot open map tile (listed in " + std::string(kIndexName) +
+                                                         ", no such file)");
+  }
+  index.keys.push_back(key);
+  index.tile_gaussians.push_back(tile.at("gaussians").get<std::size_t>());
+  index.tile_places.push_back(tile.at("places").get<std::vector<std::size_t>>());
+}
+
+// The index, parsed with memory bounded by its entries (each tile and order
+// run is checked and kept as it is read, not held as JSON), and every count
+// checked against the others in 64 bits before any tile is read.
 TileIndex ReadIndex(const std::string& dir) {
   const std::string path = (fs::path(dir) / kIndexName).string();
   const std::string text = ReadFileBytes(path, "map tiles index");
   TileIndex index;
   try {
-    const Json json = Json::parse(text);
+    std::set<TileKey> seen;
+    std::string key;
+    const Json json = Json::parse(text, [&](int depth, Json::parse_event_t event, Json& parsed) {
+      if (depth == 1 && event == Json::parse_event_t::key) key = parsed.get<std::string>();
+      if (depth != 2) return true;
+      if (key == "tiles" && event == Json::parse_event_t::object_end) {
+        TakeTile(parsed, dir, path, seen, index);
+        return false;
+      }
+      if (key == "order" && event == Json::parse_event_t::array_end) {
+        index.order.emplace_back(parsed.at(0).get<std::size_t>(), parsed.at(1).get<std::size_t>());
+        return false;
+      }
+      return true;
+    });
+    if (!json.at("tiles").is_array() || !json.at("order").is_array()) throw FileError(path, "malformed index");
     if (json.at("format").get<std::string>() != kFormat) throw FileError(path, "not an index of map tiles");
     if (json.at("version").get<int>() != kMapTilesVersion) {
       throw FileError(path, "version " + json.at("version").dump() + " (this build reads " +
@@ -68,34 +111,38 @@ TileIndex ReadIndex(const std::string& dir) {
     }
     index.gaussians = json.at("gaussians").get<std::size_t>();
     index.places = json.at("places").get<std::size_t>();
-    std::vector<int> place_seen(index.places, 0);
-    for (const Json& tile : json.at("tiles")) {
-      index.keys.emplace_back(tile.at("x").get<std::int64_t>(), tile.at("y").get<std::int64_t>());
-      const std::string file = tile.at("file").get<std::string>();
-      if (file != TileFile(index.keys.back())) throw FileError(path, "tile file '" + Printable(file) + "' unexpected");
-      index.files.push_back(file);
-      index.tile_gaussians.push_back(tile.at("gaussians").get<std::size_t>());
-      index.tile_places.push_back(tile.at("places").get<std::vector<std::size_t>>());
-      for (const std::size_t p : index.tile_places.back()) {
-        if (p >= index.places || place_seen[p]++) throw FileError(path, "place " + std::to_string(p) + " misplaced");
-      }
-    }
-    if (std::count(place_seen.begin(), place_seen.end(), 0) > 0) throw FileError(path, "a place in no tile");
-    std::vector<std::size_t> in_runs(index.keys.size(), 0);
-    std::size_t total = 0;
-    for (const Json& run : json.at("order")) {
-      const auto tile = run.at(0).get<std::size_t>();
-      const auto count = run.at(1).get<std::size_t>();
-      if (tile >= index.keys.size() || count == 0) throw FileError(path, "order names no tile");
-      in_runs[tile] += count;
-      total += count;
-      index.order.emplace_back(tile, count);
-    }
-    if (total != index.gaussians || in_runs != index.tile_gaussians) {
-      throw FileError(path, "the tiles' Gaussian counts do not add up");
-    }
   } catch (const Json::exception& e) {
     throw FileError(path, std::string("malformed index: ") + e.what());
+  }
+  // Places: each listed once; their count is that of the entries read, so
+  // the check below allocates no more than the index holds.
+  std::size_t listed = 0;
+  for (const std::vector<std::size_t>& places : index.tile_places) listed = CheckedSum(listed, places.size(), path, "places");
+  if (listed != index.places) {
+    throw FileError(path, "lists " + std::to_string(listed) + " places in its tiles for " +
+                              std::to_string(index.places) + " places");
+  }
+  std::vector<char> place_seen(index.places, 0);
+  for (const std::vector<std::size_t>& places : index.tile_places) {
+    for (const std::size_t p : places) {
+      if (p >= index.places || place_seen[p]++) throw FileError(path, "place " + std::to_string(p) + " misplaced");
+    }
+  }
+  // Gaussians: the tiles' counts add up to the map's, and the order's runs
+  // fill each tile exactly, never past its count.
+  std::size_t total = 0;
+  for (const std::size_t n : index.tile_gaussians) total = CheckedSum(total, n, path, "the tiles' Gaussian counts");
+  std::vector<std::size_t> in_runs(index.keys.size(), 0);
+  for (const auto& [tile, count] : index.order) {
+    if (tile >= index.keys.size() || count == 0) throw FileError(path, "order names no tile");
+    if (count > index.tile_gaussians[tile] - in_runs[tile]) {
+      throw FileError(path, "order's runs hold more Gaussians of tile " + TileFile(index.keys[tile]) +
+                                " than its count " + std::to_string(index.tile_gaussians[tile]));
+    }
+    in_runs[tile] += count;
+  }
+  if (total != index.gaussians || in_runs != index.tile_gaussians) {
+    throw FileError(path, "the tiles' Gaussian counts do not add up");
   }
   return index;
 }
@@ -107,7 +154,7 @@ GaussianMap ReadTiles(const std::string& dir, const TileIndex& index, const std:
   map.incidence = index.incidence;
   for (std::size_t t = 0; t < tiles.size(); ++t) {
     if (!chosen[t]) continue;
-    const std::string path = (fs::path(dir) / index.files[t]).string();
+    const std::string path = (fs::path(dir) / TileFile(index.keys[t])).string();
     tiles[t] = ReadMap(path);
     if (tiles[t].gaussians.size() != index.tile_gaussians[t] || tiles[t].places.size() != index.tile_places[t].size()) {
       throw FileError(path, "holds other counts than " + std::string(kIndexName) + " says");

@@ -114,16 +114,18 @@ nlohmann::json WindowSolves(const InertialFusion& inertial) {
   if (solves.empty()) return nullptr;
   double iterations = 0.0;
   int most = 0;
-  std::size_t reintegrated = 0;
+  std::size_t reintegrated = 0, clock_offset_held = 0;
   for (const WindowSolveSummary& solve : solves) {
     iterations += solve.iterations;
     most = std::max(most, solve.iterations);
     reintegrated += solve.reintegrated;
+    clock_offset_held += solve.clock_offset_held;
   }
   return {{"solves", solves.size()},
           {"iterations_mean", iterations / double(solves.size())},
           {"iterations_max", most},
-          {"reintegrated", reintegrated}};
+          {"reintegrated", reintegrated},
+          {"clock_offset_held", clock_offset_held}};
 }
 
 // inertial.csv: the window's newest state per scan (empty fields before it started).
@@ -187,6 +189,8 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry, const 
   if (inertial != nullptr) {
     summary["calibration"] = Calibration(*inertial);
     summary["window"] = WindowSolves(*inertial);
+    summary["imu_dropped"] = {{"beyond_range", inertial->screening().beyond_range},
+                              {"spikes", inertial->screening().spikes}};
     WriteInertialStates((out / "inertial.csv").string(), odometry, *inertial);
   }
   WriteFileAtomically((out / "summary.json").string(),

@@ -17,7 +17,7 @@ const OptionTable<RadarInertialOptions>& RadarInertialOptionTable() {
             .In(0.0, 1.0)
             .Help("the share of a match's information N_geo H the window trusts"),
         RADARGAUSS_OPTION(O, "inertial_velocity_floor", velocity_floor)
-            .AtLeast(0.0)
+            .In(0.0, 100.0)
             .Unit("m/s")
             .Help("std added in quadrature to the Doppler velocity's in the window"),
     };
@@ -35,6 +35,13 @@ InertialFusion::InertialFusion(const RadarInertialOptions& options, const SE3d& 
       imu_(std::move(imu)),
       window_(std::make_unique<InertialWindow>(options.window, radar_from_imu)) {
   CheckOptions(RadarInertialOptionTable(), options);
+  if (imu_.empty()) throw DataError("the IMU has no sample");
+  for (const ImuSample& sample : imu_) {
+    const std::string fault = ImuSampleFault(sample);
+    if (!fault.empty()) throw DataError("IMU sample at " + std::to_string(sample.stamp) + " s: " + fault);
+  }
+  screening_ = ScreenImuSamples(imu_, options.window.noise);
+  if (imu_.empty()) throw DataError("no IMU sample within the IMU's range (--imu-gyro-range, --imu-accel-range)");
   window_->AddImu(imu_);  // checks the order
 }
 

@@ -4,6 +4,8 @@
 // planted file, the extrinsic file, and the noise options' table.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -54,6 +56,8 @@ TEST_F(ImuFile, RefusesEachMalformedLineNamingIt) {
       {good + "2 0 0 0 0", ":2: expected 7 columns (stamp wx wy wz ax ay az), found 5"},
       {good + "2 0 0 0 0 0 9.8 1\n", ":2: expected 7 columns (stamp wx wy wz ax ay az), found 8"},
       {good + "2 0 0 0x 0 0 9.8\n", ":2: not a number: '0x'"},
+      {good + "2 1e300 0 0 0 0 9.8\n", ":2: angular rate 1e+300 rad/s is past any IMU's 10000"},
+      {good + "2 0 0 0 0 0 -2e5\n", ":2: specific force 200000 m/s^2 is past any IMU's 100000"},
       {"# only a comment\n", ": no IMU sample (lines 'stamp wx wy wz ax ay az')"},
   };
   for (const auto& [content, message] : cases) {
@@ -94,8 +98,62 @@ TEST_F(ImuFile, ExtrinsicFileIsAPose) {
   EXPECT_TRUE((T.rotation() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY(), 1e-12));
   WriteFile("T_radar_imu.txt", "0 0 0 0 0 0 2\n");
   EXPECT_THROW(ReadExtrinsicFile(path), DataError);
-  WriteFile("T_radar_imu.txt", "0 0 nan 0 0 0 1\n");
-  EXPECT_THROW(ReadExtrinsicFile(path), DataError);
+  const auto refusal = [&](const std::string& content) {
+    WriteFile("T_radar_imu.txt", content);
+    try {
+      ReadExtrinsicFile(path);
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refusal("0 0 nan 0 0 0 1\n"), path + ": extrinsic holds nan, a value that is not finite");
+  EXPECT_EQ(refusal("0 0 1e400 0 0 0 1\n"), path + ": extrinsic holds 1e400, a value that is not finite");
+  EXPECT_EQ(refusal("0 0 x 0 0 0 1\n"), path + ": extrinsic holds 'x', not a number");
+  EXPECT_EQ(refusal("1e300 0 0 0 0 0 1\n"),
+            path + ": extrinsic's translation is past 1000 m (a sensor's mounting on its vehicle)");
+  EXPECT_EQ(refusal("0 0 0 0 0 0 1 0\n"), path + ": extrinsic needs exactly 7 numbers");
+}
+
+// A drive's samples with one glitched sample on each sensor and two beyond
+// the range: exactly those are dropped, and counted.
+TEST(ImuScreening, DropsPlantedSpikesAndSamplesBeyondTheRange) {
+  std::vector<ImuSample> samples;
+  for (int k = 0; k < 400; ++k) {
+    const double t = 0.005 * k;
+    samples.push_back({t, Eigen::Vector3d(0.1 * std::sin(t), 0.05, 0.3 * std::cos(2 * t)),
+                       Eigen::Vector3d(2.0 * std::sin(3 * t), 0.5, 9.81)});
+  }
+  std::vector<ImuSample> planted = samples;
+  planted[100].specific_force.x() = 1e5 * 0.999;  // a glitch past the range
+  planted[200].angular_velocity.z() = 40.0;       // past 2000 deg/s
+  planted[250].specific_force.z() = 9.81 + 60.0;  // a spike within the range: 6 g for one sample
+  planted[300].angular_velocity.y() = 10.0;       // a 570 deg/s spike
+  ImuNoise imu;
+  const ImuScreening screening = ScreenImuSamples(planted, imu);
+  EXPECT_EQ(screening.beyond_range, 2u);
+  EXPECT_EQ(screening.spikes, 2u);
+  ASSERT_EQ(planted.size(), samples.size() - 4);
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    if (k == 100 || k == 200 || k == 250 || k == 300) continue;
+    EXPECT_EQ(planted[kept++].stamp, samples[k].stamp);
+  }
+  // Motion is no spike: a step the next sample holds, and a clean drive, are kept whole.
+  std::vector<ImuSample> step = samples;
+  for (std::size_t k = 250; k < step.size(); ++k) step[k].specific_force.x() += 50.0;
+  EXPECT_EQ(ScreenImuSamples(step, imu).spikes, 0u);
+  std::vector<ImuSample> ramp = samples;  // 0, 45, 90 m/s^2 over three samples: steep, but motion
+  for (std::size_t k = 300; k < ramp.size(); ++k) ramp[k].specific_force.x() = 45.0 * double(std::min<std::size_t>(k - 299, 2));
+  EXPECT_EQ(ScreenImuSamples(ramp, imu).spikes, 0u);
+  std::vector<ImuSample> clean = samples;
+  const ImuScreening none = ScreenImuSamples(clean, imu);
+  EXPECT_EQ(none.beyond_range + none.spikes, 0u);
+  EXPECT_EQ(clean.size(), samples.size());
+  // A narrower range drops what exceeds it: the 9.81 of gravity past a 9 m/s^2 accelerometer.
+  imu.accel_range = 9.0;
+  std::vector<ImuSample> narrow = samples;
+  EXPECT_EQ(ScreenImuSamples(narrow, imu).beyond_range, samples.size());
 }
 
 TEST(ImuNoise, DefaultsPassAndNonPositiveDensitiesAreRefused) {

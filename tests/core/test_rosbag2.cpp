@@ -8,7 +8,11 @@
 #include "radargauss/io/rosbag2.hpp"
 
 #include <gtest/gtest.h>
+#include <lz4frame.h>
 #include <sqlite3.h>
+#include <sys/resource.h>
+#include <zlib.h>
+#include <zstd.h>
 
 #include <cstring>
 #include <filesystem>
@@ -147,6 +151,51 @@ TEST(Cdr, LiesAndTruncationsAreRefused) {
   std::vector<std::uint8_t> parameter_list = bytes;
   parameter_list[1] = 0x03;  // PL_CDR_LE
   EXPECT_THROW(DecodeRos2PointCloud2(parameter_list.data(), parameter_list.size(), "m", cloud), DataError);
+  // A NUL inside a field's name ("x\0" -> "\0\0"): refused, not read as a name cut short.
+  std::vector<std::uint8_t> nul = bytes;
+  ASSERT_EQ(nul[fields_count + 4 + 4], 'x');
+  nul[fields_count + 4 + 4] = 0;
+  try {
+    DecodeRos2PointCloud2(nul.data(), nul.size(), "m", cloud);
+    FAIL() << "a field name with a NUL read";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("a string holds a NUL byte"), std::string::npos) << e.what();
+  }
+}
+
+// The topics a bag is written with: names ROS accepts, distinct; refused before the file is begun.
+TEST_F(Rosbag2Files, BagTopicsAreNamesAReaderFindsAgain) {
+  for (const std::string& good : std::vector<std::string>{"/radar/points", "/a", "/a_1/b2"}) {
+    EXPECT_EQ(TopicNameFault(good), "") << good;
+  }
+  for (const std::string& bad :
+       std::vector<std::string>{"", "radar", "/", "/a/", "/a//b", "/1a", "/a b", std::string("/a\0b", 4)}) {
+    EXPECT_NE(TopicNameFault(bad), "") << bad;
+  }
+  RadarScan scan;
+  scan.timestamp = 5.0;
+  scan.points.push_back({Eigen::Vector3d(1, 2, 3), 0.0, 0.0, {}});
+  const std::vector<ImuSample> imu{{4.0, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 9.81)}};
+  const auto refused = [&](const BagExportOptions& options, const std::vector<RadarScan>& scans,
+                           const std::string& fault) {
+    const std::string path = Path("topics.mcap");
+    try {
+      WriteRos2Bag(path, BagFormat::kMcap, scans, imu, nullptr, options);
+      ADD_FAILURE() << fault;
+    } catch (const DataError& e) {
+      EXPECT_NE(std::string(e.what()).find(fault), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(path));
+  };
+  BagExportOptions empty;
+  empty.scan_topic = "";
+  refused(empty, {scan}, "scan topic '' is empty");
+  BagExportOptions same;
+  same.imu_topic = same.scan_topic;
+  refused(same, {scan}, "scan topic and IMU topic are both /radar/points");
+  RadarScan before_1970 = scan;
+  before_1970.timestamp = -5.0;
+  refused({}, {scan, before_1970}, "scan 1: stamp -5.000000 s does not fit ROS's time");
 }
 
 // --- MCAP --------------------------------------------------------------
@@ -287,6 +336,93 @@ TEST_F(Rosbag2Files, HostileMcapFilesAreRefused) {
   refused("SQLite format 3" + std::string(200, '\0'), "not an MCAP file");
 }
 
+// The peak resident memory of this process, in bytes.
+std::size_t PeakMemory() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return std::size_t(usage.ru_maxrss) * 1024;
+}
+
+// HandMadeMcap's two messages as one chunk whose records are `payload`,
+// compressed with `compression`, stating `stated` bytes uncompressed and the
+// CRC `crc`; no data-section CRC, so that only the chunk's own checks remain.
+std::string McapWithChunk(const std::string& compression, const std::string& payload, std::uint64_t stated,
+                          std::uint32_t crc) {
+  std::string file = HandMadeMcap();
+  const std::size_t first_message = file.find(Record(0x05, std::string(30, '\0')).substr(0, 9));
+  std::string chunk;
+  Put(chunk, 1000, 8);
+  Put(chunk, 1001, 8);
+  Put(chunk, stated, 8);
+  Put(chunk, crc, 4);
+  PutString(chunk, compression);
+  Put(chunk, payload.size(), 8);
+  chunk += payload;
+  const std::size_t data_end = file.find(Record(0x0F, std::string(4, '\0')));
+  return file.substr(0, first_message) + Record(0x06, chunk) + file.substr(data_end);
+}
+
+// The records of HandMadeMcap's two messages, as a chunk holds them.
+std::string MessageRecords() {
+  const std::string file = HandMadeMcap();
+  const std::size_t first_message = file.find(Record(0x05, std::string(30, '\0')).substr(0, 9));
+  const std::size_t data_end = file.find(Record(0x0F, std::string(4, '\0')));
+  return file.substr(first_message, data_end - first_message);
+}
+
+std::vector<std::string> Payloads(const std::string& path) {
+  McapReader reader(path);
+  std::vector<std::string> payloads;
+  reader.ForEachMessage(
+      [&](const McapMessage& m) { payloads.emplace_back(reinterpret_cast<const char*>(m.data), m.size); });
+  return payloads;
+}
+
+// A chunk's stated size is believed only as far as its data goes: an lz4
+// chunk of a few bytes stating 1 GiB is refused by lz4's ratio before
+// anything is decompressed, a zstd frame that leaves its size out is
+// streamed, and neither costs memory for the size it states. Compressed
+// chunks laid out by hand read back; a flipped byte in an uncompressed
+// chunk is caught by the chunk's CRC alone.
+TEST_F(Rosbag2Files, McapChunkSizesAreBoundedByTheirData) {
+  const std::string records = MessageRecords();
+  const std::vector<std::string> expected{"payload0", "payload1"};
+  std::string lz4(LZ4F_compressFrameBound(records.size(), nullptr), '\0');
+  lz4.resize(LZ4F_compressFrame(lz4.data(), lz4.size(), records.data(), records.size(), nullptr));
+  ZSTD_CCtx* context = ZSTD_createCCtx();
+  ZSTD_CCtx_setParameter(context, ZSTD_c_contentSizeFlag, 0);  // a frame that does not state its size
+  std::string zstd(ZSTD_compressBound(records.size()), '\0');
+  zstd.resize(ZSTD_compress2(context, zstd.data(), zstd.size(), records.data(), records.size()));
+  ZSTD_freeCCtx(context);
+  ASSERT_EQ(ZSTD_getFrameContentSize(zstd.data(), zstd.size()), ZSTD_CONTENTSIZE_UNKNOWN);
+  EXPECT_EQ(Payloads(WriteFile("lz4.mcap", McapWithChunk("lz4", lz4, records.size(), 0))), expected);
+  EXPECT_EQ(Payloads(WriteFile("zstd.mcap", McapWithChunk("zstd", zstd, records.size(), 0))), expected);
+  EXPECT_EQ(Payloads(WriteFile("none.mcap", McapWithChunk("", records, records.size(), 0))), expected);
+
+  const auto refused = [&](const std::string& name, const std::string& bytes, const std::string& fault) {
+    const std::size_t before = PeakMemory();
+    try {
+      Payloads(WriteFile(name, bytes));
+      ADD_FAILURE() << name << " read";
+    } catch (const DataError& e) {
+      EXPECT_NE(std::string(e.what()).find(fault), std::string::npos) << e.what();
+    }
+    EXPECT_LT(PeakMemory(), before + (std::size_t(64) << 20)) << name;
+  };
+  constexpr std::uint64_t kGiB = std::uint64_t(1) << 30;
+  refused("lz4_gib.mcap", McapWithChunk("lz4", lz4, kGiB, 0), "lz4 expands at most 256-fold");
+  refused("zstd_gib.mcap", McapWithChunk("zstd", zstd, kGiB, 0), "not its stated 1073741824");
+  refused("zstd_short.mcap", McapWithChunk("zstd", zstd, records.size() - 1, 0), "decompresses past its stated");
+  refused("lz4_short.mcap", McapWithChunk("lz4", lz4, records.size() - 1, 0), "decompresses past its stated");
+  refused("lz4_cut.mcap", McapWithChunk("lz4", lz4.substr(0, lz4.size() - 5), records.size(), 0), "lz4");
+  refused("zstd_cut.mcap", McapWithChunk("zstd", zstd.substr(0, zstd.size() - 3), records.size(), 0), "zstd");
+  std::string flipped = records;
+  flipped[flipped.size() - 3] ^= 0x01;  // inside "payload1"
+  const std::uint32_t crc = std::uint32_t(crc32(0, reinterpret_cast<const Bytef*>(records.data()), records.size()));
+  EXPECT_EQ(Payloads(WriteFile("crc.mcap", McapWithChunk("", records, records.size(), crc))), expected);
+  refused("flipped.mcap", McapWithChunk("", flipped, records.size(), crc), "a chunk's CRC does not match");
+}
+
 // --- sqlite3 and folders -------------------------------------------------
 
 void Sql(const std::string& path, const std::string& sql) {
@@ -359,6 +495,46 @@ TEST_F(Rosbag2Files, FoldersReadTheirFilesInOrderAndRefuseWhatTheyCannot) {
   EXPECT_THROW(ReadBagScans(Path("bag"), "/radar/points"), DataError);
   std::filesystem::create_directories(Path("empty"));
   EXPECT_THROW(ReadBagScans(Path("empty"), "/radar/points"), DataError);
+  const auto refused = [&](const std::string& files, const std::string& fault) {
+    WriteFile("bag/metadata.yaml", "rosbag2_bagfile_information:\n  relative_file_paths: " + files + "\n");
+    try {
+      ReadBagScans(Path("bag"), "/radar/points");
+      ADD_FAILURE() << files;
+    } catch (const DataError& e) {
+      EXPECT_NE(std::string(e.what()).find(fault), std::string::npos) << e.what();
+    }
+  };
+  // A name with two dots is a name; a link out of the folder is outside it; a file listed twice is refused.
+  std::filesystem::rename(Path("bag/part_1.db3"), Path("bag/b..0.db3"));
+  WriteFile("bag/metadata.yaml", "rosbag2_bagfile_information:\n  relative_file_paths: [part_0.mcap, b..0.db3]\n");
+  EXPECT_EQ(ReadBagScans(Path("bag"), "/radar/points").size(), 6u);
+  std::filesystem::rename(Path("bag/b..0.db3"), Path("outside.db3"));
+  std::filesystem::create_symlink(Path("outside.db3"), Path("bag/link.db3"));
+  refused("[part_0.mcap, link.db3]", "'link.db3' is not inside the bag's folder");
+  refused("[part_0.mcap, part_0.mcap]", "'part_0.mcap' is listed twice");
+  refused("[part_0.mcap, ./part_0.mcap]", "'./part_0.mcap' is listed twice");
+  refused("[.]", "is not inside");
+  // One message compressed on its own: a 13-byte zstd frame stating 1 GiB (one
+  // RLE block of 100 bytes) is refused without the GiB being allocated.
+  const std::string db3 = Path("bag/compressed.db3");
+  Sql(db3,
+      "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, serialization_format TEXT "
+      "NOT NULL);"
+      "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, data "
+      "BLOB NOT NULL);"
+      "INSERT INTO topics VALUES(1, '/radar/points', 'sensor_msgs/msg/PointCloud2', 'cdr');"
+      "INSERT INTO messages VALUES(1, 1, 1, X'28B52FFDA00000004023030007');");
+  WriteFile("bag/metadata.yaml",
+            "rosbag2_bagfile_information:\n  compression_format: zstd\n  compression_mode: MESSAGE\n"
+            "  relative_file_paths: [compressed.db3]\n");
+  const std::size_t before = PeakMemory();
+  try {
+    ReadBagScans(Path("bag"), "/radar/points");
+    ADD_FAILURE() << "a 13-byte message stating 1 GiB read";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("a zstd message"), std::string::npos) << e.what();
+  }
+  EXPECT_LT(PeakMemory(), before + (std::size_t(64) << 20));
 }
 
 // The rosbag2 project's own test bags (tests/data/rosbag2: ros2/rosbag2,

@@ -6,8 +6,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <limits>
 #include <random>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -136,10 +139,42 @@ TEST_F(MapTiles, BrokenFoldersGiveClearErrors) {
   expect_error(with_index([](nlohmann::json& j) { j["version"] = 9; }), "version 9");
   expect_error(with_index([](nlohmann::json& j) { j["format"] = "x"; }), "not an index of map tiles");
   expect_error(with_index([](nlohmann::json& j) { j["gaussians"] = 1; }), "do not add up");
-  expect_error(with_index([](nlohmann::json& j) { j["tiles"][0]["places"].push_back(0); }), "misplaced");
+  expect_error(with_index([](nlohmann::json& j) { j["tiles"][0]["places"].push_back(0); }), "lists 16 places");
+  expect_error(with_index([](nlohmann::json& j) {  // two entries of one place, the count kept
+                 std::vector<nlohmann::json*> listed;
+                 for (nlohmann::json& tile : j["tiles"]) {
+                   for (nlohmann::json& place : tile["places"]) listed.push_back(&place);
+                 }
+                 *listed[1] = *listed[0];
+               }),
+               "misplaced");
   expect_error(with_index([](nlohmann::json& j) { j["tiles"][0]["file"] = "../x.rgm"; }), "unexpected");
   expect_error(with_index([](nlohmann::json& j) { j.erase("order"); }), "malformed index");
   expect_error([&] { std::ofstream(index_path) << "{"; }, "malformed index");
+  // Counts that lie: each refused before a tile is read, whatever its size.
+  const std::size_t first_tile = good["tiles"][0]["gaussians"].get<std::size_t>();
+  constexpr std::size_t kMax = std::numeric_limits<std::size_t>::max();
+  for (const std::size_t past : {std::size_t(50), std::size_t(1000000)}) {
+    expect_error(with_index([&](nlohmann::json& j) {
+                   j["order"] = {{0, first_tile + past}, {0, kMax - past + 1}};
+                 }),
+                 "more Gaussians of tile");
+  }
+  expect_error(with_index([&](nlohmann::json& j) {
+                 j["tiles"][0]["gaussians"] = kMax;
+                 j["tiles"][1]["gaussians"] = kMax;
+               }),
+               "add up past 2^64");
+  expect_error(with_index([](nlohmann::json& j) { j["tiles"].push_back(j["tiles"][0]); }), "listed twice");
+  expect_error(with_index([](nlohmann::json& j) { j["places"] = 1000000000; }), "places in its tiles for 1000000000");
+  expect_error(with_index([&](nlohmann::json& j) { j["places"] = kMax; }), "places in its tiles for");
+  expect_error(with_index([](nlohmann::json& j) {
+                 for (int k = 0; k < 20000; ++k) {
+                   j["tiles"].push_back({{"x", 1000 + k}, {"y", 7}, {"file", "tile_" + std::to_string(1000 + k) + "_7.rgm"},
+                                         {"gaussians", 1}, {"places", nlohmann::json::array()}});
+                 }
+               }),
+               "tile_1000_7.rgm: cannot open map tile");
   const std::string tile = Path("tiles/" + good["tiles"][1]["file"].get<std::string>());
   const std::string bytes = Bytes(tile);
   expect_error([&] { std::filesystem::remove(tile); }, tile);

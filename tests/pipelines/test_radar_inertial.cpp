@@ -86,6 +86,64 @@ TEST(RadarInertialOdometry, AnImuThatEndsEarlyIsRefused) {
   }
 }
 
+// One accelerometer sample of 1e5 m/s^2 and one gyro sample of 1000 rad/s
+// (glitches within the physical limits, past the IMU's range) among the
+// drive's: both dropped and counted, the drift as with the clean IMU.
+TEST(RadarInertialOdometry, GlitchedSamplesAreDroppedNotBelieved) {
+  const SimulatedSequence& s = Drive();
+  const Sequence sequence = AsSequence(s);
+  std::vector<ImuSample> glitched = s.imu;
+  glitched[781].specific_force.y() = 1e5;
+  glitched[1500].angular_velocity.x() = 1e3;
+  RadarInertialOdometry clean(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, s.imu);
+  RadarInertialOdometry inertial(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, glitched);
+  EXPECT_EQ(inertial.screening().beyond_range, 2u);
+  EXPECT_EQ(inertial.screening().spikes, 0u);
+  EXPECT_EQ(clean.screening().beyond_range + clean.screening().spikes, 0u);
+  for (std::size_t k = 0; k < 100; ++k) {
+    clean.Register(sequence.scans[k]);
+    inertial.Register(sequence.scans[k]);
+  }
+  const double clean_ate = EvaluateTrajectory(clean.odometry().trajectory(), s.ground_truth).ate_translation.rmse;
+  const double ate = EvaluateTrajectory(inertial.odometry().trajectory(), s.ground_truth).ate_translation.rmse;
+  EXPECT_LT(ate, 1.2 * clean_ate + 0.01) << ate << " m against " << clean_ate << " m";
+  // A value past any IMU (1e300) is refused, naming the sample.
+  glitched[10].angular_velocity.z() = 1e300;
+  EXPECT_THROW(RadarInertialOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, glitched),
+               DataError);
+  EXPECT_THROW(RadarInertialOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, {}), DataError);
+}
+
+// An estimated clock offset stays where the IMU's data and its range allow:
+// with the IMU starting 30 ms after the first scan (the vehicle's motion
+// term on), and with dogleg estimating the mounting too, the runs end, the
+// estimate within its bounds.
+TEST(RadarInertialOdometry, AClockOffsetEstimateIsHeldWithinItsBounds) {
+  SimulationConfig config;
+  config.scans = 40;
+  config.imu_rate_hz = 200.0;
+  const SimulatedSequence s = Simulate(config);
+  const Sequence sequence = AsSequence(s);
+  std::vector<ImuSample> late;
+  for (const ImuSample& sample : s.imu) {
+    if (sample.stamp >= sequence.scans.front().timestamp + 0.030) late.push_back(sample);
+  }
+  RadarInertialOptions walking;
+  walking.window.estimate_clock_offset = true;
+  walking.window.vehicle_motion_std = 0.1;
+  RadarInertialOptions dogleg;
+  dogleg.window.estimate_clock_offset = true;
+  dogleg.window.estimate_extrinsic_rotation = true;
+  dogleg.window.estimate_extrinsic_translation = true;
+  dogleg.window.solver = WindowSolver::kCeresDogleg;
+  for (const auto& [options, imu] : {std::make_pair(walking, late), std::make_pair(dogleg, s.imu)}) {
+    RadarInertialOdometry inertial(OdometryOptions{}, options, s.radar_from_imu, imu);
+    for (const RadarScan& scan : sequence.scans) ASSERT_NO_THROW(inertial.Register(scan));
+    EXPECT_LE(std::abs(inertial.window().clock_offset()), kMaxClockOffset);
+    EXPECT_GE(inertial.window().clock_offset(), imu.front().stamp - sequence.scans.back().timestamp);
+  }
+}
+
 // 30 s of the demo world with the faults of configs/synthetic_realistic.yaml
 // (the radar mounted 0.5 / 1.5 / -1 deg, its elevations 0.5 deg high) and
 // the IMU's stamps 20 ms late. From a nominal (identity) T_radar_imu, a zero

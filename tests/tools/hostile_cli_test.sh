@@ -239,7 +239,7 @@ expect_fail "relocalize on a map without Gaussians" "placesonly.rgm: the map has
 
 # Results folders: not the sequence's own folder, not a shared one; an
 # earlier run's evaluation does not stay beside a new trajectory.
-expect_fail "odometry into the sequence's folder" "seq: is the sequence's own folder" -- \
+expect_fail "odometry into the sequence's folder" "seq is also read (--sequence)" -- \
   "$tool" odometry "${seq[@]}" --out "$work/seq"
 mkdir -p "$work/shared" && chmod 1777 "$work/shared"
 "$tool" build-map "${seq[@]}" --out "$work/shared_map.rgm" >/dev/null
@@ -327,6 +327,58 @@ expect_fail "convert into a missing folder" "radargauss: error:" -- \
   "$tool" convert "${seq[@]}" --out "$work/absent/seq.mcap"
 printf 'not a bag at all\n' >"$work/text.mcap"
 expect_fail "a text file named .mcap" "not a bag" -- "$tool" info --bag "$work/text.mcap"
+
+# IMU values past any IMU, extrinsics that are not poses, references that name no bag or no child frame.
+printf '1702450000.00 0 0 0 0 0 9.8\n1702450000.01 1e300 0 0 0 0 9.8\n' >"$work/imu_1e300.txt"
+expect_fail "an IMU sample of 1e300 rad/s" "imu_1e300.txt:2: angular rate 1e+300 rad/s is past any IMU's 10000" -- \
+  "$tool" odometry --imu "$work/imu_1e300.txt" "${seq[@]}" --out "$work/imu_o"
+printf '0 0 nan 0 0 0 1\n' >"$work/extrinsic_nan.txt"
+expect_fail "an extrinsic holding NaN, no --gt to use it" "extrinsic_nan.txt: extrinsic holds nan, a value that is not finite" -- \
+  "$tool" odometry --sequence "$work/seq" --extrinsic "$work/extrinsic_nan.txt" --out "$work/en"
+expect_fail "--gt with no bag before ':/'" "no bag before ':/'" -- "$tool" info --sequence "$work/seq" --gt :/radar/pose
+"$tool" odometry "${seq[@]}" --out "$work/tf_run" --mcap "$work/tf_run.mcap" >/dev/null
+expect_fail "--gt BAG:/tf without a child frame" "holds transforms (tf2_msgs/TFMessage): name the child frame" -- \
+  "$tool" info --sequence "$work/seq" --gt "$work/tf_run.mcap:/tf"
+
+# convert: topics a reader finds again, distinct; stamps ROS can hold, named by their file.
+printf -- '-5 0 0 0 0 0 9.8\n-4.99 0 0 0 0 0 9.8\n' >"$work/imu_negative.txt"
+expect_fail "convert with an empty scan topic" "--scan-topic '' is empty" -- \
+  "$tool" convert "${seq[@]}" --out "$work/t.mcap" --scan-topic ''
+expect_fail "convert's IMU on the scans' topic" "--scan-topic and --imu-topic-out are both /radar/points" -- \
+  "$tool" convert "${seq[@]}" --imu "$work/imu_negative.txt" --out "$work/t.mcap" --imu-topic-out /radar/points
+expect_fail "convert's poses on the scans' topic" "--scan-topic and --pose-topic are both /radar/points" -- \
+  "$tool" convert "${seq[@]}" --out "$work/t.mcap" --pose-topic /radar/points
+expect_fail "convert with a topic of two slashes" "--pose-topic '/a//b' has a part that is empty" -- \
+  "$tool" convert "${seq[@]}" --out "$work/t.mcap" --pose-topic /a//b
+expect_fail "convert of an IMU stamped before 1970" "imu_negative.txt: IMU stamp -5.000000 s does not fit ROS's time" -- \
+  "$tool" convert "${seq[@]}" --imu "$work/imu_negative.txt" --out "$work/t.mcap"
+[[ ! -e "$work/t.mcap" ]] || { echo "FAIL: a refused convert left its bag"; failed=$((failed + 1)); }
+
+# Map tiles whose index lies: refused before a tile is read, by every reader.
+"$tool" slam "${seq[@]}" --out "$work/slam_tiles" --submap-distance 2 --map-tiles 100 >/dev/null
+ln -s "$work/slam_tiles/map_tiles" "$work/tiles"
+cp "$work/tiles/tiles.json" "$work/tiles.json.good"
+spoil_index() {
+  /usr/bin/python3 -c "import json, sys; j = json.load(open(sys.argv[1])); $1; json.dump(j, open(sys.argv[1], 'w'))" \
+    "$work/tiles/tiles.json"
+}
+for past in 50 1000000; do
+  cp "$work/tiles.json.good" "$work/tiles/tiles.json"
+  spoil_index "j['order'] = [[0, j['tiles'][0]['gaussians'] + $past], [0, 2**64 - $past]]"
+  expect_fail "tile order runs that wrap past 2^64 ($past)" "more Gaussians of tile" -- "$tool" map-info "$work/tiles"
+  expect_fail "relocalize on tiles that wrap ($past)" "more Gaussians of tile" -- \
+    "$tool" relocalize "${seq[@]}" --map "$work/tiles" --out "$work/wrap"
+done
+cp "$work/tiles.json.good" "$work/tiles/tiles.json"
+spoil_index "j['tiles'].append(j['tiles'][0])"
+expect_fail "a tile listed twice" "listed twice" -- "$tool" map-info "$work/tiles"
+cp "$work/tiles.json.good" "$work/tiles/tiles.json"
+spoil_index "j['places'] = 10**9"
+expect_fail "an index declaring 10^9 places" "places in its tiles for 1000000000 places" -- "$tool" map-info "$work/tiles"
+cp "$work/tiles.json.good" "$work/tiles/tiles.json"
+spoil_index "j['tiles'] += [dict(x=9000 + k, y=1, file='tile_%d_1.rgm' % (9000 + k), gaussians=1, places=[]) for k in range(10**6)]"
+expect_fail "10^6 tiles, none present, the first named" "tile_9000_1.rgm: cannot open map tile" -- \
+  "$tool" map-info "$work/tiles"
 
 echo "hostile cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -56,6 +56,16 @@ def ranges(tool, command):
     return found
 
 
+FLAG = re.compile(r"^\s+(--[a-z0-9-]+)(?:=(?:true|false))?(?:\s{2,}\S.*)?$")
+
+
+def flags(tool, command):
+    """Every boolean flag of `command`'s --help-all: a name with no type (and its default, when it has one)."""
+    text = subprocess.run([tool, command, "--help-all"], capture_output=True, text=True, check=True).stdout
+    found = [match.group(1) for match in map(FLAG.match, text.splitlines()) if match]
+    return [flag for flag in found if flag not in ("--help", "--help-all")]
+
+
 def outside(value, kind, direction):
     if kind != "FLOAT":
         return int(value) + direction
@@ -132,6 +142,52 @@ def main():
                 else:
                     expect(command, flag, int(end) if kind != "FLOAT" else end, False, count, pair)
                     expect(command, flag, inside(end, kind, -direction), None, count, pair)
+    # Boolean flags: the documented words only, in any case; any other word refused naming the flag,
+    # on the command line and in YAML (no abort, no word read as true).
+    every = ["info", "convert", "export", "map-info"] + list(commands)
+    flag_count = 0
+    for command in every:
+        for flag in flags(tool, command):
+            flag_count += 1
+            for word in ("maybe", "2x", "yes-please", "-1"):
+                status, error = run([tool, command, flag + "=" + word], sanitized)
+                lines = [line for line in error.splitlines() if line and not line.startswith("Run with --help")]
+                if status not in (0, None) and status < 126 and len(lines) == 1 and flag in error and \
+                        "is not one of true/false, 1/0, on/off, yes/no" in error:
+                    passed += 1
+                else:
+                    failures.append("%s %s=%s: wanted refused naming the flag, exit %s: %s" %
+                                    (command, flag, word, status, error.replace("\n", " | ")[:300]))
+    # --help shows a subset of --help-all, and says so when it leaves flags out.
+    option_name = re.compile(r"^\s+(?:-[a-z],)?(--[a-z0-9-]+)")
+    for command in every:
+        shown = {}
+        for mode in ("--help", "--help-all"):
+            text = subprocess.run([tool, command, mode], capture_output=True, text=True, check=True).stdout
+            shown[mode] = ({m.group(1) for m in map(option_name.match, text.splitlines()) if m}, text)
+        brief, every_flag = shown["--help"][0], shown["--help-all"][0]
+        if not brief <= every_flag:
+            failures.append("%s: --help lists %s, which --help-all does not" % (command, sorted(brief - every_flag)))
+        elif brief != every_flag and "--help-all lists every option" not in shown["--help"][1]:
+            failures.append("%s: --help leaves out %d flags without saying so" % (command, len(every_flag - brief)))
+        else:
+            passed += 1
+    if flag_count < 40:
+        failures.append("only %d boolean flags found in --help-all: the pattern no longer matches" % flag_count)
+    yaml_word = os.path.join(work, "maybe.yaml")
+    for command, key in (("odometry", "estimate-elevation-bias"), ("relocalize", "verify-geometric-first")):
+        with open(yaml_word, "w") as f:
+            f.write(key + ": maybe\n")
+        status, error = run([tool, command] + commands[command] + ["--config", yaml_word], sanitized)
+        if status not in (0, None) and status < 126 and key in error and "is not one of true/false" in error:
+            passed += 1
+        else:
+            failures.append("%s --config with '%s: maybe': exit %s: %s" % (command, key, status, error[:300]))
+    for word in ("yes", "no", "on", "OFF", "1", "0", "True", "false"):
+        expect("build-map", "--doppler-filter=" + word, "", True, 0)
+    with open(yaml_word, "w") as f:
+        f.write("doppler-filter: no\n")
+    expect("build-map", "--config", yaml_word, True, 1)
     for failure in failures:
         print("FAIL:", failure)
     print("option ranges: %d passed, %d failed" % (passed, len(failures)))

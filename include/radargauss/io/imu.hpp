@@ -36,11 +36,21 @@ constexpr double kGravity = 9.81;  // m/s^2
 // A file holds at most this many samples: an hour at 1 kHz with room to spare.
 constexpr std::size_t kMaxImuSamples = std::size_t(4) << 20;
 
+// No IMU reads beyond these (a thousand times a consumer part's range): a
+// value past them is garbage or another unit, refused where it is read.
+constexpr double kMaxPhysicalAngularRate = 1e4;    // rad/s
+constexpr double kMaxPhysicalSpecificForce = 1e5;  // m/s^2
+
 // The samples of a text file of lines `stamp wx wy wz ax ay az` (`#`
 // comments, blank lines skipped). Throws DataError naming the file and line
-// for a line without exactly seven numbers, a value that is not finite, a
-// stamp that does not increase, no sample at all, or more than kMaxImuSamples.
+// for a line without exactly seven numbers, a value that is not finite or
+// past the physical limits above, a stamp that does not increase, no sample
+// at all, or more than kMaxImuSamples.
 std::vector<ImuSample> ReadImuFile(const std::string& path);
+
+// Empty when `sample`'s values are finite and within the physical limits;
+// otherwise why not ("angular rate 1e+300 rad/s is past any IMU's 10000").
+std::string ImuSampleFault(const ImuSample& sample);
 
 // The IMU's noise, continuous time, as a datasheet gives it; the defaults are
 // a consumer MEMS part's (a BMI088-like gyro at 0.014 deg/s/sqrt(Hz), an
@@ -50,9 +60,25 @@ struct ImuNoise {
   double accel_noise_density = 1.5e-3;     // m/s^2/sqrt(Hz)
   double gyro_bias_random_walk = 2.0e-5;   // rad/s^2/sqrt(Hz)
   double accel_bias_random_walk = 3.0e-4;  // m/s^3/sqrt(Hz)
+  // The measuring ranges (a MEMS part's widest: 2000 deg/s, 16 g); a
+  // sample beyond them is no measurement (ScreenImuSamples).
+  double gyro_range = 34.9;    // rad/s
+  double accel_range = 156.9;  // m/s^2
 };
 // Its options (options.hpp).
 const OptionTable<ImuNoise>& ImuNoiseOptionTable();
+
+// What ScreenImuSamples dropped.
+struct ImuScreening {
+  std::size_t beyond_range = 0;  // a value past the IMU's range on any axis
+  std::size_t spikes = 0;        // isolated: far from both neighbours, which agree
+};
+
+// Drops from `samples` those beyond `imu`'s ranges, then isolated spikes: a
+// sample whose gyro (accelerometer) differs from both neighbours by more
+// than a quarter of the range while they differ from each other by less
+// than an eighth (one glitched sample, not motion: docs/design.md, "IMU").
+ImuScreening ScreenImuSamples(std::vector<ImuSample>& samples, const ImuNoise& imu);
 
 // What `info` says of an IMU: its span, rate and gaps, and the mean specific
 // force (about 9.81 m/s^2 along the IMU's up at rest or at constant velocity).

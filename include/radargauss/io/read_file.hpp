@@ -13,6 +13,15 @@ namespace radargauss {
 // or a socket is refused by its type before anything is read.
 void CheckRegularInputFile(const std::string& path, const std::string& what = "file");
 
+// Outputs never replace inputs (docs/design.md, "Bounds on input"): after
+// ProtectInputs() (the command-line tool calls it first), every file that
+// CheckRegularInputFile admits is remembered by its device and inode, and
+// the writers of atomic_file.hpp refuse to replace or remove one of them.
+// Off by default: a library user may read a map and write it back.
+void ProtectInputs();
+// Whether `path` is a file this process has read since ProtectInputs().
+bool IsProtectedInput(const std::string& path);
+
 // The file's bytes. Throws DataError naming the file when it is missing, not
 // a regular file, larger than `max_bytes`, or cannot be read
 // ("<path>: cannot open <what>").

@@ -78,6 +78,8 @@ const std::string& Ros2MessageDefinition(const std::string& type);
 
 // A stamp in s as ROS's (sec, nanosec), and back as ROS computes it.
 void SplitStamp(double stamp, std::int32_t& sec, std::uint32_t& nanosec);
+// Whether SplitStamp takes `stamp`: 0 to 2^31 s (1970 to 2038).
+bool FitsRosTime(double stamp);
 inline double JoinStamp(std::int32_t sec, std::uint32_t nanosec) { return double(sec) + 1e-9 * double(nanosec); }
 // The stamp as ns since the epoch, through SplitStamp (a bag's log time).
 std::int64_t StampNanoseconds(double stamp);

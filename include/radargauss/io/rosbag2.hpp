@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "radargauss/io/mcap.hpp"
@@ -80,7 +81,18 @@ struct BagExportOptions {
   std::string radar_frame = "radar", imu_frame = "imu", world_frame = "world";
   McapWriterOptions mcap;
 };
+// Throws DataError before anything is written for a topic name a reader
+// would not find again (TopicNameFault), two topics of one name, or a stamp
+// outside ROS's time ("scan 3: stamp -5 s ...").
 void WriteRos2Bag(const std::string& path, BagFormat format, const std::vector<RadarScan>& scans,
                   const std::vector<ImuSample>& imu, const Trajectory* reference, const BagExportOptions& options = {});
+
+// Empty when `name` is a topic name ROS accepts: '/' then parts of letters,
+// digits and '_' that do not start with a digit, separated by single '/';
+// otherwise why not.
+std::string TopicNameFault(const std::string& name);
+// Throws DataError for the first of (what names it, topic) whose topic has a
+// TopicNameFault or was named before: "--scan-topic '' is empty".
+void CheckBagTopics(const std::vector<std::pair<std::string, std::string>>& topics);
 
 }  // namespace radargauss

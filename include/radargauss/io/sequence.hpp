@@ -60,8 +60,13 @@ Trajectory ReadRadarTrajectory(const std::string& ground_truth, const SE3d& extr
 // Resolves SequenceOptions::extrinsic; throws DataError for an unknown preset
 // or a malformed file.
 SE3d ResolveExtrinsic(const std::string& spec, const std::string& ground_truth_path);
+// A sensor's mounting on its vehicle is within this of the vehicle's origin.
+constexpr double kMaxLeverArm = 1000.0;  // m
+
 // The pose of a file of one line `x y z qx qy qz qw` (`#` comments): an
-// extrinsic such as T_gt_radar or T_radar_imu. Throws DataError naming the file.
+// extrinsic such as T_gt_radar or T_radar_imu. Throws DataError naming the
+// file for a word that is not a number, a value that is not finite, a
+// quaternion that is not unit or a translation past kMaxLeverArm.
 SE3d ReadExtrinsicFile(const std::string& path);
 
 }  // namespace radargauss

@@ -44,7 +44,10 @@ const OptionTable<RadarInertialOptions>& RadarInertialOptionTable();
 class InertialFusion {
  public:
   // `imu`: the IMU's samples (time order) on the scans' clock, in its frame;
-  // radar_from_imu = T_radar_imu. Throws DataError for samples out of order.
+  // radar_from_imu = T_radar_imu. Samples beyond the IMU's ranges and
+  // isolated spikes are dropped (ScreenImuSamples, counted in screening()).
+  // Throws DataError for no samples, samples out of order, a value past the
+  // physical limits (ImuSampleFault), or none within the ranges.
   InertialFusion(const RadarInertialOptions& options, const SE3d& radar_from_imu, std::vector<ImuSample> imu);
   InertialFusion(const InertialFusion&) = delete;  // the odometry's hook holds `this`
   InertialFusion& operator=(const InertialFusion&) = delete;
@@ -61,6 +64,8 @@ class InertialFusion {
   const std::vector<WindowSolveSummary>& solves() const { return solves_; }
   const InertialWindow& window() const { return *window_; }
   const RadarInertialOptions& options() const { return options_; }
+  // The samples dropped before the window saw them.
+  const ImuScreening& screening() const { return screening_; }
 
  private:
   SE3d Fuse(const ScanEstimate& estimate);
@@ -68,6 +73,7 @@ class InertialFusion {
   RadarInertialOptions options_;
   SE3d radar_from_imu_;
   std::vector<ImuSample> imu_;
+  ImuScreening screening_;
   std::unique_ptr<InertialWindow> window_;  // made again by Attach when the elevation bias is estimated
   bool started_ = false;
   double elevation_bias_removed_ = 0.0;                         // rad: what the odometry removes from the scan now
@@ -91,6 +97,8 @@ class RadarInertialOdometry {
   const std::vector<std::optional<InertialState>>& states() const { return fusion_.states(); }
   const InertialWindow& window() const { return fusion_.window(); }
   const RadarInertialOptions& options() const { return fusion_.options(); }
+  const ImuScreening& screening() const { return fusion_.screening(); }
+  const std::vector<WindowSolveSummary>& solves() const { return fusion_.solves(); }
 
  private:
   InertialFusion fusion_;

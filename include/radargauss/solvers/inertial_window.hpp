@@ -92,8 +92,15 @@ struct WindowSolveSummary {
   double initial_cost = 0.0, final_cost = 0.0;
   bool converged = false;
   std::size_t reintegrated = 0;  // IMU terms integrated again at a moved bias
+  // The clock offset's estimate left its bounds (kMaxClockOffset, or the
+  // IMU's data beyond the window's ends) and was held at the bound.
+  bool clock_offset_held = false;
   double time_ms = 0.0;
 };
+
+// An estimated clock offset stays within this of zero (the range of
+// imu_clock_offset): beyond it the clocks disagree, which no window calibrates.
+constexpr double kMaxClockOffset = 0.1;  // s
 
 class InertialWindow {
  public:
