@@ -107,7 +107,7 @@ void AddCoarseOptions(CLI::App* app, LocalizeSettings& s) {
       ->capture_default_str();
   app->add_option("--coarse-gate", s.coarse_gate,
                   "Association gate on the coarse levels (Mahalanobis; smaller: faster, less reach)")
-      ->check(Positive())
+      ->check(InRange(kMinCoarseGate, kMaxCoarseGate))
       ->capture_default_str();
   AddBoolFlag(app, "--loss-curvature", s.loss_curvature,
                 "Own GN: the robust losses' curvature in the Hessian instead of IRLS weights alone");

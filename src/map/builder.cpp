@@ -221,7 +221,7 @@ const OptionTable<GaussianMapOptions>& GaussianMapOptionTable() {
       RADARGAUSS_OPTION(O, "kmeans_iterations", kmeans_iterations).AtLeast(1).Help("Lloyd iterations per bisection"),
       RADARGAUSS_OPTION(O, "em_iterations", em_iterations).AtLeast(0).Help("hard-EM rounds"),
       RADARGAUSS_OPTION(O, "min_std", min_std)
-          .In(kMinMapStd, kMaxMapStd)
+          .In(kMinMapStd, kMaxMinStd)
           .Unit("m")
           .Help("minimum principal std of a Gaussian"),
       RADARGAUSS_OPTION(O, "map_seed", seed).Help("seed of the bisecting k-means"),

@@ -698,5 +698,33 @@ TEST_F(Rosbag2Files, ARunForAViewerReadsBack) {
   EXPECT_EQ(scan, 30u);
 }
 
+// A run folder's CSVs read back into columns: five million keyframes (20 MB)
+// cost their numbers, not a map per row; a loop's keyframe found by its
+// stamp; a cell that is not a number named by file, line and column.
+TEST_F(Rosbag2Files, ARunsCsvsAreReadIntoColumns) {
+  std::filesystem::create_directories(Path("run"));
+  WriteFile("run/odometry.tum", "0 0 0 0 0 0 0 1\n10 10 0 0 0 0 0 1\n");
+  {
+    std::ofstream keyframes(Path("run/keyframes.csv"));
+    keyframes << "index,stamp\n";
+    for (int k = 0; k < 5000000; ++k) keyframes << k << "," << (k == 1 ? 5 : 0) << "\n";
+  }
+  WriteFile("run/loops.csv", "query,candidate,accepted\n1,0,1\n0,1,0\n");
+  const std::size_t before = PeakMemory();
+  const RunForViewer run = ReadRunFolder(Path("run"));
+  EXPECT_LT(PeakMemory(), before + (std::size_t(300) << 20));
+  ASSERT_EQ(run.loops.size(), 1u);
+  EXPECT_LT((run.loops[0].first - Eigen::Vector3d(5, 0, 0)).norm(), 1e-12);  // keyframe 1 at 5 s
+  WriteFile("run/loops.csv", "query,candidate,accepted\n1,x,1\n");
+  try {
+    ReadRunFolder(Path("run"));
+    FAIL() << "a loop naming keyframe 'x' read";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("loops.csv:2: column 'candidate' holds 'x', not a number"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace radargauss

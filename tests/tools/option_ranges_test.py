@@ -163,8 +163,8 @@ def main():
     for command in every:
         shown = {}
         for mode in ("--help", "--help-all"):
-            text = subprocess.run([tool, command, mode], capture_output=True, text=True, check=True).stdout
-            shown[mode] = ({m.group(1) for m in map(option_name.match, text.splitlines()) if m}, text)
+            listing = subprocess.run([tool, command, mode], capture_output=True, text=True, check=True).stdout
+            shown[mode] = ({m.group(1) for m in map(option_name.match, listing.splitlines()) if m}, listing)
         brief, every_flag = shown["--help"][0], shown["--help-all"][0]
         if not brief <= every_flag:
             failures.append("%s: --help lists %s, which --help-all does not" % (command, sorted(brief - every_flag)))
@@ -173,7 +173,7 @@ def main():
         else:
             passed += 1
     if flag_count < 40:
-        failures.append("only %d boolean flags found in --help-all: the pattern no longer matches" % flag_count)
+        failures.append("only %d boolean flags found in --help-all: the pattern misses the help's layout" % flag_count)
     yaml_word = os.path.join(work, "maybe.yaml")
     for command, key in (("odometry", "estimate-elevation-bias"), ("relocalize", "verify-geometric-first")):
         with open(yaml_word, "w") as f:

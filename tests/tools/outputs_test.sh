@@ -22,7 +22,7 @@ awk -v t="$start" 'BEGIN { for (k = 0; k < 200; ++k) printf "%.3f 0 0 0.01 0 0 9
 "$tool" build-map "${seq[@]}" --out "$work/map.rgm" >/dev/null
 "$tool" odometry "${seq[@]}" --out "$work/run" >/dev/null
 
-# unchanged <file>...: each file as it was before the command (a copy taken by keep).
+# unchanged <file>...: each file byte for byte as keep copied it.
 keep() { for f in "$@"; do cp -a "$f" "$f.kept"; done; }
 unchanged() {
   for f in "$@"; do

@@ -77,7 +77,7 @@ struct ImuScreening {
 // Drops from `samples` those beyond `imu`'s ranges, then isolated spikes: a
 // sample whose gyro (accelerometer) differs from both neighbours by more
 // than a quarter of the range while they differ from each other by less
-// than an eighth (one glitched sample, not motion: docs/design.md, "IMU").
+// than an eighth (one glitched sample, not motion: docs/design.md, "Bounds on input").
 ImuScreening ScreenImuSamples(std::vector<ImuSample>& samples, const ImuNoise& imu);
 
 // What `info` says of an IMU: its span, rate and gaps, and the mean specific

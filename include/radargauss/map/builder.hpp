@@ -28,6 +28,10 @@ std::string ToString(MapBuilder builder);
 MapBuilder MapBuilderFromString(const std::string& name);  // "kmeans", "voxel"; throws std::invalid_argument
 std::vector<std::string> MapBuilderNames();
 
+// A Gaussian's smallest std may not pass this: the index lists a Gaussian
+// in the cells of its box, which grow with the cube of its std.
+constexpr double kMaxMinStd = 3.0;  // m (10 m: 9.8 GB for a 6-scan localize)
+
 struct GaussianMapOptions {
   MapBuilder builder = MapBuilder::kKMeans;
   double downsample_voxel = 0.25;    // m (kKMeans)

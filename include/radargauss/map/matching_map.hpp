@@ -46,6 +46,9 @@ constexpr double kMaxCoarseSigma = 100.0;  // m
 constexpr double kMaxIndexCell = 100.0;    // m
 // A finer index cell lists a metre-wide Gaussian in millions of cells.
 constexpr double kMinIndexCell = 0.1;  // m (0.02 m: 18 s and 1.9 GB for 40 scans)
+// The coarse levels' gate in stds: their index boxes grow with its cube.
+constexpr double kMinCoarseGate = 1e-3;
+constexpr double kMaxCoarseGate = 30.0;
 
 struct MatchingMapOptions {
   std::vector<double> inflation = {1.0, 0.5, 0.25};  // sigma_k of the coarse levels (m), coarse first
