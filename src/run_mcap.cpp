@@ -139,49 +139,54 @@ void WriteRunMcap(const std::string& path, const RunForViewer& run, const RunMca
 
 namespace {
 
-// The cells of one CSV line (quotes group commas).
-std::vector<std::string> SplitCsvLine(const std::string& text) {
-  std::vector<std::string> cells;
-  std::string cell;
+// The cells of the CSV line bytes[begin, end) into `cells` (quotes group
+// commas and are dropped), reusing the strings it already holds.
+void SplitCsvLine(const std::string& bytes, std::size_t begin, std::size_t end, std::vector<std::string>& cells,
+                  std::size_t& count) {
+  count = 0;
   bool quoted = false;
-  for (const char c : text) {
+  const auto next_cell = [&] {
+    if (count == cells.size()) cells.emplace_back();
+    cells[count++].clear();
+  };
+  next_cell();
+  for (std::size_t i = begin; i < end; ++i) {
+    const char c = bytes[i];
     if (c == '"') {
       quoted = !quoted;
     } else if (c == ',' && !quoted) {
-      cells.push_back(cell);
-      cell.clear();
+      next_cell();
     } else {
-      cell += c;
+      cells[count - 1] += c;
     }
   }
-  cells.push_back(cell);
-  return cells;
 }
 
 // The columns `names` of a CSV file with a header, as numbers, read line by
-// line into one vector per column: a file of millions of rows costs its
-// numbers, not a map per row.
+// line into one vector per column, the cells' strings reused from line to
+// line: a file of millions of rows costs its numbers, not a map per row.
 std::vector<std::vector<double>> ReadCsvColumns(const std::string& path, const std::vector<std::string>& names) {
   const std::string bytes = ReadFileBytes(path, "CSV file", std::size_t(1) << 30);
   std::vector<std::size_t> wanted;
-  std::size_t columns = 0, number = 0;
+  std::vector<std::string> cells;
+  std::size_t columns = 0, count = 0, number = 0;
   std::vector<std::vector<double>> values(names.size());
   for (std::size_t begin = 0; begin < bytes.size();) {
     std::size_t end = bytes.find('\n', begin);
     if (end == std::string::npos) end = bytes.size();
-    const std::vector<std::string> cells = SplitCsvLine(bytes.substr(begin, end - begin));
+    SplitCsvLine(bytes, begin, end, cells, count);
     begin = end + 1;
     ++number;
     if (number == 1) {
-      columns = cells.size();
+      columns = count;
       for (const std::string& name : names) {
-        const auto found = std::find(cells.begin(), cells.end(), name);
-        if (found == cells.end()) throw FileError(path, "no column '" + name + "'");
+        const auto found = std::find(cells.begin(), cells.begin() + std::ptrdiff_t(count), name);
+        if (found == cells.begin() + std::ptrdiff_t(count)) throw FileError(path, "no column '" + name + "'");
         wanted.push_back(std::size_t(found - cells.begin()));
       }
       continue;
     }
-    if (cells.size() != columns) throw FileError(path, number, "expected " + std::to_string(columns) + " columns");
+    if (count != columns) throw FileError(path, number, "expected " + std::to_string(columns) + " columns");
     for (std::size_t c = 0; c < names.size(); ++c) {
       const std::string& cell = cells[wanted[c]];
       char* after = nullptr;

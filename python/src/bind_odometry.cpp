@@ -166,6 +166,17 @@ void BindOdometry(py::module_& m) {
           },
           "The window's tilt (rad, roll and pitch of the matcher's world against gravity), clock offset (s), "
           "T_radar_imu, and the standard deviations of those estimated and of the newest biases")
+      .def(
+          "imu_dropped",
+          [](LockedInertial& odometry) {
+            const ImuScreening screening = odometry.With([](RadarInertialOdometry& o) { return o.screening(); });
+            py::dict d;
+            d["beyond_range"] = screening.beyond_range;
+            d["spikes"] = screening.spikes;
+            return d;
+          },
+          "The IMU samples dropped before the window saw them: 'beyond_range' (imu_gyro_range, imu_accel_range) "
+          "and isolated 'spikes'")
       .def("__len__", [](LockedInertial& odometry) {
         return odometry.With([](RadarInertialOdometry& o) { return o.odometry().steps().size(); });
       });

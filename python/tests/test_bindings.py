@@ -322,6 +322,11 @@ def test_radar_inertial_odometry(cli, tmp_path):
     assert np.linalg.norm(step["inertial"]["gyro_bias"].ravel() - truth[1:4]) < 1e-3
     calibration = inertial.calibration()
     assert np.all(calibration["gyro_bias_std"] > 0) and calibration["tilt"].size == 2
+    assert inertial.imu_dropped() == {"beyond_range": 0, "spikes": 0}
+    glitched = imu.copy()
+    glitched[500, 4] = 1e5  # one accelerometer sample of 1e5 m/s^2
+    assert rg.RadarInertialOdometry(glitched, radar_from_imu=extrinsic).imu_dropped() == {"beyond_range": 1,
+                                                                                          "spikes": 0}
     with pytest.raises(TypeError, match="unknown keyword 'window_sise'"):
         rg.RadarInertialOdometry(imu, window_sise=5)
     with pytest.raises(ValueError, match="window_size"):
