@@ -276,6 +276,8 @@ class RadarInertialOdometry:
         ...
     def calibration(self: RadarInertialOdometry) -> dict:
         """The window's tilt (rad, roll and pitch of the matcher's world against gravity), clock offset (s), T_radar_imu, and the standard deviations of those estimated and of the newest biases"""
+    def imu_dropped(self: RadarInertialOdometry) -> dict:
+        """The IMU samples dropped before the window saw them: 'beyond_range' (imu_gyro_range, imu_accel_range) and isolated 'spikes'"""
     def register(self: RadarInertialOdometry, scan: Scan) -> dict:
         """Adds the next scan; returns RadarOdometry.register's dict with 'inertial': the window's newest state (pose, velocity, gyro_bias, accel_bias) or None before the window started"""
     def trajectory(self: RadarInertialOdometry) -> tuple:
