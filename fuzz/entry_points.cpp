@@ -240,11 +240,18 @@ void MapTiles(const std::uint8_t* data, std::size_t size) {
 }
 
 const std::vector<Target>& Targets() {
-  static const std::vector<Target> targets = {
-      {"pcd", Pcd},          {"kitti_bin", KittiBin},      {"tum", Tum},
-      {"map_file", MapFile}, {"pointcloud2", PointCloud2}, {"simulator_yaml", SimulatorYaml},
-      {"cli_yaml", CliYaml}, {"shard_json", ShardJson},    {"map_places", MapPlaces},
-      {"mcap", Mcap},        {"cdr", Cdr},                 {"map_tiles", MapTiles}};
+  static const std::vector<Target> targets = {{"pcd", Pcd},
+                                              {"kitti_bin", KittiBin},
+                                              {"tum", Tum},
+                                              {"map_file", MapFile},
+                                              {"pointcloud2", PointCloud2},
+                                              {"simulator_yaml", SimulatorYaml},
+                                              {"cli_yaml", CliYaml},
+                                              {"shard_json", ShardJson},
+                                              {"map_places", MapPlaces},
+                                              {"mcap", Mcap},
+                                              {"cdr", Cdr},
+                                              {"map_tiles", MapTiles}};
   return targets;
 }
 

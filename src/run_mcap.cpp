@@ -66,8 +66,9 @@ void WriteRunMcap(const std::string& path, const RunForViewer& run, const RunMca
     throw std::invalid_argument("WriteRunMcap: stamps, poses and scans differ in count");
   }
   if (!(options.ellipsoid_sigma > 0.0) || !(options.ellipsoid_sigma <= kMaxEllipsoidSigma)) {
-    throw std::invalid_argument("WriteRunMcap: ellipsoid_sigma must be in (0, " + std::to_string(int(kMaxEllipsoidSigma)) +
-                                "], not " + std::to_string(options.ellipsoid_sigma));
+    throw std::invalid_argument("WriteRunMcap: ellipsoid_sigma must be in (0, " +
+                                std::to_string(int(kMaxEllipsoidSigma)) + "], not " +
+                                std::to_string(options.ellipsoid_sigma));
   }
   WriteFileAtomically(
       path,

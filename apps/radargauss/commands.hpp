@@ -36,8 +36,9 @@ Subcommand AddRelocalize(CLI::App& parent);
 
 // The flags every subcommand that reads a sequence shares; the trajectory
 // that gives the scans their poses is `poses_flag` (refine: --poses).
-void AddSequenceOptions(CLI::App* app, SequenceOptions& options, const std::string& poses_flag = "--gt",
-                        const std::string& poses_help = "Ground-truth trajectory (TUM, or BAG:/topic[:child] of a ROS 2 bag)");
+void AddSequenceOptions(
+    CLI::App* app, SequenceOptions& options, const std::string& poses_flag = "--gt",
+    const std::string& poses_help = "Ground-truth trajectory (TUM, or BAG:/topic[:child] of a ROS 2 bag)");
 
 // Before a run: every output of `command` (--out, --mcap, --ply) can be
 // written, no two name the same path, and none is a file or

@@ -48,9 +48,8 @@ int RunConvert(ConvertSettings s) {
   s.bag.mcap.chunked = !s.unchunked;
   CheckOutputFile(s.out);
   // The topics written, checked before anything is read.
-  CheckBagTopics({{"--scan-topic", s.bag.scan_topic},
-                  {"--imu-topic-out", s.bag.imu_topic},
-                  {"--pose-topic", s.bag.pose_topic}});
+  CheckBagTopics(
+      {{"--scan-topic", s.bag.scan_topic}, {"--imu-topic-out", s.bag.imu_topic}, {"--pose-topic", s.bag.pose_topic}});
   // Every scan, the reference (when given) at those within its span.
   SequenceOptions scans_only = s.sequence;
   scans_only.ground_truth.clear();

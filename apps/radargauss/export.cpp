@@ -16,7 +16,9 @@ namespace radargauss::cli {
 void WriteRunForViewer(const std::string& run_folder, const std::vector<RadarScan>& scans,
                        const std::optional<Trajectory>& reference, const std::string& mcap) {
   RunForViewer run = ReadRunFolder(run_folder);
-  const auto fits = [](const std::vector<double>& stamps) { return std::all_of(stamps.begin(), stamps.end(), FitsRosTime); };
+  const auto fits = [](const std::vector<double>& stamps) {
+    return std::all_of(stamps.begin(), stamps.end(), FitsRosTime);
+  };
   if (!fits(run.stamps)) throw FileError(run_folder, "its trajectory holds a stamp outside ROS's time (0 to 2^31 s)");
   if (reference) {
     for (const StampedPose& p : *reference) {

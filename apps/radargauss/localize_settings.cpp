@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "localize_settings.hpp"
-#include "option_flags.hpp"
 
 #include <algorithm>
 #include <cstdio>
 
+#include "option_flags.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/experiment.hpp"
 #include "radargauss/names.hpp"
@@ -64,13 +64,14 @@ void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
                   "RCS residual: decibel (the paper), swerling1 or swerling3 (fluctuating RCS)")
       ->check(CLI::IsMember(RcsLikelihoodNames()))
       ->capture_default_str();
-  AddBoolFlag(app, "--rcs-confidence", s.rcs_confidence, "Weigh each RCS term by its Gaussian's fit (spread and members)");
+  AddBoolFlag(app, "--rcs-confidence", s.rcs_confidence,
+              "Weigh each RCS term by its Gaussian's fit (spread and members)");
   app->add_option("--rcs-expected-spread", s.rcs_expected_spread,
                   "The spread (dB) the confidence expects (0: the likelihood's own)")
       ->check(NonNegative())
       ->capture_default_str();
   AddBoolFlag(app, "--w-rcs-from-map", s.w_rcs_from_map,
-                "Also match with each map's data-chosen w_rcs (configuration gn-wmap...)");
+              "Also match with each map's data-chosen w_rcs (configuration gn-wmap...)");
   app->add_option("--incidences", s.incidences, "Incidence models to sweep (map built here)")
       ->delimiter(',')
       ->check(CLI::IsMember(IncidenceModelNames()));
@@ -110,7 +111,7 @@ void AddCoarseOptions(CLI::App* app, LocalizeSettings& s) {
       ->check(InRange(kMinCoarseGate, kMaxCoarseGate))
       ->capture_default_str();
   AddBoolFlag(app, "--loss-curvature", s.loss_curvature,
-                "Own GN: the robust losses' curvature in the Hessian instead of IRLS weights alone");
+              "Own GN: the robust losses' curvature in the Hessian instead of IRLS weights alone");
   AddBoolFlag(app, "--geometric-first", s.geometric_first,
               "With 0 < w < 1: the exact map's geometric term alone first, then eq. 2 (default on)");
   AddBoolFlag(

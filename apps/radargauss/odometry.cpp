@@ -31,9 +31,10 @@ void PrintSummary(const OdometrySummary& summary) {
 // The IMU samples dropped before use, when any were.
 void PrintScreening(const ImuScreening& screening) {
   if (screening.beyond_range + screening.spikes == 0) return;
-  std::printf("imu: dropped %zu samples beyond the IMU's range (--imu-gyro-range, --imu-accel-range) and %zu "
-              "isolated spikes\n",
-              screening.beyond_range, screening.spikes);
+  std::printf(
+      "imu: dropped %zu samples beyond the IMU's range (--imu-gyro-range, --imu-accel-range) and %zu "
+      "isolated spikes\n",
+      screening.beyond_range, screening.spikes);
 }
 
 // The window's last estimate: the tilt of the odometry's world against

@@ -44,7 +44,8 @@ CLI::Option* AddBoolFlag(CLI::App* app, const std::string& name, std::function<v
 }
 
 CLI::Option* AddBoolFlag(CLI::App* app, const std::string& name, bool& target, const std::string& help) {
-  return AddBoolFlag(app, name, [&target](bool on) { target = on; }, help);
+  return AddBoolFlag(
+      app, name, [&target](bool on) { target = on; }, help);
 }
 
 void ShowEveryOption(bool show) { show_every_option = show; }

@@ -130,7 +130,7 @@ Subcommand AddRelocalize(CLI::App& parent) {
   app->add_option("--out", s->odometry.out, "Output folder")->required();
   AddTableOptions(app, RelocalizationOptionTable(), s->relocalization);
   AddBoolFlag(app, "--w-rcs-from-map", s->w_rcs_from_map,
-                "Eq. 2's w_rcs chosen from the map's RCS fits instead of --w-rcs (docs/design.md)")
+              "Eq. 2's w_rcs chosen from the map's RCS fits instead of --w-rcs (docs/design.md)")
       ->excludes(app->get_option("--w-rcs"))
       ->group(HelpGroup(OptionGroup::kTuning));
   AddRunOptions(app, s->odometry);

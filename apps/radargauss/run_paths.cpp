@@ -74,11 +74,12 @@ void CheckRunPaths(const CLI::App& command, const std::string& config_path) {
     }
     for (const NamedPath& in : inputs) {
       if (SamePath(out.path, in.path)) {
-        throw DataError(out.flag + " " + out.path + " is also read (" + in.flag + "); an output never replaces an input");
+        throw DataError(out.flag + " " + out.path + " is also read (" + in.flag +
+                        "); an output never replaces an input");
       }
     }
-    const bool file = out.flag != "--out" ||
-                      std::find(kFileOut.begin(), kFileOut.end(), command.get_name()) != kFileOut.end();
+    const bool file =
+        out.flag != "--out" || std::find(kFileOut.begin(), kFileOut.end(), command.get_name()) != kFileOut.end();
     if (file) {
       CheckOutputFile(out.path);
     } else {

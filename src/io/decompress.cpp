@@ -30,8 +30,8 @@ void Append(std::vector<std::uint8_t>& out, const std::uint8_t* block, std::size
   out.insert(out.end(), block, block + n);
 }
 
-std::vector<std::uint8_t> Zstd(const std::uint8_t* data, std::size_t size, std::uint64_t bound,
-                               const std::string& path, const std::string& what, bool stated) {
+std::vector<std::uint8_t> Zstd(const std::uint8_t* data, std::size_t size, std::uint64_t bound, const std::string& path,
+                               const std::string& what, bool stated) {
   const std::unique_ptr<ZSTD_DCtx, std::size_t (*)(ZSTD_DCtx*)> context(ZSTD_createDCtx(), ZSTD_freeDCtx);
   if (!context) throw FileError(path, "cannot start zstd decompression");
   ZSTD_DCtx_setParameter(context.get(), ZSTD_d_windowLogMax, kZstdWindowLogMax);
@@ -42,7 +42,8 @@ std::vector<std::uint8_t> Zstd(const std::uint8_t* data, std::size_t size, std::
   for (;;) {
     ZSTD_outBuffer step{block.data(), block.size(), 0};
     pending = ZSTD_decompressStream(context.get(), &step, &in);
-    if (ZSTD_isError(pending)) throw FileError(path, what + " is not a valid zstd frame: " + ZSTD_getErrorName(pending));
+    if (ZSTD_isError(pending))
+      throw FileError(path, what + " is not a valid zstd frame: " + ZSTD_getErrorName(pending));
     Append(out, block.data(), step.pos, bound, path, what, stated);
     // Done once the input is read and the decoder has nothing more to give.
     if (in.pos == in.size && step.pos < step.size) break;
@@ -51,8 +52,8 @@ std::vector<std::uint8_t> Zstd(const std::uint8_t* data, std::size_t size, std::
   return out;
 }
 
-std::vector<std::uint8_t> Lz4(const std::uint8_t* data, std::size_t size, std::uint64_t bound,
-                              const std::string& path, const std::string& what, bool stated) {
+std::vector<std::uint8_t> Lz4(const std::uint8_t* data, std::size_t size, std::uint64_t bound, const std::string& path,
+                              const std::string& what, bool stated) {
   LZ4F_dctx* raw = nullptr;
   if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION))) {
     throw FileError(path, "cannot start lz4 decompression");

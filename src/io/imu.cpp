@@ -114,10 +114,9 @@ ImuScreening ScreenImuSamples(std::vector<ImuSample>& samples, const ImuNoise& i
   samples.clear();
   for (std::size_t k = 0; k < kept.size(); ++k) {
     const bool inner = k > 0 && k + 1 < kept.size();
-    if (inner && (spike(kept[k - 1].angular_velocity, kept[k].angular_velocity, kept[k + 1].angular_velocity,
-                        imu.gyro_range) ||
-                  spike(kept[k - 1].specific_force, kept[k].specific_force, kept[k + 1].specific_force,
-                        imu.accel_range))) {
+    if (inner &&
+        (spike(kept[k - 1].angular_velocity, kept[k].angular_velocity, kept[k + 1].angular_velocity, imu.gyro_range) ||
+         spike(kept[k - 1].specific_force, kept[k].specific_force, kept[k + 1].specific_force, imu.accel_range))) {
       ++screening.spikes;
       continue;
     }

@@ -65,8 +65,8 @@ void TakeTile(const Json& tile, const std::string& dir, const std::string& path,
   if (!seen.insert(key).second) throw FileError(path, "tile " + file + " listed twice");
   std::error_code error;
   if (!fs::is_regular_file(fs::path(dir) / file, error)) {
-    throw FileError((fs::path(dir) / file).string(), "cannot open map tile (listed in " + std::string(kIndexName) +
-                                                         ", no such file)");
+    throw FileError((fs::path(dir) / file).string(),
+                    "cannot open map tile (listed in " + std::string(kIndexName) + ", no such file)");
   }
   index.keys.push_back(key);
   index.tile_gaussians.push_back(tile.at("gaussians").get<std::size_t>());
@@ -117,7 +117,8 @@ TileIndex ReadIndex(const std::string& dir) {
   // Places: each listed once; their count is that of the entries read, so
   // the check below allocates no more than the index holds.
   std::size_t listed = 0;
-  for (const std::vector<std::size_t>& places : index.tile_places) listed = CheckedSum(listed, places.size(), path, "places");
+  for (const std::vector<std::size_t>& places : index.tile_places)
+    listed = CheckedSum(listed, places.size(), path, "places");
   if (listed != index.places) {
     throw FileError(path, "lists " + std::to_string(listed) + " places in its tiles for " +
                               std::to_string(index.places) + " places");

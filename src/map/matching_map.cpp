@@ -76,7 +76,9 @@ const OptionTable<MatchingMapOptions>& MatchingMapOptionTable() {
             .In(kMinIndexCell, kMaxIndexCell)
             .Unit("m")
             .Help("cell of the exact level's spatial index"),
-        RADARGAUSS_OPTION(O, "coarse_gate", coarse_gate).In(kMinCoarseGate, kMaxCoarseGate).Help("tau on the coarse levels"),
+        RADARGAUSS_OPTION(O, "coarse_gate", coarse_gate)
+            .In(kMinCoarseGate, kMaxCoarseGate)
+            .Help("tau on the coarse levels"),
     };
   }();
   return table;

@@ -144,7 +144,8 @@ TEST(ImuScreening, DropsPlantedSpikesAndSamplesBeyondTheRange) {
   for (std::size_t k = 250; k < step.size(); ++k) step[k].specific_force.x() += 50.0;
   EXPECT_EQ(ScreenImuSamples(step, imu).spikes, 0u);
   std::vector<ImuSample> ramp = samples;  // 0, 45, 90 m/s^2 over three samples: steep, but motion
-  for (std::size_t k = 300; k < ramp.size(); ++k) ramp[k].specific_force.x() = 45.0 * double(std::min<std::size_t>(k - 299, 2));
+  for (std::size_t k = 300; k < ramp.size(); ++k)
+    ramp[k].specific_force.x() = 45.0 * double(std::min<std::size_t>(k - 299, 2));
   EXPECT_EQ(ScreenImuSamples(ramp, imu).spikes, 0u);
   std::vector<ImuSample> clean = samples;
   const ImuScreening none = ScreenImuSamples(clean, imu);

@@ -720,8 +720,7 @@ TEST_F(Rosbag2Files, ARunsCsvsAreReadIntoColumns) {
     ReadRunFolder(Path("run"));
     FAIL() << "a loop naming keyframe 'x' read";
   } catch (const DataError& e) {
-    EXPECT_NE(std::string(e.what()).find("loops.csv:2: column 'candidate' holds 'x', not a number"),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("loops.csv:2: column 'candidate' holds 'x', not a number"), std::string::npos)
         << e.what();
   }
 }

@@ -170,8 +170,11 @@ TEST_F(MapTiles, BrokenFoldersGiveClearErrors) {
   expect_error(with_index([&](nlohmann::json& j) { j["places"] = kMax; }), "places in its tiles for");
   expect_error(with_index([](nlohmann::json& j) {
                  for (int k = 0; k < 20000; ++k) {
-                   j["tiles"].push_back({{"x", 1000 + k}, {"y", 7}, {"file", "tile_" + std::to_string(1000 + k) + "_7.rgm"},
-                                         {"gaussians", 1}, {"places", nlohmann::json::array()}});
+                   j["tiles"].push_back({{"x", 1000 + k},
+                                         {"y", 7},
+                                         {"file", "tile_" + std::to_string(1000 + k) + "_7.rgm"},
+                                         {"gaussians", 1},
+                                         {"places", nlohmann::json::array()}});
                  }
                }),
                "tile_1000_7.rgm: cannot open map tile");

@@ -109,8 +109,7 @@ TEST(RadarInertialOdometry, GlitchedSamplesAreDroppedNotBelieved) {
   EXPECT_LT(ate, 1.2 * clean_ate + 0.01) << ate << " m against " << clean_ate << " m";
   // A value past any IMU (1e300) is refused, naming the sample.
   glitched[10].angular_velocity.z() = 1e300;
-  EXPECT_THROW(RadarInertialOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, glitched),
-               DataError);
+  EXPECT_THROW(RadarInertialOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, glitched), DataError);
   EXPECT_THROW(RadarInertialOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, {}), DataError);
 }
 
