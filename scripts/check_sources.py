@@ -8,15 +8,20 @@ that name the file, not failures: source files past about 400 lines and
 functions past about 80 usually want splitting, README.md past 200 lines and
 bench/RESULTS.md past 400 usually want a shorter text; a limit is never a
 target to trim to.
+Every C++ file of the source folders must be as clang-format (.clang-format)
+writes it.
   scripts/check_sources.py [ROOT]"""
 import pathlib
 import re
+import shutil
+import subprocess
 import sys
 
 import check_layers
 
 ROOT = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else pathlib.Path(__file__).parent.parent)
-SOURCE_DIRS = ["include", "src", "residuals", "solvers", "apps", "peers", "examples", "tests", "bench"]
+SOURCE_DIRS = ["include", "src", "residuals", "solvers", "apps", "peers", "examples", "tests", "bench", "python",
+               "fuzz"]
 PRODUCT_DIRS = SOURCE_DIRS + ["docs", "configs", "scripts", "cmake", ".ci"]
 MAX_FILE, MAX_FUNCTION, MAX_README, MAX_RESULTS = 400, 80, 200, 400
 # Words that narrate the making of the project instead of describing it,
@@ -83,6 +88,17 @@ def long_functions(path, lines):
     return found
 
 
+def unformatted(files):
+    """The C++ files clang-format would change, as problems (one run over all of them)."""
+    tool = shutil.which("clang-format")
+    if tool is None:
+        return ["clang-format not found (scripts/deps.sh installs it)"]
+    result = subprocess.run([tool, "--dry-run", "--Werror"] + [str(f) for f in files], capture_output=True, text=True)
+    changed = sorted({line.split(":", 1)[0] for line in result.stderr.splitlines() if ": error: code should be" in line})
+    return [f"{pathlib.Path(f).resolve().relative_to(ROOT.resolve())}: not as clang-format writes it "
+            "(clang-format -i)" for f in changed]
+
+
 def main():
     problems, warnings = [], []
     design = ROOT / "docs" / "design.md"
@@ -123,6 +139,8 @@ def main():
         if count > limit:
             warnings.append(f"{name}: {count} lines (about {limit} is what a reader takes in)")
     problems += check_layers.problems(ROOT.resolve())
+    problems += unformatted([p for folder in SOURCE_DIRS for p in (ROOT / folder).rglob("*")
+                             if p.suffix in {".cpp", ".hpp"} and "data" not in p.relative_to(ROOT).parts])
     for warning in warnings:
         print("warning:", warning)
     for problem in problems:

@@ -7,8 +7,8 @@
 set -euo pipefail
 
 packages=(
-  # toolchain
-  g++ make cmake pkg-config python3
+  # toolchain (clang-format: scripts/check_sources.py checks the layout)
+  g++ make cmake pkg-config python3 clang-format
   # core (docs/design.md, "Dependencies and pitfalls")
   libceres-dev libeigen3-dev libsuitesparse-dev libmetis-dev
   libyaml-cpp-dev liblzf-dev libcli11-dev nlohmann-json3-dev libtbb-dev zlib1g-dev
