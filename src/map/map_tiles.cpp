@@ -55,11 +55,23 @@ std::size_t CheckedSum(std::size_t a, std::size_t b, const std::string& path, co
   return a + b;
 }
 
+// A number of the index as a count or a tile coordinate: a whole number in
+// 64 bits. JSON gives a number past them as a double, whose conversion would
+// be undefined, so it is refused by its kind before it is read.
+std::size_t Count(const Json& value, const std::string& path, const char* what) {
+  if (!value.is_number_unsigned()) throw FileError(path, std::string(what) + " is not a whole number in [0, 2^64)");
+  return value.get<std::size_t>();
+}
+std::int64_t Coordinate(const Json& value, const std::string& path) {
+  if (!value.is_number_integer()) throw FileError(path, "a tile's x or y is not a whole number in 64 bits");
+  return value.get<std::int64_t>();
+}
+
 // One entry of "tiles", checked as it is parsed: its file named as its key
 // says, listed once, and present (so that a missing tile is named at once).
 void TakeTile(const Json& tile, const std::string& dir, const std::string& path, std::set<TileKey>& seen,
               TileIndex& index) {
-  const TileKey key(tile.at("x").get<std::int64_t>(), tile.at("y").get<std::int64_t>());
+  const TileKey key(Coordinate(tile.at("x"), path), Coordinate(tile.at("y"), path));
   const std::string file = tile.at("file").get<std::string>();
   if (file != TileFile(key)) throw FileError(path, "tile file '" + Printable(file) + "' unexpected");
   if (!seen.insert(key).second) throw FileError(path, "tile " + file + " listed twice");
@@ -69,8 +81,11 @@ void TakeTile(const Json& tile, const std::string& dir, const std::string& path,
                     "cannot open map tile (listed in " + std::string(kIndexName) + ", no such file)");
   }
   index.keys.push_back(key);
-  index.tile_gaussians.push_back(tile.at("gaussians").get<std::size_t>());
-  index.tile_places.push_back(tile.at("places").get<std::vector<std::size_t>>());
+  index.tile_gaussians.push_back(Count(tile.at("gaussians"), path, "a tile's Gaussian count"));
+  if (!tile.at("places").is_array()) throw FileError(path, "a tile's places are not a list");
+  std::vector<std::size_t> places;
+  for (const Json& place : tile.at("places")) places.push_back(Count(place, path, "a tile's place"));
+  index.tile_places.push_back(std::move(places));
 }
 
 // The index, parsed with memory bounded by its entries (each tile and order
@@ -91,14 +106,15 @@ TileIndex ReadIndex(const std::string& dir) {
         return false;
       }
       if (key == "order" && event == Json::parse_event_t::array_end) {
-        index.order.emplace_back(parsed.at(0).get<std::size_t>(), parsed.at(1).get<std::size_t>());
+        index.order.emplace_back(Count(parsed.at(0), path, "an order run's tile"),
+                                 Count(parsed.at(1), path, "an order run's count"));
         return false;
       }
       return true;
     });
     if (!json.at("tiles").is_array() || !json.at("order").is_array()) throw FileError(path, "malformed index");
     if (json.at("format").get<std::string>() != kFormat) throw FileError(path, "not an index of map tiles");
-    if (json.at("version").get<int>() != kMapTilesVersion) {
+    if (!json.at("version").is_number_integer() || json.at("version").get<std::int64_t>() != kMapTilesVersion) {
       throw FileError(path, "version " + json.at("version").dump() + " (this build reads " +
                                 std::to_string(kMapTilesVersion) + ")");
     }
@@ -109,8 +125,8 @@ TileIndex ReadIndex(const std::string& dir) {
     } catch (const std::invalid_argument& e) {
       throw FileError(path, e.what());
     }
-    index.gaussians = json.at("gaussians").get<std::size_t>();
-    index.places = json.at("places").get<std::size_t>();
+    index.gaussians = Count(json.at("gaussians"), path, "gaussians");
+    index.places = Count(json.at("places"), path, "places");
   } catch (const Json::exception& e) {
     throw FileError(path, std::string("malformed index: ") + e.what());
   }

@@ -166,6 +166,18 @@ TEST_F(MapTiles, BrokenFoldersGiveClearErrors) {
                }),
                "add up past 2^64");
   expect_error(with_index([](nlohmann::json& j) { j["tiles"].push_back(j["tiles"][0]); }), "listed twice");
+  // Numbers past 64 bits arrive as doubles: refused by their kind, never converted.
+  expect_error(
+      [&] {
+        std::string text = good.dump();
+        const std::size_t order = text.find("\"order\":[[");
+        text.insert(order + 10, "184467440737095516152,");
+        std::ofstream(index_path) << text;
+      },
+      "is not a whole number in [0, 2^64)");
+  expect_error(with_index([](nlohmann::json& j) { j["tiles"][0]["x"] = 1.5; }), "x or y is not a whole number");
+  expect_error(with_index([](nlohmann::json& j) { j["places"] = -1; }), "places is not a whole number");
+  expect_error(with_index([](nlohmann::json& j) { j["version"] = 1e30; }), "version");
   expect_error(with_index([](nlohmann::json& j) { j["places"] = 1000000000; }), "places in its tiles for 1000000000");
   expect_error(with_index([&](nlohmann::json& j) { j["places"] = kMax; }), "places in its tiles for");
   expect_error(with_index([](nlohmann::json& j) {
