@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # scripts/check_sources.py (its layer check, scripts/check_layers.py) passes
 # on the tree, and fails on a copy of it with one upward include planted (the
-# map layer including the odometry's header) and on a file in no layer.
+# map layer including the odometry's header), a line clang-format would
+# write otherwise, and a file in no layer.
 #   tests/tools/layers_test.sh <source root>
 set -euo pipefail
 root=$1
@@ -14,7 +15,7 @@ $check "$root" > "$tmp/tree.log" || { cat "$tmp/tree.log"; echo "FAIL: the tree 
 
 mkdir -p "$tmp/copy"
 for item in README.md CMakeLists.txt include src residuals solvers peers apps python examples bench docs scripts \
-            configs cmake .ci fuzz; do
+            configs cmake .ci fuzz .clang-format; do
   cp -r "$root/$item" "$tmp/copy/"
 done
 $check "$tmp/copy" > /dev/null || { echo "FAIL: the copy fails before a plant"; exit 1; }
@@ -35,6 +36,14 @@ if $check "$tmp/copy" > "$tmp/planted.log"; then
   echo "FAIL: an include of no file passed"; exit 1
 fi
 grep -qF "$expect" "$tmp/planted.log" || { cat "$tmp/planted.log"; echo "FAIL: not named: $expect"; exit 1; }
+cp "$root/include/radargauss/map/gaussian_map.hpp" "$planted"
+# A line clang-format would write otherwise.
+sed -i 's/^#pragma once$/#pragma once\nconstexpr  int kBadlySpaced = 1;/' "$planted"
+expect="include/radargauss/map/gaussian_map.hpp: not as clang-format writes it"
+if $check "$tmp/copy" > "$tmp/format.log"; then
+  echo "FAIL: an unformatted file passed"; exit 1
+fi
+grep -qF "$expect" "$tmp/format.log" || { cat "$tmp/format.log"; echo "FAIL: not named: $expect"; exit 1; }
 cp "$root/include/radargauss/map/gaussian_map.hpp" "$planted"
 echo '// SPDX-License-Identifier: BSD-3-Clause' > "$tmp/copy/include/radargauss/stray.hpp"
 if $check "$tmp/copy" > "$tmp/stray.log"; then
