@@ -23,11 +23,7 @@ namespace radargauss::cli {
 // The matcher of a map version: the Gaussian solvers, or a PCL peer over the
 // active map's points (RadarOdometry makes one per map version).
 MatcherFactory MatcherOf(const std::string& matcher) {
-  if (matcher == "gaussians") {
-    return [](const LocalMap&, const MatchOptions& match) {
-      return std::shared_ptr<const ScanMatcher>(MakeScanMatcher(match));
-    };
-  }
+  if (matcher == "gaussians") return GaussianMatcherFactory();
 #ifdef RADARGAUSS_HAVE_PCL
   const PclMethod method = matcher == "pcl-ndt" ? PclMethod::kNdt : PclMethod::kGicp;
   return [method](const LocalMap& map, const MatchOptions&) {

@@ -79,10 +79,13 @@ const OptionTable<OdometryOptions>& OdometryOptionTable() {
 
 void ValidateOptions(const OdometryOptions& o) { CheckOptions(OdometryOptionTable(), o); }
 
-RadarOdometry::RadarOdometry(const OdometryOptions& options)
-    : RadarOdometry(options, [](const LocalMap&, const MatchOptions& match) {
-        return std::shared_ptr<const ScanMatcher>(MakeScanMatcher(match));
-      }) {}
+MatcherFactory GaussianMatcherFactory() {
+  return [](const LocalMap&, const MatchOptions& match) {
+    return std::shared_ptr<const ScanMatcher>(MakeScanMatcher(match));
+  };
+}
+
+RadarOdometry::RadarOdometry(const OdometryOptions& options) : RadarOdometry(options, GaussianMatcherFactory()) {}
 
 RadarOdometry::RadarOdometry(const OdometryOptions& options, MatcherFactory factory)
     : options_(options),

@@ -140,6 +140,8 @@ using PoseFusion = std::function<SE3d(const ScanEstimate& estimate)>;
 // other matchers (the PCL peers) in the same loop, map policy and Doppler filter.
 using MatcherFactory =
     std::function<std::shared_ptr<const ScanMatcher>(const LocalMap& map, const MatchOptions& options)>;
+// The default: MakeScanMatcher(options), the Gaussian solvers.
+MatcherFactory GaussianMatcherFactory();
 
 class RadarOdometry {
  public:
