@@ -149,25 +149,30 @@ struct InertialWindow::Impl {
     return blocks;
   }
 
+  // Where the clock offset may lie with the window's oldest state and a
+  // newest at `newest`: within [-kMaxClockOffset, kMaxClockOffset] and
+  // within the IMU's samples at both ends, so that every term can be
+  // integrated at it. Empty (lowest > highest) when the data leaves no room.
+  std::pair<double, double> ClockOffsetBounds(double newest) const {
+    return {std::max(-kMaxClockOffset, imu.front().stamp - nodes.front().stamp),
+            std::min(kMaxClockOffset, imu.back().stamp - newest)};
+  }
+
   // Before a state at `stamp` is added: an offset at which its IMU interval
   // would pass the IMU's last sample is held at the largest the data covers
-  // (when that is within its bounds; otherwise the interval is refused as
-  // the data's fault), and the next Solve reads every term again at it.
+  // (when there is room; otherwise the interval is refused as the data's
+  // fault), and the next Solve reads every term again at it.
   void HoldClockOffsetFor(double stamp) {
-    const double lowest = std::max(-kMaxClockOffset, imu.front().stamp - nodes.front().stamp);
-    const double highest = std::min(kMaxClockOffset, imu.back().stamp - stamp);
+    const auto [lowest, highest] = ClockOffsetBounds(stamp);
     if (std::max(clock_offset[0], clock_linearisation) <= highest || highest < lowest) return;
     clock_offset[0] = std::min(clock_offset[0], highest);
     clock_linearisation = std::min(clock_linearisation, highest);
     clock_held = true;
   }
 
-  // The clock offset put back within [-kMaxClockOffset, kMaxClockOffset] and
-  // within what the IMU's samples cover at the window's ends (so that every
-  // term can be integrated again at it); whether it had left them.
+  // After a solve: the estimate put back within its bounds; whether it had left them.
   bool HoldClockOffsetInBounds() {
-    const double lowest = std::max(-kMaxClockOffset, imu.front().stamp - nodes.front().stamp);
-    const double highest = std::min(kMaxClockOffset, imu.back().stamp - nodes.back().stamp);
+    const auto [lowest, highest] = ClockOffsetBounds(nodes.back().stamp);
     double& offset = clock_offset[0];
     if (lowest > highest || (offset >= lowest && offset <= highest)) return false;
     offset = std::clamp(offset, lowest, highest);

@@ -136,9 +136,9 @@ bool HoldsProtectedInput(const fs::path& path) {
   return false;
 }
 
-}  // namespace
-
-void CheckOutputFile(const std::string& path) {
+// CheckOutputFile's checks but the trial: for a writer that creates the
+// file's temporary next, which is the trial.
+void CheckOutputTarget(const std::string& path) {
   if (path.empty()) throw DataError("an output file needs a name");
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
@@ -149,6 +149,12 @@ void CheckOutputFile(const std::string& path) {
   if (IsProtectedInput(path)) throw FileError(path, "is read by this run; an output never replaces an input");
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty() && !fs::is_directory(parent, error)) throw FileError(path, "its folder does not exist");
+}
+
+}  // namespace
+
+void CheckOutputFile(const std::string& path) {
+  CheckOutputTarget(path);
   TryCreating(TemporaryOf(path), path);
 }
 
@@ -167,7 +173,7 @@ void CheckOutputFolder(const std::string& path) {
 }
 
 std::string TemporaryFileFor(const std::string& path) {
-  CheckOutputFile(path);
+  CheckOutputTarget(path);
   RemoveStaleTemporaries(fs::path(path).parent_path());
   return TemporaryOf(path);
 }
@@ -238,9 +244,7 @@ void StagedFolder::Commit() {
 }
 
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write, bool binary) {
-  CheckOutputFile(path);
-  RemoveStaleTemporaries(fs::path(path).parent_path());
-  const std::string temporary = TemporaryOf(path);
+  const std::string temporary = TemporaryFileFor(path);
   try {
     {
       std::ofstream out(temporary, binary ? std::ios::out | std::ios::binary : std::ios::out);

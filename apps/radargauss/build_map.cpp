@@ -4,7 +4,6 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/map/map_file.hpp"
 
@@ -21,8 +20,6 @@ struct BuildMapSettings {
 
 int RunBuildMap(const BuildMapSettings& s) {
   if (s.sequence.ground_truth.empty()) throw DataError("build-map needs --gt");
-  CheckOutputFile(s.out);  // both destinations before the build writes either
-  if (!s.ply.empty()) CheckOutputFile(s.ply);
   const Sequence sequence = LoadSequence(s.sequence);
   const MapGeometry geometry = BuildGeometry(sequence, s.build, true);
   const GaussianMap map =

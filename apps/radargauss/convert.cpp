@@ -7,7 +7,6 @@
 
 #include "commands.hpp"
 #include "option_flags.hpp"
-#include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/ros2_messages.hpp"
@@ -46,7 +45,6 @@ int RunConvert(ConvertSettings s) {
                            : s.compression == "none" ? McapCompression::kNone
                                                      : McapCompression::kZstd;
   s.bag.mcap.chunked = !s.unchunked;
-  CheckOutputFile(s.out);
   // The topics written, checked before anything is read.
   CheckBagTopics(
       {{"--scan-topic", s.bag.scan_topic}, {"--imu-topic-out", s.bag.imu_topic}, {"--pose-topic", s.bag.pose_topic}});

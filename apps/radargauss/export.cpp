@@ -1,12 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss export: a results folder as an MCAP file a robotics viewer opens.
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 
 #include "commands.hpp"
-#include "radargauss/atomic_file.hpp"
 #include "radargauss/error.hpp"
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/run_mcap.hpp"
@@ -16,14 +14,15 @@ namespace radargauss::cli {
 void WriteRunForViewer(const std::string& run_folder, const std::vector<RadarScan>& scans,
                        const std::optional<Trajectory>& reference, const std::string& mcap) {
   RunForViewer run = ReadRunFolder(run_folder);
-  const auto fits = [](const std::vector<double>& stamps) {
-    return std::all_of(stamps.begin(), stamps.end(), FitsRosTime);
-  };
-  if (!fits(run.stamps)) throw FileError(run_folder, "its trajectory holds a stamp outside ROS's time (0 to 2^31 s)");
-  if (reference) {
-    for (const StampedPose& p : *reference) {
-      if (!FitsRosTime(p.time)) throw DataError("--gt: a stamp " + std::to_string(p.time) + " s outside ROS's time");
-    }
+  // Stamps ROS cannot hold, named before the file is begun.
+  for (const double stamp : run.stamps) {
+    if (!FitsRosTime(stamp))
+      throw FileError(run_folder,
+                      "its trajectory's stamp " + std::to_string(stamp) + " s does not fit ROS's time (0 to 2^31 s)");
+  }
+  for (std::size_t k = 0; reference && k < reference->size(); ++k) {
+    const double stamp = (*reference)[k].time;
+    if (!FitsRosTime(stamp)) throw DataError("--gt: stamp " + std::to_string(stamp) + " s does not fit ROS's time");
   }
   if (!scans.empty()) {
     // Each pose's scan by stamp (the TUM file holds 9 decimals); a pose without one shows none.
@@ -56,7 +55,6 @@ struct ExportSettings {
 };
 
 int RunExport(const ExportSettings& s) {
-  CheckOutputFile(s.mcap);
   std::vector<RadarScan> scans;
   if (!s.sequence.sequence_dir.empty() || !s.sequence.bag.empty()) {
     SequenceOptions scans_only = s.sequence;

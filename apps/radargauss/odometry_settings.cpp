@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <system_error>
 #include <utility>
 
@@ -177,11 +176,6 @@ RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs) {
 }
 
 StagedFolder RunFolder(const OdometrySettings& s, std::vector<std::string> outputs) {
-  if (!s.mcap.empty()) CheckOutputFile(s.mcap);
-  std::error_code error;
-  if (!s.sequence.sequence_dir.empty() && std::filesystem::equivalent(s.out, s.sequence.sequence_dir, error)) {
-    throw FileError(s.out, "is the sequence's own folder; refused as an output folder");
-  }
   outputs.insert(outputs.end(), {"evaluation.json", "evaluation.md"});
   return StagedFolder(s.out, std::move(outputs));
 }

@@ -39,7 +39,6 @@ int RunSimulate(const SimulateSettings& s) {
   if (!s.bag.empty() && extension != ".mcap" && extension != ".db3") {
     throw DataError("--mcap " + s.bag + ": name a .mcap or .db3 file");
   }
-  if (!s.bag.empty()) CheckOutputFile(s.bag);
   StagedFolder folder(s.out);  // with --force, the new scans replace the old ones whole
   const SimulatedSequence sequence = Simulate(config);
   WriteSimulatedSequence(folder.path(), sequence);

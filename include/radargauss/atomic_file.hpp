@@ -35,8 +35,9 @@ void CheckOutputFolder(const std::string& path);
 // The temporary name a writer that cannot go through WriteFileAtomically (a
 // sqlite3 database, a file written over a whole run) writes `path` under,
 // to rename it over `path` when complete: "<path>.radargauss-tmp.<pid>",
-// after CheckOutputFile(path); the temporaries beside it of processes that
-// have ended (killed during a write) are removed first.
+// after CheckOutputFile's checks (but its trial: creating the temporary is
+// one); the temporaries beside it of processes that have ended (killed
+// during a write) are removed first.
 std::string TemporaryFileFor(const std::string& path);
 
 // A results folder written whole: a command writes into path(), a staging
