@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "radargauss/lie/se3.hpp"
-#include "radargauss/sh.hpp"
+#include "radargauss/core/sh.hpp"
 
 namespace radargauss {
 namespace {

@@ -7,12 +7,12 @@
 #include <fstream>
 #include <random>
 
-#include "radargauss/doppler.hpp"
+#include "radargauss/core/doppler.hpp"
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/io/rosbag2.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 
 namespace radargauss {
 namespace {

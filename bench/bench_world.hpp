@@ -15,10 +15,10 @@
 #include <string>
 #include <type_traits>
 
-#include "radargauss/experiment.hpp"
+#include "radargauss/experiment/experiment.hpp"
 #include "radargauss/radargauss.hpp"
-#include "radargauss/simulator.hpp"
-#include "radargauss/stats.hpp"
+#include "radargauss/simulator/simulator.hpp"
+#include "radargauss/core/stats.hpp"
 
 namespace radargauss {
 

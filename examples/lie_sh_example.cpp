@@ -3,8 +3,8 @@
 #include <cstdio>
 
 #include "radargauss/lie/se3.hpp"
-#include "radargauss/sh.hpp"
-#include "radargauss/trajectory.hpp"
+#include "radargauss/core/sh.hpp"
+#include "radargauss/core/trajectory.hpp"
 
 int main() {
   using namespace radargauss;

@@ -12,8 +12,8 @@
 #include <sstream>
 
 #include "../apps/radargauss/yaml_config.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/experiment.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/experiment.hpp"
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/mcap.hpp"
 #include "radargauss/io/pcd.hpp"
@@ -21,9 +21,9 @@
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/map_tiles.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "radargauss/slam/place_recognition.hpp"
-#include "radargauss/trajectory.hpp"
+#include "radargauss/core/trajectory.hpp"
 
 namespace radargauss::fuzz {
 

@@ -10,7 +10,8 @@ import sys
 
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 ROW = re.compile(r"^\|\s*([a-z ]+?)\s*\|\s*((?:`[a-z_]+`,?\s*)+)\|", re.M)
-LIBRARY_DIRS = {"include/radargauss": "", "src": "", "residuals": "residuals/", "solvers": "solvers/"}
+# The sources mirror the headers: src/X.cpp belongs with include/radargauss/X.hpp.
+LIBRARY_DIRS = ("include/radargauss", "src")
 # Headers of the peers built outside CMake against their own trees (bench/*_peer.cpp).
 EXTERNAL = ("kiss_icp/", "small_gicp/")
 
@@ -34,9 +35,9 @@ def layer_of(name, layers):
 def library_name(root, path):
     """The radargauss/ name of a file of the library, or its top folder."""
     relative = path.relative_to(root).with_suffix("").as_posix()
-    for folder, prefix in LIBRARY_DIRS.items():
+    for folder in LIBRARY_DIRS:
         if relative.startswith(folder + "/"):
-            return prefix + relative[len(folder) + 1:]
+            return relative[len(folder) + 1:]
     return relative.split("/")[0]
 
 
@@ -49,8 +50,7 @@ def included_name(root, path, target):
 def problems(root):
     layers = read_layers(root)
     found = []
-    folders = [root / f for f in ["include", "src", "residuals", "solvers", "apps", "python", "peers", "bench",
-                                  "tests", "examples", "fuzz"]]
+    folders = [root / f for f in ["include", "src", "apps", "python", "bench", "tests", "examples", "fuzz"]]
     for path in sorted(p for folder in folders if folder.exists() for p in folder.rglob("*")
                        if p.suffix in {".hpp", ".cpp", ".h"}):
         own = layer_of(library_name(root, path), layers)

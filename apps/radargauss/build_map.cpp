@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/map/map_file.hpp"
 
 namespace radargauss::cli {

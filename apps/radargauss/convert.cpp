@@ -7,7 +7,7 @@
 
 #include "commands.hpp"
 #include "option_flags.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/io/rosbag2.hpp"

@@ -4,8 +4,8 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/evaluation.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 
 namespace radargauss::cli {
 

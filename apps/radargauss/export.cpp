@@ -5,9 +5,9 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/ros2_messages.hpp"
-#include "radargauss/run_mcap.hpp"
+#include "radargauss/experiment/run_mcap.hpp"
 
 namespace radargauss::cli {
 

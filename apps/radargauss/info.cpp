@@ -6,10 +6,10 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/rosbag.hpp"
-#include "radargauss/stats.hpp"
+#include "radargauss/core/stats.hpp"
 
 namespace radargauss::cli {
 

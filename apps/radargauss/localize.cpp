@@ -11,12 +11,12 @@
 
 #include "commands.hpp"
 #include "localize_settings.hpp"
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/experiment.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/experiment.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/map_tiles.hpp"
-#include "radargauss/progress.hpp"
+#include "radargauss/core/progress.hpp"
 #include "radargauss/solvers/factory.hpp"
 #ifdef RADARGAUSS_HAVE_PCL
 #include "radargauss/peers/pcl_peers.hpp"

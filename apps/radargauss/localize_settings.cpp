@@ -5,9 +5,9 @@
 #include <cstdio>
 
 #include "option_flags.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/experiment.hpp"
-#include "radargauss/names.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/experiment.hpp"
+#include "radargauss/core/names.hpp"
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/solvers/factory.hpp"
 

@@ -12,8 +12,8 @@
 
 #include "commands.hpp"
 #include "option_flags.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/read_file.hpp"
 #include "yaml_config.hpp"
 
 namespace {

@@ -6,10 +6,10 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/experiment.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/experiment.hpp"
+#include "radargauss/core/read_file.hpp"
 
 namespace radargauss::cli {
 

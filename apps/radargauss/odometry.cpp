@@ -8,11 +8,11 @@
 
 #include "commands.hpp"
 #include "odometry_settings.hpp"
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/evaluation.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/odometry/mounting.hpp"
-#include "radargauss/progress.hpp"
+#include "radargauss/core/progress.hpp"
 
 namespace radargauss::cli {
 

@@ -7,12 +7,12 @@
 #include <system_error>
 #include <utility>
 
-#include "radargauss/error.hpp"
-#include "radargauss/evaluation.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/io/sequence.hpp"
-#include "radargauss/names.hpp"
+#include "radargauss/core/names.hpp"
 #ifdef RADARGAUSS_HAVE_PCL
 #include "radargauss/peers/pcl_peers.hpp"
 #endif

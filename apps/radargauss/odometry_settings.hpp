@@ -11,12 +11,12 @@
 
 #include "commands.hpp"
 #include "option_flags.hpp"
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
-#include "radargauss/progress.hpp"
-#include "radargauss/trajectory.hpp"
+#include "radargauss/core/progress.hpp"
+#include "radargauss/core/trajectory.hpp"
 
 namespace radargauss::cli {
 

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "radargauss/options.hpp"
+#include "radargauss/core/options.hpp"
 
 namespace radargauss::cli {
 

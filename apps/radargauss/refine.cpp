@@ -7,9 +7,9 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/evaluation.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/solvers/joint_refinement.hpp"
 

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss::cli {
 

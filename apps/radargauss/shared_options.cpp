@@ -6,8 +6,8 @@
 
 #include "commands.hpp"
 #include "option_flags.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/progress.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/progress.hpp"
 
 namespace radargauss::cli {
 

@@ -6,10 +6,10 @@
 
 #include "commands.hpp"
 #include "option_flags.hpp"
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/rosbag2.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 
 namespace radargauss::cli {
 

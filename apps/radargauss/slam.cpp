@@ -10,12 +10,12 @@
 #include "commands.hpp"
 #include "odometry_settings.hpp"
 #include "option_flags.hpp"
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/evaluation.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/map_tiles.hpp"
-#include "radargauss/progress.hpp"
+#include "radargauss/core/progress.hpp"
 #include "radargauss/slam/radar_slam.hpp"
 
 namespace radargauss::cli {

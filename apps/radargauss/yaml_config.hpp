@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/yaml_file.hpp"
 
 namespace radargauss {

@@ -13,17 +13,17 @@
 
 #include <vector>
 
-#include "radargauss/error.hpp"
-#include "radargauss/evaluation.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/pipeline.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "radargauss/solvers/factory.hpp"
-#include "radargauss/trajectory.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/trajectory.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

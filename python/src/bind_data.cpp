@@ -7,10 +7,10 @@
 #include "bindings.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/rosbag2.hpp"
-#include "radargauss/run_mcap.hpp"
+#include "radargauss/experiment/run_mcap.hpp"
 #include "radargauss/io/sequence.hpp"
-#include "radargauss/simulator.hpp"
-#include "radargauss/trajectory.hpp"
+#include "radargauss/simulator/simulator.hpp"
+#include "radargauss/core/trajectory.hpp"
 
 namespace radargauss::python {
 

@@ -7,8 +7,8 @@
 
 #include "bindings.hpp"
 #include "option_fields.hpp"
-#include "radargauss/evaluation.hpp"
-#include "radargauss/experiment.hpp"
+#include "radargauss/experiment/evaluation.hpp"
+#include "radargauss/experiment/experiment.hpp"
 #include "radargauss/radargauss.hpp"
 
 namespace radargauss::python {

@@ -9,7 +9,7 @@
 #include "convert.hpp"
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/map/matching_map.hpp"
-#include "radargauss/trajectory.hpp"
+#include "radargauss/core/trajectory.hpp"
 
 namespace radargauss::python {
 

@@ -12,7 +12,7 @@
 #include <Eigen/Core>
 
 #include "radargauss/lie/se3.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss::python {
 

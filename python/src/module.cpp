@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "bindings.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "radargauss/names.hpp"
+#include "radargauss/core/names.hpp"
 
 namespace radargauss::python {
 

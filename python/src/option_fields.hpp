@@ -8,7 +8,7 @@
 #include <string>
 
 #include "convert.hpp"
-#include "radargauss/options.hpp"
+#include "radargauss/core/options.hpp"
 
 namespace radargauss::python {
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Bags of every kind behind one API (io/rosbag.hpp): ROS1 through its
 // library, ROS 2 through io/rosbag2.hpp and the CDR messages.
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/io/rosbag2.hpp"

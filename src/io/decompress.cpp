@@ -8,7 +8,7 @@
 #include <array>
 #include <memory>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss {
 

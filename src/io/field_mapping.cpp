@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss {
 

@@ -9,8 +9,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "radargauss/error.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/read_file.hpp"
 #include "radargauss/io/pcd.hpp"
 
 namespace radargauss {

@@ -7,9 +7,9 @@
 #include <utility>
 
 #include "decompress.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/mcap_records.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/read_file.hpp"
 
 namespace radargauss {
 

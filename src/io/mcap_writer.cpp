@@ -7,7 +7,7 @@
 #include <tuple>
 #include <utility>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/mcap.hpp"
 #include "radargauss/io/mcap_records.hpp"
 

@@ -13,9 +13,9 @@
 #include <iterator>
 #include <sstream>
 
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/read_file.hpp"
 #include "pcd_header.hpp"
 
 namespace radargauss {

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <sstream>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss::internal {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/rosbag.hpp"
 
 namespace radargauss {

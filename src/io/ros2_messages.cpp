@@ -6,7 +6,7 @@
 #include <map>
 #include <stdexcept>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss {
 

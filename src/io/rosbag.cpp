@@ -10,8 +10,8 @@
 #include <algorithm>
 #include <map>
 
-#include "radargauss/error.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/read_file.hpp"
 
 namespace radargauss {
 

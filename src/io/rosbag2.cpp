@@ -14,8 +14,8 @@
 
 #include "decompress.hpp"
 #include "sqlite_database.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/read_file.hpp"
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/io/yaml_file.hpp"
 

@@ -9,8 +9,8 @@
 #include <limits>
 #include <optional>
 
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/io/rosbag2.hpp"
 #include "sqlite_database.hpp"

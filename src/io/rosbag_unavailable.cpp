@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Built when Debian's ROS1 bag library is absent: the bag API says so.
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/rosbag.hpp"
 
 namespace radargauss {

@@ -7,10 +7,10 @@
 #include <filesystem>
 #include <sstream>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/pcd.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/read_file.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/io/rosbag2.hpp"
 

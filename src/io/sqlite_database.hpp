@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss {
 

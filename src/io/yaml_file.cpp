@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "radargauss/error.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/read_file.hpp"
 
 namespace radargauss {
 

@@ -14,7 +14,7 @@
 
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/matching_map.hpp"
-#include "radargauss/names.hpp"
+#include "radargauss/core/names.hpp"
 
 namespace radargauss {
 

@@ -13,8 +13,8 @@
 #include <Eigen/LU>
 #include <Eigen/Eigenvalues>
 
-#include "radargauss/error.hpp"
-#include "radargauss/names.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/names.hpp"
 
 namespace radargauss {
 

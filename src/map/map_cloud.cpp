@@ -3,7 +3,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss {
 

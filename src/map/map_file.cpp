@@ -15,9 +15,9 @@
 #include <Eigen/LU>
 #include <Eigen/Geometry>
 
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/read_file.hpp"
 
 namespace radargauss {
 

@@ -13,11 +13,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
-#include "radargauss/io/read_file.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/read_file.hpp"
 #include "radargauss/map/map_file.hpp"
-#include "radargauss/voxel_grid.hpp"
+#include "radargauss/core/voxel_grid.hpp"
 
 namespace radargauss {
 

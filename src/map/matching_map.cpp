@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "radargauss/map/builder.hpp"
-#include "radargauss/names.hpp"
+#include "radargauss/core/names.hpp"
 
 namespace radargauss {
 

@@ -3,7 +3,7 @@
 
 #include <utility>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss {
 

@@ -8,7 +8,7 @@
 
 #include <Eigen/QR>
 
-#include "radargauss/stats.hpp"
+#include "radargauss/core/stats.hpp"
 
 namespace radargauss {
 

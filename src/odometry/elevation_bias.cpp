@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "radargauss/stats.hpp"
+#include "radargauss/core/stats.hpp"
 
 namespace radargauss {
 

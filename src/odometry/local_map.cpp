@@ -7,7 +7,7 @@
 #include <unordered_map>
 
 #include "radargauss/map/map_cloud.hpp"
-#include "radargauss/names.hpp"
+#include "radargauss/core/names.hpp"
 
 namespace radargauss {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "radargauss/stats.hpp"
+#include "radargauss/core/stats.hpp"
 
 namespace radargauss {
 

@@ -9,13 +9,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/odometry/mounting.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
-#include "radargauss/stats.hpp"
+#include "radargauss/core/stats.hpp"
 
 namespace radargauss {
 

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss {
 

@@ -8,8 +8,8 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "radargauss/conventions.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/conventions.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss {
 

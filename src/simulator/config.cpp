@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The simulator's configuration file and outputs.
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -13,8 +13,8 @@
 #include <utility>
 #include <variant>
 
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/yaml_file.hpp"
 

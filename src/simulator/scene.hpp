@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 
 #include "radargauss/lie/se3.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 
 namespace radargauss::simulation {
 

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <random>
 
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "scene.hpp"
 
 namespace radargauss {

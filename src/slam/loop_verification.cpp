@@ -14,7 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "radargauss/map/matching_map.hpp"
-#include "radargauss/voxel_grid.hpp"
+#include "radargauss/core/voxel_grid.hpp"
 
 namespace radargauss {
 

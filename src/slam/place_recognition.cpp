@@ -8,8 +8,8 @@
 #include <unordered_set>
 #include <utility>
 
-#include "radargauss/names.hpp"
-#include "radargauss/voxel_grid.hpp"
+#include "radargauss/core/names.hpp"
+#include "radargauss/core/voxel_grid.hpp"
 
 namespace radargauss {
 

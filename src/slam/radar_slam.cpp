@@ -10,7 +10,7 @@
 #include <functional>
 #include <stdexcept>
 
-#include "radargauss/serial_worker.hpp"
+#include "radargauss/core/serial_worker.hpp"
 
 namespace radargauss {
 

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <unordered_set>
 
-#include "radargauss/voxel_grid.hpp"
+#include "radargauss/core/voxel_grid.hpp"
 
 namespace radargauss {
 

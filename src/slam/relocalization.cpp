@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/slam/radar_slam.hpp"
 
 namespace radargauss {

@@ -6,7 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "radargauss/names.hpp"
+#include "radargauss/core/names.hpp"
 
 namespace radargauss {
 

@@ -7,11 +7,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/map/pipeline.hpp"
 #include "radargauss/slam/radar_slam.hpp"
-#include "radargauss/stats.hpp"
+#include "radargauss/core/stats.hpp"
 
 namespace radargauss {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "radargauss/doppler.hpp"
+#include "radargauss/core/doppler.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/odometry/mounting.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "support/temp_dir.hpp"
 #include "support/test_util.hpp"
 

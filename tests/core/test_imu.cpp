@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "support/temp_dir.hpp"

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "radargauss/options.hpp"
+#include "radargauss/core/options.hpp"
 #include "radargauss/slam/radar_slam.hpp"
 #include "radargauss/slam/relocalization.hpp"
 

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace radargauss {

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "support/temp_dir.hpp"
 

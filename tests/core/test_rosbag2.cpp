@@ -20,12 +20,12 @@
 #include <map>
 #include <sstream>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/mcap.hpp"
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
-#include "radargauss/run_mcap.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/experiment/run_mcap.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "support/temp_dir.hpp"
 
 namespace radargauss {

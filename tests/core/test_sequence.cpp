@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "support/temp_dir.hpp"

@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-#include "radargauss/serial_worker.hpp"
+#include "radargauss/core/serial_worker.hpp"
 
 namespace radargauss {
 namespace {

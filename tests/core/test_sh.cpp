@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "radargauss/sh.hpp"
+#include "radargauss/core/sh.hpp"
 
 #include <ceres/jet.h>
 #include <gtest/gtest.h>

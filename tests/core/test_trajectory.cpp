@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "radargauss/trajectory.hpp"
+#include "radargauss/core/trajectory.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <fstream>
 #include <random>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "support/test_util.hpp"
 
 namespace radargauss {

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 
 namespace radargauss {
 namespace {

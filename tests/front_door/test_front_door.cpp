@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "radargauss/radargauss.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "support/scan_matching_fixtures.hpp"
 
 namespace radargauss {

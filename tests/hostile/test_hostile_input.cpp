@@ -16,16 +16,16 @@
 #include <stdexcept>
 #include <string>
 
-#include "radargauss/atomic_file.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/io/yaml_file.hpp"
 #include "radargauss/map/map_file.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "radargauss/map/matching_map.hpp"
-#include "radargauss/trajectory.hpp"
+#include "radargauss/core/trajectory.hpp"
 #include "support/temp_dir.hpp"
 
 namespace radargauss {

@@ -12,13 +12,13 @@
 #include <limits>
 #include <random>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/map/builder.hpp"
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/map/map_cloud.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/rcs_model.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "support/temp_dir.hpp"
 #include "support/map_fixtures.hpp"
 

@@ -14,7 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/map_tiles.hpp"
 #include "support/temp_dir.hpp"

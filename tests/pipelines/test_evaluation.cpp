@@ -7,8 +7,8 @@
 #include <cmath>
 #include <random>
 
-#include "radargauss/error.hpp"
-#include "radargauss/evaluation.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 #include "support/test_util.hpp"
 
 namespace radargauss {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "radargauss/experiment.hpp"
+#include "radargauss/experiment/experiment.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "radargauss/radargauss.hpp"
-#include "radargauss/simulator.hpp"
-#include "radargauss/trajectory.hpp"
+#include "radargauss/simulator/simulator.hpp"
+#include "radargauss/core/trajectory.hpp"
 #include "radargauss/solvers/gauss_newton.hpp"
 #include "support/temp_dir.hpp"
 

@@ -11,13 +11,13 @@
 #include <random>
 #include <vector>
 
-#include "radargauss/error.hpp"
-#include "radargauss/evaluation.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/map/builder.hpp"
 #include "radargauss/odometry/mounting.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "support/temp_dir.hpp"
 
 namespace radargauss {

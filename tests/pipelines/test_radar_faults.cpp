@@ -11,12 +11,12 @@
 #include <cmath>
 #include <vector>
 
-#include "radargauss/error.hpp"
-#include "radargauss/evaluation.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/odometry/elevation_bias.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "support/temp_dir.hpp"
 
 namespace radargauss {

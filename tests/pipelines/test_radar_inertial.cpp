@@ -5,10 +5,10 @@
 // and in SLAM's front end, and an IMU that ends before the scans refused.
 #include <gtest/gtest.h>
 
-#include "radargauss/error.hpp"
-#include "radargauss/evaluation.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "radargauss/slam/radar_slam.hpp"
 
 namespace radargauss {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "support/temp_dir.hpp"

@@ -10,7 +10,7 @@
 
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/sequence.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "support/temp_dir.hpp"
 
 namespace radargauss {

@@ -13,9 +13,9 @@
 #include <filesystem>
 #include <memory>
 
-#include "radargauss/evaluation.hpp"
-#include "radargauss/simulator.hpp"
-#include "radargauss/error.hpp"
+#include "radargauss/experiment/evaluation.hpp"
+#include "radargauss/simulator/simulator.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/map_tiles.hpp"
 #include "radargauss/slam/radar_slam.hpp"

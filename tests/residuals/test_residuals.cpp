@@ -14,13 +14,13 @@
 #include <limits>
 #include <random>
 
-#include "radargauss/experiment.hpp"
+#include "radargauss/experiment/experiment.hpp"
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/map/builder.hpp"
 #include "radargauss/map/map_cloud.hpp"
 #include "radargauss/map/rcs_model.hpp"
-#include "radargauss/sh.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/core/sh.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "radargauss/residuals/geometric_residual.hpp"
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/residuals/rcs_likelihood.hpp"

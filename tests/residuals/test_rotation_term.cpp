@@ -9,7 +9,7 @@
 #include <cmath>
 
 #include "radargauss/odometry/radar_odometry.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "support/scan_matching_fixtures.hpp"
 
 namespace radargauss {

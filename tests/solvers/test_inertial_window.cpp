@@ -12,9 +12,9 @@
 #include <cstdio>
 #include <random>
 
-#include "radargauss/error.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/residuals/radar_inertial_residuals.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 #include "radargauss/solvers/inertial_window.hpp"
 
 namespace radargauss {

@@ -3,9 +3,9 @@
 
 #include <gtest/gtest.h>
 
-#include "radargauss/experiment.hpp"
+#include "radargauss/experiment/experiment.hpp"
 #include "radargauss/map/map_cloud.hpp"
-#include "radargauss/simulator.hpp"
+#include "radargauss/simulator/simulator.hpp"
 
 namespace radargauss {
 namespace {

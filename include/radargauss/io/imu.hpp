@@ -14,7 +14,7 @@
 #include <Eigen/Core>
 
 #include "radargauss/lie/se3.hpp"
-#include "radargauss/options.hpp"
+#include "radargauss/core/options.hpp"
 
 namespace radargauss {
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "radargauss/io/field_mapping.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

@@ -15,7 +15,7 @@
 
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/field_mapping.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

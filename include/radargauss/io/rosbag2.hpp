@@ -17,7 +17,7 @@
 
 #include "radargauss/io/mcap.hpp"
 #include "radargauss/io/rosbag.hpp"
-#include "radargauss/trajectory.hpp"
+#include "radargauss/core/trajectory.hpp"
 
 namespace radargauss {
 

@@ -15,8 +15,8 @@
 
 #include "radargauss/io/field_mapping.hpp"
 #include "radargauss/lie/se3.hpp"
-#include "radargauss/trajectory.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/trajectory.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

@@ -8,7 +8,7 @@
 
 #include <cmath>
 
-#include "radargauss/conventions.hpp"
+#include "radargauss/core/conventions.hpp"
 #include "radargauss/lie/so3.hpp"
 
 namespace radargauss {

@@ -18,8 +18,8 @@
 #include <Eigen/Core>
 
 #include "radargauss/map/gaussian_map.hpp"
-#include "radargauss/options.hpp"
-#include "radargauss/voxel_grid.hpp"
+#include "radargauss/core/options.hpp"
+#include "radargauss/core/voxel_grid.hpp"
 
 namespace radargauss {
 

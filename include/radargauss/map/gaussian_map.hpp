@@ -12,10 +12,10 @@
 #include <Eigen/Core>
 
 #include "radargauss/lie/se3.hpp"
-#include "radargauss/linear_probing_table.hpp"
-#include "radargauss/sh.hpp"
-#include "radargauss/types.hpp"
-#include "radargauss/voxel_grid.hpp"
+#include "radargauss/core/linear_probing_table.hpp"
+#include "radargauss/core/sh.hpp"
+#include "radargauss/core/types.hpp"
+#include "radargauss/core/voxel_grid.hpp"
 
 namespace radargauss {
 

@@ -11,7 +11,7 @@
 
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/map/rcs_model.hpp"
-#include "radargauss/sh.hpp"
+#include "radargauss/core/sh.hpp"
 
 namespace radargauss {
 

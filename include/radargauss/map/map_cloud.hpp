@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "radargauss/doppler.hpp"
+#include "radargauss/core/doppler.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/lie/se3.hpp"
 

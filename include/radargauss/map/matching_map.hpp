@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "radargauss/map/gaussian_map.hpp"
-#include "radargauss/options.hpp"
+#include "radargauss/core/options.hpp"
 
 namespace radargauss {
 

@@ -22,7 +22,7 @@
 
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/map/map_cloud.hpp"
-#include "radargauss/options.hpp"
+#include "radargauss/core/options.hpp"
 
 namespace radargauss {
 

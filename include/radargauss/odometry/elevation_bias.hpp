@@ -20,8 +20,8 @@
 #include <Eigen/Core>
 
 #include "radargauss/lie/so3.hpp"
-#include "radargauss/options.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/options.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

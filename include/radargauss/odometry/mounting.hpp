@@ -15,7 +15,7 @@
 
 #include "radargauss/lie/so3.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
-#include "radargauss/trajectory.hpp"
+#include "radargauss/core/trajectory.hpp"
 
 namespace radargauss {
 

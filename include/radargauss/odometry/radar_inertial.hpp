@@ -21,7 +21,7 @@
 
 #include "radargauss/io/imu.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
-#include "radargauss/options.hpp"
+#include "radargauss/core/options.hpp"
 #include "radargauss/solvers/inertial_window.hpp"
 
 namespace radargauss {

@@ -22,13 +22,13 @@
 
 #include <Eigen/Core>
 
-#include "radargauss/doppler.hpp"
+#include "radargauss/core/doppler.hpp"
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/odometry/elevation_bias.hpp"
 #include "radargauss/odometry/local_map.hpp"
 #include "radargauss/solvers/factory.hpp"
-#include "radargauss/trajectory.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/trajectory.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

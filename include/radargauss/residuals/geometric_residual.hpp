@@ -42,7 +42,7 @@ class GeometricResidual {
   }
 
   using AutoDiff = ceres::AutoDiffCostFunction<GeometricResidual, 3, 4, 3>;
-  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
+  // Defined in src/residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const Eigen::Vector3d& point_radar, const Eigen::Vector3d& mean,
                                      const Eigen::Matrix3d& sqrt_information_t);
   // The same around a functor the caller keeps a pointer to (for Reset).

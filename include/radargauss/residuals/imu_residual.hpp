@@ -77,7 +77,7 @@ class ImuResidual {
   }
 
   using AutoDiff = ceres::AutoDiffCostFunction<ImuResidual, 15, 4, 3, 9, 4, 3, 9>;
-  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
+  // Defined in src/residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const ImuPreintegration& preintegration, const ImuNoise& noise,
                                      const Eigen::Vector3d& gravity = Eigen::Vector3d(0.0, 0.0, -kGravity));
 

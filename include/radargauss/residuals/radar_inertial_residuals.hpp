@@ -30,7 +30,7 @@
 
 #include <Eigen/Core>
 
-#include "radargauss/conventions.hpp"
+#include "radargauss/core/conventions.hpp"
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/residuals/imu_residual.hpp"
 
@@ -105,7 +105,7 @@ class RadarPoseResidual {
   }
 
   using AutoDiff = ceres::AutoDiffCostFunction<RadarPoseResidual, 6, 4, 3, 9, 4, 3, 2, 1>;
-  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
+  // Defined in src/residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const SE3d& measured, const Eigen::Matrix<double, 6, 6>& sqrt_information,
                                      const ImuAtScan& imu);
 
@@ -142,7 +142,7 @@ class RadarVelocityResidual {
   }
 
   using AutoDiff = ceres::AutoDiffCostFunction<RadarVelocityResidual, 3, 4, 9, 4, 3, 1, 1>;
-  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
+  // Defined in src/residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& sqrt_information,
                                      const ImuAtScan& imu, double elevation_bias_removed = 0.0);
 
@@ -171,7 +171,7 @@ class VehicleMotionResidual {
   }
 
   using AutoDiff = ceres::AutoDiffCostFunction<VehicleMotionResidual, 2, 4, 9>;
-  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
+  // Defined in src/residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(double sigma);
 
  private:

@@ -37,7 +37,7 @@
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/map/rcs_model.hpp"
 #include "radargauss/residuals/rcs_likelihood.hpp"
-#include "radargauss/sh.hpp"
+#include "radargauss/core/sh.hpp"
 #include "radargauss/residuals/quaternion_jacobians.hpp"
 
 namespace radargauss {
@@ -121,7 +121,7 @@ class RcsResidual {
   void Reset(const RcsTerm& term) { term_ = term; }
 
   using AutoDiff = ceres::AutoDiffCostFunction<RcsResidual, 1, 4, 3>;
-  static ceres::CostFunction* Create(const RcsTerm& term);                   // residuals/autodiff_costs.cpp
+  static ceres::CostFunction* Create(const RcsTerm& term);                   // src/residuals/autodiff_costs.cpp
   static ceres::CostFunction* Create(std::unique_ptr<RcsResidual> functor);  // kept by the caller for Reset
 
  private:

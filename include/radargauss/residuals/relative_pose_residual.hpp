@@ -14,7 +14,7 @@
 
 #include <Eigen/Core>
 
-#include "radargauss/conventions.hpp"
+#include "radargauss/core/conventions.hpp"
 #include "radargauss/lie/se3.hpp"
 
 namespace radargauss {
@@ -42,7 +42,7 @@ class RelativePoseResidual {
   }
 
   using AutoDiff = ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 4, 3, 4, 3>;
-  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
+  // Defined in src/residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const SE3d& measured, const Eigen::Matrix<double, 6, 6>& sqrt_information);
 
  private:

@@ -33,7 +33,7 @@ class RotationResidual {
   }
 
   using AutoDiff = ceres::AutoDiffCostFunction<RotationResidual, 3, 4>;
-  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
+  // Defined in src/residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const SO3d& predicted, const Eigen::Matrix3d& sqrt_information);
 
  private:

@@ -38,7 +38,7 @@ class VelocityResidual {
   }
 
   using AutoDiff = ceres::AutoDiffCostFunction<VelocityResidual, 3, 3>;
-  // Defined in residuals/autodiff_costs.cpp (docs/design.md, "Build").
+  // Defined in src/residuals/autodiff_costs.cpp (docs/design.md, "Build").
   static ceres::CostFunction* Create(const SE3d& previous, const Eigen::Vector3d& velocity, double dt,
                                      const Eigen::Matrix3d& sqrt_information);
 

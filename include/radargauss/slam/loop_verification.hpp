@@ -18,7 +18,7 @@
 #include "radargauss/map/builder.hpp"
 #include "radargauss/map/matching_map.hpp"
 #include "radargauss/solvers/factory.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

@@ -16,7 +16,7 @@
 
 #include <Eigen/Core>
 
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

@@ -17,11 +17,11 @@
 
 #include <Eigen/Core>
 
-#include "radargauss/options.hpp"
+#include "radargauss/core/options.hpp"
 #include "radargauss/slam/place_descriptor.hpp"
 #include "radargauss/slam/radon_descriptor.hpp"
 #include "radargauss/slam/scan_context.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "radargauss/slam/place_descriptor.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

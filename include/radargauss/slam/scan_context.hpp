@@ -14,7 +14,7 @@
 #include <Eigen/Core>
 
 #include "radargauss/slam/place_descriptor.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

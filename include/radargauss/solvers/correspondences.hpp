@@ -13,7 +13,7 @@
 #include "radargauss/residuals/priors.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
 #include "radargauss/solvers/scan_matcher.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

@@ -28,7 +28,7 @@
 
 #include "radargauss/io/imu.hpp"
 #include "radargauss/lie/se3.hpp"
-#include "radargauss/options.hpp"
+#include "radargauss/core/options.hpp"
 
 namespace radargauss {
 

@@ -18,11 +18,11 @@
 
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/map/matching_map.hpp"
-#include "radargauss/options.hpp"
+#include "radargauss/core/options.hpp"
 #include "radargauss/residuals/loss.hpp"
 #include "radargauss/residuals/priors.hpp"
 #include "radargauss/residuals/rcs_likelihood.hpp"
-#include "radargauss/types.hpp"
+#include "radargauss/core/types.hpp"
 
 namespace radargauss {
 

@@ -1,0 +1,495 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/solvers/inertial_window.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include <ceres/crs_matrix.h>
+#include <ceres/problem.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+
+#include "radargauss/core/error.hpp"
+#include "radargauss/lie/manifold.hpp"
+#include "radargauss/residuals/imu_preintegration.hpp"
+#include "radargauss/residuals/imu_residual.hpp"
+#include "radargauss/residuals/radar_inertial_residuals.hpp"
+#include "radargauss/residuals/rotation_residual.hpp"
+#include "radargauss/solvers/marginalization.hpp"
+#include "radargauss/solvers/window_solvers.hpp"
+
+namespace radargauss {
+
+namespace {
+
+constexpr double kClockRelinearisation = 0.002;  // s
+
+// W with W^T W = information, for a positive semi-definite information.
+Eigen::MatrixXd SqrtInformation(const Eigen::MatrixXd& information) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(0.5 * (information + information.transpose()));
+  const Eigen::VectorXd roots = eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  return roots.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+using CostPointer = std::shared_ptr<ceres::CostFunction>;
+
+// r_i = (x_i - mean_i) / sigma_i on one Euclidean block: the first state's
+// priors. (Not ceres::NormalPrior: its Eigen members are allocated inside
+// Debian's library and would be freed here, which the address sanitizer
+// refuses.)
+class DiagonalPrior final : public ceres::CostFunction {
+ public:
+  DiagonalPrior(const Eigen::VectorXd& mean, const Eigen::VectorXd& sigma)
+      : mean_(mean), weight_(sigma.cwiseInverse()) {
+    set_num_residuals(int(mean.size()));
+    mutable_parameter_block_sizes()->push_back(int(mean.size()));
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const Eigen::Map<const Eigen::VectorXd> x(parameters[0], mean_.size());
+    Eigen::Map<Eigen::VectorXd>(residuals, mean_.size()) = weight_.cwiseProduct(x - mean_);
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(jacobians[0], mean_.size(),
+                                                                                           mean_.size());
+      J = weight_.asDiagonal();
+    }
+    return true;
+  }
+
+ private:
+  Eigen::VectorXd mean_, weight_;
+};
+
+}  // namespace
+
+// One state and the terms that end at it.
+struct InertialWindow::Node {
+  double stamp = 0.0;
+  Eigen::Vector4d rotation = Eigen::Vector4d(0, 0, 0, 1);  // R_world_imu, x y z w
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 9, 1> motion = Eigen::Matrix<double, 9, 1>::Zero();  // v, b_g, b_a
+  std::optional<ImuPreintegration> from_previous;  // the IMU between the node before and this one
+  CostPointer imu, pose, velocity, vehicle;        // terms on this node (imu: from the one before)
+  // The measurements, kept to make their terms again at a new clock offset.
+  std::optional<std::pair<SE3d, Eigen::Matrix<double, 6, 6>>> pose_measurement;  // pose, W
+  struct VelocityMeasurement {
+    Eigen::Vector3d velocity;
+    Eigen::Matrix3d sqrt_information;
+    double elevation_bias_removed = 0.0;  // rad
+  };
+  std::optional<VelocityMeasurement> velocity_measurement;
+  std::vector<std::pair<CostPointer, std::vector<double*>>> first_priors;  // the first state's
+
+  InertialState State() const {
+    InertialState s;
+    s.stamp = stamp;
+    s.pose = SE3d(SO3d::FromXyzw(rotation.data()), position);
+    s.velocity = motion.segment<3>(kMotionVelocity);
+    s.bias.gyro = motion.segment<3>(kMotionGyroBias);
+    s.bias.accel = motion.segment<3>(kMotionAccelBias);
+    return s;
+  }
+  ImuBias Bias() const { return {motion.segment<3>(kMotionGyroBias), motion.segment<3>(kMotionAccelBias)}; }
+};
+
+struct InertialWindow::Impl {
+  std::deque<Node> nodes;  // a deque keeps the blocks' addresses as states come and go
+  std::vector<ImuSample> imu;
+  SO3Manifold so3;
+  Eigen::Vector4d extrinsic_rotation;  // R_imu_radar, x y z w
+  Eigen::Vector3d extrinsic_translation;
+  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
+  double clock_offset[1] = {0.0};    // t_d: the block
+  double clock_linearisation = 0.0;  // t_0: where the samples were read
+  bool clock_held = false;           // held at a bound since the last solve: every term read again
+  double elevation_bias[1] = {0.0};  // b: the block
+  std::shared_ptr<MarginalizationPrior> prior;
+
+  // The IMU's reading in force at a scan's stamp, at the clock offset t_0.
+  ImuAtScan ImuAt(double stamp) const {
+    const double t = stamp + clock_linearisation;
+    auto after =
+        std::upper_bound(imu.begin(), imu.end(), t, [](double s, const ImuSample& sample) { return s < sample.stamp; });
+    if (after != imu.begin()) --after;
+    if (after == imu.end()) throw DataError("no IMU sample at " + std::to_string(t) + " s");
+    return {after->angular_velocity, after->specific_force, clock_linearisation};
+  }
+  void MakeRadarTerms(Node& node) const {
+    if (node.pose_measurement) {
+      node.pose = std::make_shared<RadarPoseCostFunction>(node.pose_measurement->first, node.pose_measurement->second,
+                                                          ImuAt(node.stamp));
+    }
+    if (node.velocity_measurement) {
+      const Node::VelocityMeasurement& m = *node.velocity_measurement;
+      node.velocity = std::make_shared<RadarVelocityCostFunction>(m.velocity, m.sqrt_information, ImuAt(node.stamp),
+                                                                  m.elevation_bias_removed);
+    }
+  }
+
+  // The blocks the solvers move, in a fixed order.
+  std::vector<double*> VariableBlocks(const InertialWindowOptions& options) {
+    std::vector<double*> blocks;
+    for (Node& node : nodes) {
+      blocks.insert(blocks.end(), {node.rotation.data(), node.position.data(), node.motion.data()});
+    }
+    for (double* global : GlobalBlocks(options)) blocks.push_back(global);
+    return blocks;
+  }
+  std::vector<double*> GlobalBlocks(const InertialWindowOptions& options) {
+    std::vector<double*> blocks;
+    if (options.estimate_tilt) blocks.push_back(tilt.data());
+    if (options.estimate_extrinsic_rotation) blocks.push_back(extrinsic_rotation.data());
+    if (options.estimate_extrinsic_translation) blocks.push_back(extrinsic_translation.data());
+    if (options.estimate_clock_offset) blocks.push_back(clock_offset);
+    if (options.estimate_elevation_bias) blocks.push_back(elevation_bias);
+    return blocks;
+  }
+
+  // Where the clock offset may lie with the window's oldest state and a
+  // newest at `newest`: within [-kMaxClockOffset, kMaxClockOffset] and
+  // within the IMU's samples at both ends, so that every term can be
+  // integrated at it. Empty (lowest > highest) when the data leaves no room.
+  std::pair<double, double> ClockOffsetBounds(double newest) const {
+    return {std::max(-kMaxClockOffset, imu.front().stamp - nodes.front().stamp),
+            std::min(kMaxClockOffset, imu.back().stamp - newest)};
+  }
+
+  // Before a state at `stamp` is added: an offset at which its IMU interval
+  // would pass the IMU's last sample is held at the largest the data covers
+  // (when there is room; otherwise the interval is refused as the data's
+  // fault), and the next Solve reads every term again at it.
+  void HoldClockOffsetFor(double stamp) {
+    const auto [lowest, highest] = ClockOffsetBounds(stamp);
+    if (std::max(clock_offset[0], clock_linearisation) <= highest || highest < lowest) return;
+    clock_offset[0] = std::min(clock_offset[0], highest);
+    clock_linearisation = std::min(clock_linearisation, highest);
+    clock_held = true;
+  }
+
+  // After a solve: the estimate put back within its bounds; whether it had left them.
+  bool HoldClockOffsetInBounds() {
+    const auto [lowest, highest] = ClockOffsetBounds(nodes.back().stamp);
+    double& offset = clock_offset[0];
+    if (lowest > highest || (offset >= lowest && offset <= highest)) return false;
+    offset = std::clamp(offset, lowest, highest);
+    return true;
+  }
+
+  // Every term of the window in `problem`; the ids of those on the oldest state in `oldest_terms`.
+  void Build(ceres::Problem& problem, const InertialWindowOptions& options,
+             std::vector<ceres::ResidualBlockId>* oldest_terms) {
+    for (Node& node : nodes) {
+      problem.AddParameterBlock(node.rotation.data(), 4, &so3);
+      problem.AddParameterBlock(node.position.data(), 3);
+      problem.AddParameterBlock(node.motion.data(), 9);
+    }
+    problem.AddParameterBlock(extrinsic_rotation.data(), 4, &so3);
+    problem.AddParameterBlock(extrinsic_translation.data(), 3);
+    problem.AddParameterBlock(tilt.data(), 2);
+    problem.AddParameterBlock(clock_offset, 1);
+    problem.AddParameterBlock(elevation_bias, 1);
+    if (!options.estimate_clock_offset) problem.SetParameterBlockConstant(clock_offset);
+    if (!options.estimate_elevation_bias) problem.SetParameterBlockConstant(elevation_bias);
+    if (!options.estimate_extrinsic_rotation) problem.SetParameterBlockConstant(extrinsic_rotation.data());
+    if (!options.estimate_extrinsic_translation) problem.SetParameterBlockConstant(extrinsic_translation.data());
+    if (!options.estimate_tilt) problem.SetParameterBlockConstant(tilt.data());
+    std::vector<ceres::ResidualBlockId> ids;  // the terms on the oldest state
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      Node& node = nodes[k];
+      const auto on_oldest = [&](ceres::ResidualBlockId id, bool touches_oldest) {
+        if (touches_oldest) ids.push_back(id);
+      };
+      for (auto& [cost, blocks] : node.first_priors) {
+        on_oldest(problem.AddResidualBlock(cost.get(), nullptr, blocks), k == 0);
+      }
+      if (node.pose) {
+        on_oldest(problem.AddResidualBlock(
+                      node.pose.get(), nullptr,
+                      {node.rotation.data(), node.position.data(), node.motion.data(), extrinsic_rotation.data(),
+                       extrinsic_translation.data(), tilt.data(), clock_offset}),
+                  k == 0);
+      }
+      if (node.velocity) {
+        on_oldest(problem.AddResidualBlock(node.velocity.get(), nullptr,
+                                           {node.rotation.data(), node.motion.data(), extrinsic_rotation.data(),
+                                            extrinsic_translation.data(), clock_offset, elevation_bias}),
+                  k == 0);
+      }
+      if (node.vehicle) {
+        on_oldest(problem.AddResidualBlock(node.vehicle.get(), nullptr, node.rotation.data(), node.motion.data()),
+                  k == 0);
+      }
+      if (k > 0 && node.imu) {
+        Node& before = nodes[k - 1];
+        on_oldest(problem.AddResidualBlock(node.imu.get(), nullptr,
+                                           {before.rotation.data(), before.position.data(), before.motion.data(),
+                                            node.rotation.data(), node.position.data(), node.motion.data()}),
+                  k == 1);
+      }
+    }
+    if (prior) ids.push_back(problem.AddResidualBlock(prior.get(), nullptr, prior->parameter_blocks()));
+    if (oldest_terms != nullptr) *oldest_terms = ids;
+  }
+};
+
+InertialWindow::InertialWindow(const InertialWindowOptions& options, const SE3d& radar_from_imu)
+    : options_(options), impl_(std::make_unique<Impl>()) {
+  CheckOptions(InertialWindowOptionTable(), options);
+  const SE3d imu_from_radar = radar_from_imu.Inverse();
+  impl_->extrinsic_rotation = imu_from_radar.rotation().quaternion().coeffs();
+  impl_->extrinsic_translation = imu_from_radar.translation();
+  impl_->clock_offset[0] = impl_->clock_linearisation = options.clock_offset;
+}
+
+InertialWindow::~InertialWindow() = default;
+
+void InertialWindow::AddImu(const std::vector<ImuSample>& samples) {
+  std::vector<ImuSample>& imu = impl_->imu;
+  for (const ImuSample& sample : samples) {
+    if (!imu.empty() && !(sample.stamp > imu.back().stamp)) {
+      throw DataError("IMU sample at " + std::to_string(sample.stamp) + " s does not follow the one at " +
+                      std::to_string(imu.back().stamp) + " s");
+    }
+    imu.push_back(sample);
+  }
+}
+
+void InertialWindow::Start(const InertialState& state) {
+  if (!impl_->nodes.empty()) throw std::logic_error("InertialWindow::Start: the window has started");
+  if (!state.pose.translation().allFinite() || !state.pose.rotation().quaternion().coeffs().allFinite() ||
+      !state.velocity.allFinite() || !state.bias.gyro.allFinite() || !state.bias.accel.allFinite() ||
+      !std::isfinite(state.stamp)) {
+    throw std::invalid_argument("InertialWindow::Start: the first state is not finite");
+  }
+  Node node;
+  node.stamp = state.stamp;
+  node.rotation = state.pose.rotation().quaternion().coeffs();
+  node.position = state.pose.translation();
+  node.motion << state.velocity, state.bias.gyro, state.bias.accel;
+  if (options_.vehicle_motion_std > 0.0) {
+    node.vehicle = std::make_shared<VehicleMotionCostFunction>(options_.vehicle_motion_std);
+  }
+  impl_->nodes.push_back(node);
+  Node& first = impl_->nodes.back();
+  // Biases about zero, the velocity about the start's; the tilt and the clock offset about their starts.
+  Eigen::Matrix<double, 9, 1> sigmas;
+  sigmas << Eigen::Vector3d::Constant(options_.velocity_prior), Eigen::Vector3d::Constant(options_.gyro_bias_prior),
+      Eigen::Vector3d::Constant(options_.accel_bias_prior);
+  Eigen::Matrix<double, 9, 1> mean;
+  mean << state.velocity, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero();
+  first.first_priors.push_back({std::make_shared<DiagonalPrior>(mean, sigmas), {first.motion.data()}});
+  if (options_.estimate_clock_offset) {
+    // Unobservable while the drive is straight and even: held near its start until it turns.
+    constexpr double kClockPrior = 0.05;  // s
+    first.first_priors.push_back({std::make_shared<DiagonalPrior>(Eigen::VectorXd::Constant(1, impl_->clock_offset[0]),
+                                                                  Eigen::VectorXd::Constant(1, kClockPrior)),
+                                  {impl_->clock_offset}});
+  }
+  if (options_.estimate_extrinsic_rotation) {
+    constexpr double kExtrinsicRotationPrior = 3.0 * M_PI / 180.0;  // rad: a mounting is known to a few degrees
+    const RotationPrior prior{SO3d::FromXyzw(impl_->extrinsic_rotation.data()),
+                              Eigen::Matrix3d::Identity() / kExtrinsicRotationPrior};
+    first.first_priors.push_back({std::make_shared<RotationCostFunction>(prior), {impl_->extrinsic_rotation.data()}});
+  }
+  if (options_.estimate_elevation_bias) {
+    constexpr double kElevationBiasPrior = 2.0 * M_PI / 180.0;  // rad: a radar's bias is a fraction of a degree
+    first.first_priors.push_back(
+        {std::make_shared<DiagonalPrior>(Eigen::VectorXd::Constant(1, impl_->elevation_bias[0]),
+                                         Eigen::VectorXd::Constant(1, kElevationBiasPrior)),
+         {impl_->elevation_bias}});
+  }
+  if (options_.estimate_tilt) {
+    constexpr double kTiltPrior = 0.1;  // rad: the start's tilt from the accelerometer is this good at worst
+    first.first_priors.push_back(
+        {std::make_shared<DiagonalPrior>(impl_->tilt, Eigen::Vector2d::Constant(kTiltPrior)), {impl_->tilt.data()}});
+  }
+}
+
+void InertialWindow::AddState(double stamp) {
+  if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::AddState before Start");
+  const Node& last = impl_->nodes.back();
+  if (!(stamp > last.stamp)) {
+    throw DataError("state at " + std::to_string(stamp) + " s does not follow the one at " +
+                    std::to_string(last.stamp) + " s");
+  }
+  if (options_.estimate_clock_offset) impl_->HoldClockOffsetFor(stamp);
+  const double t0 = impl_->clock_linearisation;
+  const ImuPreintegration between = Preintegrate(impl_->imu, last.stamp + t0, stamp + t0, last.Bias(), options_.noise);
+  // The prediction (imu_preintegration.hpp's model) is the new state's start.
+  const SE3d pose = last.State().pose;
+  const ImuDelta& d = between.delta();
+  const Eigen::Vector3d g(0.0, 0.0, -kGravity), v = last.motion.segment<3>(kMotionVelocity);
+  Node node;
+  node.stamp = stamp;
+  node.rotation = (pose.rotation() * d.rotation).quaternion().coeffs();
+  node.position =
+      pose.translation() + v * d.duration + 0.5 * g * d.duration * d.duration + pose.rotation() * d.position;
+  node.motion = last.motion;
+  node.motion.segment<3>(kMotionVelocity) = v + g * d.duration + pose.rotation() * d.velocity;
+  node.from_previous = between;
+  node.imu = std::make_shared<ImuCostFunction>(between, options_.noise);
+  if (options_.vehicle_motion_std > 0.0) {
+    node.vehicle = std::make_shared<VehicleMotionCostFunction>(options_.vehicle_motion_std);
+  }
+  impl_->nodes.push_back(std::move(node));
+}
+
+void InertialWindow::AddPose(const SE3d& world_from_radar, const Eigen::Matrix<double, 6, 6>& information) {
+  if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::AddPose before Start");
+  if (!world_from_radar.translation().allFinite() || !world_from_radar.rotation().quaternion().coeffs().allFinite() ||
+      !information.allFinite()) {
+    throw std::invalid_argument("InertialWindow::AddPose: a pose or information that is not finite");
+  }
+  Node& node = impl_->nodes.back();
+  node.pose_measurement = std::make_pair(world_from_radar, Eigen::Matrix<double, 6, 6>(SqrtInformation(information)));
+  impl_->MakeRadarTerms(node);
+}
+
+void InertialWindow::AddVelocity(const Eigen::Vector3d& radar_velocity, const Eigen::Matrix3d& covariance,
+                                 double elevation_bias_removed) {
+  if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::AddVelocity before Start");
+  if (!radar_velocity.allFinite() || !covariance.allFinite() || !std::isfinite(elevation_bias_removed)) {
+    throw std::invalid_argument("InertialWindow::AddVelocity: a velocity or covariance that is not finite");
+  }
+  const Eigen::LLT<Eigen::Matrix3d> factor(covariance);
+  if (factor.info() != Eigen::Success) throw std::invalid_argument("AddVelocity: covariance not positive definite");
+  Node& node = impl_->nodes.back();
+  node.velocity_measurement = Node::VelocityMeasurement{
+      radar_velocity, SqrtInformation(factor.solve(Eigen::Matrix3d::Identity())), elevation_bias_removed};
+  impl_->MakeRadarTerms(node);
+}
+
+std::size_t InertialWindow::size() const { return impl_->nodes.size(); }
+InertialState InertialWindow::state(std::size_t index) const { return impl_->nodes.at(index).State(); }
+InertialState InertialWindow::newest() const { return impl_->nodes.back().State(); }
+Eigen::Vector2d InertialWindow::tilt() const { return impl_->tilt; }
+double InertialWindow::clock_offset() const { return impl_->clock_offset[0]; }
+double InertialWindow::elevation_bias() const { return impl_->elevation_bias[0]; }
+void InertialWindow::set_tilt(const Eigen::Vector2d& roll_pitch) { impl_->tilt = roll_pitch; }
+
+SE3d InertialWindow::radar_from_imu() const {
+  return SE3d(SO3d::FromXyzw(impl_->extrinsic_rotation.data()), impl_->extrinsic_translation).Inverse();
+}
+
+SE3d InertialWindow::RadarPoseInMatcherWorld() const {
+  const SE3d tilt(TiltRotation(impl_->tilt.data()), Eigen::Vector3d::Zero());
+  return tilt * newest().pose * radar_from_imu().Inverse();
+}
+
+namespace {
+
+ceres::Problem::Options BorrowingProblem() {
+  ceres::Problem::Options options;
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return options;
+}
+
+}  // namespace
+
+WindowSolveSummary InertialWindow::Solve() {
+  const auto start = std::chrono::steady_clock::now();
+  if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::Solve before Start");
+  std::deque<Node>& nodes = impl_->nodes;
+  while (nodes.size() > options_.size) RemoveOldest();
+  // A clock offset moved past kClockRelinearisation: every term read again
+  // at it (the terms' first-order move d stays small).
+  const double t0 = impl_->clock_offset[0];
+  const bool clock_moved = std::abs(t0 - impl_->clock_linearisation) > kClockRelinearisation || impl_->clock_held;
+  if (clock_moved) {
+    impl_->clock_linearisation = t0;
+    for (Node& node : nodes) impl_->MakeRadarTerms(node);
+  }
+  // The IMU terms whose bias moved past the first-order correction (or whose
+  // clock did), integrated again.
+  std::size_t reintegrated = 0;
+  for (std::size_t k = 1; k < nodes.size(); ++k) {
+    Node& node = nodes[k];
+    if (!node.from_previous || (!clock_moved && node.from_previous->WithinCorrection(nodes[k - 1].Bias()))) continue;
+    node.from_previous = Preintegrate(impl_->imu, nodes[k - 1].stamp + impl_->clock_linearisation,
+                                      node.stamp + impl_->clock_linearisation, nodes[k - 1].Bias(), options_.noise);
+    node.imu = std::make_shared<ImuCostFunction>(*node.from_previous, options_.noise);
+    ++reintegrated;
+  }
+  ceres::Problem problem(BorrowingProblem());
+  impl_->Build(problem, options_, nullptr);
+  WindowSolveSummary summary =
+      options_.solver == WindowSolver::kGaussNewton
+          ? SolveWithGaussNewton(problem, impl_->VariableBlocks(options_), options_.max_iterations)
+          : SolveWithCeres(problem, options_);
+  summary.reintegrated = reintegrated;
+  const bool held_after = options_.estimate_clock_offset && impl_->HoldClockOffsetInBounds();
+  summary.clock_offset_held = std::exchange(impl_->clock_held, false) || held_after;
+  summary.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+WindowUncertainty InertialWindow::Uncertainty() const {
+  if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::Uncertainty before Start");
+  ceres::Problem problem(BorrowingProblem());
+  impl_->Build(problem, options_, nullptr);
+  const std::vector<double*> blocks = impl_->VariableBlocks(options_);
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = blocks;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+  const Eigen::MatrixXd J = DenseJacobian(crs);
+  const Eigen::MatrixXd covariance = (J.transpose() * J).completeOrthogonalDecomposition().pseudoInverse();
+  // The tangent offset of each block, in VariableBlocks' order.
+  std::vector<int> offset(blocks.size() + 1, 0);
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const ceres::Manifold* manifold = problem.GetManifold(blocks[b]);
+    offset[b + 1] = offset[b] + (manifold ? manifold->TangentSize() : problem.ParameterBlockSize(blocks[b]));
+  }
+  const auto std_of = [&](std::size_t block, int first, int n) {
+    Eigen::VectorXd s(n);
+    for (int i = 0; i < n; ++i)
+      s(i) = std::sqrt(std::max(0.0, covariance(offset[block] + first + i, offset[block] + first + i)));
+    return s;
+  };
+  WindowUncertainty u;
+  const std::size_t motion = 3 * impl_->nodes.size() - 1;  // the newest state's [v; b_g; b_a]
+  u.velocity = std_of(motion, kMotionVelocity, 3);
+  u.gyro_bias = std_of(motion, kMotionGyroBias, 3);
+  u.accel_bias = std_of(motion, kMotionAccelBias, 3);
+  std::size_t global = 3 * impl_->nodes.size();
+  if (options_.estimate_tilt) u.tilt = std_of(global++, 0, 2);
+  if (options_.estimate_extrinsic_rotation) u.extrinsic_rotation = std_of(global++, 0, 3);
+  if (options_.estimate_extrinsic_translation) u.extrinsic_translation = std_of(global++, 0, 3);
+  if (options_.estimate_clock_offset) u.clock_offset = std_of(global++, 0, 1)(0);
+  if (options_.estimate_elevation_bias) u.elevation_bias = std_of(global++, 0, 1)(0);
+  return u;
+}
+
+// The oldest state leaves: its terms become a prior on what they share with
+// the rest (the next state and the estimated globals), or are dropped.
+void InertialWindow::RemoveOldest() {
+  std::deque<Node>& nodes = impl_->nodes;
+  if (options_.marginalize && nodes.size() > 1) {
+    ceres::Problem problem(BorrowingProblem());
+    std::vector<ceres::ResidualBlockId> terms;
+    impl_->Build(problem, options_, &terms);
+    Node& oldest = nodes.front();
+    Node& next = nodes[1];
+    std::vector<double*> kept = {next.rotation.data(), next.position.data(), next.motion.data()};
+    for (double* global : impl_->GlobalBlocks(options_)) kept.push_back(global);
+    impl_->prior =
+        Marginalize(problem, terms, {oldest.rotation.data(), oldest.position.data(), oldest.motion.data()}, kept);
+  }
+  // The IMU samples before the new oldest state are not needed any more.
+  const double keep_from = nodes[1].stamp + impl_->clock_linearisation - 0.2;  // room for the offset to move
+  nodes.pop_front();
+  nodes.front().from_previous.reset();
+  nodes.front().imu.reset();
+  std::vector<ImuSample>& imu = impl_->imu;
+  auto first_needed = std::upper_bound(imu.begin(), imu.end(), keep_from,
+                                       [](double t, const ImuSample& sample) { return t < sample.stamp; });
+  if (first_needed != imu.begin()) --first_needed;
+  imu.erase(imu.begin(), first_needed);
+}
+
+}  // namespace radargauss
