@@ -11,7 +11,8 @@
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/io/rosbag.hpp"
-#include "radargauss/io/rosbag2.hpp"
+#include "radargauss/io/bag_reader.hpp"
+#include "radargauss/io/bag_writer.hpp"
 #include "radargauss/simulator/simulator.hpp"
 
 namespace radargauss {
@@ -134,6 +135,40 @@ void BM_ReadRos2Bag(benchmark::State& state) {
       benchmark::Counter(double(fs::file_size(bag)) * double(state.iterations()) / 1e6, benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_ReadRos2Bag)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
+
+// The demo's drive with a 200 Hz IMU (120 scans) as `convert` writes it
+// (zstd chunks of 1 MiB, scans and IMU interleaved by time), read through
+// the bag reader: 0 the IMU alone, 1 the scans of the first 2 s, 2
+// everything. Counters: the chunks decompressed and skipped per read.
+void BM_ReadBagFiltered(benchmark::State& state) {
+  static const std::string bag = [] {
+    SimulationConfig config;
+    config.scans = 120;
+    config.imu_rate_hz = 200.0;
+    const SimulatedSequence drive = Simulate(config);
+    const std::string path = (fs::temp_directory_path() / "radargauss_bench_io_filtered.mcap").string();
+    WriteRos2Bag(path, BagFormat::kMcap, drive.scans, drive.imu, &drive.ground_truth);
+    return path;
+  }();
+  BagReadOptions options;
+  const std::unique_ptr<BagReader> probe = OpenBag(bag);
+  std::int64_t first = 0;
+  probe->Read({{"/radar/points"}}, [&](const BagMessage& m) { first = first == 0 ? m.log_time : first; });
+  if (state.range(0) == 0) options.topics = {"/imu/data"};
+  if (state.range(0) == 1) options = {{"/radar/points"}, first, first + 2'000'000'000};
+  std::size_t messages = 0;
+  BagReadStatistics last;
+  for (auto _ : state) {
+    const std::unique_ptr<BagReader> reader = OpenBag(bag);
+    reader->Read(options, [&](const BagMessage&) { ++messages; });
+    last = reader->statistics();
+  }
+  state.SetLabel(state.range(0) == 0 ? "IMU alone" : state.range(0) == 1 ? "scans of 2 s" : "everything");
+  state.counters["chunks read"] = double(last.chunks_read);
+  state.counters["chunks skipped"] = double(last.chunks_skipped);
+  state.counters["messages"] = double(messages) / double(state.iterations());
+}
+BENCHMARK(BM_ReadBagFiltered)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 
 void BM_EgoVelocity800(benchmark::State& state) {
   const RadarScan& scan = BenchmarkScan();

@@ -148,12 +148,18 @@ void PointCloud2(const std::uint8_t* data, std::size_t size) {
   Expecting([&] { DecodePointCloud2(cloud, 1702450000.5, FieldMapping(), "message"); });
 }
 
-// An MCAP file, every message visited (chunks decompressed, CRCs checked).
+// An MCAP file, every message visited (chunks decompressed, CRCs checked),
+// then read again through its chunk index, filtered as a bag's IMU is.
 void Mcap(const std::uint8_t* data, std::size_t size) {
   const std::string path = WriteInput(data, size, "bag.mcap");
   Expecting([&] {
     McapReader reader(path);
     reader.ForEachMessage([](const McapMessage&) {});
+  });
+  Expecting([&] {
+    McapReader reader(path);
+    const std::string topic = reader.channels().empty() ? "/imu" : reader.channels().back().topic;
+    reader.Read({{topic}, 1, ~0ull - 1}, [](const McapMessage&) {});
   });
 }
 

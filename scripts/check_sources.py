@@ -33,7 +33,8 @@ PROCESS_WORDS = re.compile(
     r"(s[e]ssion|r[o]und|p[a]ss of the work)|previously m[e]asured|used t[o] be|no l[o]nger|was b[e]fore)\b",
     re.IGNORECASE)
 COMMIT_HASH = re.compile(r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}\b")
-DESIGN_CITATION = re.compile(r'docs/design\.md,?\s*(?:section\s*)?"([^"]+)"')
+# A citation: docs/design.md or docs/design/<layer>.md, then one of its headings in quotes.
+DESIGN_CITATION = re.compile(r'(docs/design(?:/[a-z_]+)?\.md),?\s*(?:section\s*)?\\?"([^"\\]+)\\?"')
 CONTROL = re.compile(r"^\s*(if|for|while|switch|catch|do|else|try)\b|\]\s*\(|=\s*\[|return \[")
 
 
@@ -101,10 +102,10 @@ def unformatted(files):
 
 def main():
     problems, warnings = [], []
-    design = ROOT / "docs" / "design.md"
-    headings = set()
-    if design.exists():
-        headings = {h.strip() for h in re.findall(r"^#+\s*(?:\d+(?:\.\d+)*\.?\s*)?(.+)$", design.read_text(), re.M)}
+    headings = {}  # design file -> its headings
+    for design in [ROOT / "docs" / "design.md"] + sorted((ROOT / "docs" / "design").glob("*.md")):
+        headings[design.relative_to(ROOT).as_posix()] = {
+            h.strip() for h in re.findall(r"^#+\s*(?:\d+(?:\.\d+)*\.?\s*)?(.+)$", design.read_text(), re.M)}
     for path in product_files():
         relative = path.relative_to(ROOT)
         try:
@@ -114,10 +115,10 @@ def main():
         lines = text.split("\n")
         # Citations may wrap over comment lines.
         joined = re.sub(r"\n\s*(//|#)\s*", " ", text)
-        for section in DESIGN_CITATION.findall(joined):
+        for cited, section in DESIGN_CITATION.findall(joined):
             section = " ".join(section.split())
-            if section not in headings:
-                problems.append(f"{relative}: docs/design.md has no section \"{section}\"")
+            if section not in headings.get(cited, set()):
+                problems.append(f"{relative}: {cited} has no section \"{section}\"")
         is_source = path.suffix in {".cpp", ".hpp", ".h", ".cc"}
         if is_source and len(lines) - 1 > MAX_FILE:
             warnings.append(f"{relative}: {len(lines) - 1} lines (about {MAX_FILE} usually want splitting)")

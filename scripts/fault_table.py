@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
 """The fault table of bench/REAL_RADAR.md: the simulator's faults of real
-radars (docs/design.md, "The faults of real radars"), each alone and all
+radars (docs/design/simulator.md, "The faults of real radars"), each alone and all
 together, on the demo's world and on the motorway (configs/synthetic_motorway.yaml).
 Per row: odometry (one thread, defaults) RPE and ATE against the truth, and
 the paper's localisation from 2 m / 5 deg in the map built from the truth:

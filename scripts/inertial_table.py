@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""The radar-inertial tables of bench/RESULTS.md (docs/design.md,
+"""The radar-inertial tables of bench/RESULTS.md (docs/design/odometry.md,
 "Radar-inertial odometry"): simulated drives with a 200 Hz MEMS IMU (the
 simulator's defaults: noise densities, turn-on biases, random walks), one
 thread, one run at a time.

@@ -10,7 +10,7 @@
 #include "radargauss/core/error.hpp"
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/ros2_messages.hpp"
-#include "radargauss/io/rosbag2.hpp"
+#include "radargauss/io/bag_writer.hpp"
 
 namespace radargauss::cli {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// radargauss localize: the paper's localisation experiment (docs/design.md,
+// radargauss localize: the paper's localisation experiment (docs/design/experiment.md,
 // "The localisation experiment"): every scan matched from its reference
 // pose plus a seeded error, for every combination of the swept settings.
 #include <zlib.h>
@@ -160,7 +160,7 @@ std::string Hex(std::uint32_t value) {
   return text;
 }
 
-// What makes shards parts of one experiment (docs/design.md, "Shards"): the
+// What makes shards parts of one experiment (docs/design/experiment.md, "Shards"): the
 // value of every flag that changes results, and the contents behind the
 // paths (scans, reference poses, the maps matched) rather than their
 // spelling, so workers may mount the data elsewhere.

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss merge: the folders of `localize --shard I/N`, joined into the
-// results one run writes (docs/design.md, "Shards").
+// results one run writes (docs/design/experiment.md, "Shards").
 #include <cstdio>
 #include <filesystem>
 #include <memory>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss odometry: radar odometry on a map the run builds itself
-// (docs/design.md, "Odometry"), evaluated against a reference when one is given.
+// (docs/design/odometry.md, "Odometry"), evaluated against a reference when one is given.
 #include <algorithm>
 #include <cstdio>
 #include <memory>

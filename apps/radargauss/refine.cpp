@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss refine: joint refinement of a trajectory's poses and a map's SH
-// coefficients (docs/design.md, "Joint refinement"), evaluated against a
+// coefficients (docs/design/solvers.md, "Joint refinement"), evaluated against a
 // reference before and after when one is given.
 #include <cstdio>
 #include <filesystem>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss relocalize: a sequence located in a SLAM map without an initial
-// pose (docs/design.md, "Relocalisation"), evaluated against a reference
+// pose (docs/design/slam.md, "Relocalisation"), evaluated against a reference
 // when one is given.
 #include <cstdio>
 #include <filesystem>

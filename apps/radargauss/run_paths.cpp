@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The files and folders a command writes, checked against each other and
-// against every path it reads before the run starts (docs/design.md,
+// against every path it reads before the run starts (docs/design/formats.md,
 // "Bounds on input"): an output never replaces an input.
 #include <algorithm>
 #include <filesystem>

@@ -8,7 +8,7 @@
 #include "option_flags.hpp"
 #include "radargauss/core/atomic_file.hpp"
 #include "radargauss/core/error.hpp"
-#include "radargauss/io/rosbag2.hpp"
+#include "radargauss/io/bag_writer.hpp"
 #include "radargauss/simulator/simulator.hpp"
 
 namespace radargauss::cli {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss slam: radar odometry with loop closure on a pose graph and one
 // Gaussian-RCS map of the place from the optimised trajectory
-// (docs/design.md, "SLAM"), evaluated against a reference when one is given.
+// (docs/design/slam.md, "SLAM"), evaluated against a reference when one is given.
 #include <cstdio>
 #include <filesystem>
 #include <memory>

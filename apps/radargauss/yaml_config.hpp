@@ -30,7 +30,7 @@ class YamlConfig final : public CLI::Config {
   std::string to_config(const CLI::App*, bool, bool, std::string) const override { return {}; }
 
   // Reads the file by its path (bounded, one document, no key twice), not
-  // the stream CLI11 opened: docs/design.md, "Bounds on input".
+  // the stream CLI11 opened: docs/design/formats.md, "Bounds on input".
   std::vector<CLI::ConfigItem> from_config(std::istream&) const override {
     YAML::Node root;
     try {

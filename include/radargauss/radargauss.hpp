@@ -42,7 +42,7 @@ ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE
                          const MatchOptions& options = {});
 
 // `radargauss odometry`: every scan of `sequence` registered in order on a
-// map built on the way (docs/design.md, "Odometry"); its steps, trajectory()
+// map built on the way (docs/design/odometry.md, "Odometry"); its steps, trajectory()
 // and map() hold the run. Throws DataError for stamps that do not increase.
 RadarOdometry Odometry(const Sequence& sequence, const OdometryOptions& options = {});
 

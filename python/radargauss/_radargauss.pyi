@@ -269,7 +269,7 @@ class MatchResult:
     def time_ms(self) -> Any: ...
 
 class RadarInertialOdometry:
-    """Radar-inertial odometry (docs/design.md, "Radar-inertial odometry"): the radar odometry with a sliding window of IMU states. Threads may share one: its calls take turns."""
+    """Radar-inertial odometry (docs/design/odometry.md, "Radar-inertial odometry"): the radar odometry with a sliding window of IMU states. Threads may share one: its calls take turns."""
     def __init__(self: RadarInertialOdometry, imu: Any, radar_from_imu: Any = None, **kwargs) -> None:
         ...
     def __len__(self: RadarInertialOdometry) -> int:
@@ -284,7 +284,7 @@ class RadarInertialOdometry:
         """(stamps (N,), poses (N, 7)) of the radar so far, in the matcher's world"""
 
 class RadarOdometry:
-    """Radar odometry on a map it builds as it goes (docs/design.md, "Odometry"): register scans in time order. Threads may share one: its calls take turns."""
+    """Radar odometry on a map it builds as it goes (docs/design/odometry.md, "Odometry"): register scans in time order. Threads may share one: its calls take turns."""
     def __init__(self: RadarOdometry, **options: Unpack[OdometryOptions]) -> None:
         ...
     def __len__(self: RadarOdometry) -> int:
@@ -301,7 +301,7 @@ class RadarOdometry:
         """(stamps (N,), poses (N, 7)) so far"""
 
 class RadarSlam:
-    """Radar SLAM (docs/design.md, "SLAM"): odometry, keyframes with submaps, place recognition, verified loops on a pose graph. Threads may share one: its calls take turns."""
+    """Radar SLAM (docs/design/slam.md, "SLAM"): odometry, keyframes with submaps, place recognition, verified loops on a pose graph. Threads may share one: its calls take turns."""
     def __init__(self: RadarSlam, **options: Unpack[SlamOptions]) -> None:
         ...
     def finish(self: RadarSlam) -> None:
@@ -320,7 +320,7 @@ class RadarSlam:
         """(stamps (N,), poses (N, 7)): every scan at its keyframe's optimised pose"""
 
 class Relocalizer:
-    """Relocalisation in a map of RadarSlam without an initial pose (docs/design.md, "Relocalisation"). Threads may share one: its calls take turns."""
+    """Relocalisation in a map of RadarSlam without an initial pose (docs/design/slam.md, "Relocalisation"). Threads may share one: its calls take turns."""
     def __init__(self: Relocalizer, map: GaussianMap, **options: Unpack[RelocalizationOptions]) -> None:
         ...
     @property
@@ -406,7 +406,7 @@ def read_imu(path: str) -> numpy.ndarray:
     """An IMU file (lines 'stamp wx wy wz ax ay az') as an (N, 7) array; DataError names the line"""
 
 def read_map(path: str) -> GaussianMap:
-    """Reads a .rgm map file (validated: docs/design.md, "Bounds on input")."""
+    """Reads a .rgm map file (validated: docs/design/formats.md, "Bounds on input")."""
 
 def read_pcd(path: str) -> Scan:
     """One PCD scan (ascii, binary or binary_compressed); the stamp from a <secs>.<nsecs>.pcd name."""

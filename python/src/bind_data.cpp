@@ -6,7 +6,7 @@
 
 #include "bindings.hpp"
 #include "radargauss/io/pcd.hpp"
-#include "radargauss/io/rosbag2.hpp"
+#include "radargauss/io/rosbag.hpp"
 #include "radargauss/experiment/run_mcap.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/simulator/simulator.hpp"

@@ -149,7 +149,7 @@ void BindMap(py::module_& m) {
       "T_world_radar (4x4 or [x y z qx qy qz qw]). builder: kmeans or voxel; incidence: offset, view or none.");
   m.def(
       "read_map", [](const std::string& path) { return std::make_shared<PyMap>(ReadMapOrTiles(path)); },
-      py::arg("path"), "Reads a .rgm map file (validated: docs/design.md, \"Bounds on input\").");
+      py::arg("path"), "Reads a .rgm map file (validated: docs/design/formats.md, \"Bounds on input\").");
   m.def(
       "write_map", [](const std::string& path, const PyMap& map) { WriteMap(path, map.map()); }, py::arg("path"),
       py::arg("map"), "Writes a .rgm map file atomically.");

@@ -49,7 +49,7 @@ py::dict StepToDict(const OdometryStep& s) {
 
 const char* OdometryDoc() {
   static const std::string doc =
-      "Radar odometry on a map it builds as it goes (docs/design.md, \"Odometry\"): register scans in time "
+      "Radar odometry on a map it builds as it goes (docs/design/odometry.md, \"Odometry\"): register scans in time "
       "order. Threads may share one: its calls take turns.\n\nParameters\n----------\n"
       "**options\n    any of the keywords below (odometry_options() gives them all with their values)\n" +
       ParametersDoc(OdometryOptionTable());
@@ -102,7 +102,8 @@ std::pair<OdometryOptions, RadarInertialOptions> InertialOptionsFrom(const py::k
 
 const char* InertialDoc() {
   static const std::string doc =
-      "Radar-inertial odometry (docs/design.md, \"Radar-inertial odometry\"): the radar odometry with a sliding "
+      "Radar-inertial odometry (docs/design/odometry.md, \"Radar-inertial odometry\"): the radar odometry with a "
+      "sliding "
       "window of IMU states. Threads may share one: its calls take turns.\n\nParameters\n----------\n"
       "imu : array (N, 7)\n    [stamp wx wy wz ax ay az] per sample, time order, on the scans' clock (s, rad/s, "
       "m/s^2, the IMU's frame)\nradar_from_imu : array (4, 4) or [x y z qx qy qz qw], default identity\n    "

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Radar SLAM and relocalisation in Python (docs/design.md, "SLAM", "Relocalisation").
+// Radar SLAM and relocalisation in Python (docs/design/slam.md, "SLAM", "Relocalisation").
 #include <pybind11/stl.h>
 
 #include <string>
@@ -42,7 +42,7 @@ std::unique_ptr<LockedRelocalizer> MakeRelocalizer(const PyMap& map, const py::k
 
 const char* SlamDoc() {
   static const std::string doc =
-      "Radar SLAM (docs/design.md, \"SLAM\"): odometry, keyframes with submaps, place recognition, verified loops "
+      "Radar SLAM (docs/design/slam.md, \"SLAM\"): odometry, keyframes with submaps, place recognition, verified loops "
       "on a pose graph. Threads may share one: its calls take turns.\n\nParameters\n----------\n"
       "**options\n    any of the keywords below (option_fields('slam') lists them)\n" +
       ParametersDoc(SlamOptionTable());
@@ -51,7 +51,7 @@ const char* SlamDoc() {
 
 const char* RelocalizerDoc() {
   static const std::string doc =
-      "Relocalisation in a map of RadarSlam without an initial pose (docs/design.md, \"Relocalisation\"). Threads "
+      "Relocalisation in a map of RadarSlam without an initial pose (docs/design/slam.md, \"Relocalisation\"). Threads "
       "may share one: its calls take turns.\n\nParameters\n----------\nmap : Map\n    a map of RadarSlam, with "
       "places\n**options\n    any of the keywords below (option_fields('relocalization') lists them)\n" +
       ParametersDoc(RelocalizationOptionTable());

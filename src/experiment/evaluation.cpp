@@ -56,7 +56,7 @@ Eigen::Vector3d PrincipalSpread(const std::vector<Eigen::Vector3d>& points, Eige
 }
 
 // The rotation nearest the mean of R_ref R_est^T over the pairs: the
-// alignment's rotation as the orientations give it (docs/design.md, "Evaluation").
+// alignment's rotation as the orientations give it (docs/design/experiment.md, "Evaluation").
 SO3d OrientationAlignment(const std::vector<SE3d>& est, const std::vector<SE3d>& ref) {
   Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
   for (std::size_t k = 0; k < est.size(); ++k) sum += (ref[k].rotation() * est[k].rotation().Inverse()).Matrix();

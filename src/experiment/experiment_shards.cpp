@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Shards of the localisation experiment and their merge (docs/design.md,
+// Shards of the localisation experiment and their merge (docs/design/experiment.md,
 // "Shards"): shard.json holds the experiment's identity, the shard's range
 // and every number of its outcomes as JSON doubles, which read back bit for
 // bit, so the merge writes the files of one run. Every field is read with

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // zstd and lz4 frames undone as a stream: the output grows only as the data
 // produces it, so a container that states a size the data does not hold
-// costs no more memory than the data itself (docs/design.md, "Bounds on input").
+// costs no more memory than the data itself (docs/design/formats.md, "Bounds on input").
 #pragma once
 
 #include <cstddef>

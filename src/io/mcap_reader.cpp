@@ -171,6 +171,7 @@ void McapReader::ReadSummary(std::uint64_t start, std::uint64_t end) {
     const std::uint8_t* body = records.Bytes(length);
     if (opcode == kSchema) AddSchema(body, std::size_t(length));
     if (opcode == kChannel) AddChannel(body, std::size_t(length));
+    if (opcode == kChunkIndex) AddChunkIndex(body, std::size_t(length));
     if (opcode == kStatistics) {
       Cursor c(body, std::size_t(length), path_, "statistics");
       c.Bytes(8 + 2 + 4 + 4 + 4 + 4 + 8 + 8);
@@ -190,7 +191,149 @@ void McapReader::ReadSummary(std::uint64_t start, std::uint64_t end) {
   for (auto& [id, channel] : channels_) channel.message_count = counts.count(id) ? counts[id] : 0;
 }
 
+void McapReader::AddChunkIndex(const std::uint8_t* body, std::size_t size) {
+  Cursor c(body, size, path_, "chunk index");
+  McapChunkIndex index;
+  index.start_time = c.Int<std::uint64_t>();
+  index.end_time = c.Int<std::uint64_t>();
+  index.offset = c.Int<std::uint64_t>();
+  index.length = c.Int<std::uint64_t>();
+  const auto map_bytes = c.Int<std::uint32_t>();
+  Cursor map(c.Bytes(map_bytes), map_bytes, path_, "chunk index");
+  while (map.remaining() > 0) {
+    index.channels.push_back(map.Int<std::uint16_t>());
+    map.Int<std::uint64_t>();  // where its message index is: not needed to read the chunk
+  }
+  if (index.start_time > index.end_time) throw FileError(path_, "a chunk index ends before it starts");
+  if (index.offset < sizeof(kMagic) || index.length < kRecordHeader || index.offset > data_end_ ||
+      index.length > data_end_ - index.offset || index.length - kRecordHeader > kMaxMcapChunkBytes) {
+    throw FileError(path_, "a chunk index points outside the data section");
+  }
+  chunk_indexes_.push_back(std::move(index));
+}
+
 void McapReader::ForEachMessage(const std::function<void(const McapMessage&)>& visit) { Scan(&visit); }
+
+McapMessage McapReader::ParseMessage(const std::uint8_t* data, std::size_t size) {
+  Cursor c(data, size, path_, "message");
+  McapMessage message;
+  const auto channel_id = c.Int<std::uint16_t>();
+  message.sequence = c.Int<std::uint32_t>();
+  message.log_time = c.Int<std::uint64_t>();
+  message.publish_time = c.Int<std::uint64_t>();
+  message.size = c.remaining();
+  message.data = c.Bytes(message.size);
+  const auto channel = channels_.find(channel_id);
+  if (channel == channels_.end()) {
+    throw FileError(path_, "a message on channel " + std::to_string(channel_id) + ", which is not defined before it");
+  }
+  message.channel = &channel->second;
+  return message;
+}
+
+std::vector<std::uint8_t> McapReader::ChunkRecords(const std::uint8_t* body, std::size_t size, std::uint64_t position) {
+  Cursor c(body, size, path_, "chunk");
+  c.Bytes(16);  // message start and end times
+  const auto uncompressed_size = c.Int<std::uint64_t>();
+  const auto uncompressed_crc = c.Int<std::uint32_t>();
+  const std::string compression = c.String();
+  const auto records_size = c.Int<std::uint64_t>();
+  const std::uint8_t* compressed = c.Bytes(records_size);
+  std::vector<std::uint8_t> records =
+      Decompress(compression, compressed, std::size_t(records_size), uncompressed_size, path_);
+  ++chunks_read_;
+  if (uncompressed_crc != 0 && Crc(0, records.data(), records.size()) != uncompressed_crc) {
+    throw FileError(path_, "a chunk's CRC does not match (offset " + std::to_string(position) + ")");
+  }
+  return records;
+}
+
+void McapReader::ForEachRecord(const std::vector<std::uint8_t>& records,
+                               const std::function<void(const std::uint8_t*, std::size_t)>& on_message) {
+  Cursor inner(records.data(), records.size(), path_, "chunk");
+  while (inner.remaining() > 0) {
+    const auto opcode = inner.Int<std::uint8_t>();
+    const auto length = inner.Int<std::uint64_t>();
+    const std::uint8_t* body = inner.Bytes(length);
+    if (opcode == kSchema) AddSchema(body, std::size_t(length));
+    if (opcode == kChannel) AddChannel(body, std::size_t(length));
+    if (opcode == kMessage) on_message(body, std::size_t(length));
+  }
+}
+
+void McapReader::Read(const McapReadOptions& options, const std::function<void(const McapMessage&)>& visit) {
+  std::vector<std::uint16_t> wanted;
+  for (const auto& [id, channel] : channels_) {
+    if (options.topics.empty() ||
+        std::find(options.topics.begin(), options.topics.end(), channel.topic) != options.topics.end()) {
+      wanted.push_back(id);
+    }
+  }
+  const auto admitted = [&](const McapMessage& m) {
+    return std::binary_search(wanted.begin(), wanted.end(), m.channel->id) && m.log_time >= options.start &&
+           m.log_time <= options.end;
+  };
+  if (chunk_indexes_.empty()) {
+    const std::function<void(const McapMessage&)> filtered = [&](const McapMessage& m) {
+      if (admitted(m)) visit(m);
+    };
+    Scan(&filtered);
+    return;
+  }
+  // The chunks the index admits, by start time; a chunk whose index states
+  // no channels may hold any.
+  std::vector<const McapChunkIndex*> chosen;
+  for (const McapChunkIndex& chunk : chunk_indexes_) {
+    const bool in_range = chunk.end_time >= options.start && chunk.start_time <= options.end;
+    const bool has_topic =
+        chunk.channels.empty() || std::any_of(chunk.channels.begin(), chunk.channels.end(), [&](std::uint16_t id) {
+          return std::binary_search(wanted.begin(), wanted.end(), id);
+        });
+    if (in_range && has_topic) {
+      chosen.push_back(&chunk);
+    } else {
+      ++chunks_skipped_;
+    }
+  }
+  std::stable_sort(chosen.begin(), chosen.end(), [](const McapChunkIndex* a, const McapChunkIndex* b) {
+    return std::tie(a->start_time, a->offset) < std::tie(b->start_time, b->offset);
+  });
+  // Chunks whose time spans overlap are read together, their messages merged by log time.
+  std::vector<std::uint8_t> body;
+  for (std::size_t first = 0; first < chosen.size();) {
+    std::size_t last = first + 1;
+    std::uint64_t end = chosen[first]->end_time;
+    while (last < chosen.size() && chosen[last]->start_time <= end) end = std::max(end, chosen[last++]->end_time);
+    std::vector<std::vector<std::uint8_t>> groups;
+    std::vector<McapMessage> messages;
+    for (std::size_t k = first; k < last; ++k) {
+      const McapChunkIndex& chunk = *chosen[k];
+      std::uint8_t header[kRecordHeader];
+      file_.clear();
+      file_.seekg(std::streamoff(chunk.offset));
+      file_.read(reinterpret_cast<char*>(header), kRecordHeader);
+      Cursor h(header, kRecordHeader, path_, "record");
+      if (h.Int<std::uint8_t>() != kChunk || h.Int<std::uint64_t>() != chunk.length - kRecordHeader) {
+        throw FileError(path_,
+                        "a chunk index points to no chunk of its length (offset " + std::to_string(chunk.offset) + ")");
+      }
+      body.resize(std::size_t(chunk.length - kRecordHeader));
+      file_.read(reinterpret_cast<char*>(body.data()), std::streamsize(body.size()));
+      if (!file_) throw FileError(path_, "cannot read the chunk at offset " + std::to_string(chunk.offset));
+      groups.push_back(ChunkRecords(body.data(), body.size(), chunk.offset));
+    }
+    for (const std::vector<std::uint8_t>& records : groups) {
+      ForEachRecord(records, [&](const std::uint8_t* data, std::size_t size) {
+        const McapMessage message = ParseMessage(data, size);
+        if (admitted(message)) messages.push_back(message);
+      });
+    }
+    std::stable_sort(messages.begin(), messages.end(),
+                     [](const McapMessage& a, const McapMessage& b) { return a.log_time < b.log_time; });
+    for (const McapMessage& message : messages) visit(message);
+    first = last;
+  }
+}
 
 // One pass over the data section: schemas and channels as they come, each
 // message counted (visit null) or visited; chunks decompressed one at a time.
@@ -205,22 +348,10 @@ void McapReader::Scan(const std::function<void(const McapMessage&)>* visit) {
   std::vector<std::uint8_t> body;
   bool first = true;
   const auto on_message = [&](const std::uint8_t* data, std::size_t size) {
-    Cursor c(data, size, path_, "message");
-    McapMessage message;
-    const auto channel_id = c.Int<std::uint16_t>();
-    message.sequence = c.Int<std::uint32_t>();
-    message.log_time = c.Int<std::uint64_t>();
-    message.publish_time = c.Int<std::uint64_t>();
-    message.size = c.remaining();
-    message.data = c.Bytes(message.size);
-    const auto channel = channels_.find(channel_id);
-    if (channel == channels_.end()) {
-      throw FileError(path_, "a message on channel " + std::to_string(channel_id) + ", which is not defined before it");
-    }
+    const McapMessage message = ParseMessage(data, size);
     if (visit == nullptr) {
-      ++channel->second.message_count;
+      ++channels_.at(message.channel->id).message_count;
     } else {
-      message.channel = &channel->second;
       (*visit)(message);
     }
   };
@@ -255,28 +386,7 @@ void McapReader::Scan(const std::function<void(const McapMessage&)>* visit) {
     if (opcode == kSchema) AddSchema(body.data(), body.size());
     if (opcode == kChannel) AddChannel(body.data(), body.size());
     if (opcode == kMessage) on_message(body.data(), body.size());
-    if (opcode != kChunk) continue;
-    Cursor c(body.data(), body.size(), path_, "chunk");
-    c.Bytes(16);  // message start and end times
-    const auto uncompressed_size = c.Int<std::uint64_t>();
-    const auto uncompressed_crc = c.Int<std::uint32_t>();
-    const std::string compression = c.String();
-    const auto records_size = c.Int<std::uint64_t>();
-    const std::uint8_t* compressed = c.Bytes(records_size);
-    const std::vector<std::uint8_t> records =
-        Decompress(compression, compressed, std::size_t(records_size), uncompressed_size, path_);
-    if (uncompressed_crc != 0 && Crc(0, records.data(), records.size()) != uncompressed_crc) {
-      throw FileError(path_, "a chunk's CRC does not match (offset " + std::to_string(position) + ")");
-    }
-    Cursor inner(records.data(), records.size(), path_, "chunk");
-    while (inner.remaining() > 0) {
-      const auto inner_opcode = inner.Int<std::uint8_t>();
-      const auto inner_length = inner.Int<std::uint64_t>();
-      const std::uint8_t* inner_body = inner.Bytes(inner_length);
-      if (inner_opcode == kSchema) AddSchema(inner_body, std::size_t(inner_length));
-      if (inner_opcode == kChannel) AddChannel(inner_body, std::size_t(inner_length));
-      if (inner_opcode == kMessage) on_message(inner_body, std::size_t(inner_length));
-    }
+    if (opcode == kChunk) ForEachRecord(ChunkRecords(body.data(), body.size(), position), on_message);
   }
   if (first) throw FileError(path_, "an MCAP file without a header record");
 }

@@ -19,7 +19,7 @@ std::vector<std::string> SplitWords(const std::string& line) {
 
 namespace {
 
-// Bounds on a header (docs/design.md, "Bounds on input"): radar and lidar
+// Bounds on a header (docs/design/formats.md, "Bounds on input"): radar and lidar
 // PCDs have tens of fields of a few values; these stop a hostile header from
 // turning into large allocations before any data is read.
 constexpr std::size_t kMaxPcdFields = 256;

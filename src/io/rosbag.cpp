@@ -1,17 +1,20 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Built only when Debian's ROS1 bag library is found (RADARGAUSS_HAVE_ROSBAG).
-#include "radargauss/io/rosbag.hpp"
-
+// The ROS1 bag reader and ROS1's serialisation, through Debian's ROS1 bag
+// library. Built only when it is found (RADARGAUSS_HAVE_ROSBAG).
+#include <ros/serialization.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/PointCloud2.h>
 
 #include <algorithm>
+#include <limits>
 #include <map>
 
+#include "bag_readers.hpp"
 #include "radargauss/core/error.hpp"
 #include "radargauss/core/read_file.hpp"
+#include "radargauss/io/bag_reader.hpp"
 
 namespace radargauss {
 
@@ -19,107 +22,135 @@ bool RosbagSupported() { return true; }
 
 namespace {
 
-void OpenBag(rosbag::Bag& bag, const std::string& path) {
-  CheckRegularInputFile(path, "ROS1 bag");
-  try {
-    bag.open(path, rosbag::bagmode::Read);
-  } catch (const std::exception& e) {
-    throw FileError(path, std::string("cannot read ROS1 bag: ") + e.what());
-  }
-}
-
-}  // namespace
-
-std::vector<BagTopic> ListRos1BagTopics(const std::string& bag_path) {
-  rosbag::Bag bag;
-  OpenBag(bag, bag_path);
-  std::map<std::string, BagTopic> topics;
-  try {
-    rosbag::View view(bag);
-    for (const rosbag::ConnectionInfo* connection : view.getConnections()) {
-      BagTopic& topic = topics[connection->topic];
-      topic.name = connection->topic;
-      topic.type = connection->datatype;
-    }
-    for (const rosbag::MessageInstance& message : view) {
-      BagTopic& topic = topics[message.getTopic()];
-      const double t = message.getTime().toSec();
-      topic.first = topic.messages == 0 ? t : std::min(topic.first, t);
-      topic.last = std::max(topic.last, t);
-      ++topic.messages;
-    }
-  } catch (const std::exception& e) {
-    throw FileError(bag_path, std::string("corrupt ROS1 bag: ") + e.what());
-  }
-  std::vector<BagTopic> result;
-  for (auto& entry : topics) result.push_back(entry.second);
-  return result;
-}
-
-namespace {
-
-// Calls read(message, source) for every message of `topic` in bag order,
-// `source` naming it ("<bag>:<topic>#<index>"); a missing topic and
-// the library's own exceptions become DataError naming the bag.
-template <typename Read>
-void ForEachMessage(const std::string& bag_path, const std::string& topic, Read&& read) {
-  rosbag::Bag bag;
-  OpenBag(bag, bag_path);
-  std::size_t index = 0;
-  try {
-    rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{topic}));
-    for (const rosbag::MessageInstance& message : view) {
-      read(message, bag_path + ":" + topic + "#" + std::to_string(index++));
-    }
-  } catch (const DataError&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw FileError(bag_path, std::string("corrupt ROS1 bag: ") + e.what());
-  }
-  if (index == 0) throw FileError(bag_path, "no messages on topic '" + topic + "'");
-}
-
-// The message as `Message`, or DataError naming `source` and the type it holds.
+// The message in `m` as `Message`, or DataError naming `source`.
 template <typename Message>
-typename Message::ConstPtr Instantiate(const rosbag::MessageInstance& message, const std::string& source,
-                                       const char* type) {
-  const typename Message::ConstPtr msg = message.instantiate<Message>();
-  if (!msg) throw FileError(source, "message is " + message.getDataType() + ", not " + type);
-  return msg;
+Message Deserialize(const BagMessage& m, const std::string& source) {
+  Message message;
+  try {
+    ros::serialization::IStream stream(const_cast<std::uint8_t*>(m.data), std::uint32_t(m.size));
+    ros::serialization::deserialize(stream, message);
+  } catch (const std::exception& e) {
+    throw FileError(source, std::string("message is cut short: ") + e.what());
+  }
+  return message;
 }
+
+class Ros1 final : public MessageCodec {
+ public:
+  // As ros::Time::toSec computes it.
+  double RecordStamp(std::int64_t log_time) const override {
+    ros::Time time;
+    time.fromNSec(std::uint64_t(log_time));
+    return time.toSec();
+  }
+  double PointCloud2(const BagMessage& m, const std::string& source, PointCloud2Data& cloud) const override {
+    const auto msg = Deserialize<sensor_msgs::PointCloud2>(m, source);
+    cloud.height = msg.height;
+    cloud.width = msg.width;
+    cloud.fields.clear();
+    for (const auto& f : msg.fields) cloud.fields.push_back({f.name, f.offset, f.datatype, f.count});
+    cloud.is_bigendian = msg.is_bigendian;
+    cloud.point_step = msg.point_step;
+    cloud.row_step = msg.row_step;
+    cloud.data = msg.data;
+    return msg.header.stamp.isZero() ? 0.0 : msg.header.stamp.toSec();
+  }
+  double Imu(const BagMessage& m, const std::string& source, ImuSample& sample) const override {
+    const auto msg = Deserialize<sensor_msgs::Imu>(m, source);
+    sample.angular_velocity = {msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z};
+    sample.specific_force = {msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z};
+    return msg.header.stamp.isZero() ? 0.0 : msg.header.stamp.toSec();
+  }
+  bool Pose(const BagMessage&, const std::string& source, const std::string&, double&, SE3d&) const override {
+    throw NoPoses(source);
+  }
+  bool Path(const BagMessage&, const std::string& source, std::vector<StampedPose>&) const override {
+    throw NoPoses(source);
+  }
+
+ private:
+  static DataError NoPoses(const std::string& source) {
+    return FileError(source, "reference poses are read from ROS 2 bags (convert a ROS1 bag's with a TUM file)");
+  }
+};
+
+ros::Time TimeOf(std::int64_t ns) {
+  if (ns <= 0) return ros::TIME_MIN;
+  if (std::uint64_t(ns) >= ros::TIME_MAX.toNSec()) return ros::TIME_MAX;
+  ros::Time time;
+  time.fromNSec(std::uint64_t(ns));
+  return time;
+}
+
+class Ros1Bag final : public BagReader {
+ public:
+  explicit Ros1Bag(const std::string& path) : BagReader(path) {
+    CheckRegularInputFile(path, "ROS1 bag");
+    try {
+      bag_.open(path, rosbag::bagmode::Read);
+    } catch (const std::exception& e) {
+      throw FileError(path, std::string("cannot read ROS1 bag: ") + e.what());
+    }
+  }
+
+  std::vector<BagTopic> Topics() override {
+    std::map<std::string, BagTopic> topics;
+    try {
+      rosbag::View view(bag_);
+      for (const rosbag::ConnectionInfo* connection : view.getConnections()) {
+        BagTopic& topic = topics[connection->topic];
+        topic.name = connection->topic;
+        topic.type = connection->datatype;
+      }
+      for (const rosbag::MessageInstance& message : view) {
+        BagTopic& topic = topics[message.getTopic()];
+        const double t = message.getTime().toSec();
+        topic.first = topic.messages == 0 ? t : std::min(topic.first, t);
+        topic.last = std::max(topic.last, t);
+        ++topic.messages;
+      }
+    } catch (const std::exception& e) {
+      throw FileError(path(), std::string("corrupt ROS1 bag: ") + e.what());
+    }
+    std::vector<BagTopic> result;
+    for (auto& entry : topics) result.push_back(entry.second);
+    return result;
+  }
+
+  // The library's view, in time order; its own exceptions become DataError naming the bag.
+  void Read(const BagReadOptions& options, const std::function<void(const BagMessage&)>& visit) override {
+    if (options.end < options.start) return;
+    std::vector<std::uint8_t> bytes;
+    try {
+      std::unique_ptr<rosbag::View> view =
+          options.topics.empty() ? std::make_unique<rosbag::View>(bag_, TimeOf(options.start), TimeOf(options.end))
+                                 : std::make_unique<rosbag::View>(bag_, rosbag::TopicQuery(options.topics),
+                                                                  TimeOf(options.start), TimeOf(options.end));
+      for (const rosbag::MessageInstance& message : *view) {
+        bytes.resize(message.size());
+        ros::serialization::OStream stream(bytes.data(), std::uint32_t(bytes.size()));
+        message.write(stream);
+        const std::string topic = message.getTopic(), type = message.getDataType();
+        visit({&topic, &type, std::int64_t(message.getTime().toNSec()), bytes.data(), bytes.size(), &Ros1Codec()});
+      }
+    } catch (const DataError&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw FileError(path(), std::string("corrupt ROS1 bag: ") + e.what());
+    }
+  }
+
+ private:
+  rosbag::Bag bag_;
+};
 
 }  // namespace
 
-std::vector<RadarScan> ReadRos1BagScans(const std::string& bag_path, const std::string& topic,
-                                        const FieldMapping& mapping) {
-  std::vector<RadarScan> scans;
-  ForEachMessage(bag_path, topic, [&](const rosbag::MessageInstance& message, const std::string& source) {
-    const auto msg = Instantiate<sensor_msgs::PointCloud2>(message, source, "sensor_msgs/PointCloud2");
-    PointCloud2Data cloud;
-    cloud.height = msg->height;
-    cloud.width = msg->width;
-    for (const auto& f : msg->fields) cloud.fields.push_back({f.name, f.offset, f.datatype, f.count});
-    cloud.is_bigendian = msg->is_bigendian;
-    cloud.point_step = msg->point_step;
-    cloud.row_step = msg->row_step;
-    cloud.data = msg->data;
-    const double stamp = msg->header.stamp.isZero() ? message.getTime().toSec() : msg->header.stamp.toSec();
-    scans.push_back(DecodePointCloud2(cloud, stamp, mapping, source));
-  });
-  return scans;
+const MessageCodec& Ros1Codec() {
+  static const Ros1 codec;
+  return codec;
 }
 
-std::vector<ImuSample> ReadRos1BagImu(const std::string& bag_path, const std::string& topic, bool record_time) {
-  std::vector<ImuSample> samples;
-  ForEachMessage(bag_path, topic, [&](const rosbag::MessageInstance& message, const std::string& source) {
-    const auto msg = Instantiate<sensor_msgs::Imu>(message, source, "sensor_msgs/Imu");
-    ImuSample sample;
-    sample.stamp = record_time || msg->header.stamp.isZero() ? message.getTime().toSec() : msg->header.stamp.toSec();
-    sample.angular_velocity = {msg->angular_velocity.x, msg->angular_velocity.y, msg->angular_velocity.z};
-    sample.specific_force = {msg->linear_acceleration.x, msg->linear_acceleration.y, msg->linear_acceleration.z};
-    AppendBagImuSample(samples, sample, source);
-  });
-  return samples;
-}
+std::unique_ptr<BagReader> OpenRos1Bag(const std::string& path) { return std::make_unique<Ros1Bag>(path); }
 
 }  // namespace radargauss

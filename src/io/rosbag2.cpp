@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "radargauss/io/rosbag2.hpp"
+// The readers of ROS 2 bags (docs/design/formats.md, "ROS 2 bags"): an MCAP
+// file, a sqlite3 file, and a rosbag2 folder of them.
 
 #include <zstd.h>
 
@@ -12,11 +13,13 @@
 #include <map>
 #include <optional>
 
+#include "bag_readers.hpp"
 #include "decompress.hpp"
 #include "sqlite_database.hpp"
 #include "radargauss/core/error.hpp"
 #include "radargauss/core/read_file.hpp"
-#include "radargauss/io/ros2_messages.hpp"
+#include "radargauss/io/bag_reader.hpp"
+#include "radargauss/io/mcap.hpp"
 #include "radargauss/io/yaml_file.hpp"
 
 namespace radargauss {
@@ -112,136 +115,176 @@ void AddToListing(std::map<std::string, BagTopic>& listing, const std::string& n
   t.messages += messages;
 }
 
-void ForEachInFile(const std::string& path, const std::string& topic, bool message_compression,
-                   const std::function<void(const Ros2Message&)>& visit, std::map<std::string, BagTopic>* listing) {
-  const BagFormat format = DetectBagFormat(path);
-  std::vector<std::uint8_t> decompressed;
-  const auto deliver = [&](Ros2Message message, const std::string& source) {
-    if (message_compression) {
-      DecompressMessage(message.data, message.size, source, decompressed);
-      message.data = decompressed.data();
-      message.size = decompressed.size();
+std::vector<BagTopic> Listed(const std::map<std::string, BagTopic>& listing) {
+  std::vector<BagTopic> result;
+  for (const auto& entry : listing) result.push_back(entry.second);
+  return result;
+}
+
+class McapBag final : public BagReader {
+ public:
+  explicit McapBag(const std::string& path) : BagReader(path), reader_(path) {}
+
+  std::vector<BagTopic> Topics() override {
+    // Names, types and counts from the reader (the summary's when there is
+    // one); the time spans from one pass over the messages.
+    std::map<std::string, std::pair<double, double>> spans;
+    reader_.ForEachMessage([&](const McapMessage& m) {
+      const double t = double(m.log_time) * 1e-9;
+      auto [it, fresh] = spans.try_emplace(m.channel->topic, t, t);
+      if (!fresh) it->second = {std::min(it->second.first, t), std::max(it->second.second, t)};
+    });
+    std::map<std::string, BagTopic> listing;
+    for (const McapChannel& channel : reader_.channels()) {
+      const auto span = spans.find(channel.topic);
+      AddToListing(listing, channel.topic, channel.schema_name, channel.message_count,
+                   span == spans.end() ? std::make_pair(0.0, 0.0) : span->second);
     }
-    visit(message);
-  };
-  if (format == BagFormat::kMcap) {
-    McapReader reader(path);
-    if (listing != nullptr) {
-      // Names, types and counts from the reader (the summary's when there is
-      // one); the time spans from one pass over the messages.
-      std::map<std::string, std::pair<double, double>> spans;
-      reader.ForEachMessage([&](const McapMessage& m) {
-        const double t = double(m.log_time) * 1e-9;
-        auto [it, fresh] = spans.try_emplace(m.channel->topic, t, t);
-        if (!fresh) it->second = {std::min(it->second.first, t), std::max(it->second.second, t)};
-      });
-      for (const McapChannel& channel : reader.channels()) {
-        const auto span = spans.find(channel.topic);
-        AddToListing(*listing, channel.topic, channel.schema_name, channel.message_count,
-                     span == spans.end() ? std::make_pair(0.0, 0.0) : span->second);
-      }
-      return;
-    }
-    std::size_t index = 0;
-    reader.ForEachMessage([&](const McapMessage& m) {
-      if (!topic.empty() && m.channel->topic != topic) return;
+    return Listed(listing);
+  }
+
+  BagReadStatistics statistics() const override { return {reader_.chunks_read(), reader_.chunks_skipped()}; }
+
+  void Read(const BagReadOptions& options, const std::function<void(const BagMessage&)>& visit) override {
+    if (options.end < 0 || options.end < options.start) return;  // MCAP's log times are unsigned
+    const McapReadOptions read{options.topics, std::uint64_t(std::max<std::int64_t>(options.start, 0)),
+                               std::uint64_t(options.end)};
+    reader_.Read(read, [&](const McapMessage& m) {
       if (m.channel->message_encoding != "cdr") {
-        throw FileError(path, "topic '" + Printable(m.channel->topic) + "' is " +
-                                  Printable(m.channel->message_encoding) + ", not cdr");
+        throw FileError(path(), "topic '" + Printable(m.channel->topic) + "' is " +
+                                    Printable(m.channel->message_encoding) + ", not cdr");
       }
       if (m.log_time > std::uint64_t(std::numeric_limits<std::int64_t>::max())) {
-        throw FileError(path, "a message's log time is past 2^63 ns");
+        throw FileError(path(), "a message's log time is past 2^63 ns");
       }
-      deliver({&m.channel->topic, &m.channel->schema_name, std::int64_t(m.log_time), m.data, m.size},
-              path + ":" + m.channel->topic + "#" + std::to_string(index++));
+      visit({&m.channel->topic, &m.channel->schema_name, std::int64_t(m.log_time), m.data, m.size, &CdrCodec()});
     });
-    return;
   }
-  if (format != BagFormat::kSqlite3) throw FileError(path, "not a ROS 2 bag file (sqlite3 or MCAP)");
-  Database db(path, SQLITE_OPEN_READONLY);
-  const std::vector<SqliteTopic> topics = SqliteTopics(db, path);
-  if (listing != nullptr) {
+
+ private:
+  McapReader reader_;
+};
+
+class SqliteBag final : public BagReader {
+ public:
+  explicit SqliteBag(const std::string& path)
+      : BagReader(path), db_(path, SQLITE_OPEN_READONLY), topics_(SqliteTopics(db_, path)) {}
+
+  std::vector<BagTopic> Topics() override {
     Database::Statement counts(
-        db, "SELECT topic_id, count(*), min(timestamp), max(timestamp) FROM messages GROUP BY topic_id");
+        db_, "SELECT topic_id, count(*), min(timestamp), max(timestamp) FROM messages GROUP BY topic_id");
     std::map<std::int64_t, std::array<std::int64_t, 3>> by_topic;
     while (counts.Step()) by_topic[counts.Int(0)] = {counts.Int(1), counts.Int(2), counts.Int(3)};
-    for (const SqliteTopic& t : topics) {
+    std::map<std::string, BagTopic> listing;
+    for (const SqliteTopic& t : topics_) {
       const auto found = by_topic.find(t.id);
       if (found == by_topic.end()) {
-        AddToListing(*listing, t.name, t.type, 0, {0.0, 0.0});
+        AddToListing(listing, t.name, t.type, 0, {0.0, 0.0});
       } else {
-        AddToListing(*listing, t.name, t.type, std::size_t(found->second[0]),
+        AddToListing(listing, t.name, t.type, std::size_t(found->second[0]),
                      {double(found->second[1]) * 1e-9, double(found->second[2]) * 1e-9});
       }
     }
-    return;
+    return Listed(listing);
   }
-  for (const SqliteTopic& t : topics) {
-    if (!topic.empty() && t.name != topic) continue;
-    if (t.format != "cdr") {
-      throw FileError(path, "topic '" + Printable(t.name) + "' is " + Printable(t.format) + ", not cdr");
-    }
-    Database::Statement query(db, "SELECT timestamp, data FROM messages WHERE topic_id = ? ORDER BY timestamp, id");
-    query.Bind(1, t.id);
-    std::size_t index = 0;
-    while (query.Step()) {
-      Ros2Message message{&t.name, &t.type, query.Int(0), nullptr, 0};
-      message.data = query.Blob(1, message.size);
-      deliver(message, path + ":" + t.name + "#" + std::to_string(index++));
-    }
-  }
-}
 
-// The files of a bag: a folder's in metadata.yaml's order, or the one file.
-FolderPlan PlanOf(const std::string& path) {
-  const BagFormat format = DetectBagFormat(path);
-  if (format == BagFormat::kRos1) throw FileError(path, "a ROS1 bag, not a ROS 2 one");
-  if (format == BagFormat::kRos2Folder) return ReadFolder(path);
-  return {{path}, false};
-}
+  // One query over the admitted topics, in log-time order (the timestamp index).
+  void Read(const BagReadOptions& options, const std::function<void(const BagMessage&)>& visit) override {
+    std::map<std::int64_t, const SqliteTopic*> admitted;
+    for (const SqliteTopic& t : topics_) {
+      if (!options.topics.empty() &&
+          std::find(options.topics.begin(), options.topics.end(), t.name) == options.topics.end()) {
+        continue;
+      }
+      if (t.format != "cdr") {
+        throw FileError(path(), "topic '" + Printable(t.name) + "' is " + Printable(t.format) + ", not cdr");
+      }
+      admitted[t.id] = &t;
+    }
+    if (admitted.empty()) return;
+    std::string ids;
+    for (std::size_t k = 0; k < admitted.size(); ++k) ids += k == 0 ? "?" : ", ?";
+    Database::Statement query(db_, "SELECT topic_id, timestamp, data FROM messages WHERE topic_id IN (" + ids +
+                                       ") AND timestamp >= ? AND timestamp <= ? ORDER BY timestamp, id");
+    int parameter = 1;
+    for (const auto& entry : admitted) query.Bind(parameter++, entry.first);
+    query.Bind(parameter++, options.start);
+    query.Bind(parameter, options.end);
+    while (query.Step()) {
+      const SqliteTopic& t = *admitted.at(query.Int(0));
+      BagMessage message{&t.name, &t.type, query.Int(1), nullptr, 0, &CdrCodec()};
+      message.data = query.Blob(2, message.size);
+      visit(message);
+    }
+  }
+
+ private:
+  Database db_;
+  std::vector<SqliteTopic> topics_;
+};
+
+// A rosbag2 folder: its files in metadata.yaml's order, each read by its own
+// reader, messages compressed one by one undone on the way.
+class Ros2Folder final : public BagReader {
+ public:
+  explicit Ros2Folder(const std::string& path) : BagReader(path), plan_(ReadFolder(path)) {
+    for (const std::string& file : plan_.files) {
+      switch (DetectBagFormat(file)) {
+        case BagFormat::kMcap:
+          files_.push_back(OpenMcapBag(file));
+          break;
+        case BagFormat::kSqlite3:
+          files_.push_back(OpenSqliteBag(file));
+          break;
+        default:
+          throw FileError(file, "not a ROS 2 bag file (sqlite3 or MCAP)");
+      }
+    }
+  }
+
+  std::vector<BagTopic> Topics() override {
+    std::map<std::string, BagTopic> listing;
+    for (const auto& file : files_) {
+      for (const BagTopic& t : file->Topics()) AddToListing(listing, t.name, t.type, t.messages, {t.first, t.last});
+    }
+    return Listed(listing);
+  }
+
+  BagReadStatistics statistics() const override {
+    BagReadStatistics total;
+    for (const auto& file : files_) {
+      total.chunks_read += file->statistics().chunks_read;
+      total.chunks_skipped += file->statistics().chunks_skipped;
+    }
+    return total;
+  }
+
+  void Read(const BagReadOptions& options, const std::function<void(const BagMessage&)>& visit) override {
+    std::vector<std::uint8_t> decompressed;
+    for (const auto& file : files_) {
+      std::map<std::string, std::size_t> index;
+      file->Read(options, [&](BagMessage message) {
+        if (plan_.message_compression) {
+          const std::string source =
+              file->path() + ":" + *message.topic + "#" + std::to_string(index[*message.topic]++);
+          DecompressMessage(message.data, message.size, source, decompressed);
+          message.data = decompressed.data();
+          message.size = decompressed.size();
+        }
+        visit(message);
+      });
+    }
+  }
+
+ private:
+  FolderPlan plan_;
+  std::vector<std::unique_ptr<BagReader>> files_;
+};
 
 }  // namespace
 
-BagFormat DetectBagFormat(const std::string& path) {
-  std::error_code error;
-  if (fs::is_directory(path, error)) {
-    if (fs::exists(fs::path(path) / "metadata.yaml", error)) return BagFormat::kRos2Folder;
-    throw FileError(path, "a folder without metadata.yaml is not a rosbag2 bag");
-  }
-  CheckRegularInputFile(path, "bag");
-  std::ifstream file(path, std::ios::binary);
-  char head[16] = {};
-  file.read(head, sizeof(head));
-  const std::size_t got = std::size_t(file.gcount());
-  if (got >= 13 && std::memcmp(head, "#ROSBAG V2.0\n", 13) == 0) return BagFormat::kRos1;
-  if (got >= 16 && std::memcmp(head, "SQLite format 3\0", 16) == 0) return BagFormat::kSqlite3;
-  if (got >= 8 && IsMcapFile(path)) return BagFormat::kMcap;
-  throw FileError(path, "not a bag: neither a ROS1 bag, a sqlite3 file, an MCAP file nor a rosbag2 folder");
-}
-
-void ForEachRos2Message(const std::string& path, const std::string& topic,
-                        const std::function<void(const Ros2Message&)>& visit) {
-  const FolderPlan plan = PlanOf(path);
-  std::size_t seen = 0;
-  for (const std::string& file : plan.files) {
-    ForEachInFile(
-        file, topic, plan.message_compression,
-        [&](const Ros2Message& m) {
-          ++seen;
-          visit(m);
-        },
-        nullptr);
-  }
-  if (seen == 0 && !topic.empty()) throw FileError(path, "no messages on topic '" + Printable(topic) + "'");
-}
-
-std::vector<BagTopic> ListRos2Topics(const std::string& path) {
-  const FolderPlan plan = PlanOf(path);
-  std::map<std::string, BagTopic> topics;
-  for (const std::string& file : plan.files) ForEachInFile(file, "", false, nullptr, &topics);
-  std::vector<BagTopic> result;
-  for (auto& entry : topics) result.push_back(entry.second);
-  return result;
-}
+std::unique_ptr<BagReader> OpenMcapBag(const std::string& path) { return std::make_unique<McapBag>(path); }
+std::unique_ptr<BagReader> OpenSqliteBag(const std::string& path) { return std::make_unique<SqliteBag>(path); }
+std::unique_ptr<BagReader> OpenRos2Folder(const std::string& path) { return std::make_unique<Ros2Folder>(path); }
 
 }  // namespace radargauss

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Writing ROS 2 bags (.mcap, .db3): Ros2BagWriter and WriteRos2Bag.
+// Writing ROS 2 bags (.mcap, .db3): Ros2BagWriter over one writer per format, and WriteRos2Bag.
 #include <unistd.h>
 
 #include <cctype>
@@ -12,109 +12,146 @@
 #include "radargauss/core/atomic_file.hpp"
 #include "radargauss/core/error.hpp"
 #include "radargauss/io/ros2_messages.hpp"
-#include "radargauss/io/rosbag2.hpp"
+#include "radargauss/io/bag_writer.hpp"
 #include "sqlite_database.hpp"
 
 namespace radargauss {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// One format's file, written at a temporary path that Ros2BagWriter renames.
+class FormatWriter {
+ public:
+  virtual ~FormatWriter() = default;
+  // The topic's id: 1, 2, ... in the order added.
+  virtual void AddTopic(int id, const std::string& name, const std::string& type) = 0;
+  virtual void Write(int topic, std::int64_t log_time, const std::vector<std::uint8_t>& data) = 0;
+  virtual void Close() = 0;
+};
+
+class McapFile final : public FormatWriter {
+ public:
+  McapFile(const std::string& path, const std::string& temporary, const McapWriterOptions& options) : path_(path) {
+    file_.open(temporary, std::ios::binary | std::ios::trunc);
+    if (!file_) throw FileError(path, "cannot write");
+    mcap_ = std::make_unique<McapWriter>(file_, options);
+  }
+  void AddTopic(int, const std::string& name, const std::string& type) override {
+    const std::uint16_t schema = mcap_->AddSchema(type, "ros2msg", Ros2MessageDefinition(type));
+    channels_.push_back(mcap_->AddChannel(name, schema, "cdr"));
+  }
+  void Write(int topic, std::int64_t log_time, const std::vector<std::uint8_t>& data) override {
+    mcap_->Write(channels_[std::size_t(topic - 1)], std::uint64_t(log_time), std::uint64_t(log_time), data);
+  }
+  void Close() override {
+    mcap_->Finish();
+    file_.close();
+    if (!file_) throw FileError(path_, "cannot write");
+  }
+
+ private:
+  std::string path_;
+  std::ofstream file_;
+  std::unique_ptr<McapWriter> mcap_;
+  std::vector<std::uint16_t> channels_;  // topic id - 1 -> channel
+};
+
+class SqliteFile final : public FormatWriter {
+ public:
+  explicit SqliteFile(const std::string& temporary)
+      : db_(std::make_unique<Database>(temporary, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE)) {
+    db_->Execute(
+        "PRAGMA journal_mode=OFF; PRAGMA synchronous=OFF;"
+        "CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);"
+        "INSERT INTO schema VALUES(3, 'humble');"
+        "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL,"
+        " serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL);"
+        "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL,"
+        " data BLOB NOT NULL);"
+        "CREATE INDEX timestamp_idx ON messages (timestamp ASC);"
+        "BEGIN TRANSACTION;");
+    insert_ =
+        std::make_unique<Database::Statement>(*db_, "INSERT INTO messages(topic_id, timestamp, data) VALUES(?, ?, ?)");
+  }
+  ~SqliteFile() override {
+    insert_.reset();
+    db_.reset();
+  }
+  void AddTopic(int id, const std::string& name, const std::string& type) override {
+    Ros2MessageDefinition(type);  // a type this writer knows
+    Database::Statement topic(*db_, "INSERT INTO topics VALUES(?, ?, ?, 'cdr', '')");
+    topic.Bind(1, std::int64_t(id));
+    topic.Bind(2, name);
+    topic.Bind(3, type);
+    topic.Step();
+  }
+  void Write(int topic, std::int64_t log_time, const std::vector<std::uint8_t>& data) override {
+    insert_->Reset();
+    insert_->Bind(1, std::int64_t(topic));
+    insert_->Bind(2, log_time);
+    insert_->Bind(3, data);
+    insert_->Step();
+  }
+  void Close() override {
+    db_->Execute("COMMIT;");
+    insert_.reset();
+    db_.reset();
+  }
+
+ private:
+  std::unique_ptr<Database> db_;
+  std::unique_ptr<Database::Statement> insert_;
+};
+
+}  // namespace
+
 struct Ros2BagWriter::Impl {
   std::string path, temporary;
-  BagFormat format;
-  McapWriterOptions mcap_options;
-  std::ofstream file;
-  std::unique_ptr<McapWriter> mcap;
-  std::unique_ptr<Database> db;
-  std::unique_ptr<Database::Statement> insert;
-  std::vector<std::uint16_t> channels;  // MCAP: topic id -> channel
+  std::unique_ptr<FormatWriter> format;
+  int topics = 0;
   bool finished = false;
 };
 
 Ros2BagWriter::Ros2BagWriter(const std::string& path, BagFormat format, const McapWriterOptions& mcap)
     : impl_(std::make_unique<Impl>()) {
-  if (format != BagFormat::kMcap && format != BagFormat::kSqlite3) {
-    throw std::invalid_argument("Ros2BagWriter writes .mcap or .db3 files");
-  }
   Impl& w = *impl_;
   w.path = path;
   w.temporary = TemporaryFileFor(path);
-  w.format = format;
-  w.mcap_options = mcap;
   std::remove(w.temporary.c_str());
-  if (format == BagFormat::kMcap) {
-    w.file.open(w.temporary, std::ios::binary | std::ios::trunc);
-    if (!w.file) throw FileError(path, "cannot write");
-    w.mcap = std::make_unique<McapWriter>(w.file, mcap);
-    return;
+  switch (format) {
+    case BagFormat::kMcap:
+      w.format = std::make_unique<McapFile>(path, w.temporary, mcap);
+      break;
+    case BagFormat::kSqlite3:
+      w.format = std::make_unique<SqliteFile>(w.temporary);
+      break;
+    default:
+      throw std::invalid_argument("Ros2BagWriter writes .mcap or .db3 files");
   }
-  w.db = std::make_unique<Database>(w.temporary, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
-  w.db->Execute(
-      "PRAGMA journal_mode=OFF; PRAGMA synchronous=OFF;"
-      "CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);"
-      "INSERT INTO schema VALUES(3, 'humble');"
-      "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL,"
-      " serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL);"
-      "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL,"
-      " data BLOB NOT NULL);"
-      "CREATE INDEX timestamp_idx ON messages (timestamp ASC);"
-      "BEGIN TRANSACTION;");
-  w.insert =
-      std::make_unique<Database::Statement>(*w.db, "INSERT INTO messages(topic_id, timestamp, data) VALUES(?, ?, ?)");
 }
 
 Ros2BagWriter::~Ros2BagWriter() {
   if (impl_->finished) return;
-  impl_->insert.reset();
-  impl_->db.reset();
-  impl_->file.close();
+  impl_->format.reset();
   std::remove(impl_->temporary.c_str());
 }
 
 int Ros2BagWriter::AddTopic(const std::string& name, const std::string& type) {
-  Impl& w = *impl_;
-  if (w.format == BagFormat::kMcap) {
-    const std::uint16_t schema = w.mcap->AddSchema(type, "ros2msg", Ros2MessageDefinition(type));
-    w.channels.push_back(w.mcap->AddChannel(name, schema, "cdr"));
-    return int(w.channels.size());
-  }
-  Ros2MessageDefinition(type);  // a type this writer knows
-  const int id = int(w.channels.size() + 1);
-  w.channels.push_back(std::uint16_t(id));
-  Database::Statement topic(*w.db, "INSERT INTO topics VALUES(?, ?, ?, 'cdr', '')");
-  topic.Bind(1, std::int64_t(id));
-  topic.Bind(2, name);
-  topic.Bind(3, type);
-  topic.Step();
-  return id;
+  impl_->format->AddTopic(impl_->topics + 1, name, type);
+  return ++impl_->topics;
 }
 
 void Ros2BagWriter::Write(int topic, std::int64_t log_time, const std::vector<std::uint8_t>& data) {
-  Impl& w = *impl_;
-  if (topic < 1 || std::size_t(topic) > w.channels.size()) throw std::invalid_argument("Ros2BagWriter: no such topic");
-  if (w.format == BagFormat::kMcap) {
-    w.mcap->Write(w.channels[std::size_t(topic - 1)], std::uint64_t(log_time), std::uint64_t(log_time), data);
-    return;
-  }
-  w.insert->Reset();
-  w.insert->Bind(1, std::int64_t(topic));
-  w.insert->Bind(2, log_time);
-  w.insert->Bind(3, data);
-  w.insert->Step();
+  if (topic < 1 || topic > impl_->topics) throw std::invalid_argument("Ros2BagWriter: no such topic");
+  impl_->format->Write(topic, log_time, data);
 }
 
 void Ros2BagWriter::Finish() {
   Impl& w = *impl_;
   if (w.finished) return;
-  if (w.format == BagFormat::kMcap) {
-    w.mcap->Finish();
-    w.file.close();
-    if (!w.file) throw FileError(w.path, "cannot write");
-  } else {
-    w.db->Execute("COMMIT;");
-    w.insert.reset();
-    w.db.reset();
-  }
+  w.format->Close();
   std::error_code error;
   fs::rename(w.temporary, w.path, error);
   if (error) throw FileError(w.path, "cannot write: " + error.message());

@@ -12,7 +12,7 @@
 #include "radargauss/io/pcd.hpp"
 #include "radargauss/core/read_file.hpp"
 #include "radargauss/io/rosbag.hpp"
-#include "radargauss/io/rosbag2.hpp"
+#include "radargauss/io/rosbag.hpp"
 
 namespace radargauss {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The updatable spatial index of odometry's local map (docs/design.md,
+// The updatable spatial index of odometry's local map (docs/design/odometry.md,
 // "Odometry"): the cells a change touches get new lists appended to the
 // entries (or rewritten in place when they fit the old), and the entries are
 // compacted once stale ones outnumber the live.

@@ -225,7 +225,7 @@ GaussianMap ReadMap(const std::string& path) {
       g.rcs.spread_db = reader.Get<double>();
       g.rcs.explained = reader.Get<double>();
       g.rcs.mean_offset_db = reader.Get<double>();
-    } else {  // no statistics: the fit's rmse in dB, view-dependent (docs/design.md, "RCS confidence")
+    } else {  // no statistics: the fit's rmse in dB, view-dependent (docs/design/map.md, "RCS confidence")
       g.rcs.spread_db = g.rcs.fit_rmse * g.rcs.scale;
     }
     const auto fail = [&](const std::string& what) {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The incremental estimator of odometry's local map (docs/design.md, "The
+// The incremental estimator of odometry's local map (docs/design/odometry.md, "The
 // incremental map"): each point joins the nearest Gaussian of its region
 // whose gate holds it and updates that Gaussian's sufficient statistics; the
 // points no gate holds seed new Gaussians by build-map's estimator once there
@@ -35,7 +35,7 @@ std::int64_t DownsampleKey(const Eigen::Vector3d& point, double voxel) {
 }
 
 // The unit incidence direction of a member at `point` seen from `pose` for a
-// Gaussian at `mean`, facing the radar (docs/design.md, "RCS models"); zero
+// Gaussian at `mean`, facing the radar (docs/design/map.md, "RCS models"); zero
 // when it has none.
 Eigen::Vector3d IncidenceDirection(const SE3d& pose, const Eigen::Vector3d& point, const Eigen::Vector3d& mean,
                                    IncidenceModel model) {

@@ -289,7 +289,7 @@ Sequence AsSequence(const SimulatedSequence& simulated) {
 
 namespace {
 
-// imu.txt, imu_extrinsic.txt and imu_biases.txt of docs/design.md, "The synthetic world".
+// imu.txt, imu_extrinsic.txt and imu_biases.txt of docs/design/simulator.md, "The synthetic world".
 void WriteSimulatedImu(const std::string& dir, const SimulatedSequence& sequence) {
   namespace fs = std::filesystem;
   WriteFileAtomically((fs::path(dir) / "imu.txt").string(), [&](std::ostream& out) {

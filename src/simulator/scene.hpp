@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The simulator's loop (docs/design.md, "The synthetic world"): the road,
+// The simulator's loop (docs/design/simulator.md, "The synthetic world"): the road,
 // the town's buildings, poles and cars or the motorway's guardrails,
 // gantries and traffic along it, and ray casting through them. Internal to
 // src/simulator/.

@@ -97,7 +97,7 @@ bool Detected(const SimulationConfig& config, double rcs, double distance, Draws
 // detected, and with multipath_probability when that surface is a wall or
 // guardrail, the ghost of what the mirrored ray meets beyond it: seen along
 // the ray at the path's length (the target mirrored across the reflector),
-// with the mirrored target's velocity (docs/design.md, "The faults of real
+// with the mirrored target's velocity (docs/design/simulator.md, "The faults of real
 // radars"). Appends to `scan` and `truth`.
 void Detect(const SimulationConfig& config, const Scene& scene, const ScanState& state, Draws& draws, RadarScan& scan,
             std::vector<DetectionTruth>& truth) {
@@ -178,7 +178,7 @@ struct ScanTime {
   double since_start = 0.0;
 };
 
-// The IMU's samples over the drive (docs/design.md, "The synthetic world"):
+// The IMU's samples over the drive (docs/design/simulator.md, "The synthetic world"):
 // the IMU frame's mean rate and specific force over the interval from each
 // sample to the next (delta angle and delta velocity over dt), plus turn-on biases, their random walks and white noise,
 // drawn from a generator of their own so that the scans are the same with an

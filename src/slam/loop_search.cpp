@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// SLAM's loop search (docs/design.md, "SLAM"): a closed keyframe's
+// SLAM's loop search (docs/design/slam.md, "SLAM"): a closed keyframe's
 // candidates through the cheapest checks first, their verification in
 // waves, the graph's solve after an accepted loop, and the robustness
 // study's injected false loops. The back end's side of RadarSlam.
@@ -128,7 +128,7 @@ void RadarSlam::SearchLoops(int query) {
 
 // The loop corrects the drift of the `path` metres it closes: the keyframes
 // driven within that plus the margin move, the rest stays for Finish's
-// whole solve (docs/design.md, "SLAM").
+// whole solve (docs/design/slam.md, "SLAM").
 void RadarSlam::SolveAfterLoop(int query, double path) {
   int first_free = 0;
   if (options_.local_solve_margin > 0.0) {

@@ -49,7 +49,7 @@ bool SolveStep(const CombinedSystem& system, bool loss_curvature, Vector6& dx, s
   return true;
 }
 
-// The step check on the exact map (docs/design.md, "The own Gauss-Newton"):
+// The step check on the exact map (docs/design/solvers.md, "The own Gauss-Newton"):
 // a step must not raise eq. 2 for its association; one that does is halved
 // (at most max_step_halvings times). When the next iteration keeps the
 // association, its system carries the cost at the new pose, so the check
@@ -120,7 +120,7 @@ std::string GaussNewtonSolver::Name() const {
   return options_.jacobians == JacobianMode::kAnalytic ? "gn" : "gn-autodiff";
 }
 
-// The paper's loop per stage (docs/design.md, "Coarse to fine"): associate,
+// The paper's loop per stage (docs/design/solvers.md, "Coarse to fine"): associate,
 // linearise eq. 2, solve the 6x6 system, update the pose (checked on the
 // exact map), stop on a small step.
 ScanMatchingResult GaussNewtonSolver::Match(const RadarScan& scan, const MatchingMap& map, const SE3d& initial,

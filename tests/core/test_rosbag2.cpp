@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// ROS 2 bags (docs/design.md, "ROS 2 bags"): CDR against hand-laid bytes
+// ROS 2 bags (docs/design/formats.md, "ROS 2 bags"): CDR against hand-laid bytes
 // and in every encoding; MCAP written and read back in each layout, and a
 // file laid out by hand that has no summary; sqlite3 bags of schema 1 and 3;
 // rosbag2 folders; the rosbag2 project's own test bags; one simulated
 // sequence read from its PCD folder and from each kind of bag giving the same
 // scans and odometry; and hostile files refused with one DataError.
-#include "radargauss/io/rosbag2.hpp"
+#include "radargauss/io/bag_reader.hpp"
+#include "radargauss/io/bag_writer.hpp"
 
 #include <gtest/gtest.h>
 #include <lz4frame.h>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Inputs built to hurt (docs/design.md, "Bounds on input"): each is refused
+// Inputs built to hurt (docs/design/formats.md, "Bounds on input"): each is refused
 // with a message naming the file and the fault, at once and without a large
 // allocation, instead of crashing, hanging or running into UB.
 

@@ -119,7 +119,7 @@ TEST(RcsModelFit, RmseMatchesNoiseLevel) {
   EXPECT_NEAR(model.fit_rmse * model.scale, noise, 0.1 * noise);
 }
 
-// The fit's statistics (docs/design.md, "RCS confidence") on planted data:
+// The fit's statistics (docs/design/map.md, "RCS confidence") on planted data:
 // a view law with 1 dB of noise gives a 1 dB spread and a view that explains
 // most of the variance; noise alone explains nothing and, with
 // min_explained, gets the constant model; a law without noise has no spread

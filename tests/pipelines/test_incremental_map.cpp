@@ -216,7 +216,7 @@ MapSummary Summarise(const std::vector<Gaussian>& gaussians, const std::vector<E
   return {d2.size(), Median(d2), Median(stds), Median(offsets)};
 }
 
-// The bound the two estimators agree within on a static scene (docs/design.md,
+// The bound the two estimators agree within on a static scene (docs/design/odometry.md,
 // "The incremental map"): Gaussian count within 20 %; as many of a scan's
 // points within the gate, as close in Mahalanobis terms (median within 30 %);
 // the median largest std within 30 %; the means on the planted surfaces

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The simulator's faults of real radars (docs/design.md, "The faults of real
+// The simulator's faults of real radars (docs/design/simulator.md, "The faults of real
 // radars"), each against its law: ghosts mirrored across their reflector
 // with the mirrored Doppler, Swerling RCS variances, the elevation bias and
 // its growth off boresight, the mounting offset, the motorway's traffic, and

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Radar-inertial odometry (docs/design.md, "Radar-inertial odometry") on a
+// Radar-inertial odometry (docs/design/odometry.md, "Radar-inertial odometry") on a
 // simulated drive with a MEMS IMU: its drift below the radar's alone, the
 // window's gyro bias near the truth, the same trajectory for the same input
 // and in SLAM's front end, and an IMU that ends before the scans refused.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The simulator's IMU (docs/design.md, "The synthetic world"): noise-free
+// The simulator's IMU (docs/design/simulator.md, "The synthetic world"): noise-free
 // gyro rates integrate to the ground truth's rotations exactly; over a closed lap the
 // specific force averages to gravity's reaction; biases and white noise
 // follow their laws; the scans are the same with an IMU or without; the

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// IMU preintegration (docs/design.md, "IMU preintegration") against
+// IMU preintegration (docs/design/residuals.md, "IMU preintegration") against
 // independent references: planted motions whose exact IMU integrates to
 // their states to 1e-9, the first-order bias correction against integrating
 // again (second-order agreement), and the covariance against Monte Carlo.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The preintegrated IMU term (docs/design.md, "The IMU term"): analytic
+// The preintegrated IMU term (docs/design/residuals.md, "The IMU term"): analytic
 // Jacobians against automatic differentiation and central differences, and
 // a zero residual at the states of a planted motion whose exact IMU it
 // integrates; the radar's pose and velocity terms on an IMU state likewise.
@@ -103,7 +103,7 @@ TEST(ImuResidual, NoSamplesIsRefused) {
   EXPECT_THROW(ImuCostFunction(empty, ImuNoise{}), std::invalid_argument);
 }
 
-// The radar's terms on an IMU state (docs/design.md, "The sliding window"):
+// The radar's terms on an IMU state (docs/design/solvers.md, "The sliding window"):
 // zero at a hand-made state and its exact measurements, and automatic
 // differentiation against central differences on every block.
 struct RadarOnImu {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The sliding window of IMU states (docs/design.md, "The sliding window") on
+// The sliding window of IMU states (docs/design/solvers.md, "The sliding window") on
 // a simulated drive with a MEMS IMU, turned and away from the radar: from
 // noisy radar poses in a tilted world and noisy Doppler velocities it
 // recovers the planted biases, the world's tilt against gravity and the

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Marginalisation by the Schur complement (docs/design.md, "The sliding
+// Marginalisation by the Schur complement (docs/design/solvers.md, "The sliding
 // window"): on a linear-Gaussian chain the prior left by the first states
 // puts the rest at the whole problem's optimum, from any linearisation
 // point; on a rotation its Jacobian agrees with central differences.

@@ -162,7 +162,7 @@ inline Eigen::MatrixXd Dense(const ceres::CRSMatrix& jacobian) {
 // A pure rotation error reduced by the RCS term alone, on planted
 // parameters: Gaussians 6 to 12 m around the radar whose RCS models are
 // planted degree-2 SH patterns, and a scan whose RCS values are those
-// patterns evaluated at the true pose with the incidence law of docs/design.md,
+// patterns evaluated at the true pose with the incidence law of docs/design/map.md,
 // "Building the map", written out here independently of the residual code. With
 // w = 1 and rotation-only the geometric term has no weight, so whatever
 // corrects the rotation is the RCS term.

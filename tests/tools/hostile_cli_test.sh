@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
-# Hostile input through the command-line tool (docs/design.md, "Bounds on
+# Hostile input through the command-line tool (docs/design/formats.md, "Bounds on
 # input"): one line naming the file and the fault, a non-zero exit, at once.
 #   hostile_cli_test.sh <path to radargauss> <source dir> [privileged]
 set -u
@@ -303,7 +303,7 @@ touch "$work/a_file"
 expect_fail "odometry --out a file" "a_file: exists and is not a folder" -- "$tool" odometry "${seq[@]}" --out "$work/a_file"
 
 
-# ROS 2 bags (docs/design.md, "ROS 2 bags"): a bag of the sequence, then lies about it.
+# ROS 2 bags (docs/design/formats.md, "ROS 2 bags"): a bag of the sequence, then lies about it.
 "$tool" convert "${seq[@]}" --out "$work/seq.mcap" >/dev/null
 bag_bytes=$(stat -c %s "$work/seq.mcap")
 head -c $((bag_bytes - 100)) "$work/seq.mcap" >"$work/cut.mcap"

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
 # build-map and localize killed with SIGKILL at moments spread over their run
-# (docs/design.md, "Bounds on input"): every output file is then absent or
+# (docs/design/formats.md, "Bounds on input"): every output file is then absent or
 # whole (the same bytes, or for files with timings the same lines, as an
 # undisturbed run), and once a run ends no temporary file or staged results
 # folder is left.

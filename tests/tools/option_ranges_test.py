@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""Documented ranges are the accepted ones (docs/design.md, "Bounds on
+"""Documented ranges are the accepted ones (docs/design/formats.md, "Bounds on
 input"): every numeric flag whose `--help-all` states a range, in every
 subcommand that runs on a sequence, is tried at each end of that range (a
 closed end is accepted and the run ends, or is refused for what the value

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
-# Outputs never replace inputs (docs/design.md, "Bounds on input"): every
+# Outputs never replace inputs (docs/design/formats.md, "Bounds on input"): every
 # command's outputs against every file and folder it reads, refused in one
 # line before the run or as the write would replace a file read, the input
 # left as it was; outputs checked writable before the run.

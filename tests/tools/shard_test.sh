@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
-# localize --shard I/N and merge (docs/design.md, "Shards"): three shards
+# localize --shard I/N and merge (docs/design/experiment.md, "Shards"): three shards
 # merged, given in any order, equal the unsharded run in every file (the
 # timing columns aside); a missing, repeated or foreign shard (another count,
 # seed or map) is refused, and so is a shard.json whose fields do not hold

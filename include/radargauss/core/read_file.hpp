@@ -13,7 +13,7 @@ namespace radargauss {
 // or a socket is refused by its type before anything is read.
 void CheckRegularInputFile(const std::string& path, const std::string& what = "file");
 
-// Outputs never replace inputs (docs/design.md, "Bounds on input"): after
+// Outputs never replace inputs (docs/design/formats.md, "Bounds on input"): after
 // ProtectInputs() (the command-line tool calls it first), every file that
 // CheckRegularInputFile admits is remembered by its device and inode, and
 // the writers of atomic_file.hpp refuse to replace or remove one of them.

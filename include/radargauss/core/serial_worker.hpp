@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // One thread that runs the work handed to it in the order it was handed
-// (SLAM's back end beside its odometry, docs/design.md "SLAM"). The first
+// (SLAM's back end beside its odometry, docs/design/slam.md "SLAM"). The first
 // exception a piece of work throws is kept, the work after it is skipped,
 // and Wait rethrows it.
 //

@@ -43,7 +43,7 @@ struct RadarScan {
 void ValidateScan(const RadarScan& scan, const std::string& source);
 
 // Lowers every point's elevation by `angle` (rad), keeping its range and
-// azimuth: removes a radar's elevation bias (docs/design.md, "The faults of
+// azimuth: removes a radar's elevation bias (docs/design/simulator.md, "The faults of
 // real radars").
 void LowerElevations(RadarScan& scan, double angle);
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Voxel grids over points: the integer voxel of a point and its packed key
-// (the spatial index's cells, docs/design.md, "The spatial index"), points
+// (the spatial index's cells, docs/design/map.md, "The spatial index"), points
 // grouped by voxel, and voxel centroids (downsampling).
 #pragma once
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Trajectory evaluation (docs/design.md, "Evaluation"): an estimate against a
+// Trajectory evaluation (docs/design/experiment.md, "Evaluation"): an estimate against a
 // reference, poses matched by time. ATE after an alignment; RPE over
 // segments of a fraction of the reference's path length from every start
 // pose (the protocol of evo's RPE with the RA-L authors' settings), and over

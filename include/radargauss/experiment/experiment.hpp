@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The paper's localisation experiment (section IV, docs/design.md, "The localisation experiment"): for
+// The paper's localisation experiment (section IV, docs/design/experiment.md, "The localisation experiment"): for
 // every scan, start from the reference pose composed with a seeded random
 // error (translation magnitude uniform in [0, max] m, rotation angle uniform in
 // [0, max] deg, random directions; the same errors for every configuration),
@@ -56,7 +56,7 @@ ConfigurationRun RunConfiguration(const std::string& name, double w_rcs, const S
                                   const std::vector<SE3d>& references, const std::vector<SE3d>& errors,
                                   std::size_t first_scan = 0);
 
-// One shard of an experiment (docs/design.md, "Shards"): shard `index` of
+// One shard of an experiment (docs/design/experiment.md, "Shards"): shard `index` of
 // `count` (1-based) matches scans [Begin, End) of `scans` in all.
 struct Shard {
   std::size_t index = 1, count = 1;

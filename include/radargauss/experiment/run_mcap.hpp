@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // A run as an MCAP file that a robotics viewer (Foxglove, RViz through
-// rosbag2) opens (docs/design.md, "ROS 2 bags"): the trajectory, the
+// rosbag2) opens (docs/design/formats.md, "ROS 2 bags"): the trajectory, the
 // reference, the scans registered in the map's frame, the map's Gaussians
 // (means with their RCS, and ellipsoids), the loops, and map -> radar as tf.
 //

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// An IMU beside the radar (docs/design.md, "Data in and out"): samples of
+// An IMU beside the radar (docs/design/formats.md, "Data in and out"): samples of
 // angular rate and specific force in the IMU's frame, read from a text file
 // or a bag; the IMU's noise as datasheet figures; a file's summary.
 //
@@ -77,7 +77,7 @@ struct ImuScreening {
 // Drops from `samples` those beyond `imu`'s ranges, then isolated spikes: a
 // sample whose gyro (accelerometer) differs from both neighbours by more
 // than a quarter of the range while they differ from each other by less
-// than an eighth (one glitched sample, not motion: docs/design.md, "Bounds on input").
+// than an eighth (one glitched sample, not motion: docs/design/formats.md, "Bounds on input").
 ImuScreening ScreenImuSamples(std::vector<ImuSample>& samples, const ImuNoise& imu);
 
 // What `info` says of an IMU: its span, rate and gaps, and the mean specific

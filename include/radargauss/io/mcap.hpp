@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // MCAP files (https://mcap.dev/spec, version 0), the default storage of
-// rosbag2 (docs/design.md, "ROS 2 bags"): read record by record from the
+// rosbag2 (docs/design/formats.md, "ROS 2 bags"): read record by record from the
 // file, chunked or not, chunks uncompressed, zstd or lz4 (Debian's libzstd
 // and liblz4), every CRC that the file states checked; and written with
 // chunks, message indexes and a summary (schemas, channels, statistics,
@@ -10,13 +10,15 @@
 //
 //   McapReader reader(path);
 //   for (const McapChannel& c : reader.channels()) ...
-//   reader.ForEachMessage([&](const McapMessage& m) { ... });
+//   reader.ForEachMessage([&](const McapMessage& m) { ... });        // all, in file order
+//   reader.Read({{"/imu/data"}}, [&](const McapMessage& m) { ... });  // by the chunk index
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <ostream>
@@ -49,6 +51,21 @@ struct McapMessage {
   std::size_t size = 0;
 };
 
+// What McapReader::Read delivers: the messages of `topics` (every topic
+// when empty) whose log time lies in [start, end] (ns).
+struct McapReadOptions {
+  std::vector<std::string> topics;
+  std::uint64_t start = 0;
+  std::uint64_t end = std::numeric_limits<std::uint64_t>::max();
+};
+
+// A chunk as the summary's chunk index states it.
+struct McapChunkIndex {
+  std::uint64_t start_time = 0, end_time = 0;  // ns: its first and last message's log time
+  std::uint64_t offset = 0, length = 0;        // of the chunk record, in the file
+  std::vector<std::uint16_t> channels;         // those with a message index (empty: not stated)
+};
+
 class McapReader {
  public:
   // Opens the file and checks both magics; reads the summary section when
@@ -62,12 +79,30 @@ class McapReader {
   // a time), checking each chunk's CRC and, over a whole pass, the data
   // section's. Throws DataError naming the file for any malformed record.
   void ForEachMessage(const std::function<void(const McapMessage&)>& visit);
+  // Calls visit for every message the options admit, in log-time order.
+  // With the summary's chunk indexes, only the chunks whose index admits a
+  // topic and overlaps the range are read (each CRC checked); chunks whose
+  // times overlap are read together and merged. Without them, one pass in
+  // file order as ForEachMessage.
+  void Read(const McapReadOptions& options, const std::function<void(const McapMessage&)>& visit);
+  const std::vector<McapChunkIndex>& chunk_indexes() const { return chunk_indexes_; }
+  // Chunks decompressed and chunks skipped by their index, over every pass so far.
+  std::size_t chunks_read() const { return chunks_read_; }
+  std::size_t chunks_skipped() const { return chunks_skipped_; }
 
  private:
   void ReadSummary(std::uint64_t summary_start, std::uint64_t footer_offset);
   void Scan(const std::function<void(const McapMessage&)>* visit);
   void AddSchema(const std::uint8_t* body, std::size_t size);
   void AddChannel(const std::uint8_t* body, std::size_t size);
+  void AddChunkIndex(const std::uint8_t* body, std::size_t size);
+  // A chunk record's body decompressed (its CRC checked), `position` naming it.
+  std::vector<std::uint8_t> ChunkRecords(const std::uint8_t* body, std::size_t size, std::uint64_t position);
+  // Calls on_message for each message record among `records` (schemas and
+  // channels among them added first).
+  void ForEachRecord(const std::vector<std::uint8_t>& records,
+                     const std::function<void(const std::uint8_t*, std::size_t)>& on_message);
+  McapMessage ParseMessage(const std::uint8_t* data, std::size_t size);
 
   std::string path_;
   std::ifstream file_;
@@ -79,6 +114,8 @@ class McapReader {
   std::map<std::uint16_t, Schema> schemas_;
   std::map<std::uint16_t, McapChannel> channels_;
   std::vector<McapChannel> channel_list_;
+  std::vector<McapChunkIndex> chunk_indexes_;
+  std::size_t chunks_read_ = 0, chunks_skipped_ = 0;
 };
 
 enum class McapCompression { kNone, kZstd, kLz4 };

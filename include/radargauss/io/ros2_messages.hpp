@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The ROS 2 messages radargauss reads and writes, in CDR (docs/design.md,
+// The ROS 2 messages radargauss reads and writes, in CDR (docs/design/formats.md,
 // "ROS 2 bags"): a 4-byte encapsulation header, then the fields little- or
 // big-endian, each aligned to its size (XCDR1) or to at most 4 bytes
 // (XCDR2, plain). Strings and sequences are bounded by the message's bytes:

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Bags: ROS1 bags, read through Debian's ROS1 bag library (rosbag::Bag /
-// rosbag::View: uncompressed, bz2 and lz4 bags), and ROS 2 bags
-// (io/rosbag2.hpp: a rosbag2 folder, a .db3 or an .mcap file), told apart by
+// Bags: what radargauss reads from them, whatever their format. ROS1 bags
+// are read through Debian's ROS1 bag library (uncompressed, bz2 and lz4
+// bags), ROS 2 bags (a rosbag2 folder, a .db3 or an .mcap file) without ROS;
+// each format has its reader behind io/bag_reader.hpp, told apart by
 // content. ROS1 support is an optional component: without it
 // (RosbagSupported() false) a ROS1 bag gets a DataError saying so.
 #pragma once
@@ -15,11 +16,18 @@
 
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/field_mapping.hpp"
+#include "radargauss/core/trajectory.hpp"
 #include "radargauss/core/types.hpp"
 
 namespace radargauss {
 
 bool RosbagSupported();
+
+enum class BagFormat { kRos1, kSqlite3, kMcap, kRos2Folder };
+
+// What `path` holds, by its first bytes (a folder: by its metadata.yaml).
+// Throws DataError naming it when it is none of these.
+BagFormat DetectBagFormat(const std::string& path);
 
 struct BagTopic {
   std::string name;
@@ -76,11 +84,11 @@ std::vector<ImuSample> ReadBagImu(const std::string& bag_path, const std::string
 // and force, a stamp after the last one's; DataError naming `source` otherwise.
 void AppendBagImuSample(std::vector<ImuSample>& samples, const ImuSample& sample, const std::string& source);
 
-// The same three for ROS1 bags alone (src/io/rosbag.cpp, or its stand-in
-// without the library).
-std::vector<BagTopic> ListRos1BagTopics(const std::string& bag_path);
-std::vector<RadarScan> ReadRos1BagScans(const std::string& bag_path, const std::string& topic,
-                                        const FieldMapping& mapping);
-std::vector<ImuSample> ReadRos1BagImu(const std::string& bag_path, const std::string& topic, bool record_time);
+// Reference poses from a ROS 2 bag's `topic`: geometry_msgs/msg/PoseStamped
+// or nav_msgs/msg/Odometry (each message's pose at its stamp),
+// tf2_msgs/msg/TFMessage (the transforms whose child frame is
+// `child_frame`), or nav_msgs/msg/Path (the last message's poses). Stamps
+// that do not increase are refused; DataError names the message.
+Trajectory ReadBagPoses(const std::string& path, const std::string& topic, const std::string& child_frame = "");
 
 }  // namespace radargauss

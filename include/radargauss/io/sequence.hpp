@@ -49,7 +49,7 @@ struct Sequence {
 // Throws DataError (one line naming the file and fault) on any bad input.
 Sequence LoadSequence(const SequenceOptions& options);
 
-// T_xt32_ars548 of the Snail-Radar 2023-12-13 sequences (docs/design.md, "Data in and out").
+// T_xt32_ars548 of the Snail-Radar 2023-12-13 sequences (docs/design/formats.md, "Data in and out").
 SE3d SnailRadar20231213Extrinsic();
 
 // A ground-truth TUM file as T_world_radar samples (times the extrinsic

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Configuration files in YAML, read one way by the simulator and the
-// command-line tool (docs/design.md, "Bounds on input").
+// command-line tool (docs/design/formats.md, "Bounds on input").
 #pragma once
 
 #include <yaml-cpp/yaml.h>

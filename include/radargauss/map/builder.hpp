@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Gaussian map builders (docs/design.md, "Gaussians").
+// Gaussian map builders (docs/design/map.md, "Gaussians").
 //   kKMeans (default, the RA-L work done natively): voxel-downsample the
 //     cloud (0.25 m), K = round(N_downsampled / points_per_gaussian),
 //     bisecting k-means initialisation with a fixed seed, then hard EM: every

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The Gaussian-RCS map (paper section III-A, docs/design.md, "Building the map"): 3D
+// The Gaussian-RCS map (paper section III-A, docs/design/map.md, "Building the map"): 3D
 // Gaussians in the world frame, each with an optional RCS model, and the
 // spatial index used to associate points with them.
 #pragma once
@@ -19,7 +19,7 @@
 
 namespace radargauss {
 
-// How the incidence vector d of a member point is formed (docs/design.md,
+// How the incidence vector d of a member point is formed (docs/design/map.md,
 // "RCS models"), in the radar frame of the point's scan, mu_r = R^T (mu - t):
 //   kOffset (the paper's): d = normalize(p_r - mu_r)
 //   kView (radar-to-centre ray): d = normalize(-mu_r)
@@ -39,7 +39,7 @@ struct RcsModel {
   std::array<double, ShCoefficientCount(kMaxShDegree)> coefficients{};
   double fit_rmse = 0.0;  // normalised units, over the inliers
   std::uint32_t inliers = 0;
-  // The fit's statistics over its inliers (docs/design.md, "RCS confidence"):
+  // The fit's statistics over its inliers (docs/design/map.md, "RCS confidence"):
   // the residuals' std in dB with the fitted coefficients' degrees of freedom
   // taken out; the share of the RCS variance the view explains (adjusted
   // R^2, in [0, 1]); and the dB from the model's value to the members'
@@ -62,7 +62,7 @@ struct Gaussian {
 
 // A keyframe of the run that built the map (SLAM): where it was and the
 // static points it saw, so that a later run can describe its own submaps and
-// relocalise against the map (docs/design.md, "Relocalisation").
+// relocalise against the map (docs/design/slam.md, "Relocalisation").
 struct MapPlace {
   SE3d pose;                       // T_world_keyframe
   std::vector<RadarPoint> points;  // its submap in its frame (position and RCS)
@@ -78,7 +78,7 @@ struct GaussianMap {
 // columns are the principal axes (det +1). Sigma = R diag(std^2) R^T.
 void PrincipalAxes(const Eigen::Matrix3d& covariance, Eigen::Vector3d& std_devs, Eigen::Matrix3d& axes);
 
-// Clamps every principal std to at least `min_std` (docs/design.md, "Building the map").
+// Clamps every principal std to at least `min_std` (docs/design/map.md, "Building the map").
 Eigen::Matrix3d ClampCovariance(const Eigen::Matrix3d& covariance, double min_std);
 
 // The upper triangle (00 01 02 11 12 22) of Sigma^-1 = L L^T from that of the
@@ -98,7 +98,7 @@ void InformationFromSqrtInformationT(const T u[6], T information[6]) {
 // ellipsoid of `extent_sigmas` standard deviations (Mahalanobis distance)
 // meets, so a query point has a few candidates; association is the candidate
 // of smallest Mahalanobis^2, gated by tau^2 (complete for tau <= extent).
-// Bounds on the work of indexing (docs/design.md, "Bounds on input"): the
+// Bounds on the work of indexing (docs/design/formats.md, "Bounds on input"): the
 // cells of the box around one Gaussian's ellipsoid (each is tested; 2^24 take
 // about half a second), and those of all Gaussians of a static index.
 inline constexpr std::size_t kMaxIndexCellsPerGaussian = std::size_t(1) << 24;
@@ -111,7 +111,7 @@ class GaussianIndex {
   // the bounds above.
   GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size = 1.0, double extent_sigmas = 3.0);
 
-  // An empty index that Update can change (docs/design.md, "Odometry"): it
+  // An empty index that Update can change (docs/design/odometry.md, "Odometry"): it
   // also keeps the cells each Gaussian is listed in.
   static GaussianIndex Updatable(double cell_size = 1.0, double extent_sigmas = 3.0);
   // Lists gaussians[id] anew for every id of `changed` (ids may grow the

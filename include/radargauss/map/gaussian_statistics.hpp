@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Sufficient statistics of a Gaussian and of its RCS least squares, updated
-// point by point (docs/design.md, "The incremental map"): adding, removing
+// point by point (docs/design/odometry.md, "The incremental map"): adding, removing
 // and merging members costs O(1) per point, and the Gaussian and the RCS
 // model they give equal the batch fit of the same members.
 #pragma once
@@ -30,7 +30,7 @@ struct PointStatistics {
   Eigen::Matrix3d Covariance() const { return scatter / double(count); }
 };
 
-// The normal equations of one Gaussian's RCS fit (paper eq. 2, docs/design.md,
+// The normal equations of one Gaussian's RCS fit (paper eq. 2, docs/design/map.md,
 // "RCS models") at degree kMaxShDegree: N = sum Y(d) Y(d)^T, r = sum Y(d) y,
 // sum y^2, over the members that are inliers of a normalisation (median,
 // scale) fixed when the statistics are (re)started. A lower degree's system is

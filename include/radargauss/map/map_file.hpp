@@ -33,7 +33,7 @@ namespace radargauss {
 
 inline constexpr std::uint32_t kMapFileVersion = 3;
 
-// What ReadMap accepts of a Gaussian (docs/design.md, "Bounds on input"):
+// What ReadMap accepts of a Gaussian (docs/design/formats.md, "Bounds on input"):
 // every mean coordinate within kMaxMapCoordinate of the origin (UTM
 // northings fit), principal stds within [kMinMapStd, kMaxMapStd] (a radar
 // map's Gaussians are centimetres to metres; a kilometre one would list

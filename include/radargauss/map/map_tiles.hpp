@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// A map of the place in square tiles (docs/design.md, "Map tiles"): a folder
+// A map of the place in square tiles (docs/design/slam.md, "Map tiles"): a folder
 // with one map file (.rgm, map_file.hpp) per tile of `tile_size` metres in
 // x and y, holding the Gaussians whose mean and the places whose pose lie in
 // it, and `tiles.json`, the index:

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The map as the solvers use it (docs/design.md, "Coarse to fine"): the
+// The map as the solvers use it (docs/design/solvers.md, "Coarse to fine"): the
 // Gaussians and one spatial index per level, coarse levels first. Odometry's
 // local map keeps one that follows its changes (MatchingMap::Update).
 #pragma once
@@ -39,7 +39,7 @@ std::vector<std::string> CoarseLevelsNames();
 
 // The map as the solvers use it: the Gaussians and coarse-to-fine indexes,
 // level k blurred by sigma_k (coarse first), the exact map last
-// (docs/design.md, "Coarse to fine").
+// (docs/design/solvers.md, "Coarse to fine").
 // Bounds of the matching structures' sizes: a blur or an index cell beyond
 // these is a wrong number (and squared, could overflow the cell counts).
 constexpr double kMaxCoarseSigma = 100.0;  // m

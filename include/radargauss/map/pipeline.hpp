@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The map pipeline of docs/design.md, "Building the map": static points
+// The map pipeline of docs/design/map.md, "Building the map": static points
 // (Doppler filter) merged with the reference poses, Gaussians, RCS models.
 // BuildMap (radargauss.hpp) runs it in one call; the two stages are public
 // so that several RCS fits (incidence models, degrees) share one geometry.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Per-Gaussian RCS models (paper section III-A, docs/design.md, "RCS models").
+// Per-Gaussian RCS models (paper section III-A, docs/design/map.md, "RCS models").
 //
 // Normalisation: m = median of the members' RCS (mean of the two middle
 // values for an even count), s = min(m - min, max - m); members with
@@ -45,7 +45,7 @@ Eigen::Matrix<T, 3, 1> IncidenceVector(IncidenceModel model, const Eigen::Matrix
 }
 
 // The sign s that makes s u face the radar ((s u).x <= 0): the incidence
-// direction is d = s u / |u| (docs/design.md, "RCS models").
+// direction is d = s u / |u| (docs/design/map.md, "RCS models").
 inline double FacingSign(const Eigen::Vector3d& u) { return u.x() > 0.0 ? -1.0 : 1.0; }
 
 struct RcsFitOptions {
@@ -82,7 +82,7 @@ struct RcsFitStats {
   // How a target's RCS varies across frames: the median over the Gaussians
   // of at least kSpreadMinMembers members of their members' RCS std (dB,
   // every member), binned by the members' mean range and mean |azimuth|
-  // (docs/design.md, "RCS statistics"); -1 for an empty bin.
+  // (docs/design/map.md, "RCS statistics"); -1 for an empty bin.
   static constexpr std::size_t kSpreadMinMembers = 4;
   static constexpr std::array<double, 4> kRangeBins{0.0, 20.0, 40.0, 70.0};  // m, lower edges
   static constexpr std::array<double, 3> kAzimuthBins{0.0, 15.0, 30.0};      // deg, lower edges

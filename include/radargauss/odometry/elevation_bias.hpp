@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // A radar's constant elevation bias estimated from the Doppler velocity and
-// removed from every point (docs/design.md, "The faults of real radars"; a
+// removed from every point (docs/design/simulator.md, "The faults of real radars"; a
 // known bias is removed as the sequence is read, SequenceOptions): a
 // bias b lifts every return by b, and the Doppler fit then lifts the ego
 // velocity by b too, while a vehicle moves along its own x axis. So the

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Odometry's map, built as the radar moves (docs/design.md, "Odometry"):
+// Odometry's map, built as the radar moves (docs/design/odometry.md, "Odometry"):
 // static points at their estimated poses in a hash of regions (cubes of
 // `region` metres). A region that has gained enough points since its last
 // fit gets its Gaussians fitted again from its points with the estimator of
@@ -40,7 +40,7 @@ inline MatchingMapOptions LocalMatchingMapOptions() {
   return options;
 }
 
-// How a region's Gaussians follow its points (docs/design.md, "The
+// How a region's Gaussians follow its points (docs/design/odometry.md, "The
 // incremental map"): kRefit fits them again from all its points with
 // build-map's estimator once enough have come; kIncremental updates each
 // Gaussian's sufficient statistics point by point and publishes a Gaussian
@@ -67,7 +67,7 @@ struct LocalMapOptions {
   // The radar's angular noise: a Gaussian is at least this angle times the
   // mean range its members were seen at wide, horizontally (azimuth) and
   // vertically (elevation), and at least min_std, so that far, sparse
-  // returns still gate into the map (docs/design.md, "Odometry").
+  // returns still gate into the map (docs/design/odometry.md, "Odometry").
   double azimuth_std_deg = 0.0;  // in [0, kMaxAngularNoiseDeg]
   double elevation_std_deg = 0.0;
   GaussianMapOptions gaussians;                             // the estimator of build-map
@@ -80,7 +80,7 @@ const OptionTable<LocalMapOptions>& LocalMapOptionTable();
 void ValidateOptions(const LocalMapOptions& options);
 
 // `covariance` widened to the radar's angular noise at `range` (m) and at
-// least min_std: Sigma' = F clamp(F^-1 Sigma F^-1, 1) F (docs/design.md,
+// least min_std: Sigma' = F clamp(F^-1 Sigma F^-1, 1) F (docs/design/odometry.md,
 // "Odometry").
 Eigen::Matrix3d FlooredAtRange(const Eigen::Matrix3d& covariance, double range, const LocalMapOptions& options);
 

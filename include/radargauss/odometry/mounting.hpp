@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The radar's mounting pitch and yaw from the Doppler velocity's direction
-// (docs/design.md, "Mounting"): driving straight, the vehicle moves along its
+// (docs/design/odometry.md, "Mounting"): driving straight, the vehicle moves along its
 // own forward axis, so the measured velocity's direction in the radar frame
 // is that axis. Roll about it is not observable this way. The levelled frame
 // is the vehicle's at the first scan: T_level_radar = R_vehicle_radar T_world_radar.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Radar-inertial odometry (docs/design.md, "Radar-inertial odometry"): the
+// Radar-inertial odometry (docs/design/odometry.md, "Radar-inertial odometry"): the
 // radar odometry of odometry/radar_odometry.hpp with an IMU. The prediction
 // turns by the gyro's rates less the window's gyro bias; each scan's match
 // (its pose and eq. 2's information) and Doppler velocity enter a sliding

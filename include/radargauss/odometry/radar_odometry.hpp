@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Radar odometry on a Gaussian-RCS map it builds itself (docs/design.md,
+// Radar odometry on a Gaussian-RCS map it builds itself (docs/design/odometry.md,
 // "Odometry"). Per scan, in time order: the Doppler ego velocity gated by
 // the motion model's prediction; a predicted pose (translation from that
 // velocity, rotation from gyro rates or at the last yaw rate, roll and pitch
@@ -53,11 +53,11 @@ struct OdometryOptions {
   double velocity_floor = 0.05;        // m: std of the floor Q = diag(floor^2, floor^2, vertical^2) of the term
   // m: the floor along the radar's z. Larger lets the term leave the vertical
   // to the geometry (an elevation bias tilts the Doppler velocity, not the
-  // scan's fit to the map: docs/design.md, "The faults of real radars"); 0: velocity_floor.
+  // scan's fit to the map: docs/design/simulator.md, "The faults of real radars"); 0: velocity_floor.
   double velocity_vertical_floor = 0.0;
   // The rotation term: the match's rotation against the predicted one, with
   // sigma = rotation_rate_std * dt about the radar's x, y, z (roll, pitch,
-  // yaw); docs/design.md, "The rotation term".
+  // yaw); docs/design/residuals.md, "The rotation term".
   double rotation_weight = 1.0;                           // 0: off
   Eigen::Vector3d rotation_rate_std_deg{1.0, 1.0, 90.0};  // deg/s: rate changes the prediction allows
   MatchOptions match;                                     // solver and eq. 2 (w_rcs, losses, incidence via map.rcs)
@@ -76,7 +76,7 @@ struct OdometryOptions {
 };
 
 // R_vehicle_radar = Rz(yaw) Ry(pitch) Rx(roll) (z up, a positive pitch looks
-// down: docs/design.md, "Mounting").
+// down: docs/design/odometry.md, "Mounting").
 SO3d VehicleFromRadar(const Eigen::Vector3d& roll_pitch_yaw_deg);
 
 // Its options (options.hpp): its own, then the Doppler filter's, the

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The geometric residual of scan matching (paper section III-B, docs/design.md,
+// The geometric residual of scan matching (paper section III-B, docs/design/residuals.md,
 // "Residuals"), for a radar point p associated to the Gaussian (mu, Sigma):
 //
 //   r_geo = L^T (R p + t - mu),   Sigma^-1 = L L^T,

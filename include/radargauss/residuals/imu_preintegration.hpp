@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // IMU preintegration on the manifold (Forster et al. 2017, "On-Manifold
-// Preintegration for Real-Time Visual-Inertial Odometry"; docs/design.md,
+// Preintegration for Real-Time Visual-Inertial Odometry"; docs/design/residuals.md,
 // "IMU preintegration"): the rotation, velocity and position increments
 // between two states from the samples in between, at a linearisation point
 // of the biases, with their covariance and their Jacobians with respect to

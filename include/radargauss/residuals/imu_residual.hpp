@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The preintegrated IMU term between two states (Forster et al. 2017, eq. 45;
-// docs/design.md, "The IMU term"). A state is the IMU's pose in a
+// docs/design/residuals.md, "The IMU term"). A state is the IMU's pose in a
 // gravity-aligned world (R, p), its velocity v there and its biases b_g, b_a;
 // with the increments corrected to first order at b_i (ImuPreintegration):
 //
@@ -87,7 +87,7 @@ class ImuResidual {
   const Matrix15 sqrt_information_;
 };
 
-// The analytic twin (docs/design.md, "The IMU term", gives each block). With
+// The analytic twin (docs/design/residuals.md, "The IMU term", gives each block). With
 // right perturbations R Exp(phi), additive p, v and b, and e_R the rotation
 // error: de_R/dphi_j = Jr^-1(e_R), de_R/dphi_i = -Jr^-1(e_R) R_j^T R_i,
 // de_R/db_g,i = -Jr^-1(e_R) Exp(e_R)^T Jr(J_R^g db_g) J_R^g; the velocity and

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The terms odometry adds to eq. 2 for one scan, as plain values: the
-// Doppler velocity term (docs/design.md, "The velocity term") and the
-// rotation term (docs/design.md, "The rotation term"). They are arguments of
+// Doppler velocity term (docs/design/residuals.md, "The velocity term") and the
+// rotation term (docs/design/residuals.md, "The rotation term"). They are arguments of
 // a match (ScanMatcher::Match), not options: they change with every scan.
 // Their Ceres functors are residuals/velocity_residual.hpp and
 // residuals/rotation_residual.hpp.

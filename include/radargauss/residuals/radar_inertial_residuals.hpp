@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The radar's terms on an IMU state (docs/design.md, "The sliding window").
+// The radar's terms on an IMU state (docs/design/solvers.md, "The sliding window").
 // The state is the IMU's pose (R, p) in a gravity-aligned world G, its
 // velocity v there and its biases; the radar sits at T_imu_radar = (R_e, t_e)
 // on the IMU, and the scan matcher's world M is G turned by the tilt A (roll
@@ -68,7 +68,7 @@ void MovedState(const T* rotation, const T* motion, const T* clock_offset, const
 
 // L(v, delta): v with its elevation lowered by delta; v itself when it has
 // no horizontal part. A scan whose elevations read delta too high fits a
-// Doppler velocity raised by about delta (docs/design.md, "The faults of real radars").
+// Doppler velocity raised by about delta (docs/design/simulator.md, "The faults of real radars").
 template <typename T>
 Eigen::Matrix<T, 3, 1> LowerElevation(const Eigen::Vector3d& v, const T& delta) {
   using std::cos;
@@ -178,7 +178,7 @@ class VehicleMotionResidual {
   const double weight_;
 };
 
-// The analytic twins (docs/design.md, "The sliding window", gives each block).
+// The analytic twins (docs/design/solvers.md, "The sliding window", gives each block).
 class RadarPoseCostFunction final : public ceres::SizedCostFunction<6, 4, 3, 9, 4, 3, 2, 1> {
  public:
   RadarPoseCostFunction(const SE3d& measured, const Eigen::Matrix<double, 6, 6>& sqrt_information, const ImuAtScan& imu)

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The likelihoods of the RCS term (docs/design.md, "RCS likelihoods") and
+// The likelihoods of the RCS term (docs/design/residuals.md, "RCS likelihoods") and
 // the per-Gaussian confidence that weighs it ("RCS confidence").
 //
 // decibel     r = y - c . Y(d): the paper's residual in the Gaussian's
@@ -88,7 +88,7 @@ inline double SwerlingResidualDerivative(double k, double z) {
 }
 
 // What a map's RCS models know, over the Gaussians with a model
-// (docs/design.md, "The RCS weight from the map").
+// (docs/design/map.md, "The RCS weight from the map").
 struct RcsMapSummary {
   std::size_t models = 0;
   double median_spread_db = 0.0;
@@ -102,7 +102,7 @@ struct RcsMapSummary {
 RcsMapSummary SummariseRcs(const GaussianMap& map, const RcsTermOptions& options);
 
 // The data-chosen w_rcs of eq. 2: kRcsWeightPerInformation times the map's
-// view information, at most kMaxChosenRcsWeight (docs/design.md, "The RCS
+// view information, at most kMaxChosenRcsWeight (docs/design/map.md, "The RCS
 // weight from the map").
 inline constexpr double kRcsWeightPerInformation = 1.5;
 inline constexpr double kMaxChosenRcsWeight = 0.75;

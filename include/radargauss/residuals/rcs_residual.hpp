@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The RCS residual of scan matching (paper section III-B, docs/design.md,
+// The RCS residual of scan matching (paper section III-B, docs/design/residuals.md,
 // "Residuals"), for a radar point p_r whose normalised RCS y (with the associated
 // Gaussian's median and scale) lies in [-1, 1]:
 //
@@ -254,7 +254,7 @@ class RcsRotationCostFunction final : public ceres::SizedCostFunction<1, 4> {
   Eigen::Vector3d translation_;
 };
 
-// Joint refinement (docs/design.md, "Joint refinement"): the same residual with the
+// Joint refinement (docs/design/solvers.md, "Joint refinement"): the same residual with the
 // Gaussian's coefficients c as a parameter block, so that scans tie their
 // poses to the map. Blocks: rotation (4), coefficients ((degree + 1)^2) and,
 // with `full`, translation (3); rotation-only takes the translation as a

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The relative-pose term of the pose graph (docs/design.md, "The pose graph"):
+// The relative-pose term of the pose graph (docs/design/solvers.md, "The pose graph"):
 // keyframes i and j at T_i, T_j (world from keyframe) and a measured
 // relative pose Z_ij (frame i from frame j) give the error transform
 //

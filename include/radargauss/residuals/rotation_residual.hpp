@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The rotation term of odometry (docs/design.md, "The rotation term"): the
+// The rotation term of odometry (docs/design/residuals.md, "The rotation term"): the
 // scan's rotation against the motion model's prediction R_pred (the last
 // rotation turned by the constant-rate or gyro increment),
 //

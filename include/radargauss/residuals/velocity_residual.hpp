@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The Doppler velocity term of odometry (docs/design.md, "The velocity term"):
+// The Doppler velocity term of odometry (docs/design/residuals.md, "The velocity term"):
 // the translation since the previous scan, in the previous scan's radar
 // frame, against the Doppler velocity times the time step,
 //

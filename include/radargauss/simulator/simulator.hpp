@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Synthetic 4D radar world (docs/design.md, "The synthetic world"): a town block of ground,
+// Synthetic 4D radar world (docs/design/simulator.md, "The synthetic world"): a town block of ground,
 // building walls, poles, parked and moving cars, seen by an ARS548-like radar
 // driving a loop with turns. Deterministic for a seed.
 //
@@ -74,7 +74,7 @@ struct SimulationConfig {
   double rcs_noise_db = 1.0;
   double clutter_fraction = 0.05;      // share of detections that are clutter
   double rcs_outlier_fraction = 0.01;  // share with RCS + U(-25, 25) dB
-  // The faults of real radars (docs/design.md, "The faults of real radars"),
+  // The faults of real radars (docs/design/simulator.md, "The faults of real radars"),
   // all off by default.
   double elevation_bias_deg = 0.0;      // added to every elevation
   double elevation_noise_growth = 0.0;  // elevation std x (1 + growth (azimuth / azimuth_fov)^2)
@@ -84,7 +84,7 @@ struct SimulationConfig {
   int rcs_swerling = 0;                // RCS fluctuation per detection: 0 none, 1 Swerling I, 3 Swerling III
   double multipath_probability = 0.0;  // a ray that meets a wall or guardrail also returns a ghost
   double multipath_loss_db = 6.0;      // the ghost's RCS below its target's
-  // An IMU on the vehicle (docs/design.md, "The synthetic world"); none at
+  // An IMU on the vehicle (docs/design/simulator.md, "The synthetic world"); none at
   // imu_rate_hz 0. Noise densities and bias random walks as a datasheet
   // gives them (io/imu.hpp's ImuNoise); the turn-on biases drawn per axis.
   double imu_rate_hz = 0.0;

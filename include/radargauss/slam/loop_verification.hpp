@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Verification of a loop candidate (docs/design.md, "Loop verification"):
+// Verification of a loop candidate (docs/design/slam.md, "Loop verification"):
 // the query keyframe's submap rotated by the descriptor's yaw and shifted in
 // bird's eye view to the candidate's best overlap, then matched against the
 // candidate's Gaussians by the multi-hypothesis Gauss-Newton; accepted on

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The place-descriptor interface (docs/design.md, "Place recognition"): a
+// The place-descriptor interface (docs/design/slam.md, "Place recognition"): a
 // descriptor describes a submap, gives its rotation-invariant key, and
 // compares two descriptions with the yaw of one in the other. Scan Context
 // and Radon stand behind it; PlaceDatabase (place_recognition.hpp) ranks the

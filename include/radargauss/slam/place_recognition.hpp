@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Place recognition over submaps (docs/design.md, "Place recognition"): the
+// Place recognition over submaps (docs/design/slam.md, "Place recognition"): the
 // selected descriptor (place_descriptor.hpp) describes a submap; a
 // PlaceDatabase holds the places, ranks the candidates nearest a query by
 // key and compares them in full, which gives a distance and the yaws to

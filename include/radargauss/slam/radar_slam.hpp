@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Radar SLAM (docs/design.md, "SLAM"): radar odometry as the front end;
+// Radar SLAM (docs/design/slam.md, "SLAM"): radar odometry as the front end;
 // every submap_distance metres a keyframe whose submap holds the static
 // points of the scans until the next, in its own frame. A closed submap is
 // described (Scan Context or the Radon descriptor), its nearest keyframes by

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // A Radon-sinogram descriptor of a keyframe's submap after RING (Lu et al.,
-// RSS 2022; docs/design.md, "Place recognition"): the bird's-eye occupancy
+// RSS 2022; docs/design/slam.md, "Place recognition"): the bird's-eye occupancy
 // projected on `angles` directions over [0, pi), each projection's DFT
 // magnitude without its mean. A translation shifts every projection and leaves the magnitudes
 // alone; a yaw shifts the rows circularly, so the best row shift gives the

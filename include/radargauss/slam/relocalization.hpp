@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Relocalisation in a SLAM map without an initial pose (docs/design.md,
+// Relocalisation in a SLAM map without an initial pose (docs/design/slam.md,
 // "Relocalisation"): the run's own odometry accumulates submaps of
 // submap_distance metres; each is described and its nearest places of the
 // map verified (slam/loop_verification.hpp, no graph prior). Two submaps

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Scan Context (Kim and Kim, IROS 2018) of a keyframe's submap
-// (docs/design.md, "Place recognition"): the bird's-eye view in rings x
+// (docs/design/slam.md, "Place recognition"): the bird's-eye view in rings x
 // sectors around the keyframe, with a geometric channel (the highest point
 // of each bin above the lowest of the submap) and an RCS channel (the
 // strongest return of each bin above a floor, radar's counterpart of lidar

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The ceres::Problem of a scan match (docs/design.md, "Ceres"): the pose
+// The ceres::Problem of a scan match (docs/design/solvers.md, "Ceres"): the pose
 // blocks and the terms of the current association, with eq. 2's weights.
 #pragma once
 
@@ -14,7 +14,7 @@ namespace radargauss {
 
 // The ceres::Problem of one match, kept across associations: the pose blocks
 // and the current association's terms, shared, square-root or one block per
-// term (docs/design.md, "The residual blocks"), with eq. 2's weights.
+// term (docs/design/solvers.md, "The residual blocks"), with eq. 2's weights.
 class CeresScanProblem {
  public:
   static constexpr std::size_t kTermsPerBlock = 64;  // kShared

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Scan matching with Ceres (docs/design.md, "Ceres"): the same residual functors
+// Scan matching with Ceres (docs/design/solvers.md, "Ceres"): the same residual functors
 // in a ceres::Problem with a rotation block (SO3Manifold) and a translation
 // block, eq. 2's weights as ScaledLoss, a dense linear solver; an outer loop
 // re-associates between solves.

@@ -192,7 +192,7 @@ class TermRangeCost final : public ceres::CostFunction {
 
 // The residual blocks of one kind of term, kept across associations: cost
 // function k holds term k of the current association, re-targeted by Reset
-// (docs/design.md, "The residual blocks").
+// (docs/design/solvers.md, "The residual blocks").
 template <typename Functor, typename AnalyticCost>
 class TermBlocks {
  public:

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The loop every single-scan solver shares (docs/design.md, "Coarse to
+// The loop every single-scan solver shares (docs/design/solvers.md, "Coarse to
 // fine" and "Association"): the stages of a match, the correspondences of
 // each iteration, and the end of the match. A solver gives the step alone:
 //

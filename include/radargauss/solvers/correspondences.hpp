@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// What every single-scan solver shares (docs/design.md, "Association" and
+// What every single-scan solver shares (docs/design/residuals.md, "Association" and
 // "The combined cost"): the correspondences of a scan with a level of the
 // MatchingMap, how they are made and kept, and eq. 2 on them.
 #pragma once

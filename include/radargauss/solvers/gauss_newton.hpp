@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The own Gauss-Newton scan matcher (docs/design.md, "The own Gauss-Newton"): per outer
+// The own Gauss-Newton scan matcher (docs/design/solvers.md, "The own Gauss-Newton"): per outer
 // iteration, re-associate (lazily on the exact map: CoarseToFine),
 // accumulate H and g per residual with IRLS weights
 // rho'(s) from the losses, combine with eq. 2's weights, solve the 6x6 system

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// A sliding window of IMU states at the radar's scans (docs/design.md, "The
+// A sliding window of IMU states at the radar's scans (docs/design/solvers.md, "The
 // sliding window"): pose, velocity and biases in a gravity-aligned world,
 // tied by preintegrated IMU terms (residuals/imu_residual.hpp) and held by
 // the radar's terms (residuals/radar_inertial_residuals.hpp): the scan

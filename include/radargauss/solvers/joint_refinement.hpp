@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Joint refinement (docs/design.md, "Joint refinement"): the poses of many scans and every
+// Joint refinement (docs/design/solvers.md, "Joint refinement"): the poses of many scans and every
 // Gaussian's SH coefficients in one sparse Ceres problem. Geometric residuals
 // tie a pose to the map; RCS residuals tie a rotation block (and, with kFull,
 // a translation block) to the SH block of their Gaussian. Each scan's terms

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Marginalisation by the Schur complement (docs/design.md, "The sliding
+// Marginalisation by the Schur complement (docs/design/solvers.md, "The sliding
 // window"): the factors on the blocks that leave a problem, linearised at
 // their current values, become one Gaussian prior on the blocks they share
 // with the rest,

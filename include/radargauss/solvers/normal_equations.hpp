@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The normal equations of eq. 2 for fixed correspondences (docs/design.md,
+// The normal equations of eq. 2 for fixed correspondences (docs/design/solvers.md,
 // "The own Gauss-Newton"): per term H += w J^T J and g += w J^T r over the
 // tangent [dt; dphi], w the loss's IRLS weight rho'(s); the geometric sums
 // in closed form (two terms per SIMD lane pair) or with Jets through the

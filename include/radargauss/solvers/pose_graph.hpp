@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// A pose graph over keyframes (docs/design.md, "The pose graph"): odometry
+// A pose graph over keyframes (docs/design/solvers.md, "The pose graph"): odometry
 // edges between consecutive keyframes and loop edges between revisits, each
 // a relative-pose term (residuals/relative_pose_residual.hpp) weighted by
 // the square root of its match's information. Loop edges take a robust loss

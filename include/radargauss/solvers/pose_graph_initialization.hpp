@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// A pose graph's initial estimate from its edges alone (docs/design.md, "The
+// A pose graph's initial estimate from its edges alone (docs/design/solvers.md, "The
 // pose graph"): rotations by the chordal relaxation, then translations by
 // linear least squares given them (Carlone et al. 2015, "Initialization
 // techniques for 3D SLAM"). From this start Levenberg-Marquardt needs a few

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Scan matching against a Gaussian-RCS map (paper section III-B, docs/design.md,
+// Scan matching against a Gaussian-RCS map (paper section III-B, docs/design/residuals.md,
 // "Scan matching"): the options, the result and the interface every solver
 // implements (the pieces they share: solvers/correspondences.hpp).
 //
@@ -58,7 +58,7 @@ struct ScanMatchingOptions {
   bool geometric_first = true;
   bool reassociate = true;  // false: associate once at the initial pose
   // Lazy re-association on the exact map: again only once the pose has moved
-  // more than this since the last association (docs/design.md,
+  // more than this since the last association (docs/design/residuals.md,
   // "Association"); 0 re-associates after every step.
   double reassociation_translation = 0.01;     // m
   double reassociation_rotation = 0.002;       // rad
@@ -86,7 +86,7 @@ struct ScanMatchingResult {
   // (1-w)/N_geo H_geo + w/N_rcs H_rcs with the losses' IRLS weights, the RCS
   // part on the rotation block only when rotation-only. Zero when no match
   // was made. Multiply by N_geo (w = 0) for the information of the pose in
-  // the Gaussians' units; docs/design.md, "The information matrix".
+  // the Gaussians' units; docs/design/solvers.md, "The information matrix".
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
   // The velocity prior's Gauss-Newton matrix, weight J^T J on the translation
   // block (zero without the prior), kept apart from eq. 2's.

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // What each solver has beyond ScanMatchingOptions, as plain values (no
-// Ceres header): the own Gauss-Newton's (docs/design.md, "The own
-// Gauss-Newton"), Ceres's (docs/design.md, "Ceres") and multi-hypothesis
-// matching's (docs/design.md, "Multi-hypothesis matching").
+// Ceres header): the own Gauss-Newton's (docs/design/solvers.md, "The own
+// Gauss-Newton"), Ceres's (docs/design/solvers.md, "Ceres") and multi-hypothesis
+// matching's (docs/design/solvers.md, "Multi-hypothesis matching").
 #pragma once
 
 #include <string>
@@ -40,9 +40,9 @@ struct CeresSolverOptions {
   // the outer loop re-associates after each solve there.
   int max_inner_iterations = 2;
   // In the last stage a solve also ends when the pose leaves the association
-  // or a step is below the loop's tolerances (docs/design.md, "Ceres").
+  // or a step is below the loop's tolerances (docs/design/solvers.md, "Ceres").
   int max_exact_inner_iterations = 8;
-  // How analytic terms enter the problem (docs/design.md, "The residual blocks").
+  // How analytic terms enter the problem (docs/design/solvers.md, "The residual blocks").
   CeresBlocks blocks = CeresBlocks::kSquareRoot;
   int threads = 1;
   // Ceres's stopping rules per association (Ceres's defaults; the outer

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The solvers of the sliding window's problem (docs/design.md, "The sliding
+// The solvers of the sliding window's problem (docs/design/solvers.md, "The sliding
 // window"), on the same terms: Ceres's Levenberg-Marquardt or dogleg, or the
 // own Gauss-Newton on the tangent Jacobians Ceres evaluates. The problem
 // holds the window's blocks and terms; `blocks` are the ones that move.

@@ -1,54 +1,19 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// ROS 2 bags without ROS (docs/design.md, "ROS 2 bags"): a rosbag2 folder
-// (its metadata.yaml and every file it lists, in order), or one of its
-// files alone: sqlite3 (.db3, schema versions 1-4, through Debian's
-// libsqlite3) or MCAP (io/mcap.hpp). Told apart by content, not by name.
-// Messages are CDR (io/ros2_messages.hpp); per-message zstd compression
-// (compression_mode MESSAGE) is undone, a whole-file one is refused.
+// Writing ROS 2 bags without ROS (docs/design/formats.md, "ROS 2 bags"): an
+// .mcap or a .db3 file, its messages in CDR (io/ros2_messages.hpp).
 #pragma once
 
-#include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "radargauss/core/trajectory.hpp"
 #include "radargauss/io/mcap.hpp"
 #include "radargauss/io/rosbag.hpp"
-#include "radargauss/core/trajectory.hpp"
 
 namespace radargauss {
-
-enum class BagFormat { kRos1, kSqlite3, kMcap, kRos2Folder };
-
-// What `path` holds, by its first bytes (a folder: by its metadata.yaml).
-// Throws DataError naming it when it is none of these.
-BagFormat DetectBagFormat(const std::string& path);
-
-// One message of a ROS 2 bag; `data` lives until the visitor returns.
-struct Ros2Message {
-  const std::string* topic = nullptr;
-  const std::string* type = nullptr;  // "sensor_msgs/msg/PointCloud2"
-  std::int64_t log_time = 0;          // ns: the recorder's receive time
-  const std::uint8_t* data = nullptr;
-  std::size_t size = 0;
-};
-
-// Calls visit for every message on `topic` (every topic when empty), file by
-// file, in each file's time order (sqlite3) or file order (MCAP). Throws
-// DataError naming the file for a malformed bag or a missing topic.
-void ForEachRos2Message(const std::string& path, const std::string& topic,
-                        const std::function<void(const Ros2Message&)>& visit);
-std::vector<BagTopic> ListRos2Topics(const std::string& path);
-
-// Reference poses from a ROS 2 bag's `topic`: geometry_msgs/msg/PoseStamped
-// or nav_msgs/msg/Odometry (each message's pose at its stamp),
-// tf2_msgs/msg/TFMessage (the transforms whose child frame is
-// `child_frame`), or nav_msgs/msg/Path (the last message's poses). Stamps
-// that do not increase are refused; DataError names the message.
-Trajectory ReadBagPoses(const std::string& path, const std::string& topic, const std::string& child_frame = "");
 
 // Writes a ROS 2 bag file (an .mcap or a .db3, chosen by `format`)
 // atomically: nothing appears at `path` until Finish succeeds.
