@@ -1,23 +1,20 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// SLAM's loop search (docs/design/slam.md, "SLAM"): a closed keyframe's
-// candidates through the cheapest checks first, their verification in
-// waves, the graph's solve after an accepted loop, and the robustness
-// study's injected false loops. The back end's side of RadarSlam.
+#include "radargauss/slam/loop_search.hpp"
+
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <functional>
 #include <limits>
-#include <queue>
 #include <random>
 #include <utility>
 
-#include "radargauss/slam/radar_slam.hpp"
-
 namespace radargauss {
+
+LoopSearch::LoopSearch(const SlamOptions& options)
+    : options_(options), places_(options.place_recognition), targets_(options.verification.kept_targets) {}
 
 // Cheapest checks first: the descriptor's distance (close or not), each
 // yaw's bird's-eye start against the graph (farther than the consistency
@@ -26,23 +23,26 @@ namespace radargauss {
 // match of the verify_budget best overlapping, in that order, as one thread
 // would: the first that verifies is accepted and those after it are not
 // matched. The matches run in waves of as many as there are threads
-// (against the same graph, which changes only on acceptance), so that the
-// accepted loop and every outcome are those of one thread; a wave may match
-// some that one thread would not have reached.
-void RadarSlam::SearchLoops(int query) {
-  const auto start = std::chrono::steady_clock::now();
+// (against the same graph: the search reads it, the caller adds the
+// accepted loop), so that the accepted loop and every outcome are those of
+// one thread; a wave may match some that one thread would not have reached.
+LoopSearchResult LoopSearch::Search(int query, const KeyframeGraph& graph) {
+  const std::vector<Keyframe>& keyframes = graph.keyframes();
+  LoopSearchResult result;
   if (last_loop_path_ >= 0.0 && options_.loop_spacing > 0.0 &&
-      keyframes_[std::size_t(query)].path - last_loop_path_ < options_.loop_spacing) {
-    return;
+      keyframes[std::size_t(query)].path - last_loop_path_ < options_.loop_spacing) {
+    return result;
   }
-  std::vector<int> eligible;  // far enough back along the path
-  for (int c = 0; c < query && keyframes_[query].path - keyframes_[c].path >= options_.min_loop_path; ++c) {
+  result.searched = true;
+  std::vector<int>& eligible = result.eligible;  // far enough back along the path
+  for (int c = 0; c < query && keyframes[query].path - keyframes[c].path >= options_.min_loop_path; ++c) {
     eligible.push_back(c);
   }
   std::vector<PlaceMatch> ranked = places_.Rank(places_.place(std::size_t(query)), eligible);
-  const std::vector<double> paths = PathsThroughGraph(query);
+  const std::vector<double> paths = graph.PathsFrom(query);
   const LoopVerificationOptions& verification = options_.verification;
-  std::vector<LoopCandidate> outcomes(ranked.size());
+  std::vector<LoopCandidate>& outcomes = result.outcomes;
+  outcomes.resize(ranked.size());
   std::vector<double> overlaps(ranked.size(), 0.0);
   std::vector<std::size_t> to_match;  // close, consistent and overlapping, best overlap first
   for (std::size_t i = 0; i < ranked.size(); ++i) {
@@ -58,9 +58,9 @@ void RadarSlam::SearchLoops(int query) {
       continue;
     }
     // The yaws whose start may end consistent with the graph, and their best overlap.
-    const GraphPrior prior = PriorOf(c.candidate, query, paths);
+    const GraphPrior prior = graph.PriorOf(c.candidate, query, paths);
     const std::vector<BirdsEyeStart> starts =
-        BirdsEyeStarts(keyframes_[query].points, keyframes_[c.candidate].points, ranked[i].yaws, verification);
+        BirdsEyeStarts(keyframes[query].points, keyframes[c.candidate].points, ranked[i].yaws, verification);
     std::vector<double> yaws;
     for (const BirdsEyeStart& start : starts) {
       if (!CorrectGraph(start.pose(), prior, verification, verification.start_margin, verification.start_margin_deg)
@@ -104,7 +104,7 @@ void RadarSlam::SearchLoops(int query) {
       for (const std::size_t i : members) outcomes[i].check.reason = "another candidate was accepted";
       continue;
     }
-    const std::vector<LoopCandidate> results = VerifyWave(query, ranked, members, paths);
+    const std::vector<LoopCandidate> results = VerifyWave(query, graph, ranked, members, paths);
     for (std::size_t k = 0; k < members.size(); ++k) {
       LoopCandidate& c = outcomes[members[k]];
       if (accepted) {
@@ -113,85 +113,64 @@ void RadarSlam::SearchLoops(int query) {
       }
       c = results[k];
       if (c.check.accepted) {
-        graph_.AddLoop(c.candidate, query, c.check.relative, c.check.sqrt_information);
-        SolveAfterLoop(query, paths[std::size_t(c.candidate)]);
-        last_loop_path_ = keyframes_[std::size_t(query)].path;
+        result.accepted = members[k];
+        result.path = paths[std::size_t(c.candidate)];
+        last_loop_path_ = keyframes[std::size_t(query)].path;
         accepted = true;
       }
     }
   }
   candidates_.insert(candidates_.end(), outcomes.begin(), outcomes.end());
-  keyframes_[query].search_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  if (study_.rate > 0.0 && !eligible.empty()) InjectFalseLoop(query, eligible);
+  return result;
 }
 
-// The loop corrects the drift of the `path` metres it closes: the keyframes
-// driven within that plus the margin move, the rest stays for Finish's
-// whole solve (docs/design/slam.md, "SLAM").
-void RadarSlam::SolveAfterLoop(int query, double path) {
-  int first_free = 0;
-  if (options_.local_solve_margin > 0.0) {
-    const double reach = path + options_.local_solve_margin;
-    first_free = query;
-    while (first_free > 0 &&
-           keyframes_[std::size_t(query)].path - keyframes_[std::size_t(first_free - 1)].path <= reach) {
-      --first_free;
-    }
-  }
-  graph_.Optimize(options_.graph, first_free);
-  whole_solve_due_ = whole_solve_due_ || first_free > 0;
-}
-
-void RadarSlam::InjectFalseLoop(int query, const std::vector<int>& eligible) {
-  if (std::uniform_real_distribution<double>(0.0, 1.0)(false_loops_) >= study_.rate) return;
+std::optional<LoopCandidate> FalseLoops::Inject(int query, const std::vector<int>& eligible, KeyframeGraph& graph) {
+  if (study_.rate <= 0.0 || eligible.empty()) return std::nullopt;
+  if (std::uniform_real_distribution<double>(0.0, 1.0)(random_) >= study_.rate) return std::nullopt;
   LoopCandidate loop;
   loop.query = query;
-  loop.candidate = eligible[std::uniform_int_distribution<std::size_t>(0, eligible.size() - 1)(false_loops_)];
+  loop.candidate = eligible[std::uniform_int_distribution<std::size_t>(0, eligible.size() - 1)(random_)];
   loop.injected = true;
   loop.check.accepted = true;
   loop.check.reason = "injected false loop";
   Eigen::Matrix<double, 6, 1> weights;
-  weights << Eigen::Vector3d::Constant(1.0 / options_.verification.translation_floor_std),
-      Eigen::Vector3d::Constant(180.0 / M_PI / options_.verification.rotation_floor_std_deg);
+  weights << Eigen::Vector3d::Constant(1.0 / verification_.translation_floor_std),
+      Eigen::Vector3d::Constant(180.0 / M_PI / verification_.rotation_floor_std_deg);
   loop.check.sqrt_information = weights.asDiagonal();
-  graph_.AddLoop(loop.candidate, query, SE3d(), loop.check.sqrt_information);
-  graph_.Optimize(options_.graph);
-  candidates_.push_back(loop);
+  graph.AddLoopAndSolve(loop.candidate, query, SE3d(), loop.check.sqrt_information);
+  return loop;
 }
 
-std::vector<LoopCandidate> RadarSlam::VerifyWave(int query, const std::vector<PlaceMatch>& ranked,
-                                                 const std::vector<std::size_t>& members,
-                                                 const std::vector<double>& paths) {
+std::vector<LoopCandidate> LoopSearch::VerifyWave(int query, const KeyframeGraph& graph,
+                                                  const std::vector<PlaceMatch>& ranked,
+                                                  const std::vector<std::size_t>& members,
+                                                  const std::vector<double>& paths) {
+  const std::vector<Keyframe>& keyframes = graph.keyframes();
   std::vector<int> indices;
   std::vector<const std::vector<RadarPoint>*> points;
   for (const std::size_t j : members) {
     indices.push_back(ranked[j].candidate);
-    points.push_back(&keyframes_[ranked[j].candidate].points);
+    points.push_back(&keyframes[ranked[j].candidate].points);
   }
   const std::vector<std::shared_ptr<const VerificationTarget>> targets =
       targets_.GetAll(indices, points, options_.verification);
   std::vector<LoopCandidate> results(members.size());
   tbb::parallel_for(std::size_t(0), members.size(), [&](std::size_t m) {
     const PlaceMatch& match = ranked[members[m]];
-    results[m] = Verify(query, match, *targets[m], PriorOf(match.candidate, query, paths));
+    results[m] = Verify(query, graph, match, *targets[m], graph.PriorOf(match.candidate, query, paths));
   });
   return results;
 }
 
-GraphPrior RadarSlam::PriorOf(int candidate, int query, const std::vector<double>& paths) const {
-  return {graph_.poses()[candidate].Inverse() * graph_.poses()[query], paths[candidate]};
-}
-
-LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match, const VerificationTarget& target,
-                                const GraphPrior& prior) const {
+LoopCandidate LoopSearch::Verify(int query, const KeyframeGraph& graph, const PlaceMatch& match,
+                                 const VerificationTarget& target, const GraphPrior& prior) const {
   LoopCandidate result;
   result.query = query;
   result.candidate = match.candidate;
   result.distance = match.distance;
   result.verified = true;
   for (const double yaw : match.yaws) {
-    LoopCheck check = VerifyLoop(keyframes_[query].points, target, yaw, prior, options_.verification);
+    LoopCheck check = VerifyLoop(graph.keyframes()[query].points, target, yaw, prior, options_.verification);
     if (check.accepted || yaw == match.yaws.front() || check.associated > result.check.associated) {
       result.check = std::move(check);
       result.yaw = yaw;
@@ -199,34 +178,6 @@ LoopCandidate RadarSlam::Verify(int query, const PlaceMatch& match, const Verifi
     if (result.check.accepted) break;
   }
   return result;
-}
-
-std::vector<double> RadarSlam::PathsThroughGraph(int from) const {
-  // Dijkstra over the keyframes: odometry edges weigh the metres driven, loop edges nothing.
-  std::vector<std::vector<int>> loops(keyframes_.size());
-  for (const PoseGraphEdge& edge : graph_.edges()) {
-    if (!edge.loop) continue;
-    loops[edge.from].push_back(edge.to);
-    loops[edge.to].push_back(edge.from);
-  }
-  std::vector<double> distance(keyframes_.size(), std::numeric_limits<double>::infinity());
-  using Entry = std::pair<double, int>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
-  distance[from] = 0.0;
-  queue.emplace(0.0, from);
-  while (!queue.empty()) {
-    const double d = queue.top().first;
-    const int k = queue.top().second;
-    queue.pop();
-    if (d > distance[k]) continue;
-    const auto relax = [&](int next, double weight) {
-      if (d + weight < distance[next]) queue.emplace(distance[next] = d + weight, next);
-    };
-    if (k > 0) relax(k - 1, keyframes_[k].path - keyframes_[k - 1].path);
-    if (k + 1 < int(keyframes_.size())) relax(k + 1, keyframes_[k + 1].path - keyframes_[k].path);
-    for (const int next : loops[k]) relax(next, 0.0);
-  }
-  return distance;
 }
 
 }  // namespace radargauss

@@ -95,13 +95,12 @@ void ValidateOptions(const SlamOptions& o) {
 
 RadarSlam::RadarSlam(const SlamOptions& options, const FalseLoopStudy& study)
     : options_(options),
-      study_(study),
       odometry_(options.odometry),
-      places_(options.place_recognition),
-      targets_(options.verification.kept_targets),
-      false_loops_(study.seed) {
+      graph_(options),
+      search_(options),
+      false_loops_(study, options.verification) {
   ValidateOptions(options_);
-  CheckOptions(FalseLoopStudyOptionTable(), study_);
+  CheckOptions(FalseLoopStudyOptionTable(), study);
   const std::size_t threads =
       std::min<std::size_t>(std::size_t(std::max(1, tbb::this_task_arena::max_concurrency())),
                             tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
@@ -149,10 +148,7 @@ void RadarSlam::Finish() {
   const auto start = std::chrono::steady_clock::now();
   const bool closing = open_;
   if (open_) CloseKeyframe();
-  ToBackEnd([this] {
-    if (whole_solve_due_) graph_.Optimize(options_.graph);
-    whole_solve_due_ = false;
-  });
+  ToBackEnd([this] { graph_.SolveWhole(); });
   Wait();
   if (scan_times_.empty()) return;
   scan_times_.back().back_end_ms += MillisecondsSince(start);
@@ -166,7 +162,7 @@ void RadarSlam::OpenKeyframe(std::size_t scan, const SE3d& pose, double stamp) {
   open_keyframe_.odometry_pose = pose;
   open_keyframe_.path = path_;
   ++opened_;
-  ToBackEnd([this, keyframe = open_keyframe_] { AddKeyframe(keyframe); });
+  ToBackEnd([this, keyframe = open_keyframe_] { graph_.Add(keyframe); });
   open_points_.clear();
   open_ = true;
 }
@@ -191,58 +187,49 @@ void RadarSlam::Wait() const {
 
 const std::vector<Keyframe>& RadarSlam::keyframes() const {
   Wait();
-  return keyframes_;
+  return graph_.keyframes();
 }
 
 const std::vector<LoopCandidate>& RadarSlam::candidates() const {
   Wait();
-  return candidates_;
+  return search_.candidates();
 }
 
 const PoseGraph& RadarSlam::graph() const {
   Wait();
-  return graph_;
-}
-
-// The keyframe's graph node at the previous node's optimised pose times the
-// odometry between them, and their odometry edge.
-void RadarSlam::AddKeyframe(Keyframe keyframe) {
-  if (keyframes_.empty()) {
-    graph_.AddKeyframe(keyframe.odometry_pose);
-  } else {
-    const Keyframe& last = keyframes_.back();
-    const SE3d measured = last.odometry_pose.Inverse() * keyframe.odometry_pose;
-    const int from = int(keyframes_.size()) - 1;
-    const int to = graph_.AddKeyframe(graph_.poses()[from] * measured);
-    const double driven = keyframe.path - last.path;
-    const double translation_std = options_.odometry_translation_std + options_.odometry_drift * driven;
-    const double rotation_std =
-        (options_.odometry_rotation_std_deg + options_.odometry_drift_deg * driven) * M_PI / 180.0;
-    Eigen::Matrix<double, 6, 1> weights;
-    weights << Eigen::Vector3d::Constant(1.0 / translation_std), Eigen::Vector3d::Constant(1.0 / rotation_std);
-    graph_.AddOdometry(from, to, measured, weights.asDiagonal());
-  }
-  keyframes_.push_back(std::move(keyframe));
+  return graph_.graph();
 }
 
 void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap) {
   const auto start = std::chrono::steady_clock::now();
-  Keyframe& keyframe = keyframes_.back();
+  Keyframe& keyframe = graph_.last();
   keyframe.points = DownsampleSubmap(submap, options_.place_recognition.submap_voxel);
-  places_.Add(places_.Describe(keyframe.points));
+  search_.AddPlace(keyframe.points);
   keyframe.describe_ms = MillisecondsSince(start);
-  SearchLoops(int(keyframes_.size()) - 1);
+  const auto search = std::chrono::steady_clock::now();
+  const int query = int(graph_.keyframes().size()) - 1;
+  const LoopSearchResult found = search_.Search(query, graph_);
+  if (found.accepted) {
+    const LoopCandidate& loop = found.outcomes[*found.accepted];
+    graph_.CloseLoop(loop.candidate, query, loop.check.relative, loop.check.sqrt_information, found.path);
+  }
+  if (!found.searched) return;
+  graph_.last().search_ms = MillisecondsSince(search);
+  if (const std::optional<LoopCandidate> injected = false_loops_.Inject(query, found.eligible, graph_)) {
+    search_.Record(*injected);
+  }
 }
 
 std::size_t RadarSlam::loops() const {
   Wait();
-  return std::size_t(std::count_if(candidates_.begin(), candidates_.end(),
+  const std::vector<LoopCandidate>& candidates = search_.candidates();
+  return std::size_t(std::count_if(candidates.begin(), candidates.end(),
                                    [](const LoopCandidate& c) { return c.check.accepted && !c.injected; }));
 }
 
 std::size_t RadarSlam::verification_targets_built() const {
   Wait();
-  return targets_.built();
+  return search_.verification_targets_built();
 }
 
 std::vector<SE3d> RadarSlam::Poses() const {
@@ -250,10 +237,7 @@ std::vector<SE3d> RadarSlam::Poses() const {
   std::vector<SE3d> poses;
   const std::vector<OdometryStep>& steps = odometry_.steps();
   poses.reserve(steps.size());
-  for (std::size_t s = 0; s < steps.size(); ++s) {
-    const std::size_t k = scan_keyframe_[s];
-    poses.push_back(graph_.poses()[k] * (keyframes_[k].odometry_pose.Inverse() * steps[s].pose));
-  }
+  for (std::size_t s = 0; s < steps.size(); ++s) poses.push_back(graph_.PoseOf(scan_keyframe_[s], steps[s].pose));
   return poses;
 }
 

@@ -311,6 +311,42 @@ TEST(RadarSlam, LoopSpacingLeavesTheKeyframesAfterALoopUnsearched) {
   }
 }
 
+// RadarSlam's parts replayed by hand over the yard's keyframes, in the
+// order it calls them (a keyframe into the graph, its place, its search, the
+// accepted loop into the graph): the same verdicts and poses, and a search
+// that leaves the graph as it found it.
+TEST(RadarSlam, ItsPartsReplayedByHandGiveTheSameRun) {
+  const RadarSlam& slam = YardSlam();
+  const SlamOptions options = YardOptions();
+  KeyframeGraph graph(options);
+  LoopSearch search(options);
+  for (std::size_t k = 0; k < slam.keyframes().size(); ++k) {
+    graph.Add(slam.keyframes()[k]);
+    search.AddPlace(graph.keyframes()[k].points);
+    const std::size_t edges = graph.graph().edges().size();
+    const SE3d last = graph.graph().poses().back();
+    const LoopSearchResult found = search.Search(int(k), graph);
+    ASSERT_EQ(graph.graph().edges().size(), edges);
+    ASSERT_EQ(graph.graph().poses().back().translation(), last.translation());
+    if (found.accepted) {
+      const LoopCandidate& loop = found.outcomes[*found.accepted];
+      graph.CloseLoop(loop.candidate, int(k), loop.check.relative, loop.check.sqrt_information, found.path);
+    }
+  }
+  graph.SolveWhole();
+  ASSERT_EQ(search.candidates().size(), slam.candidates().size());
+  for (std::size_t i = 0; i < slam.candidates().size(); ++i) {
+    EXPECT_EQ(search.candidates()[i].query, slam.candidates()[i].query);
+    EXPECT_EQ(search.candidates()[i].candidate, slam.candidates()[i].candidate);
+    EXPECT_EQ(search.candidates()[i].check.accepted, slam.candidates()[i].check.accepted) << i;
+    EXPECT_EQ(search.candidates()[i].check.reason, slam.candidates()[i].check.reason) << i;
+  }
+  EXPECT_GT(slam.loops(), 0u);
+  for (std::size_t k = 0; k < slam.keyframes().size(); ++k) {
+    EXPECT_EQ(graph.graph().poses()[k].translation(), slam.graph().poses()[k].translation()) << k;
+  }
+}
+
 // Verification targets kept between searches (the default) or built anew for
 // every candidate (one kept): the same loops and poses, fewer builds.
 TEST(RadarSlam, KeptVerificationTargetsChangeNothing) {

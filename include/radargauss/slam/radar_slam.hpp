@@ -4,12 +4,13 @@
 // points of the scans until the next, in its own frame. A closed submap is
 // described (Scan Context or the Radon descriptor), its nearest keyframes by
 // the yaw-invariant key farther back than min_loop_path are compared and
-// verified (slam/loop_verification.hpp), and an accepted loop enters the
-// pose graph, which is optimised again from its current estimate. Each scan
-// follows its keyframe. With more than one thread the back end (all of the
-// above but the odometry) runs beside the odometry on its own thread, in the
-// keyframes' order: nothing of it feeds back into the odometry, so the
-// results are those of one thread.
+// verified (slam/loop_search.hpp), and an accepted loop enters the pose
+// graph (slam/keyframe_graph.hpp), which is optimised again from its current
+// estimate. Each scan follows its keyframe. RadarSlam holds the front end,
+// the back end's parts and the order of their calls: with more than one
+// thread the back end (all of the above but the odometry) runs beside the
+// odometry on its own thread, in the keyframes' order; nothing of it feeds
+// back into the odometry, so the results are those of one thread.
 //
 //   RadarSlam slam(options);
 //   for (const RadarScan& scan : sequence.scans) slam.Register(scan);
@@ -18,91 +19,18 @@
 #pragma once
 
 #include <cstddef>
-#include <cstdint>
 #include <functional>
 #include <memory>
-#include <optional>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
-#include "radargauss/slam/loop_verification.hpp"
-#include "radargauss/slam/place_recognition.hpp"
-#include "radargauss/solvers/pose_graph.hpp"
+#include "radargauss/slam/keyframe_graph.hpp"
+#include "radargauss/slam/loop_search.hpp"
+#include "radargauss/slam/slam_options.hpp"
 
 namespace radargauss {
-
-struct SlamOptions {
-  OdometryOptions odometry;
-  double submap_distance = 10.0;  // m driven per keyframe
-  PlaceRecognitionOptions place_recognition;
-  double min_loop_path = 150.0;  // m driven between a loop's keyframes (the active map closes shorter ones)
-  // After an accepted loop, the keyframes closed within this many metres
-  // driven are not searched: the loop has just corrected them. 0: every one.
-  double loop_spacing = 0.0;  // m
-  LoopVerificationOptions verification;
-  PoseGraphOptions graph;
-  // The odometry edges' stds: floor plus drift per metre driven between keyframes.
-  double odometry_translation_std = 0.05;  // m
-  double odometry_drift = 0.02;            // m per m
-  double odometry_rotation_std_deg = 0.1;
-  double odometry_drift_deg = 0.02;  // deg per m
-  // With more than one thread, the back end on its own thread (same results).
-  bool asynchronous_back_end = true;
-  // An accepted loop re-solves the keyframes driven within its path through
-  // the graph plus this margin of the query, the rest held; Finish solves
-  // the whole graph. 0: every solve is of the whole graph.
-  double local_solve_margin = 100.0;  // m
-  // The map of the place keeps a keyframe as a place unless a place already
-  // kept lies within this many metres and degrees of its optimised pose: a
-  // revisit adds no place. 0 (the default): every keyframe is a place.
-  double place_merge_distance = 0.0;  // m
-  double place_merge_angle_deg = 45.0;
-};
-
-// Robustness studies, apart from what a user sets: after each keyframe's
-// search, with probability `rate` a false loop to a keyframe chosen at
-// random (at least min_loop_path back) claiming the two coincide (identity,
-// at the loop floors' weight) goes into the graph, recorded in candidates()
-// as injected. 0: none.
-struct FalseLoopStudy {
-  double rate = 0.0;
-  std::uint32_t seed = 1;
-};
-const OptionTable<FalseLoopStudy>& FalseLoopStudyOptionTable();
-
-// Throws std::invalid_argument naming the bad option.
-// The rows a search for places shares, SLAM's and relocalisation's alike:
-// the odometry's, place recognition's and the loop verification's
-// (verify_*), of a struct that holds the three under those names.
-template <typename Options>
-void AppendPlaceSearchRows(OptionTable<Options>& table) {
-  AppendNested(
-      table, OdometryOptionTable(), +[](Options & o) -> auto& { return o.odometry; }, "odometry");
-  AppendNested(
-      table, PlaceRecognitionOptionTable(), +[](Options & o) -> auto& { return o.place_recognition; },
-      "place_recognition");
-  AppendNested(
-      table, LoopVerificationOptionTable(), +[](Options & o) -> auto& { return o.verification; }, "verification",
-      "verify_");
-}
-
-// Its options (options.hpp): its own, the odometry's, place recognition's,
-// the loop verification's (verify_*) and the pose graph's.
-const OptionTable<SlamOptions>& SlamOptionTable();
-void ValidateOptions(const SlamOptions& options);
-
-struct Keyframe {
-  std::size_t scan = 0;  // the scan that opened it
-  double stamp = 0.0;
-  SE3d odometry_pose;                         // the odometry's T_world_radar at that scan
-  double path = 0.0;                          // m driven to it
-  std::vector<RadarPoint> points;             // its submap, in its frame (closed keyframes)
-  double describe_ms = 0.0, search_ms = 0.0;  // place recognition's time
-  double back_end_ms() const { return describe_ms + search_ms; }
-};
 
 // One scan's time in Register (ms): the front end (the odometry, the IMU's
 // fusion) and the back end (closing a keyframe: its description, the place
@@ -112,16 +40,6 @@ struct ScanTime {
   double front_end_ms = 0.0, back_end_ms = 0.0;
   bool closed_keyframe = false;  // the back end described and searched a keyframe
   double total_ms() const { return front_end_ms + back_end_ms; }
-};
-
-// A compared pair: the descriptor's verdict, then the verification's.
-struct LoopCandidate {
-  int query = 0, candidate = 0;  // keyframes
-  double distance = 1.0;         // the descriptor's
-  double yaw = 0.0;              // rad: the descriptor's, of the query in the candidate
-  bool verified = false;         // passed to verification
-  bool injected = false;         // a false loop of FalseLoopStudy, not a candidate
-  LoopCheck check;               // check.accepted: in the graph
 };
 
 class SerialWorker;
@@ -166,26 +84,11 @@ class RadarSlam {
   void CloseKeyframe();
   void ToBackEnd(std::function<void()> work);
   void Wait() const;  // rethrows what the back end threw
-  // The back end's side.
-  void AddKeyframe(Keyframe keyframe);
+  // The back end's side: the closed keyframe's place, its loop search, the
+  // accepted loop into the graph, and the study's false loop.
   void DescribeAndSearch(std::vector<RadarPoint> submap);
-  // After a loop whose path through the graph was `path` metres.
-  void SolveAfterLoop(int query, double path);
-  void SearchLoops(int query);
-  void InjectFalseLoop(int query, const std::vector<int>& eligible);
-  // The Gaussian matches of ranked[members], in parallel.
-  std::vector<LoopCandidate> VerifyWave(int query, const std::vector<PlaceMatch>& ranked,
-                                        const std::vector<std::size_t>& members, const std::vector<double>& paths);
-  LoopCandidate Verify(int query, const PlaceMatch& match, const VerificationTarget& target,
-                       const GraphPrior& prior) const;
-  // The metres driven from keyframe `from` to each keyframe along the graph's
-  // odometry edges, loop edges crossed for free: how far the graph's estimate
-  // may have drifted.
-  std::vector<double> PathsThroughGraph(int from) const;
-  GraphPrior PriorOf(int candidate, int query, const std::vector<double>& paths) const;
 
   SlamOptions options_;
-  FalseLoopStudy study_;
   // The front end.
   RadarOdometry odometry_;
   std::unique_ptr<InertialFusion> inertial_;
@@ -197,14 +100,9 @@ class RadarSlam {
   double path_ = 0.0;
   bool open_ = false;
   // The back end.
-  PoseGraph graph_;
-  std::vector<Keyframe> keyframes_;
-  PlaceDatabase places_;         // a place per closed keyframe
-  VerificationTargets targets_;  // the last verified keyframes' verification maps
-  std::vector<LoopCandidate> candidates_;
-  std::mt19937 false_loops_;
-  bool whole_solve_due_ = false;          // a local solve since the last whole one
-  double last_loop_path_ = -1.0;          // m driven to the last accepted loop's query (-1: none)
+  KeyframeGraph graph_;
+  LoopSearch search_;
+  FalseLoops false_loops_;
   std::unique_ptr<SerialWorker> worker_;  // the back end's thread; null: in Register
 };
 
