@@ -13,6 +13,8 @@ value.
 
     option_ranges_test.py <path to radargauss>
 """
+import concurrent.futures
+import itertools
 import math
 import os
 import re
@@ -20,6 +22,7 @@ import resource
 import subprocess
 import sys
 import tempfile
+import threading
 
 TIMEOUT_S = 60
 MEMORY_BYTES = 4 << 30  # a run that needs more has exhausted what a flag's range should allow
@@ -109,11 +112,16 @@ def main():
         "simulate": ["--out", os.path.join(work, "sim"), "--force"],
     }
     passed, failures = 0, []
+    lock, runs = threading.Lock(), itertools.count()
 
     def expect(command, flag, value, accepted, count, companion=None):
         nonlocal passed
         extra = [companion, text(value)] if companion else []
-        status, error = run([tool, command] + commands[command] + [flag] + [text(value)] * count + extra, sanitized)
+        arguments = list(commands[command])
+        if "--out" in arguments:  # runs side by side: each writes its own results
+            at = arguments.index("--out") + 1
+            arguments[at] += "_%d" % next(runs)
+        status, error = run([tool, command] + arguments + [flag] + [text(value)] * count + extra, sanitized)
         lines = [line for line in error.splitlines() if line and not line.startswith("Run with --help")]
         one_line = len(lines) <= 1
         crashed = status is None or status < 0 or status > 125 or "out of memory" in error or "bad_alloc" in error
@@ -123,33 +131,53 @@ def main():
             ok = status not in (0, None) and not crashed and one_line and flag.lstrip("-") in error
         else:  # either, but cleanly
             ok = not crashed and (status == 0 or (one_line and flag.lstrip("-") in error))
-        if ok:
-            passed += 1
-        else:
-            wanted = {True: "accepted", False: "refused naming the flag", None: "accepted or refused cleanly"}[accepted]
-            failures.append("%s %s %s: wanted %s, exit %s: %s" % (command, flag, text(value), wanted, status,
-                                                                   error.replace("\n", " | ")[:300]))
+        with lock:
+            if ok:
+                passed += 1
+            else:
+                wanted = {True: "accepted", False: "refused naming the flag",
+                          None: "accepted or refused cleanly"}[accepted]
+                failures.append("%s %s %s: wanted %s, exit %s: %s" % (command, flag, text(value), wanted, status,
+                                                                       error.replace("\n", " | ")[:300]))
 
+    # The runs are independent: as many side by side as there are cores.
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=os.cpu_count() or 1)
+    jobs = []
+    tried = set()
     for command in commands:
         for flag, kind, low, high, low_closed, high_closed, count, companion in ranges(tool, command):
+            # A row nested in several commands (the match's, the odometry's) reaches the same code
+            # from each: the sanitizer tree tries it in the first command that has it, the other in all.
+            if sanitized and (flag, low, high) in tried:
+                continue
+            tried.add((flag, low, high))
             for end, closed, direction in ((low, low_closed, -1), (high, high_closed, +1)):
                 if math.isinf(end):
                     continue
                 pair = companion if direction < 0 else None
+                at_end = int(end) if kind != "FLOAT" else end
                 if closed:
-                    expect(command, flag, int(end) if kind != "FLOAT" else end, True, count, pair)
-                    expect(command, flag, outside(end, kind, direction), False, count, pair)
+                    jobs.append(pool.submit(expect, command, flag, at_end, True, count, pair))
+                    jobs.append(pool.submit(expect, command, flag, outside(end, kind, direction), False, count, pair))
                 else:
-                    expect(command, flag, int(end) if kind != "FLOAT" else end, False, count, pair)
-                    expect(command, flag, inside(end, kind, -direction), None, count, pair)
+                    jobs.append(pool.submit(expect, command, flag, at_end, False, count, pair))
+                    jobs.append(pool.submit(expect, command, flag, inside(end, kind, -direction), None, count, pair))
+    for job in jobs:
+        job.result()
+    pool.shutdown()
     # Boolean flags: the documented words only, in any case; any other word refused naming the flag,
     # on the command line and in YAML (no abort, no word read as true).
     every = ["info", "convert", "export", "map-info"] + list(commands)
     flag_count = 0
+    words_tried = set()
     for command in every:
         for flag in flags(tool, command):
             flag_count += 1
-            # The parse is the same code in both trees: the sanitizer tree tries one word, the other four.
+            # The parse is the same code in both trees and for every command: the sanitizer tree
+            # tries one word per flag, in the first command that has it; the other four in all.
+            if sanitized and flag in words_tried:
+                continue
+            words_tried.add(flag)
             for word in ("maybe",) if sanitized else ("maybe", "2x", "yes-please", "-1"):
                 status, error = run([tool, command, flag + "=" + word], sanitized)
                 lines = [line for line in error.splitlines() if line and not line.startswith("Run with --help")]
@@ -189,7 +217,7 @@ def main():
     with open(yaml_word, "w") as f:
         f.write("doppler-filter: no\n")
     expect("build-map", "--config", yaml_word, True, 1)
-    for failure in failures:
+    for failure in sorted(failures):
         print("FAIL:", failure)
     print("option ranges: %d passed, %d failed" % (passed, len(failures)))
     return 1 if failures else 0
