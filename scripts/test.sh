@@ -3,8 +3,9 @@
 # Installs what is missing, then builds and runs every test twice: in a
 # Release tree and in an AddressSanitizer + UndefinedBehaviorSanitizer tree;
 # then fuzzes every input format a little (scripts/fuzz.sh, 20 s per target,
-# in its own clang tree: libFuzzer's coverage instrumentation would slow the
-# sanitizer tree's tests several times over).
+# 10 s under CI=true, in its own clang tree: libFuzzer's coverage
+# instrumentation would slow the sanitizer tree's tests several times over).
+# Ends with the time each phase took.
 #   scripts/test.sh            both trees and the fuzzers
 #   scripts/test.sh --quick    the Release tree's tests labelled fast, no fuzzing (for iteration)
 #   RADARGAUSS_TEST_TREES=release scripts/test.sh   one tree only
@@ -12,6 +13,13 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+# phase NAME: the seconds since the last phase, kept for the summary at the end.
+phases=()
+last=$SECONDS
+phase() {
+  phases+=("$1 $((SECONDS - last)) s")
+  last=$SECONDS
+}
 jobs=$(nproc)
 trees=${RADARGAUSS_TEST_TREES:-"release sanitize"}
 labels=()
@@ -29,11 +37,13 @@ RADARGAUSS_DEPS_EXTRA="librosbag-storage-dev libsensor-msgs-dev libpcl-dev pytho
   python3-pybind11 pybind11-dev python3-pytest python3-hypothesis python3-matplotlib python3-distributed
   ${RADARGAUSS_DEPS_EXTRA:-}" \
   "$root/scripts/deps.sh"
+phase "packages"
 
 # The product's own rules: no narrative of the work, design citations and
 # includes that resolve, the layers; lengths of files, functions, README and
 # RESULTS as warnings.
 /usr/bin/python3 "$root/scripts/check_sources.py" "$root"
+phase "source checks"
 
 for tree in $trees; do
   build="$root/build/$tree"
@@ -54,14 +64,20 @@ for tree in $trees; do
       exit 2 ;;
   esac
   cmake --build "$build" -j "$jobs"
+  phase "$tree build"
   echo "== tests: $tree tree =="
   (cd "$build" && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
      UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
      ctest --output-on-failure -j "$jobs" "${labels[@]}")
+  phase "$tree tests"
 done
 
-fuzz_seconds=${RADARGAUSS_FUZZ_SECONDS:-20}
+default_fuzz_seconds=20
+if [ "${CI:-}" = true ]; then default_fuzz_seconds=10; fi
+fuzz_seconds=${RADARGAUSS_FUZZ_SECONDS:-$default_fuzz_seconds}
 if [ "$fuzz_seconds" != 0 ]; then
   echo "== fuzzing: every target for $fuzz_seconds s =="
   "$root/scripts/fuzz.sh" all "$fuzz_seconds"
+  phase "fuzzing"
 fi
+echo "test.sh: $(IFS=,; echo "${phases[*]}" | sed 's/,/, /g'); $SECONDS s in all"

@@ -172,7 +172,7 @@ void AddClutter(const SimulationConfig& config, const ScanState& state, int coun
 }
 
 // Scan k's time in integer nanoseconds from the start, so file names are exact.
-struct ScanTime {
+struct ScanStamp {
   std::string stem;
   double timestamp = 0.0;
   double since_start = 0.0;
@@ -228,7 +228,7 @@ void SimulateImu(const SimulationConfig& config, const simulation::LoopPath& pat
   }
 }
 
-ScanTime TimeOfScan(const SimulationConfig& config, int k) {
+ScanStamp TimeOfScan(const SimulationConfig& config, int k) {
   const long long start_seconds = static_cast<long long>(std::floor(config.start_time));
   const long long start_nanoseconds = std::llround((config.start_time - static_cast<double>(start_seconds)) * 1e9);
   const long long offset_nanoseconds = std::llround(k * 1e9 / config.rate_hz);
@@ -260,7 +260,7 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
   state.stds = {float(config.range_noise), float(config.azimuth_noise_deg * kDeg),
                 float(config.elevation_noise_deg * kDeg), float(config.doppler_noise)};
   for (int k = 0; k < config.scans; ++k) {
-    const ScanTime time = TimeOfScan(config, k);
+    const ScanStamp time = TimeOfScan(config, k);
     sequence.file_stems.push_back(time.stem);
     Eigen::Vector3d velocity_world;
     SensorState(config, path, time.since_start, state.pose, velocity_world);

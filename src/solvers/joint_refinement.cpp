@@ -23,9 +23,10 @@ namespace radargauss {
 namespace {
 
 // r = weight * Log((T_i0^-1 T_j0)^-1 T_i^-1 T_j), blocks R_i, t_i, R_j, t_j.
-class RelativePoseResidual {
+class RelativePoseLogResidual {
  public:
-  RelativePoseResidual(const SE3d& measured, double weight) : measured_inverse_(measured.Inverse()), weight_(weight) {}
+  RelativePoseLogResidual(const SE3d& measured, double weight)
+      : measured_inverse_(measured.Inverse()), weight_(weight) {}
 
   template <typename T>
   bool operator()(const T* ri, const T* ti, const T* rj, const T* tj, T* residual) const {
@@ -162,7 +163,7 @@ class JointProblem {
     if (options_.relative_pose_prior > 0.0) {
       for (std::size_t k = 0; k + 1 < initial_poses.size(); ++k) {
         problem_.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 4, 3, 4, 3>(new RelativePoseResidual(
+            new ceres::AutoDiffCostFunction<RelativePoseLogResidual, 6, 4, 3, 4, 3>(new RelativePoseLogResidual(
                 initial_poses[k].Inverse() * initial_poses[k + 1], options_.relative_pose_prior)),
             nullptr, blocks_.rotations[k].data(), blocks_.translations[k].data(), blocks_.rotations[k + 1].data(),
             blocks_.translations[k + 1].data());
