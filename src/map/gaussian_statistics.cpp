@@ -90,47 +90,37 @@ RcsModel RcsStatistics::Solve(const RcsFitOptions& options) const {
   if (!normalisation.valid || inliers == 0) return model;
   model.median = normalisation.median;
   model.scale = normalisation.scale;
-  for (int degree = options.max_degree; degree >= 0; --degree) {
+  return FitAdaptiveDegree(model, inliers, options, [&](int degree, RcsModel& fit) {
     const int count = ShCoefficientCount(degree);
-    if (inliers >= std::size_t(count)) {
-      // A square root M^T M = N and M^T z = r: min |M c - z| is the members'
-      // least squares, and the pivoted QR of M has the R of the members'
-      // basis matrix (it depends on N alone), so the decomposition keeps and
-      // truncates the directions FitRcsModel does.
-      const Eigen::MatrixXd block = normal.topLeftCorner(count, count).selfadjointView<Eigen::Lower>();
-      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(block);
-      const Eigen::VectorXd roots = solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
-      const Eigen::MatrixXd root = roots.asDiagonal() * solver.eigenvectors().transpose();
-      Eigen::VectorXd z = solver.eigenvectors().transpose() * rhs.head(count);
-      for (int j = 0; j < count; ++j) z[j] = roots[j] > 0.0 ? z[j] / roots[j] : 0.0;
-      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
-      cod.setThreshold(options.rank_threshold);
-      cod.compute(root);
-      if (cod.rank() >= std::max(1, count / 2) || !options.adaptive) {
-        const Eigen::VectorXd c = cod.solve(z);
-        model.degree = degree;
-        model.coefficients.fill(0.0);
-        for (int j = 0; j < count; ++j) model.coefficients[j] = c[j];
-        // |A c - y|^2 = sum y^2 - 2 c.r + c^T N c
-        const double residual = sum_y_squared - 2.0 * c.dot(rhs.head(count)) + c.dot(block * c);
-        model.fit_rmse = std::sqrt(std::max(residual, 0.0) / double(inliers));
-        model.inliers = std::uint32_t(inliers);
-        // Sum of (y - mean y)^2: Y_0 is the constant kC0, so sum y = rhs_0 / kC0.
-        const double sum_y = rhs[0] / sh_constants::kC0;
-        SetRcsFitSpread(model, residual, sum_y_squared - sum_y * sum_y / double(inliers), inliers, count);
-        // Without the members: the offset of a log-normal spread, sigma^2 ln(10) / 20 dB.
-        model.mean_offset_db = model.spread_db * model.spread_db * std::log(10.0) / 20.0;
-        if (degree > 0 && model.explained < options.min_explained) {
-          degree = 1;
-          continue;
-        }
-        return model;
-      }
-    }
-    if (!options.adaptive) break;
-  }
-  model.degree = -1;
-  return model;
+    // A square root M^T M = N and M^T z = r: min |M c - z| is the members'
+    // least squares, and the pivoted QR of M has the R of the members'
+    // basis matrix (it depends on N alone), so the decomposition keeps and
+    // truncates the directions FitRcsModel does.
+    const Eigen::MatrixXd block = normal.topLeftCorner(count, count).selfadjointView<Eigen::Lower>();
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(block);
+    const Eigen::VectorXd roots = solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+    const Eigen::MatrixXd root = roots.asDiagonal() * solver.eigenvectors().transpose();
+    Eigen::VectorXd z = solver.eigenvectors().transpose() * rhs.head(count);
+    for (int j = 0; j < count; ++j) z[j] = roots[j] > 0.0 ? z[j] / roots[j] : 0.0;
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+    cod.setThreshold(options.rank_threshold);
+    cod.compute(root);
+    if (cod.rank() < std::max(1, count / 2) && options.adaptive) return false;
+    const Eigen::VectorXd c = cod.solve(z);
+    fit.degree = degree;
+    fit.coefficients.fill(0.0);
+    for (int j = 0; j < count; ++j) fit.coefficients[j] = c[j];
+    // |A c - y|^2 = sum y^2 - 2 c.r + c^T N c
+    const double residual = sum_y_squared - 2.0 * c.dot(rhs.head(count)) + c.dot(block * c);
+    fit.fit_rmse = std::sqrt(std::max(residual, 0.0) / double(inliers));
+    fit.inliers = std::uint32_t(inliers);
+    // Sum of (y - mean y)^2: Y_0 is the constant kC0, so sum y = rhs_0 / kC0.
+    const double sum_y = rhs[0] / sh_constants::kC0;
+    SetRcsFitSpread(fit, residual, sum_y_squared - sum_y * sum_y / double(inliers), inliers, count);
+    // Without the members: the offset of a log-normal spread, sigma^2 ln(10) / 20 dB.
+    fit.mean_offset_db = fit.spread_db * fit.spread_db * std::log(10.0) / 20.0;
+    return true;
+  });
 }
 
 double KullbackLeibler(const Eigen::Vector3d& mean_a, const Eigen::Matrix3d& covariance_a,

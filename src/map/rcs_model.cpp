@@ -72,39 +72,43 @@ RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::
     EvaluateShBasis<kMaxShDegree>(directions[inliers[k]], values);
     for (int j = 0; j < ShCoefficientCount(kMaxShDegree); ++j) basis(k, j) = values[j];
   }
-  for (int degree = options.max_degree; degree >= 0; --degree) {
+  return FitAdaptiveDegree(model, std::size_t(n), options, [&](int degree, RcsModel& fit) {
     const int count = ShCoefficientCount(degree);
-    const bool enough = n >= count;
-    if (enough) {
-      const Eigen::MatrixXd A = basis.leftCols(count);
-      // Rank-revealing least squares: the minimum-norm solution with the
-      // directions whose pivots fall below the threshold truncated, so an
-      // ill-determined combination gets no weight instead of a huge one.
-      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
-      cod.setThreshold(options.rank_threshold);
-      cod.compute(A);
-      if (cod.rank() >= std::max(1, count / 2) || !options.adaptive) {
-        const Eigen::VectorXd c = cod.solve(y);
-        model.degree = degree;
-        model.coefficients.fill(0.0);
-        for (int j = 0; j < count; ++j) model.coefficients[j] = c[j];
-        const Eigen::VectorXd fitted = A * c;
-        model.fit_rmse = std::sqrt((fitted - y).squaredNorm() / n);
-        model.inliers = std::uint32_t(n);
-        SetRcsFitSpread(model, (fitted - y).squaredNorm(), (y.array() - y.mean()).square().sum(), std::size_t(n),
-                        count);
-        // 10 log10 of the mean of 10^((rcs - prediction) / 10): the inliers'
-        // linear mean over the model's dB value.
-        double linear_sum = 0.0;
-        for (int k = 0; k < n; ++k) linear_sum += std::pow(10.0, model.scale * (y[k] - fitted[k]) / 10.0);
-        model.mean_offset_db = 10.0 * std::log10(linear_sum / n);
-        // Not view-dependent beyond its noise: the constant model instead.
-        if (degree > 0 && model.explained < options.min_explained) {
-          degree = 1;
-          continue;
-        }
-        return model;
+    const Eigen::MatrixXd A = basis.leftCols(count);
+    // Rank-revealing least squares: the minimum-norm solution with the
+    // directions whose pivots fall below the threshold truncated, so an
+    // ill-determined combination gets no weight instead of a huge one.
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+    cod.setThreshold(options.rank_threshold);
+    cod.compute(A);
+    if (cod.rank() < std::max(1, count / 2) && options.adaptive) return false;
+    const Eigen::VectorXd c = cod.solve(y);
+    fit.degree = degree;
+    fit.coefficients.fill(0.0);
+    for (int j = 0; j < count; ++j) fit.coefficients[j] = c[j];
+    const Eigen::VectorXd fitted = A * c;
+    fit.fit_rmse = std::sqrt((fitted - y).squaredNorm() / n);
+    fit.inliers = std::uint32_t(n);
+    SetRcsFitSpread(fit, (fitted - y).squaredNorm(), (y.array() - y.mean()).square().sum(), std::size_t(n), count);
+    // 10 log10 of the mean of 10^((rcs - prediction) / 10): the inliers'
+    // linear mean over the model's dB value.
+    double linear_sum = 0.0;
+    for (int k = 0; k < n; ++k) linear_sum += std::pow(10.0, fit.scale * (y[k] - fitted[k]) / 10.0);
+    fit.mean_offset_db = 10.0 * std::log10(linear_sum / n);
+    return true;
+  });
+}
+
+RcsModel FitAdaptiveDegree(RcsModel model, std::size_t inliers, const RcsFitOptions& options,
+                           const std::function<bool(int degree, RcsModel& model)>& fit_at) {
+  for (int degree = options.max_degree; degree >= 0; --degree) {
+    if (inliers >= std::size_t(ShCoefficientCount(degree)) && fit_at(degree, model)) {
+      // Not view-dependent beyond its noise: the constant model instead.
+      if (degree > 0 && model.explained < options.min_explained) {
+        degree = 1;
+        continue;
       }
+      return model;
     }
     if (!options.adaptive) break;
   }

@@ -16,6 +16,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -67,6 +68,15 @@ const OptionTable<RcsFitOptions>& RcsFitOptionTable();
 // squared residual and their squared deviation from their mean, both
 // normalised, for `coefficients` fitted coefficients.
 void SetRcsFitSpread(RcsModel& model, double residual_sq, double total_sq, std::size_t inliers, int coefficients);
+
+// The adaptive degree, shared by the fit from the members (FitRcsModel) and
+// the one from their statistics (RcsStatistics::Solve): from max_degree
+// down, each degree the `inliers` determine is fitted by fit_at, which fills
+// `model` and says whether its decomposition kept enough directions (always,
+// without `adaptive`); a fit that explains less than min_explained gives
+// way to the constant model. Degree -1: no fit.
+RcsModel FitAdaptiveDegree(RcsModel model, std::size_t inliers, const RcsFitOptions& options,
+                           const std::function<bool(int degree, RcsModel& model)>& fit_at);
 
 // Fits one model from the members' incidence directions and raw RCS.
 RcsModel FitRcsModel(const std::vector<Eigen::Vector3d>& directions, const std::vector<double>& rcs,
