@@ -9,11 +9,13 @@
 #include <stdexcept>
 
 #include "radargauss/residuals/imu_preintegration.hpp"
+#include "support/imu_fixtures.hpp"
 
 namespace radargauss {
 namespace {
 
-const Eigen::Vector3d kG(0.0, 0.0, -9.81);
+using testing::IntegrateTurningDrive;
+const Eigen::Vector3d kG = testing::kGravityVector;
 
 struct State {
   SO3d R;
@@ -53,22 +55,7 @@ TEST(ImuPreintegration, ConstantAccelerationIntegratesExactly) {
   EXPECT_LT((j.p - (p0 + v0 * 1.0 + 0.5 * a)).norm(), 1e-9);
 }
 
-// Samples of a turning, accelerating drive (smooth, not exact).
-std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> Drive() {
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> samples;
-  for (int k = 0; k < 200; ++k) {
-    const double t = k * 0.005;
-    samples.push_back({Eigen::Vector3d(0.05 * std::sin(3 * t), -0.03, 0.4 + 0.2 * t),
-                       Eigen::Vector3d(1.0 + std::cos(2 * t), 0.5 * t, 9.81 + 0.1 * std::sin(5 * t))});
-  }
-  return samples;
-}
-
-ImuDelta Integrated(const ImuBias& bias) {
-  ImuPreintegration between(bias, ImuNoise{});
-  for (const auto& [gyro, accel] : Drive()) between.Integrate(gyro, accel, 0.005);
-  return between.delta();
-}
+ImuDelta Integrated(const ImuBias& bias) { return IntegrateTurningDrive(bias, 200).delta(); }
 
 double Difference(const ImuDelta& a, const ImuDelta& b) {
   return (a.rotation.Inverse() * b.rotation).Log().norm() + (a.velocity - b.velocity).norm() +
@@ -78,7 +65,7 @@ double Difference(const ImuDelta& a, const ImuDelta& b) {
 TEST(ImuPreintegration, FirstOrderBiasCorrectionAgreesWithIntegratingAgain) {
   const ImuBias linearisation{Eigen::Vector3d(0.002, -0.001, 0.003), Eigen::Vector3d(0.05, -0.02, 0.01)};
   ImuPreintegration between(linearisation, ImuNoise{});
-  for (const auto& [gyro, accel] : Drive()) between.Integrate(gyro, accel, 0.005);
+  for (const auto& [gyro, accel] : testing::TurningDriveSamples(200)) between.Integrate(gyro, accel, 0.005);
   const Eigen::Vector3d direction_g(0.6, -0.8, 0.3), direction_a(-0.5, 0.2, 0.9);
   double previous = 0.0;
   for (const double step : {4e-3, 2e-3, 1e-3}) {
@@ -102,7 +89,7 @@ TEST(ImuPreintegration, CovarianceMatchesMonteCarlo) {
   noise.accel_noise_density = 2e-2;
   const double dt = 0.005;
   ImuPreintegration mean(ImuBias{}, noise);
-  for (const auto& [gyro, accel] : Drive()) mean.Integrate(gyro, accel, dt);
+  for (const auto& [gyro, accel] : testing::TurningDriveSamples(200)) mean.Integrate(gyro, accel, dt);
   std::mt19937 rng(7);
   std::normal_distribution<double> normal;
   const auto draw = [&](double std) -> Eigen::Vector3d {
@@ -112,7 +99,7 @@ TEST(ImuPreintegration, CovarianceMatchesMonteCarlo) {
   Eigen::Matrix<double, 9, 9> sample = Eigen::Matrix<double, 9, 9>::Zero();
   for (int r = 0; r < runs; ++r) {
     ImuPreintegration noisy(ImuBias{}, noise);
-    for (const auto& [gyro, accel] : Drive()) {
+    for (const auto& [gyro, accel] : testing::TurningDriveSamples(200)) {
       noisy.Integrate(gyro + draw(noise.gyro_noise_density / std::sqrt(dt)),
                       accel + draw(noise.accel_noise_density / std::sqrt(dt)), dt);
     }

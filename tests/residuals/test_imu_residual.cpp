@@ -11,21 +11,16 @@
 #include "radargauss/residuals/imu_residual.hpp"
 #include "radargauss/residuals/radar_inertial_residuals.hpp"
 #include "support/cost_function_checks.hpp"
+#include "support/imu_fixtures.hpp"
 
 namespace radargauss {
 namespace {
 
-const Eigen::Vector3d kG(0.0, 0.0, -kGravity);
+const Eigen::Vector3d kG = testing::kGravityVector;
 
-// 0.5 s of a turning, accelerating drive at 200 Hz, integrated at `linearisation`.
+// 0.5 s of the turning drive, integrated at `linearisation`.
 ImuPreintegration DriveBetween(const ImuBias& linearisation) {
-  ImuPreintegration between(linearisation, ImuNoise{});
-  for (int k = 0; k < 100; ++k) {
-    const double t = k * 0.005;
-    between.Integrate(Eigen::Vector3d(0.05 * std::sin(3 * t), -0.03, 0.4 + 0.2 * t),
-                      Eigen::Vector3d(1.0 + std::cos(2 * t), 0.5 * t, 9.81 + 0.1 * std::sin(5 * t)), 0.005);
-  }
-  return between;
+  return testing::IntegrateTurningDrive(linearisation, 100);
 }
 
 Eigen::Matrix<double, 9, 1> RandomMotion(std::mt19937& rng) {
