@@ -4,7 +4,8 @@
 operand), rebuilds the test that guards the place, and expects it to fail:
 a check that the tests of the pose graph, place recognition,
 relocalisation, the odometry's terms, the IMU's residual, preintegration
-and clock offset, the bag readers and writers, the IMU reader and the
+and clock offset, the bag readers (the chunk index among them) and writers,
+the keyframe graph's local solve, the IMU reader and the
 tile index would catch a wrong answer. Every file is restored, whatever happens.
 
     scripts/mutation_check.py [BUILD_DIR]    (default build/release, configured)
@@ -65,8 +66,8 @@ MUTATIONS = [
     ("MCAP writer: a chunk's CRC computed from the wrong seed", "src/io/mcap_writer.cpp",
      "Put(body, Crc(0, chunk.data(), chunk.size()), 4);", "Put(body, Crc(1, chunk.data(), chunk.size()), 4);",
      "test_rosbag2", "Rosbag2Files.McapEveryLayoutRoundTrips"),
-    ("sqlite3 bag writer: messages filed under the next topic", "src/io/rosbag2.cpp",
-     "w.insert->Bind(1, std::int64_t(topic));", "w.insert->Bind(1, std::int64_t(topic) + 1);",
+    ("sqlite3 bag writer: messages filed under the next topic", "src/io/rosbag2_writer.cpp",
+     "insert_->Bind(1, std::int64_t(topic));", "insert_->Bind(1, std::int64_t(topic) + 1);",
      "test_rosbag2", "Rosbag2Files.OneSequenceFromItsPcdFolderAndEveryBagIsTheSame"),
     ("rosbag2 folder: a file listed twice read twice", "src/io/rosbag2.cpp",
      "if (std::find(seen.begin(), seen.end(), resolved) != seen.end()) {", "if (false) {",
@@ -74,9 +75,18 @@ MUTATIONS = [
     ("CDR: a string with a NUL inside read as a name cut short", "src/io/ros2_messages.cpp",
      "if (s.find('\\0') != std::string::npos) throw", "if (false && s.find('\\0') != std::string::npos) throw",
      "test_rosbag2", "Cdr.LiesAndTruncationsAreRefused"),
-    ("bag writer: two topics of one name written", "src/io/rosbag2.cpp",
+    ("bag writer: two topics of one name written", "src/io/rosbag2_writer.cpp",
      "if (topics[i].second == topics[j].second) {", "if (false) {",
      "test_rosbag2", "Rosbag2Files.BagTopicsAreNamesAReaderFindsAgain"),
+    ("MCAP reader: chunks holding none of the topics decompressed", "src/io/mcap_reader.cpp",
+     "    if (in_range && has_topic) {", "    if (in_range || has_topic) {",
+     "test_rosbag2", "BagReaders.AnMcapReadDecompressesOnlyTheChunksItsFilterAdmits"),
+    ("MCAP reader: overlapping chunks delivered unmerged", "src/io/mcap_reader.cpp",
+     "    std::stable_sort(messages.begin(), messages.end(),", "    if (false) std::stable_sort(messages.begin(), messages.end(),",
+     "test_rosbag2", "BagReaders.OverlappingChunksAreReadInLogTimeOrder"),
+    ("keyframe graph: a loop's solve frees the whole graph", "src/slam/keyframe_graph.cpp",
+     "    first_free = query;", "    first_free = 1;",
+     "test_slam", "KeyframeGraph.*"),
     ("IMU file: a value past any IMU read", "src/io/imu.cpp",
      "if (rate > kMaxPhysicalAngularRate) {", "if (rate > 1e301) {",
      "test_sequence", "ImuFile.*"),
