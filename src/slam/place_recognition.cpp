@@ -62,41 +62,33 @@ std::unique_ptr<PlaceDescriptor> MakePlaceDescriptor(const PlaceRecognitionOptio
 
 const OptionTable<PlaceRecognitionOptions>& PlaceRecognitionOptionTable() {
   using O = PlaceRecognitionOptions;
-  static const OptionTable<O> table = {
-      RADARGAUSS_OPTION(O, "descriptor", descriptor)
-          .Choices(PlaceDescriptorNames())
-          .Sensor()
-          .Help("place descriptor: scan-context or radon"),
-      RADARGAUSS_OPTION(O, "candidates", candidates).In(1, 100000).Help("places compared per submap (nearest keys)"),
-      RADARGAUSS_OPTION(O, "max_scan_context_distance", max_scan_context_distance)
-          .In(0.0, 1.0)
-          .Help("places farther by Scan Context are not verified"),
-      RADARGAUSS_OPTION(O, "max_radon_distance", max_radon_distance)
-          .In(0.0, 1.0)
-          .Help("places farther by the Radon descriptor are not verified"),
-      RADARGAUSS_OPTION(O, "submap_voxel", submap_voxel)
-          .Above(0.0)
-          .Unit("m")
-          .Help("a submap keeps the first point of each voxel of this edge"),
-      RADARGAUSS_CHOICE(O, "channel", scan_context.channel, ScanContextChannelNames(), ScanContextChannelFromString)
-          .Help("Scan Context channels: geometric, rcs or both"),
-      RADARGAUSS_OPTION(O, "scan_context_rings", scan_context.rings).In(1, 1000).Help("Scan Context: rings"),
-      RADARGAUSS_OPTION(O, "scan_context_sectors", scan_context.sectors).In(1, 1000).Help("Scan Context: sectors"),
-      RADARGAUSS_OPTION(O, "scan_context_max_range", scan_context.max_range)
-          .Above(0.0)
-          .Unit("m")
-          .Help("Scan Context: points beyond are left out"),
-      RADARGAUSS_OPTION(O, "scan_context_rcs_floor", scan_context.rcs_floor)
-          .Unit("dBsm")
-          .Help("Scan Context: the RCS channel holds rcs - floor, at least 0"),
-      RADARGAUSS_OPTION(O, "radon_angles", radon.angles).In(2, 1000).Help("Radon: projection directions over [0, pi)"),
-      RADARGAUSS_OPTION(O, "radon_offsets", radon.offsets).In(2, 1000).Help("Radon: bins of a projection"),
-      RADARGAUSS_OPTION(O, "radon_cell", radon.cell).Above(0.0).Unit("m").Help("Radon: the bird's-eye grid's cell"),
-      RADARGAUSS_OPTION(O, "radon_max_range", radon.max_range)
-          .Above(0.0)
-          .Unit("m")
-          .Help("Radon: cells farther are left out"),
-  };
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {
+        RADARGAUSS_OPTION(O, "descriptor", descriptor)
+            .Choices(PlaceDescriptorNames())
+            .Sensor()
+            .Help("place descriptor: scan-context or radon"),
+        RADARGAUSS_OPTION(O, "candidates", candidates).In(1, 100000).Help("places compared per submap (nearest keys)"),
+        RADARGAUSS_OPTION(O, "max_scan_context_distance", max_scan_context_distance)
+            .In(0.0, 1.0)
+            .Help("places farther by Scan Context are not verified"),
+        RADARGAUSS_OPTION(O, "max_radon_distance", max_radon_distance)
+            .In(0.0, 1.0)
+            .Help("places farther by the Radon descriptor are not verified"),
+        RADARGAUSS_OPTION(O, "submap_voxel", submap_voxel)
+            .Above(0.0)
+            .Unit("m")
+            .Help("a submap keeps the first point of each voxel of this edge"),
+        RADARGAUSS_CHOICE(O, "channel", scan_context.channel, ScanContextChannelNames(), ScanContextChannelFromString)
+            .Help("Scan Context channels: geometric, rcs or both"),
+    };
+    // The descriptors' own rows, as scan_context_* and radon_*.
+    AppendNested(
+        t, ScanContextOptionTable(), +[](O & o) -> auto& { return o.scan_context; }, "scan_context", "scan_context_");
+    AppendNested(
+        t, RadonOptionTable(), +[](O & o) -> auto& { return o.radon; }, "radon", "radon_");
+    return t;
+  }();
   return table;
 }
 

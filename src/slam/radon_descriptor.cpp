@@ -10,16 +10,18 @@
 
 namespace radargauss {
 
-void ValidateRadonOptions(const RadonOptions& options) {
-  if (options.angles < 2 || options.offsets < 2) {
-    throw std::invalid_argument("radon descriptor: angles and offsets must be >= 2");
-  }
-  for (const double value : {options.cell, options.max_range}) {
-    if (!(value > 0.0) || !std::isfinite(value)) {
-      throw std::invalid_argument("radon descriptor: cell and max_range must be positive and finite");
-    }
-  }
+const OptionTable<RadonOptions>& RadonOptionTable() {
+  using O = RadonOptions;
+  static const OptionTable<O> table = {
+      RADARGAUSS_OPTION(O, "angles", angles).In(2, 1000).Help("Radon: projection directions over [0, pi)"),
+      RADARGAUSS_OPTION(O, "offsets", offsets).In(2, 1000).Help("Radon: bins of a projection"),
+      RADARGAUSS_OPTION(O, "cell", cell).Above(0.0).Unit("m").Help("Radon: the bird's-eye grid's cell"),
+      RADARGAUSS_OPTION(O, "max_range", max_range).Above(0.0).Unit("m").Help("Radon: cells farther are left out"),
+  };
+  return table;
 }
+
+void ValidateRadonOptions(const RadonOptions& options) { CheckOptions(RadonOptionTable(), options); }
 
 namespace {
 

@@ -22,15 +22,23 @@ ScanContextChannel ScanContextChannelFromString(const std::string& name) {
 }
 std::vector<std::string> ScanContextChannelNames() { return NamesOf(kChannelNames); }
 
-void ValidateScanContextOptions(const ScanContextOptions& options) {
-  if (options.rings < 1 || options.sectors < 1) {
-    throw std::invalid_argument("scan context: rings and sectors must be >= 1");
-  }
-  if (!(options.max_range > 0.0) || !std::isfinite(options.max_range)) {
-    throw std::invalid_argument("scan context: max_range must be positive and finite");
-  }
-  if (!std::isfinite(options.rcs_floor)) throw std::invalid_argument("scan context: rcs_floor must be finite");
+const OptionTable<ScanContextOptions>& ScanContextOptionTable() {
+  using O = ScanContextOptions;
+  static const OptionTable<O> table = {
+      RADARGAUSS_OPTION(O, "rings", rings).In(1, 1000).Help("Scan Context: rings"),
+      RADARGAUSS_OPTION(O, "sectors", sectors).In(1, 1000).Help("Scan Context: sectors"),
+      RADARGAUSS_OPTION(O, "max_range", max_range)
+          .Above(0.0)
+          .Unit("m")
+          .Help("Scan Context: points beyond are left out"),
+      RADARGAUSS_OPTION(O, "rcs_floor", rcs_floor)
+          .Unit("dBsm")
+          .Help("Scan Context: the RCS channel holds rcs - floor, at least 0"),
+  };
+  return table;
 }
+
+void ValidateScanContextOptions(const ScanContextOptions& options) { CheckOptions(ScanContextOptionTable(), options); }
 
 ScanContext MakeScanContext(const std::vector<RadarPoint>& points, const ScanContextOptions& options) {
   ValidateScanContextOptions(options);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -13,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "radargauss/slam/loop_verification.hpp"
+#include "radargauss/slam/place_recognition.hpp"
 #include "radargauss/slam/radon_descriptor.hpp"
 #include "radargauss/slam/scan_context.hpp"
 
@@ -111,6 +113,35 @@ TEST(ScanContext, EmptyAndInvalid) {
   ScanContextOptions other;
   other.rings = 10;
   EXPECT_THROW(CompareScanContexts(empty, MakeScanContext({}, other), ScanContextOptions{}), std::invalid_argument);
+}
+
+// The descriptors' own validators are their tables' rows, the same that
+// place recognition's scan_context_* and radon_* flags state: a value past
+// a row's end is refused by both, naming the option.
+TEST(PlaceDescriptors, ValidateByTheRowsTheirFlagsState) {
+  const auto refused = [](const std::function<void()>& validate, const std::string& name) {
+    try {
+      validate();
+      ADD_FAILURE() << name << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  };
+  ScanContextOptions rings;
+  rings.rings = 1001;  // the row is In(1, 1000)
+  refused([&] { ValidateScanContextOptions(rings); }, "rings");
+  RadonOptions angles;
+  angles.angles = 1001;
+  refused([&] { ValidateRadonOptions(angles); }, "angles");
+  PlaceRecognitionOptions place;
+  place.radon.angles = 1001;
+  refused([&] { ValidateOptions(place); }, "radon_angles");
+  place.radon.angles = 1000;
+  ValidateOptions(place);
+  ValidateRadonOptions(place.radon);
+  ScanContextOptions floor;
+  floor.rcs_floor = std::nan("");
+  refused([&] { ValidateScanContextOptions(floor); }, "rcs_floor");
 }
 
 // The Radon descriptor does not change with a translation: a copy shifted by

@@ -10,8 +10,9 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "radargauss/slam/place_descriptor.hpp"
+#include "radargauss/core/options.hpp"
 #include "radargauss/core/types.hpp"
+#include "radargauss/slam/place_descriptor.hpp"
 
 namespace radargauss {
 
@@ -22,8 +23,9 @@ struct RadonOptions {
   double max_range = 80.0;  // m: cells farther are left out
 };
 
-// Throws std::invalid_argument on angles or offsets < 2, or a cell or range
-// that is not positive and finite.
+// Its options (options.hpp): place recognition's rows radon_*.
+const OptionTable<RadonOptions>& RadonOptionTable();
+// CheckOptions with that table: throws std::invalid_argument naming the option.
 void ValidateRadonOptions(const RadonOptions& options);
 
 struct RadonDescriptor {

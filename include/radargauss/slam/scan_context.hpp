@@ -13,8 +13,9 @@
 
 #include <Eigen/Core>
 
-#include "radargauss/slam/place_descriptor.hpp"
+#include "radargauss/core/options.hpp"
 #include "radargauss/core/types.hpp"
+#include "radargauss/slam/place_descriptor.hpp"
 
 namespace radargauss {
 
@@ -31,8 +32,10 @@ struct ScanContextOptions {
   ScanContextChannel channel = ScanContextChannel::kBoth;
 };
 
-// Throws std::invalid_argument on rings or sectors < 1 or a range that is not
-// positive and finite.
+// Its options (options.hpp) but the channel, which is its type's: place
+// recognition's rows scan_context_*.
+const OptionTable<ScanContextOptions>& ScanContextOptionTable();
+// CheckOptions with that table: throws std::invalid_argument naming the option.
 void ValidateScanContextOptions(const ScanContextOptions& options);
 
 struct ScanContext {
