@@ -21,13 +21,23 @@ double Spread(const std::vector<double>& values, double median) {
 
 }  // namespace
 
-void ValidateOptions(const MountingOptions& o) {
-  if (!(o.min_speed > 0.0) || !std::isfinite(o.min_speed)) {
-    throw std::invalid_argument("mounting: min_speed must be positive");
-  }
-  if (!(o.max_yaw_rate_deg > 0.0)) throw std::invalid_argument("mounting: max_yaw_rate_deg must be positive");
-  if (o.min_scans < 1) throw std::invalid_argument("mounting: min_scans must be >= 1");
+const OptionTable<MountingOptions>& MountingOptionTable() {
+  using O = MountingOptions;
+  static const OptionTable<O> table = {
+      RADARGAUSS_OPTION(O, "min_speed", min_speed)
+          .Above(0.0)
+          .Unit("m/s")
+          .Help("slower scans say little about the direction of travel"),
+      RADARGAUSS_OPTION(O, "max_yaw_rate", max_yaw_rate_deg)
+          .Above(0.0)
+          .Unit("deg/s")
+          .Help("turning adds the lever arm's lateral velocity"),
+      RADARGAUSS_OPTION(O, "min_scans", min_scans).AtLeast(1).Help("straight scans at speed needed for an estimate"),
+  };
+  return table;
 }
+
+void ValidateOptions(const MountingOptions& o) { CheckOptions(MountingOptionTable(), o); }
 
 SO3d Mounting::vehicle_from_radar() const { return VehicleFromRadar(Eigen::Vector3d(0.0, pitch_deg, yaw_deg)); }
 

@@ -4,7 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/odometry/mounting.hpp"
@@ -277,6 +282,21 @@ TEST(Mounting, RecoversPlantedPitchAndYawAndLevelsTheTrack) {
   MountingOptions bad;
   bad.min_speed = 0.0;
   EXPECT_THROW(EstimateMounting(steps, bad), std::invalid_argument);
+  // By its table's rows, each named: min_scans at least 1, the yaw rate positive and finite.
+  for (const auto& [option, set] : std::vector<std::pair<std::string, std::function<void(MountingOptions&)>>>{
+           {"min_scans", [](MountingOptions& o) { o.min_scans = 0; }},
+           {"max_yaw_rate", [](MountingOptions& o) { o.max_yaw_rate_deg = std::nan(""); }},
+           {"min_speed", [](MountingOptions& o) { o.min_speed = -1.0; }}}) {
+    MountingOptions o;
+    set(o);
+    try {
+      ValidateOptions(o);
+      ADD_FAILURE() << option << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(option), std::string::npos) << e.what();
+    }
+  }
+  ValidateOptions(MountingOptions{});
 }
 
 }  // namespace

@@ -25,7 +25,9 @@ struct MountingOptions {
   std::size_t min_scans = 10;     // straight scans at speed needed for an estimate
 };
 
-// Throws std::invalid_argument naming the bad option.
+// Its options (options.hpp).
+const OptionTable<MountingOptions>& MountingOptionTable();
+// CheckOptions with that table: throws std::invalid_argument naming the bad option.
 void ValidateOptions(const MountingOptions& options);
 
 // R_vehicle_radar = Rz(yaw) Ry(pitch) (roll unobserved, 0), the convention
