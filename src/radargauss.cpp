@@ -26,4 +26,19 @@ RadarOdometry Odometry(const Sequence& sequence, const OdometryOptions& options)
   return odometry;
 }
 
+std::unique_ptr<RadarInertialOdometry> InertialOdometry(const Sequence& sequence, std::vector<ImuSample> imu,
+                                                        const SE3d& radar_from_imu, const OdometryOptions& odometry,
+                                                        const RadarInertialOptions& options) {
+  auto run = std::make_unique<RadarInertialOdometry>(odometry, options, radar_from_imu, std::move(imu));
+  for (const RadarScan& scan : sequence.scans) run->Register(scan);
+  return run;
+}
+
+std::unique_ptr<RadarSlam> Slam(const Sequence& sequence, const SlamOptions& options) {
+  auto slam = std::make_unique<RadarSlam>(options);
+  for (const RadarScan& scan : sequence.scans) slam->Register(scan);
+  slam->Finish();
+  return slam;
+}
+
 }  // namespace radargauss

@@ -2,15 +2,17 @@
 // The front door: the main jobs in a few calls, without a Ceres header (the
 // solvers keep Ceres behind the library). Simulate or load a sequence, build
 // a Gaussian-RCS map from scans and reference poses, match a scan against it,
-// run odometry on a map built on the way, evaluate a trajectory.
-// docs/design.md explains each step.
+// run odometry on a map built on the way (with an IMU or without), run SLAM,
+// evaluate a trajectory. docs/design.md explains each step.
 //
 //   const Sequence sequence = LoadSequence(sequence_options);
 //   const MatchingMap map(BuildMap(sequence));
 //   const ScanMatchingResult match = Match(scan, map, initial_guess);
 //   const RadarOdometry odometry = Odometry(sequence);
+//   const auto slam = Slam(sequence);  // slam->trajectory()
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "radargauss/core/error.hpp"
@@ -19,8 +21,10 @@
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/pipeline.hpp"
+#include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/simulator/simulator.hpp"
+#include "radargauss/slam/radar_slam.hpp"
 #include "radargauss/solvers/factory.hpp"
 #include "radargauss/core/trajectory.hpp"
 #include "radargauss/core/types.hpp"
@@ -45,5 +49,18 @@ ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE
 // map built on the way (docs/design/odometry.md, "Odometry"); its steps, trajectory()
 // and map() hold the run. Throws DataError for stamps that do not increase.
 RadarOdometry Odometry(const Sequence& sequence, const OdometryOptions& options = {});
+
+// `radargauss odometry --imu`: the same with the IMU's samples (on the scans'
+// clock) and T_radar_imu (docs/design/odometry.md, "Radar-inertial
+// odometry"). Throws DataError when the IMU does not cover the scans.
+std::unique_ptr<RadarInertialOdometry> InertialOdometry(const Sequence& sequence, std::vector<ImuSample> imu,
+                                                        const SE3d& radar_from_imu,
+                                                        const OdometryOptions& odometry = {},
+                                                        const RadarInertialOptions& options = {});
+
+// `radargauss slam`: every scan of `sequence` through SLAM, finished
+// (docs/design/slam.md, "SLAM"); its trajectory(), keyframes() and loops()
+// hold the run.
+std::unique_ptr<RadarSlam> Slam(const Sequence& sequence, const SlamOptions& options = {});
 
 }  // namespace radargauss

@@ -50,6 +50,34 @@ TEST(FrontDoor, BuildMapIsTheMapPipeline) {
   EXPECT_THROW(BuildMap(sequence.scans, {}, options), DataError);
 }
 
+// InertialOdometry and Slam are the classes run over every scan, bit for bit.
+TEST(FrontDoor, InertialOdometryAndSlamAreTheirClassesRunOverTheSequence) {
+  SimulationConfig config;
+  config.scans = 40;
+  config.imu_rate_hz = 200.0;
+  const SimulatedSequence simulated = Simulate(config);
+  const Sequence sequence = AsSequence(simulated);
+  const auto inertial = InertialOdometry(sequence, simulated.imu, simulated.radar_from_imu);
+  RadarInertialOdometry by_hand(OdometryOptions{}, RadarInertialOptions{}, simulated.radar_from_imu, simulated.imu);
+  for (const RadarScan& scan : sequence.scans) by_hand.Register(scan);
+  ASSERT_EQ(inertial->odometry().steps().size(), sequence.scans.size());
+  for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
+    EXPECT_EQ(inertial->odometry().steps()[k].pose.translation(), by_hand.odometry().steps()[k].pose.translation());
+  }
+  EXPECT_THROW(InertialOdometry(sequence, {}, simulated.radar_from_imu), DataError);
+
+  SlamOptions options;
+  options.submap_distance = 5.0;
+  const auto slam = Slam(sequence, options);
+  RadarSlam slam_by_hand(options);
+  for (const RadarScan& scan : sequence.scans) slam_by_hand.Register(scan);
+  slam_by_hand.Finish();
+  const std::vector<SE3d> poses = slam->Poses(), expected = slam_by_hand.Poses();
+  ASSERT_EQ(poses.size(), sequence.scans.size());
+  EXPECT_GT(slam->keyframes().size(), 2u);
+  for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(poses[k].translation(), expected[k].translation());
+}
+
 // Match with a solver kind is that solver's match, bit for bit.
 TEST(FrontDoor, MatchIsTheNamedSolver) {
   const World& world = SimulatedWorld();
