@@ -130,8 +130,8 @@ class Ros1Bag final : public BagReader {
         bytes.resize(message.size());
         ros::serialization::OStream stream(bytes.data(), std::uint32_t(bytes.size()));
         message.write(stream);
-        const std::string topic = message.getTopic(), type = message.getDataType();
-        visit({&topic, &type, std::int64_t(message.getTime().toNSec()), bytes.data(), bytes.size(), &Ros1Codec()});
+        visit({&message.getTopic(), &message.getDataType(), std::int64_t(message.getTime().toNSec()), bytes.data(),
+               bytes.size(), &Ros1Codec()});
       }
     } catch (const DataError&) {
       throw;

@@ -253,8 +253,9 @@ class Ros2Folder final : public BagReader {
   BagReadStatistics statistics() const override {
     BagReadStatistics total;
     for (const auto& file : files_) {
-      total.chunks_read += file->statistics().chunks_read;
-      total.chunks_skipped += file->statistics().chunks_skipped;
+      const BagReadStatistics read = file->statistics();
+      total.chunks_read += read.chunks_read;
+      total.chunks_skipped += read.chunks_skipped;
     }
     return total;
   }
