@@ -31,15 +31,27 @@ struct Seen {
   bool operator==(const Seen& o) const { return topic == o.topic && log_time == o.log_time && payload == o.payload; }
 };
 
+// An MCAP writer of std_msgs/String messages into `out`, a chunk closing
+// past `chunk_bytes`; `schema` for its channels.
+struct StringMcap {
+  StringMcap(std::ostream& out, std::size_t chunk_bytes) : writer(out, Options(chunk_bytes)) {}
+  static McapWriterOptions Options(std::size_t chunk_bytes) {
+    McapWriterOptions options;
+    options.chunk_bytes = chunk_bytes;
+    return options;
+  }
+  McapWriter writer;
+  const std::uint16_t schema = writer.AddSchema("std_msgs/msg/String", "ros2msg", "string data\n");
+};
+
 // An MCAP file of small chunks: 300 messages on /radar (t = 0..299 us),
 // then 300 on /imu, then 300 on /radar again, so that most chunks hold one
 // topic; `interleave` writes them alternating instead.
 std::string WriteSegments(const std::string& path, bool interleave = false) {
   std::ofstream out(path, std::ios::binary);
-  McapWriterOptions options;
-  options.chunk_bytes = 2048;
-  McapWriter writer(out, options);
-  const std::uint16_t schema = writer.AddSchema("std_msgs/msg/String", "ros2msg", "string data\n");
+  StringMcap mcap(out, 2048);
+  McapWriter& writer = mcap.writer;
+  const std::uint16_t schema = mcap.schema;
   const std::uint16_t radar = writer.AddChannel("/radar", schema), imu = writer.AddChannel("/imu", schema);
   for (int k = 0; k < 900; ++k) {
     const bool on_imu = interleave ? k % 2 == 1 : (k >= 300 && k < 600);
@@ -112,10 +124,9 @@ TEST_F(BagReaders, OverlappingChunksAreReadInLogTimeOrder) {
   const std::string path = Path("overlap.mcap");
   {
     std::ofstream out(path, std::ios::binary);
-    McapWriterOptions options;
-    options.chunk_bytes = 1024;
-    McapWriter writer(out, options);
-    const std::uint16_t schema = writer.AddSchema("std_msgs/msg/String", "ros2msg", "string data\n");
+    StringMcap mcap(out, 1024);
+    McapWriter& writer = mcap.writer;
+    const std::uint16_t schema = mcap.schema;
     const std::uint16_t a = writer.AddChannel("/a", schema), b = writer.AddChannel("/b", schema);
     for (int k = 0; k < 200; ++k) writer.Write(a, 10u * k, 0, Text("a" + std::to_string(k)));
     for (int k = 0; k < 200; ++k) writer.Write(b, 5u * k + 3, 0, Text("b" + std::to_string(k)));
@@ -199,10 +210,9 @@ std::vector<std::size_t> ChunkIndexOffsets(const std::string& file) {
 TEST_F(BagReaders, ChunkIndexesThatLieAreRefused) {
   std::ostringstream written;
   {
-    McapWriterOptions options;
-    options.chunk_bytes = 512;
-    McapWriter writer(written, options);
-    const std::uint16_t schema = writer.AddSchema("std_msgs/msg/String", "ros2msg", "string data\n");
+    StringMcap mcap(written, 512);
+    McapWriter& writer = mcap.writer;
+    const std::uint16_t schema = mcap.schema;
     const std::uint16_t a = writer.AddChannel("/a", schema);
     for (int k = 0; k < 100; ++k) writer.Write(a, k, k, Text(std::string(40, char('a' + k % 26))));
     writer.Finish();
