@@ -14,7 +14,7 @@ trap 'rm -rf "$tmp"' EXIT
 $check "$root" > "$tmp/tree.log" || { cat "$tmp/tree.log"; echo "FAIL: the tree has upward includes"; exit 1; }
 
 mkdir -p "$tmp/copy"
-for item in README.md CMakeLists.txt include src residuals solvers peers apps python examples bench docs scripts \
+for item in README.md CMakeLists.txt include src apps python examples bench docs scripts \
             configs cmake .ci fuzz .clang-format; do
   cp -r "$root/$item" "$tmp/copy/"
 done
