@@ -3,6 +3,8 @@
 
 #include <utility>
 
+#include "radargauss/core/error.hpp"
+
 namespace radargauss {
 
 GaussianMap BuildMap(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses, const MapOptions& options) {
@@ -26,11 +28,11 @@ RadarOdometry Odometry(const Sequence& sequence, const OdometryOptions& options)
   return odometry;
 }
 
-std::unique_ptr<RadarInertialOdometry> InertialOdometry(const Sequence& sequence, std::vector<ImuSample> imu,
-                                                        const SE3d& radar_from_imu, const OdometryOptions& odometry,
-                                                        const RadarInertialOptions& options) {
-  auto run = std::make_unique<RadarInertialOdometry>(odometry, options, radar_from_imu, std::move(imu));
-  for (const RadarScan& scan : sequence.scans) run->Register(scan);
+RadarOdometry InertialOdometry(const Sequence& sequence, std::vector<ImuSample> imu, const SE3d& radar_from_imu,
+                               const OdometryOptions& odometry, const RadarInertialOptions& options) {
+  if (imu.empty()) throw DataError("the IMU has no sample");
+  RadarOdometry run(odometry, MakeMotionModel(options, radar_from_imu, std::move(imu)));
+  for (const RadarScan& scan : sequence.scans) run.Register(scan);
   return run;
 }
 

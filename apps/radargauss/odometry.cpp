@@ -39,8 +39,7 @@ void PrintScreening(const ImuScreening& screening) {
 
 // The window's last estimate: the tilt of the odometry's world against
 // gravity, the biases, and its cost per scan.
-void PrintInertial(const RadarInertialOdometry& inertial) {
-  PrintScreening(inertial.screening());
+void PrintInertial(const InertialMotion& inertial) {
   const auto& states = inertial.states();
   if (states.empty() || !states.back()) {
     std::printf("inertial: the window never started (no Doppler velocity)\n");
@@ -84,26 +83,18 @@ int RunOdometry(const OdometrySettings& s) {
   const std::optional<Trajectory>& reference = inputs.reference;
   StagedFolder folder = RunFolder(s, {"odometry.tum", "levelled.tum", "map.rgm", "map.ply"});  // before the run
   const ImuInput imu = ImuOf(s);  // before the run: a bad IMU leaves nothing behind
-  if (!imu.samples.empty()) CheckOverlap(GyroOf(imu), sequence, s.imu_topic.empty() ? "" : "; try --imu-stamps record");
-  std::optional<RadarInertialOdometry> inertial;
-  std::optional<RadarOdometry> radar_only;
-  if (!imu.samples.empty() && s.imu_fusion == "window") {
-    if (s.matcher != "gaussians") throw DataError("--imu-fusion window needs --matcher gaussians");
-    inertial.emplace(options, s.inertial, imu.radar_from_imu, imu.samples);
-    RegisterScans(sequence, "odometry", [&](const RadarScan& scan) { inertial->Register(scan); });
-  } else {
-    radar_only.emplace(options, MatcherOf(s.matcher));
-    if (!imu.samples.empty()) {
-      ImuInput screened = imu;
-      PrintScreening(ScreenImuSamples(screened.samples, s.inertial.window.noise));
-      radar_only->AddGyro(GyroOf(screened));
-    }
-    RegisterScans(sequence, "odometry", [&](const RadarScan& scan) { radar_only->Register(scan); });
+  if (!imu.samples.empty()) CheckOverlap(imu.samples, sequence, s.imu_topic.empty() ? "" : "; try --imu-stamps record");
+  std::unique_ptr<MotionModel> motion = MakeMotionModel(s.inertial, imu.radar_from_imu, imu.samples);
+  if (motion->name() == "window" && s.matcher != "gaussians") {
+    throw DataError("--imu-fusion window needs --matcher gaussians");
   }
-  const RadarOdometry& odometry = inertial ? inertial->odometry() : *radar_only;
+  PrintScreening(motion->screening());
+  RadarOdometry odometry(options, std::move(motion), MatcherOf(s.matcher));
+  RegisterScans(sequence, "odometry", [&](const RadarScan& scan) { odometry.Register(scan); });
+  const InertialMotion* inertial = InertialMotionOf(odometry);
   std::optional<Evaluation> evaluation;
   if (reference) evaluation = EvaluateTrajectory(odometry.trajectory(), *reference);
-  WriteOdometry(folder.path(), odometry, inertial ? &inertial->fusion() : nullptr);
+  WriteOdometry(folder.path(), odometry);
   const std::string table = evaluation ? WriteEvaluation(folder.path(), *evaluation) : std::string();
   folder.Commit();
   if (!s.mcap.empty()) WriteRunForViewer(s.out, sequence.scans, reference, s.mcap);

@@ -65,15 +65,8 @@ ImuInput ImuOf(const OdometrySettings& s) {
   return input;
 }
 
-std::vector<GyroSample> GyroOf(const ImuInput& imu) {
-  const SO3d R = imu.radar_from_imu.rotation();
-  std::vector<GyroSample> samples;
-  for (const ImuSample& sample : imu.samples) samples.push_back({sample.stamp, R * sample.angular_velocity});
-  return samples;
-}
-
-// Gyro samples that cover none of the scans' time span are a clock mismatch, not data.
-void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence, const std::string& hint) {
+// IMU samples that cover none of the scans' time span are a clock mismatch, not data.
+void CheckOverlap(const std::vector<ImuSample>& gyro, const Sequence& sequence, const std::string& hint) {
   const double first = sequence.scans.front().timestamp, last = sequence.scans.back().timestamp;
   if (gyro.back().stamp < first || gyro.front().stamp > last) {
     throw DataError("the IMU's stamps (" + std::to_string(gyro.front().stamp) + " to " +
@@ -111,16 +104,18 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   AddRunOptions(app, s);
 }
 
+ListedElsewhere OdometryListedElsewhere() {
+  return {"odometry", "verify_",
+          "The front end reads every option of `radargauss odometry` (its --help-all lists them; the sensor group "
+          "is listed here too), and --verify-X sets the loop verification's match and map as --X does the "
+          "odometry's: those listed here are the ones whose defaults differ."};
+}
+
 void AddImuOptions(CLI::App* app, OdometrySettings& s) {
   CLI::Option* imu_topic =
       app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: the IMU (--imu-fusion)");
   app->add_option("--imu", s.imu_file,
                   "IMU file of lines 'stamp wx wy wz ax ay az' (s, rad/s, m/s^2; the IMU's frame)");
-  app->add_option("--imu-fusion", s.imu_fusion,
-                  "window: a sliding window of IMU states with the matches and Doppler velocities (biases, "
-                  "gravity); gyro: the gyro's rates for the prediction only")
-      ->check(CLI::IsMember({"window", "gyro"}))
-      ->capture_default_str();
   app->add_option("--imu-extrinsic", s.imu_extrinsic,
                   "T_radar_imu: a file 'x y z qx qy qz qw' (the IMU's frame in the radar's)");
   // The IMU's settings without its topic would be read by nothing: refused.

@@ -32,8 +32,7 @@ struct OdometrySettings {
   std::size_t first_scan = 0;
   std::size_t max_scans = 0;
   std::string matcher = "gaussians";  // or a PCL peer
-  std::string imu_fusion = "window";  // or "gyro": the rates for the prediction only
-  RadarInertialOptions inertial;      // the window's, with --imu-fusion window
+  RadarInertialOptions inertial;      // the IMU's motion model (--imu-fusion) and the window's
   std::string mcap;                   // --mcap: the run for a viewer (run_mcap.hpp)
 };
 
@@ -48,11 +47,9 @@ struct ImuInput {
   SE3d radar_from_imu;
 };
 ImuInput ImuOf(const OdometrySettings& s);
-// Its gyro rates turned into the radar frame.
-std::vector<GyroSample> GyroOf(const ImuInput& imu);
-// Gyro samples that cover none of the scans' time span are a clock mismatch
+// IMU samples that cover none of the scans' time span are a clock mismatch
 // (`hint`: what to try, appended to the message).
-void CheckOverlap(const std::vector<GyroSample>& gyro, const Sequence& sequence, const std::string& hint);
+void CheckOverlap(const std::vector<ImuSample>& imu, const Sequence& sequence, const std::string& hint);
 // Throws FileError when fewer than 3 scans lie in the reference's time span.
 void CheckReferenceCovers(const Trajectory& reference, const Sequence& sequence, const std::string& path);
 // What odometry, slam and relocalize run on: every scan of the sequence (not
@@ -94,6 +91,9 @@ void RegisterScans(const Sequence& sequence, const char* stage, RegisterScan&& r
 void AddOdometryOptions(CLI::App* app, OdometrySettings& s);
 // The IMU's: its file or bag topic, stamps and rotation into the radar frame.
 void AddImuOptions(CLI::App* app, OdometrySettings& s);
+// What slam and relocalize read but leave to `odometry --help-all`: the
+// front end's tuning, and the loop verification's match rows equal to it.
+ListedElsewhere OdometryListedElsewhere();
 // The run's own: the scans to run on (slam and relocalize take the
 // odometry's options from their own tables).
 void AddRunOptions(CLI::App* app, OdometrySettings& s);

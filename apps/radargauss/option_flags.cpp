@@ -63,7 +63,16 @@ std::string HelpGroup(OptionGroup group) {
   return "Tuning";
 }
 
+const char* const kListedElsewhereGroup = "Listed elsewhere";
+
+void AddFooterLine(CLI::App* app, const std::string& line) {
+  const std::string footer = app->get_footer();
+  if (footer.find(line) != std::string::npos) return;
+  app->footer(footer.empty() ? line : footer + "\n" + line);
+}
+
 std::string GroupedHelp::make_group(std::string group, bool is_positional, std::vector<const CLI::Option*> opts) const {
+  if (group == kListedElsewhereGroup) return {};
   if (!show_every_option && (group == HelpGroup(OptionGroup::kTuning) || group == HelpGroup(OptionGroup::kStudy))) {
     return {};
   }

@@ -47,10 +47,41 @@ CLI::Option* AddBoolFlag(CLI::App* app, const std::string& name, bool& target, c
 // "Std of the velocity term's floor Q (m); at least --x".
 std::string HelpText(const OptionSpec& option);
 
+// Rows a command reads like any other but whose --help-all leaves them to
+// where they are listed in full: the tuning and study rows nested under
+// `path` (another command's table: "odometry" in slam), and the rows named
+// `echo_prefix` + n whose default is row n's ("verify_": the loop
+// verification's match where it is the odometry's). `footer` says where.
+struct ListedElsewhere {
+  std::string path;
+  std::string echo_prefix;
+  std::string footer;
+};
+// The group such rows go to: never listed.
+extern const char* const kListedElsewhereGroup;
+
+// Appends `line` to the help's footer unless it is there already.
+void AddFooterLine(CLI::App* app, const std::string& line);
+
+// Whether `option` of `table` is one that `elsewhere` leaves out of the help.
+template <typename Options>
+bool IsListedElsewhere(const OptionTable<Options>& table, const Options& options, const Option<Options>& option,
+                       const ListedElsewhere& elsewhere) {
+  if (!elsewhere.path.empty() && option.group != OptionGroup::kSensor &&
+      option.path.rfind(elsewhere.path + ".", 0) == 0) {
+    return true;
+  }
+  if (elsewhere.echo_prefix.empty() || option.name.rfind(elsewhere.echo_prefix, 0) != 0) return false;
+  const Option<Options>* echoed = FindOption(table, option.name.substr(elsewhere.echo_prefix.size()));
+  return echoed != nullptr && FormatOptionValue(echoed->get(options)) == FormatOptionValue(option.get(options));
+}
+
 // A flag per option of `table`, setting `options` (which must outlive the
 // parse); a value the table refuses is a ValidationError naming the flag.
 template <typename Options>
-void AddTableOptions(CLI::App* app, const OptionTable<Options>& table, Options& options) {
+void AddTableOptions(CLI::App* app, const OptionTable<Options>& table, Options& options,
+                     const ListedElsewhere& elsewhere = {}) {
+  bool left_out = false;
   for (const Option<Options>& entry : table) {
     const Option<Options>* option = &entry;  // the tables are static
     CLI::Option* flag = nullptr;
@@ -76,11 +107,14 @@ void AddTableOptions(CLI::App* app, const OptionTable<Options>& table, Options& 
       }
     }
     flag->default_str(FormatOptionValue(option->get(options)));
-    flag->group(HelpGroup(option->group));
+    const bool elsewhere_listed = IsListedElsewhere(table, options, *option, elsewhere);
+    flag->group(elsewhere_listed ? kListedElsewhereGroup : HelpGroup(option->group));
+    left_out = left_out || elsewhere_listed;
   }
   // What no single flag decides (an option below another) is checked once all are read.
   CheckAfterParse(app, [&table, &options] { CheckOptions(table, options, true); });
-  if (!ShowingEveryOption()) app->footer("--help-all lists every option (the tuning and study groups too)");
+  if (!ShowingEveryOption()) AddFooterLine(app, "--help-all lists every option (the tuning and study groups too)");
+  if (left_out && ShowingEveryOption()) AddFooterLine(app, elsewhere.footer);
   app->formatter(std::make_shared<GroupedHelp>());
 }
 

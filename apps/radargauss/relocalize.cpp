@@ -128,7 +128,7 @@ Subcommand AddRelocalize(CLI::App& parent) {
   AddSequenceOptions(app, s->odometry.sequence, "--gt",
                      "Reference trajectory (TUM, map frame), for the evaluation only");
   app->add_option("--out", s->odometry.out, "Output folder")->required();
-  AddTableOptions(app, RelocalizationOptionTable(), s->relocalization);
+  AddTableOptions(app, RelocalizationOptionTable(), s->relocalization, OdometryListedElsewhere());
   AddBoolFlag(app, "--w-rcs-from-map", s->w_rcs_from_map,
               "Eq. 2's w_rcs chosen from the map's RCS fits instead of --w-rcs (docs/design.md)")
       ->excludes(app->get_option("--w-rcs"))

@@ -38,13 +38,11 @@ int RunSlam(const SlamSettings& s) {
   const std::optional<Trajectory>& reference = inputs.reference;
   if (s.map_tiles > 0.0 && s.no_map) throw DataError("--map-tiles writes the map: drop --no-map");
   StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "odometry", "map.rgm", "map.ply", "map_tiles"});
-  RadarSlam slam(options, s.study);
   const ImuInput imu = ImuOf(s.odometry);  // before the run: a bad IMU leaves nothing behind
   if (!imu.samples.empty()) {
-    if (s.odometry.imu_fusion != "window") throw DataError("slam takes --imu-fusion window only");
-    CheckOverlap(GyroOf(imu), sequence, s.odometry.imu_topic.empty() ? "" : "; try --imu-stamps record");
-    slam.UseImu(s.odometry.inertial, imu.radar_from_imu, imu.samples);
+    CheckOverlap(imu.samples, sequence, s.odometry.imu_topic.empty() ? "" : "; try --imu-stamps record");
   }
+  RadarSlam slam(options, s.study, MakeMotionModel(s.odometry.inertial, imu.radar_from_imu, imu.samples));
   RegisterScans(sequence, "slam", [&](const RadarScan& scan) { slam.Register(scan); });
   slam.Finish();
   GaussianMap map;
@@ -56,7 +54,7 @@ int RunSlam(const SlamSettings& s) {
                     "trajectory without a map)");
   }
   const std::string out = folder.path();
-  WriteOdometry((std::filesystem::path(out) / "odometry").string(), slam.odometry(), slam.inertial());
+  WriteOdometry((std::filesystem::path(out) / "odometry").string(), slam.odometry());
   WriteSlam(out, slam);
   if (!s.no_map) {
     WriteMap((std::filesystem::path(out) / "map.rgm").string(), map);
@@ -98,7 +96,7 @@ Subcommand AddSlam(CLI::App& parent) {
   AddSequenceOptions(app, s->odometry.sequence, "--gt",
                      "Reference trajectory (TUM, or BAG:/topic[:child] of a ROS 2 bag), for the evaluation only");
   app->add_option("--out", s->odometry.out, "Output folder")->required();
-  AddTableOptions(app, SlamOptionTable(), s->slam);
+  AddTableOptions(app, SlamOptionTable(), s->slam, OdometryListedElsewhere());
   AddTableOptions(app, FalseLoopStudyOptionTable(), s->study);
   AddImuOptions(app, s->odometry);
   AddTableOptions(app, RadarInertialOptionTable(), s->odometry.inertial);

@@ -51,12 +51,12 @@ ScanMatchingResult Match(const RadarScan& scan, const MatchingMap& map, const SE
 RadarOdometry Odometry(const Sequence& sequence, const OdometryOptions& options = {});
 
 // `radargauss odometry --imu`: the same with the IMU's samples (on the scans'
-// clock) and T_radar_imu (docs/design/odometry.md, "Radar-inertial
-// odometry"). Throws DataError when the IMU does not cover the scans.
-std::unique_ptr<RadarInertialOdometry> InertialOdometry(const Sequence& sequence, std::vector<ImuSample> imu,
-                                                        const SE3d& radar_from_imu,
-                                                        const OdometryOptions& odometry = {},
-                                                        const RadarInertialOptions& options = {});
+// clock) and T_radar_imu, its motion model named by options.fusion
+// (docs/design/odometry.md, "Radar-inertial odometry"; InertialMotionOf
+// gives the window). Throws DataError for no samples or when the IMU does
+// not cover the scans.
+RadarOdometry InertialOdometry(const Sequence& sequence, std::vector<ImuSample> imu, const SE3d& radar_from_imu,
+                               const OdometryOptions& odometry = {}, const RadarInertialOptions& options = {});
 
 // `radargauss slam`: every scan of `sequence` through SLAM, finished
 // (docs/design/slam.md, "SLAM"); its trajectory(), keyframes() and loops()

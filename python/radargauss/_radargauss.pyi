@@ -269,7 +269,7 @@ class MatchResult:
     def time_ms(self) -> Any: ...
 
 class RadarInertialOdometry:
-    """Radar-inertial odometry (docs/design/odometry.md, "Radar-inertial odometry"): the radar odometry with a sliding window of IMU states. Threads may share one: its calls take turns."""
+    """Radar-inertial odometry (docs/design/odometry.md, "Radar-inertial odometry"): the radar odometry with the IMU's motion model named by imu_fusion: 'window', a sliding window of IMU states, or 'gyro', the gyro's rates for the prediction only. Threads may share one: its calls take turns."""
     def __init__(self: RadarInertialOdometry, imu: Any, radar_from_imu: Any = None, **kwargs) -> None:
         ...
     def __len__(self: RadarInertialOdometry) -> int:
@@ -279,7 +279,7 @@ class RadarInertialOdometry:
     def imu_dropped(self: RadarInertialOdometry) -> dict:
         """The IMU samples dropped before the window saw them: 'beyond_range' (imu_gyro_range, imu_accel_range) and isolated 'spikes'"""
     def register(self: RadarInertialOdometry, scan: Scan) -> dict:
-        """Adds the next scan; returns RadarOdometry.register's dict with 'inertial': the window's newest state (pose, velocity, gyro_bias, accel_bias) or None before the window started"""
+        """Adds the next scan; returns RadarOdometry.register's dict with 'inertial': the window's newest state (pose, velocity, gyro_bias, accel_bias), or None before the window started and with imu_fusion='gyro'"""
     def trajectory(self: RadarInertialOdometry) -> tuple:
         """(stamps (N,), poses (N, 7)) of the radar so far, in the matcher's world"""
 

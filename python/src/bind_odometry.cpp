@@ -11,6 +11,7 @@
 
 #include "bindings.hpp"
 #include "option_fields.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/io/imu.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
@@ -102,9 +103,9 @@ std::pair<OdometryOptions, RadarInertialOptions> InertialOptionsFrom(const py::k
 
 const char* InertialDoc() {
   static const std::string doc =
-      "Radar-inertial odometry (docs/design/odometry.md, \"Radar-inertial odometry\"): the radar odometry with a "
-      "sliding "
-      "window of IMU states. Threads may share one: its calls take turns.\n\nParameters\n----------\n"
+      "Radar-inertial odometry (docs/design/odometry.md, \"Radar-inertial odometry\"): the radar odometry with "
+      "the IMU's motion model named by imu_fusion: 'window', a sliding window of IMU states, or 'gyro', the gyro's "
+      "rates for the prediction only. Threads may share one: its calls take turns.\n\nParameters\n----------\n"
       "imu : array (N, 7)\n    [stamp wx wy wz ax ay az] per sample, time order, on the scans' clock (s, rad/s, "
       "m/s^2, the IMU's frame)\nradar_from_imu : array (4, 4) or [x y z qx qy qz qw], default identity\n    "
       "T_radar_imu, the IMU's frame in the radar's\n**options\n    any keyword of RadarOdometry and these "
@@ -113,25 +114,30 @@ const char* InertialDoc() {
   return doc.c_str();
 }
 
-}  // namespace
+// Its own Python type: the radar odometry with the IMU's motion model.
+struct LockedInertial : Locked<RadarOdometry> {
+  using Locked<RadarOdometry>::Locked;
+};
 
-void BindOdometry(py::module_& m) {
-  using LockedInertial = Locked<RadarInertialOdometry>;
+void BindInertialOdometry(py::module_& m) {
   py::class_<LockedInertial>(m, "RadarInertialOdometry", InertialDoc())
       .def(py::init([](const py::handle& imu, const py::object& radar_from_imu, const py::kwargs& kwargs) {
              const auto [odometry, inertial] = InertialOptionsFrom(kwargs);
              const SE3d extrinsic =
                  radar_from_imu.is_none() ? SE3d() : PoseFromPython(radar_from_imu, "radar_from_imu");
+             std::vector<ImuSample> samples = ImuFromArray(imu);
+             if (samples.empty()) throw DataError("the IMU has no sample");
              return std::make_unique<LockedInertial>(
-                 std::make_unique<RadarInertialOdometry>(odometry, inertial, extrinsic, ImuFromArray(imu)));
+                 std::make_unique<RadarOdometry>(odometry, MakeMotionModel(inertial, extrinsic, std::move(samples))));
            }),
            py::arg("imu"), py::arg("radar_from_imu") = py::none())
       .def(
           "register",
           [](LockedInertial& odometry, const RadarScan& scan) {
-            const auto [step, state] = odometry.With([&](RadarInertialOdometry& o) {
+            const auto [step, state] = odometry.With([&](RadarOdometry& o) {
               const OdometryStep s = o.Register(scan);
-              return std::make_pair(s, o.states().back());
+              const InertialMotion* window = InertialMotionOf(o);
+              return std::make_pair(s, window ? window->states().back() : std::nullopt);
             });
             py::dict d = StepToDict(step);
             d["inertial"] = StateToDict(state);
@@ -139,19 +145,20 @@ void BindOdometry(py::module_& m) {
           },
           py::arg("scan"),
           "Adds the next scan; returns RadarOdometry.register's dict with 'inertial': the window's newest state "
-          "(pose, velocity, gyro_bias, accel_bias) or None before the window started")
+          "(pose, velocity, gyro_bias, accel_bias), or None before the window started and with imu_fusion='gyro'")
       .def(
           "trajectory",
           [](LockedInertial& odometry) {
-            return TrajectoryToArrays(
-                odometry.With([](RadarInertialOdometry& o) { return o.odometry().trajectory(); }));
+            return TrajectoryToArrays(odometry.With([](RadarOdometry& o) { return o.trajectory(); }));
           },
           "(stamps (N,), poses (N, 7)) of the radar so far, in the matcher's world")
       .def(
           "calibration",
           [](LockedInertial& odometry) {
-            const auto [tilt, offset, radar_from_imu, u] = odometry.With([](RadarInertialOdometry& o) {
-              const InertialWindow& w = o.window();
+            const auto [tilt, offset, radar_from_imu, u] = odometry.With([](RadarOdometry& o) {
+              const InertialMotion* window = InertialMotionOf(o);
+              if (!window) throw std::invalid_argument("calibration: imu_fusion='gyro' has no window");
+              const InertialWindow& w = window->window();
               return std::make_tuple(Eigen::Vector2d(w.tilt()), w.clock_offset(), w.radar_from_imu(),
                                      w.size() > 0 ? w.Uncertainty() : WindowUncertainty{});
             });
@@ -170,7 +177,7 @@ void BindOdometry(py::module_& m) {
       .def(
           "imu_dropped",
           [](LockedInertial& odometry) {
-            const ImuScreening screening = odometry.With([](RadarInertialOdometry& o) { return o.screening(); });
+            const ImuScreening screening = odometry.With([](RadarOdometry& o) { return o.motion().screening(); });
             py::dict d;
             d["beyond_range"] = screening.beyond_range;
             d["spikes"] = screening.spikes;
@@ -178,9 +185,14 @@ void BindOdometry(py::module_& m) {
           },
           "The IMU samples dropped before the window saw them: 'beyond_range' (imu_gyro_range, imu_accel_range) "
           "and isolated 'spikes'")
-      .def("__len__", [](LockedInertial& odometry) {
-        return odometry.With([](RadarInertialOdometry& o) { return o.odometry().steps().size(); });
-      });
+      .def("__len__",
+           [](LockedInertial& odometry) { return odometry.With([](RadarOdometry& o) { return o.steps().size(); }); });
+}
+
+}  // namespace
+
+void BindOdometry(py::module_& m) {
+  BindInertialOdometry(m);
   m.def(
       "read_imu",
       [](const std::string& path) {

@@ -327,6 +327,14 @@ def test_radar_inertial_odometry(cli, tmp_path):
     glitched[500, 4] = 1e5  # one accelerometer sample of 1e5 m/s^2
     assert rg.RadarInertialOdometry(glitched, radar_from_imu=extrinsic).imu_dropped() == {"beyond_range": 1,
                                                                                           "spikes": 0}
+    # The gyro's model by name: the rates turn the prediction, no window.
+    gyro = rg.RadarInertialOdometry(imu, radar_from_imu=extrinsic, imu_fusion="gyro", w_rcs=0.0)
+    steps = [gyro.register(scan) for scan in sequence.scans[:20]]
+    assert len(gyro) == 20 and all(step["inertial"] is None for step in steps)
+    with pytest.raises(ValueError, match="no window"):
+        gyro.calibration()
+    with pytest.raises(ValueError, match="imu_fusion"):
+        rg.RadarInertialOdometry(imu, imu_fusion="kalman")
     with pytest.raises(TypeError, match="unknown keyword 'window_sise'"):
         rg.RadarInertialOdometry(imu, window_sise=5)
     with pytest.raises(ValueError, match="window_size"):

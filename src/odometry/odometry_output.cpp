@@ -76,7 +76,7 @@ std::vector<double> Values(const Eigen::VectorXd& v, double scale = 1.0) {
 }
 
 // The window's last estimate of what does not change along the drive, with its standard deviations.
-nlohmann::json Calibration(const InertialFusion& inertial) {
+nlohmann::json Calibration(const InertialMotion& inertial) {
   const auto& states = inertial.states();
   if (states.empty() || !states.back()) return nullptr;  // the window never started
   const InertialWindow& window = inertial.window();
@@ -109,7 +109,7 @@ nlohmann::json Calibration(const InertialFusion& inertial) {
 }
 
 // The window's solves: iterations per solve (mean, max) and integrations again.
-nlohmann::json WindowSolves(const InertialFusion& inertial) {
+nlohmann::json WindowSolves(const InertialMotion& inertial) {
   const std::vector<WindowSolveSummary>& solves = inertial.solves();
   if (solves.empty()) return nullptr;
   double iterations = 0.0;
@@ -129,7 +129,7 @@ nlohmann::json WindowSolves(const InertialFusion& inertial) {
 }
 
 // inertial.csv: the window's newest state per scan (empty fields before it started).
-void WriteInertialStates(const std::string& path, const RadarOdometry& odometry, const InertialFusion& inertial) {
+void WriteInertialStates(const std::string& path, const RadarOdometry& odometry, const InertialMotion& inertial) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     out << "stamp,vx,vy,vz,bgx,bgy,bgz,bax,bay,baz\n" << std::setprecision(9);
     const std::vector<OdometryStep>& steps = odometry.steps();
@@ -148,7 +148,8 @@ void WriteInertialStates(const std::string& path, const RadarOdometry& odometry,
 
 }  // namespace
 
-void WriteOdometry(const std::string& dir, const RadarOdometry& odometry, const InertialFusion* inertial) {
+void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
+  const InertialMotion* inertial = InertialMotionOf(odometry);
   namespace fs = std::filesystem;
   std::error_code error;
   fs::create_directories(dir, error);

@@ -13,6 +13,11 @@ const OptionTable<RadarInertialOptions>& RadarInertialOptionTable() {
   using O = RadarInertialOptions;
   static const OptionTable<O> table = [] {
     OptionTable<O> t = {
+        RADARGAUSS_OPTION(O, "imu_fusion", fusion)
+            .Choices({"window", "gyro"})
+            .Sensor()
+            .Help("window: a sliding window of IMU states with the matches and Doppler velocities (biases, "
+                  "gravity); gyro: the gyro's rates for the prediction only"),
         RADARGAUSS_OPTION(O, "match_information_scale", match_information_scale)
             .In(0.0, 1.0)
             .Help("the share of a match's information N_geo H the window trusts"),
@@ -28,7 +33,7 @@ const OptionTable<RadarInertialOptions>& RadarInertialOptionTable() {
   return table;
 }
 
-InertialFusion::InertialFusion(const RadarInertialOptions& options, const SE3d& radar_from_imu,
+InertialMotion::InertialMotion(const RadarInertialOptions& options, const SE3d& radar_from_imu,
                                std::vector<ImuSample> imu)
     : options_(options),
       radar_from_imu_(radar_from_imu),
@@ -45,28 +50,28 @@ InertialFusion::InertialFusion(const RadarInertialOptions& options, const SE3d& 
   window_->AddImu(imu_);  // checks the order
 }
 
-void InertialFusion::Attach(RadarOdometry& odometry) {
-  if (started_) throw std::logic_error("InertialFusion::Attach after the window started");
-  const bool estimate = odometry.options().elevation_bias.estimate;
-  if (estimate != options_.window.estimate_elevation_bias) {
-    options_.window.estimate_elevation_bias = estimate;
+void InertialMotion::Bind(bool estimate_elevation_bias) {
+  if (started_) throw std::logic_error("InertialMotion::Bind after the window started");
+  if (estimate_elevation_bias != options_.window.estimate_elevation_bias) {
+    options_.window.estimate_elevation_bias = estimate_elevation_bias;
     window_ = std::make_unique<InertialWindow>(options_.window, radar_from_imu_);
     window_->AddImu(imu_);
   }
-  if (estimate) odometry.HoldElevationBias(elevation_bias_removed_);
-  odometry.SetPoseFusion([this](const ScanEstimate& estimate) { return Fuse(estimate); });
 }
 
-// The rates up to the first sample at or after `stamp` (GyroIncrement needs
-// one), less the window's gyro bias now, turned into the radar frame.
-void InertialFusion::BeforeScan(RadarOdometry& odometry, double stamp) {
+std::optional<double> InertialMotion::ElevationBias() const {
+  if (!options_.window.estimate_elevation_bias) return std::nullopt;
+  return elevation_bias_removed_;
+}
+
+// Hands the rates up to the first sample at or after `stamp` (the rotation
+// needs one) to the prediction, less the window's gyro bias now, turned into
+// the radar frame.
+void InertialMotion::Advance(double stamp) {
   const Eigen::Vector3d bias = started_ ? window_->newest().bias.gyro : Eigen::Vector3d::Zero();
   const SO3d radar_from_imu = window_->radar_from_imu().rotation();
   const double offset = window_->clock_offset();  // the IMU's stamps minus the radar's
-  if (options_.window.estimate_elevation_bias) {
-    elevation_bias_removed_ = window_->elevation_bias();
-    odometry.HoldElevationBias(elevation_bias_removed_);
-  }
+  if (options_.window.estimate_elevation_bias) elevation_bias_removed_ = window_->elevation_bias();
   std::vector<GyroSample> samples;
   for (; fed_ < imu_.size() && (fed_ == 0 || imu_[fed_ - 1].stamp - offset < stamp); ++fed_) {
     const double on_radar_clock = imu_[fed_].stamp - offset;
@@ -74,28 +79,14 @@ void InertialFusion::BeforeScan(RadarOdometry& odometry, double stamp) {
     samples.push_back({on_radar_clock, radar_from_imu * (imu_[fed_].angular_velocity - bias)});
     last_fed_ = on_radar_clock;
   }
-  odometry.AddGyro(samples);
+  rates_.Add(samples);
 }
 
-void InertialFusion::AfterScan() { states_.push_back(started_ ? std::make_optional(window_->newest()) : std::nullopt); }
-
-RadarInertialOdometry::RadarInertialOdometry(const OdometryOptions& odometry, const RadarInertialOptions& options,
-                                             const SE3d& radar_from_imu, std::vector<ImuSample> imu)
-    : fusion_(options, radar_from_imu, std::move(imu)), odometry_(odometry) {
-  fusion_.Attach(odometry_);
-}
-
-const OdometryStep& RadarInertialOdometry::Register(const RadarScan& scan) {
-  fusion_.BeforeScan(odometry_, scan.timestamp);
-  const OdometryStep& step = odometry_.Register(scan);
-  fusion_.AfterScan();
-  return step;
-}
-
-SE3d InertialFusion::Fuse(const ScanEstimate& e) {
+SE3d InertialMotion::Fuse(const ScanEstimate& e) {
   if (!started_) {
     // The window starts at the first scan with a Doppler velocity that the IMU covers.
     if (!e.velocity_measured || imu_.empty() || imu_.front().stamp > e.stamp + options_.window.clock_offset) {
+      states_.push_back(std::nullopt);
       return e.pose;
     }
     const InertialStart start =
@@ -115,7 +106,21 @@ SE3d InertialFusion::Fuse(const ScanEstimate& e) {
     window_->AddVelocity(e.velocity, covariance, elevation_bias_removed_);
   }
   solves_.push_back(window_->Solve());
+  states_.push_back(window_->newest());
   return window_->RadarPoseInMatcherWorld();
+}
+
+std::unique_ptr<MotionModel> MakeMotionModel(const RadarInertialOptions& options, const SE3d& radar_from_imu,
+                                             std::vector<ImuSample> imu) {
+  if (imu.empty()) return std::make_unique<ConstantVelocityModel>();
+  if (options.fusion == "gyro")
+    return std::make_unique<GyroModel>(std::move(imu), radar_from_imu, options.window.noise);
+  if (options.fusion == "window") return std::make_unique<InertialMotion>(options, radar_from_imu, std::move(imu));
+  throw std::invalid_argument("imu_fusion: no motion model '" + options.fusion + "' (window, gyro)");
+}
+
+const InertialMotion* InertialMotionOf(const RadarOdometry& odometry) {
+  return dynamic_cast<const InertialMotion*>(&odometry.motion());
 }
 
 }  // namespace radargauss

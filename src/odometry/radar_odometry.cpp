@@ -85,16 +85,16 @@ MatcherFactory GaussianMatcherFactory() {
   };
 }
 
-RadarOdometry::RadarOdometry(const OdometryOptions& options) : RadarOdometry(options, GaussianMatcherFactory()) {}
-
-RadarOdometry::RadarOdometry(const OdometryOptions& options, MatcherFactory factory)
+RadarOdometry::RadarOdometry(const OdometryOptions& options, std::unique_ptr<MotionModel> motion,
+                             MatcherFactory factory)
     : options_(options),
       vehicle_from_radar_(VehicleFromRadar(options.mounting_deg)),
       elevation_bias_(options.elevation_bias, vehicle_from_radar_),
-      factory_(std::move(factory)),
+      motion_(motion ? std::move(motion) : std::make_unique<ConstantVelocityModel>()),
+      factory_(factory ? std::move(factory) : GaussianMatcherFactory()),
       map_(options.map) {
   ValidateOptions(options_);
-  if (!factory_) throw std::invalid_argument("RadarOdometry needs a matcher factory");
+  motion_->Bind(options_.elevation_bias.estimate);
 }
 
 const ScanMatcher& RadarOdometry::MatcherForMap() {
@@ -117,35 +117,6 @@ void RadarOdometry::LocalizeIn(std::shared_ptr<const MatchingMap> map, const SE3
   last_keyframe_ = map_from_odometry * last_keyframe_;
 }
 
-void RadarOdometry::AddGyro(const std::vector<GyroSample>& samples) {
-  for (const GyroSample& sample : samples) {
-    if (!std::isfinite(sample.stamp) || !sample.rate.allFinite()) {
-      throw DataError("gyro sample at " + std::to_string(sample.stamp) + " s is not finite");
-    }
-    if (!gyro_.empty() && !(sample.stamp > gyro_.back().stamp)) {
-      throw DataError("gyro stamps must increase (" + std::to_string(sample.stamp) + " s after " +
-                      std::to_string(gyro_.back().stamp) + " s)");
-    }
-    gyro_.push_back(sample);
-  }
-}
-
-std::optional<SO3d> RadarOdometry::GyroIncrement(double from, double to) const {
-  // Rates held piecewise constant from each sample to the next, over [from, to].
-  auto it =
-      std::upper_bound(gyro_.begin(), gyro_.end(), from, [](double t, const GyroSample& s) { return t < s.stamp; });
-  if (it == gyro_.begin() || it == gyro_.end() || gyro_.back().stamp < to) return std::nullopt;
-  --it;  // the sample in force at `from`
-  SO3d increment;
-  double t = from;
-  for (; it != gyro_.end() && t < to; ++it) {
-    const double until = std::next(it) == gyro_.end() ? to : std::min(to, std::next(it)->stamp);
-    increment = increment * SO3d::Exp(it->rate * (until - t));
-    t = until;
-  }
-  return increment;
-}
-
 SO3d VehicleFromRadar(const Eigen::Vector3d& roll_pitch_yaw_deg) {
   const Eigen::Vector3d angles = roll_pitch_yaw_deg * (M_PI / 180.0);
   return SO3d::Exp(Eigen::Vector3d(0.0, 0.0, angles.z())) * SO3d::Exp(Eigen::Vector3d(0.0, angles.y(), 0.0)) *
@@ -157,7 +128,7 @@ RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
   Prediction p;
   p.dt = stamp - last.stamp;
   SO3d increment;
-  if (const std::optional<SO3d> gyro = GyroIncrement(last.stamp, stamp)) {
+  if (const std::optional<SO3d> gyro = motion_->Rotation(last.stamp, stamp)) {
     increment = *gyro;
     p.gyro = true;
   } else if (last.before) {  // the last increment's yaw rate about the vehicle's vertical; roll and pitch held
@@ -230,6 +201,8 @@ RadarOdometry::Velocity RadarOdometry::MeasureVelocity(const RadarScan& scan,
 const OdometryStep& RadarOdometry::Register(const RadarScan& input) {
   const auto start = std::chrono::steady_clock::now();
   CheckStamp(input);
+  motion_->Advance(input.timestamp);
+  if (const std::optional<double> bias = motion_->ElevationBias()) elevation_bias_.Hold(*bias);
   const bool correct = elevation_bias_.active();
   const RadarScan corrected = correct ? elevation_bias_.Corrected(input) : RadarScan();
   const RadarScan& scan = correct ? corrected : input;
@@ -238,7 +211,7 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& input) {
   const Velocity velocity = MeasureVelocity(scan, prediction);
   if (velocity.measured && !velocity.standstill) elevation_bias_.Observe(velocity.value);
   PoseEstimate estimate = EstimatePose(scan, prediction, velocity);
-  if (fusion_) estimate.pose = fusion_(EstimateOf(scan, velocity, estimate));
+  estimate.pose = motion_->Fuse(EstimateOf(scan, velocity, estimate));
   const bool keyframe = !fixed_map_ && IsKeyframe(estimate.pose, velocity);
   if (keyframe) InsertKeyframe(scan, velocity.static_points, estimate.pose);
   last_static_points_ = velocity.static_points;

@@ -93,9 +93,9 @@ void ValidateOptions(const SlamOptions& o) {
   ValidateOptions(o.verification);
 }
 
-RadarSlam::RadarSlam(const SlamOptions& options, const FalseLoopStudy& study)
+RadarSlam::RadarSlam(const SlamOptions& options, const FalseLoopStudy& study, std::unique_ptr<MotionModel> motion)
     : options_(options),
-      odometry_(options.odometry),
+      odometry_(options.odometry, std::move(motion)),
       graph_(options),
       search_(options),
       false_loops_(study, options.verification) {
@@ -109,17 +109,10 @@ RadarSlam::RadarSlam(const SlamOptions& options, const FalseLoopStudy& study)
 
 RadarSlam::~RadarSlam() = default;
 
-void RadarSlam::UseImu(const RadarInertialOptions& options, const SE3d& radar_from_imu, std::vector<ImuSample> imu) {
-  inertial_ = std::make_unique<InertialFusion>(options, radar_from_imu, std::move(imu));
-  inertial_->Attach(odometry_);
-}
-
 const OdometryStep& RadarSlam::Register(const RadarScan& scan) {
   const auto start = std::chrono::steady_clock::now();
   const std::size_t index = odometry_.steps().size();
-  if (inertial_) inertial_->BeforeScan(odometry_, scan.timestamp);
   const OdometryStep& step = odometry_.Register(scan);
-  if (inertial_) inertial_->AfterScan();
   ScanTime time;
   time.front_end_ms = MillisecondsSince(start);
   const auto back_end = std::chrono::steady_clock::now();

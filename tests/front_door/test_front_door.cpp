@@ -57,12 +57,14 @@ TEST(FrontDoor, InertialOdometryAndSlamAreTheirClassesRunOverTheSequence) {
   config.imu_rate_hz = 200.0;
   const SimulatedSequence simulated = Simulate(config);
   const Sequence sequence = AsSequence(simulated);
-  const auto inertial = InertialOdometry(sequence, simulated.imu, simulated.radar_from_imu);
-  RadarInertialOdometry by_hand(OdometryOptions{}, RadarInertialOptions{}, simulated.radar_from_imu, simulated.imu);
+  const RadarOdometry inertial = InertialOdometry(sequence, simulated.imu, simulated.radar_from_imu);
+  ASSERT_NE(InertialMotionOf(inertial), nullptr);
+  RadarOdometry by_hand(OdometryOptions{}, std::make_unique<InertialMotion>(RadarInertialOptions{},
+                                                                            simulated.radar_from_imu, simulated.imu));
   for (const RadarScan& scan : sequence.scans) by_hand.Register(scan);
-  ASSERT_EQ(inertial->odometry().steps().size(), sequence.scans.size());
+  ASSERT_EQ(inertial.steps().size(), sequence.scans.size());
   for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
-    EXPECT_EQ(inertial->odometry().steps()[k].pose.translation(), by_hand.odometry().steps()[k].pose.translation());
+    EXPECT_EQ(inertial.steps()[k].pose.translation(), by_hand.steps()[k].pose.translation());
   }
   EXPECT_THROW(InertialOdometry(sequence, {}, simulated.radar_from_imu), DataError);
 

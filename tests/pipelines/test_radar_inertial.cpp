@@ -25,6 +25,13 @@ const SimulatedSequence& Drive() {
   return *sequence;
 }
 
+// The radar odometry with the inertial window as its motion model.
+RadarOdometry WindowOdometry(const OdometryOptions& odometry, const RadarInertialOptions& options,
+                             const SE3d& radar_from_imu, std::vector<ImuSample> imu) {
+  return RadarOdometry(odometry, std::make_unique<InertialMotion>(options, radar_from_imu, std::move(imu)));
+}
+const InertialMotion& Window(const RadarOdometry& odometry) { return *InertialMotionOf(odometry); }
+
 double RelativeError(const Trajectory& estimate) {
   return EvaluateTrajectory(estimate, Drive().ground_truth).rpe_mean.translation;
 }
@@ -33,51 +40,106 @@ TEST(RadarInertialOdometry, DriftsLessThanTheRadarAlone) {
   const SimulatedSequence& s = Drive();
   const Sequence sequence = AsSequence(s);
   RadarOdometry radar(OdometryOptions{});
-  RadarInertialOdometry inertial(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, s.imu);
+  RadarOdometry inertial = WindowOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, s.imu);
   for (const RadarScan& scan : sequence.scans) {
     radar.Register(scan);
     inertial.Register(scan);
   }
   const double radar_rpe = RelativeError(radar.trajectory());
-  const double inertial_rpe = RelativeError(inertial.odometry().trajectory());
+  const double inertial_rpe = RelativeError(inertial.trajectory());
   EXPECT_LT(inertial_rpe, 0.6 * radar_rpe) << inertial_rpe << " % against " << radar_rpe << " %";
-  ASSERT_TRUE(inertial.states().back().has_value());
+  ASSERT_TRUE(Window(inertial).states().back().has_value());
   const Eigen::Vector3d true_gyro = s.imu_bias.back().gyro;
-  EXPECT_LT((inertial.states().back()->bias.gyro - true_gyro).norm(), 0.3 * true_gyro.norm());
+  EXPECT_LT((Window(inertial).states().back()->bias.gyro - true_gyro).norm(), 0.3 * true_gyro.norm());
 
   // The same input, the same trajectory.
-  RadarInertialOdometry again(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, s.imu);
+  RadarOdometry again = WindowOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, s.imu);
   for (const RadarScan& scan : sequence.scans) again.Register(scan);
-  const auto& a = inertial.odometry().steps();
-  const auto& b = again.odometry().steps();
+  const auto& a = inertial.steps();
+  const auto& b = again.steps();
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t k = 0; k < a.size(); ++k) {
     ASSERT_EQ(a[k].pose.translation(), b[k].pose.translation()) << "scan " << k;
   }
 }
 
-// SLAM's front end with UseImu is the same radar-inertial odometry, scan for scan.
-TEST(RadarInertialOdometry, SlamsFrontEndIsTheSame) {
+// SLAM's front end given a motion model is the odometry with that model,
+// scan for scan: the window and the gyro alike.
+TEST(RadarInertialOdometry, SlamsFrontEndIsTheOdometryWithTheSameModel) {
   const SimulatedSequence& s = Drive();
   const Sequence sequence = AsSequence(s);
-  RadarInertialOdometry inertial(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, s.imu);
-  RadarSlam slam;
-  slam.UseImu(RadarInertialOptions{}, s.radar_from_imu, s.imu);
-  for (std::size_t k = 0; k < 60; ++k) {
-    inertial.Register(sequence.scans[k]);
-    slam.Register(sequence.scans[k]);
-    ASSERT_EQ(inertial.odometry().steps()[k].pose.translation(), slam.odometry().steps()[k].pose.translation())
-        << "scan " << k;
+  for (const std::string fusion : {"window", "gyro"}) {
+    RadarInertialOptions options;
+    options.fusion = fusion;
+    RadarOdometry odometry(OdometryOptions{}, MakeMotionModel(options, s.radar_from_imu, s.imu));
+    RadarSlam slam(SlamOptions{}, FalseLoopStudy{}, MakeMotionModel(options, s.radar_from_imu, s.imu));
+    EXPECT_EQ(slam.odometry().motion().name(), fusion);
+    for (std::size_t k = 0; k < 60; ++k) {
+      odometry.Register(sequence.scans[k]);
+      slam.Register(sequence.scans[k]);
+      ASSERT_EQ(odometry.steps()[k].pose.translation(), slam.odometry().steps()[k].pose.translation())
+          << fusion << ", scan " << k;
+    }
+    ASSERT_EQ(slam.inertial() != nullptr, fusion == "window");
+    if (slam.inertial()) {
+      EXPECT_EQ(slam.inertial()->states().back()->bias.gyro, Window(odometry).states().back()->bias.gyro);
+    }
   }
-  ASSERT_NE(slam.inertial(), nullptr);
-  EXPECT_EQ(slam.inertial()->states().back()->bias.gyro, inertial.states().back()->bias.gyro);
+}
+
+// Rates held from each sample to the next: a hand-integrated yaw, nothing
+// outside the samples' span, and stamps that do not increase refused.
+TEST(GyroRates, IntegrateHeldRatesOverTheirSpanOnly) {
+  GyroRates rates;
+  rates.Add({{0.0, Eigen::Vector3d(0, 0, 1)}, {1.0, Eigen::Vector3d(0, 0, 2)}, {2.0, Eigen::Vector3d::Zero()}});
+  const std::optional<SO3d> turn = rates.Rotation(0.5, 1.5);
+  ASSERT_TRUE(turn.has_value());
+  EXPECT_NEAR((turn->Log() - Eigen::Vector3d(0, 0, 0.5 * 1 + 0.5 * 2)).norm(), 0.0, 1e-12);
+  EXPECT_FALSE(rates.Rotation(-1.0, 0.5).has_value());
+  EXPECT_FALSE(rates.Rotation(0.5, 2.5).has_value());
+  EXPECT_THROW(rates.Add({{2.0, Eigen::Vector3d::Zero()}}), DataError);
+  EXPECT_THROW(rates.Add({{3.0, Eigen::Vector3d(NAN, 0, 0)}}), DataError);
+}
+
+// The models by name: the window, the gyro, and without an IMU the
+// constant velocity; a name that is none of them is refused.
+TEST(RadarInertialOdometry, MotionModelsAreMadeByName) {
+  const SimulatedSequence& s = Drive();
+  RadarInertialOptions options;
+  EXPECT_EQ(MakeMotionModel(options, s.radar_from_imu, s.imu)->name(), "window");
+  EXPECT_EQ(MakeMotionModel(options, s.radar_from_imu, {})->name(), "constant_velocity");
+  options.fusion = "gyro";
+  EXPECT_EQ(MakeMotionModel(options, s.radar_from_imu, s.imu)->name(), "gyro");
+  EXPECT_EQ(RadarOdometry().motion().name(), "constant_velocity");
+  options.fusion = "kalman";
+  EXPECT_THROW(MakeMotionModel(options, s.radar_from_imu, s.imu), std::invalid_argument);
+  EXPECT_THROW(InertialMotion(options, s.radar_from_imu, s.imu), std::invalid_argument);
+}
+
+// The gyro's rates turn the prediction: the trajectory differs from the
+// constant-velocity one, its drift no more than half as large again.
+TEST(RadarInertialOdometry, TheGyroModelTurnsThePrediction) {
+  const SimulatedSequence& s = Drive();
+  const Sequence sequence = AsSequence(s);
+  RadarInertialOptions options;
+  options.fusion = "gyro";
+  RadarOdometry gyro(OdometryOptions{}, MakeMotionModel(options, s.radar_from_imu, s.imu));
+  RadarOdometry constant(OdometryOptions{});
+  for (const RadarScan& scan : sequence.scans) {
+    gyro.Register(scan);
+    constant.Register(scan);
+  }
+  EXPECT_NE(gyro.steps().back().pose.translation(), constant.steps().back().pose.translation());
+  const double gyro_rpe = RelativeError(gyro.trajectory());
+  const double constant_rpe = RelativeError(constant.trajectory());
+  EXPECT_LT(gyro_rpe, 1.5 * constant_rpe) << gyro_rpe << " % against " << constant_rpe << " %";
 }
 
 TEST(RadarInertialOdometry, AnImuThatEndsEarlyIsRefused) {
   const SimulatedSequence& s = Drive();
   const Sequence sequence = AsSequence(s);
   const std::vector<ImuSample> first_second(s.imu.begin(), s.imu.begin() + 200);
-  RadarInertialOdometry inertial(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, first_second);
+  RadarOdometry inertial = WindowOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, first_second);
   try {
     for (const RadarScan& scan : sequence.scans) inertial.Register(scan);
     FAIL() << "no error";
@@ -95,22 +157,22 @@ TEST(RadarInertialOdometry, GlitchedSamplesAreDroppedNotBelieved) {
   std::vector<ImuSample> glitched = s.imu;
   glitched[781].specific_force.y() = 1e5;
   glitched[1500].angular_velocity.x() = 1e3;
-  RadarInertialOdometry clean(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, s.imu);
-  RadarInertialOdometry inertial(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, glitched);
-  EXPECT_EQ(inertial.screening().beyond_range, 2u);
-  EXPECT_EQ(inertial.screening().spikes, 0u);
-  EXPECT_EQ(clean.screening().beyond_range + clean.screening().spikes, 0u);
+  RadarOdometry clean = WindowOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, s.imu);
+  RadarOdometry inertial = WindowOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, glitched);
+  EXPECT_EQ(Window(inertial).screening().beyond_range, 2u);
+  EXPECT_EQ(Window(inertial).screening().spikes, 0u);
+  EXPECT_EQ(Window(clean).screening().beyond_range + Window(clean).screening().spikes, 0u);
   for (std::size_t k = 0; k < 100; ++k) {
     clean.Register(sequence.scans[k]);
     inertial.Register(sequence.scans[k]);
   }
-  const double clean_ate = EvaluateTrajectory(clean.odometry().trajectory(), s.ground_truth).ate_translation.rmse;
-  const double ate = EvaluateTrajectory(inertial.odometry().trajectory(), s.ground_truth).ate_translation.rmse;
+  const double clean_ate = EvaluateTrajectory(clean.trajectory(), s.ground_truth).ate_translation.rmse;
+  const double ate = EvaluateTrajectory(inertial.trajectory(), s.ground_truth).ate_translation.rmse;
   EXPECT_LT(ate, 1.2 * clean_ate + 0.01) << ate << " m against " << clean_ate << " m";
   // A value past any IMU (1e300) is refused, naming the sample.
   glitched[10].angular_velocity.z() = 1e300;
-  EXPECT_THROW(RadarInertialOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, glitched), DataError);
-  EXPECT_THROW(RadarInertialOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, {}), DataError);
+  EXPECT_THROW(WindowOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, glitched), DataError);
+  EXPECT_THROW(WindowOdometry(OdometryOptions{}, RadarInertialOptions{}, s.radar_from_imu, {}), DataError);
 }
 
 // An estimated clock offset stays where the IMU's data and its range allow:
@@ -136,10 +198,10 @@ TEST(RadarInertialOdometry, AClockOffsetEstimateIsHeldWithinItsBounds) {
   dogleg.window.estimate_extrinsic_translation = true;
   dogleg.window.solver = WindowSolver::kCeresDogleg;
   for (const auto& [options, imu] : {std::make_pair(walking, late), std::make_pair(dogleg, s.imu)}) {
-    RadarInertialOdometry inertial(OdometryOptions{}, options, s.radar_from_imu, imu);
+    RadarOdometry inertial = WindowOdometry(OdometryOptions{}, options, s.radar_from_imu, imu);
     for (const RadarScan& scan : sequence.scans) ASSERT_NO_THROW(inertial.Register(scan));
-    EXPECT_LE(std::abs(inertial.window().clock_offset()), kMaxClockOffset);
-    EXPECT_GE(inertial.window().clock_offset(), imu.front().stamp - sequence.scans.back().timestamp);
+    EXPECT_LE(std::abs(Window(inertial).window().clock_offset()), kMaxClockOffset);
+    EXPECT_GE(Window(inertial).window().clock_offset(), imu.front().stamp - sequence.scans.back().timestamp);
   }
 }
 
@@ -167,7 +229,7 @@ TEST(RadarInertialOdometry, CalibratesTheMountingClockOffsetAndElevationBias) {
   options.window.estimate_extrinsic_rotation = true;
   options.window.estimate_clock_offset = true;
   options.window.vehicle_motion_std = 0.1;
-  RadarInertialOdometry inertial(odometry, options, SE3d(), s.imu);
+  RadarOdometry inertial = WindowOdometry(odometry, options, SE3d(), s.imu);
   OdometryOptions mounted = odometry;
   mounted.mounting_deg = Eigen::Vector3d(config.mounting_roll_deg, config.mounting_pitch_deg, config.mounting_yaw_deg);
   RadarOdometry radar(mounted);
@@ -176,16 +238,16 @@ TEST(RadarInertialOdometry, CalibratesTheMountingClockOffsetAndElevationBias) {
     radar.Register(scan);
   }
   constexpr double kDeg = 180.0 / M_PI;
-  EXPECT_NEAR(inertial.window().elevation_bias() * kDeg, 0.5, 0.15);
-  EXPECT_NEAR(inertial.window().clock_offset(), 0.020, 0.005);
+  EXPECT_NEAR(Window(inertial).window().elevation_bias() * kDeg, 0.5, 0.15);
+  EXPECT_NEAR(Window(inertial).window().clock_offset(), 0.020, 0.005);
   // On the right of R_radar_imu: x is the radar's roll axis, y its pitch, z its yaw.
   const Eigen::Vector3d error =
-      (s.radar_from_imu.rotation().Inverse() * inertial.window().radar_from_imu().rotation()).Log() * kDeg;
+      (s.radar_from_imu.rotation().Inverse() * Window(inertial).window().radar_from_imu().rotation()).Log() * kDeg;
   EXPECT_LT(std::abs(error.y()), 0.15) << error.transpose();
   EXPECT_LT(std::abs(error.z()), 0.15) << error.transpose();
   EXPECT_LT(std::abs(error.x()), 1.5) << error.transpose();
   const double radar_rpe = EvaluateTrajectory(radar.trajectory(), s.ground_truth).rpe_mean.translation;
-  const double inertial_rpe = EvaluateTrajectory(inertial.odometry().trajectory(), s.ground_truth).rpe_mean.translation;
+  const double inertial_rpe = EvaluateTrajectory(inertial.trajectory(), s.ground_truth).rpe_mean.translation;
   EXPECT_LT(inertial_rpe, 0.6 * radar_rpe) << inertial_rpe << " % against " << radar_rpe << " %";
 }
 

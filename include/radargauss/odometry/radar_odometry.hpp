@@ -26,6 +26,7 @@
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/odometry/elevation_bias.hpp"
 #include "radargauss/odometry/local_map.hpp"
+#include "radargauss/odometry/motion_model.hpp"
 #include "radargauss/solvers/factory.hpp"
 #include "radargauss/core/trajectory.hpp"
 #include "radargauss/core/types.hpp"
@@ -110,29 +111,6 @@ struct OdometryStep {
   Eigen::Matrix<double, 6, 6> rotation_information = Eigen::Matrix<double, 6, 6>::Zero();  // the rotation term's
 };
 
-// Gyro rates in the radar frame (rad/s), stamped; integrated between scans
-// instead of the last yaw rate when given.
-struct GyroSample {
-  double stamp = 0.0;
-  Eigen::Vector3d rate = Eigen::Vector3d::Zero();
-};
-
-// What a scan's estimate is before its pose is kept: what a fusion with
-// other sensors (odometry/radar_inertial.hpp) needs.
-struct ScanEstimate {
-  double stamp = 0.0;
-  SE3d pose;             // T_world_radar: matched, or predicted
-  bool matched = false;  // `information` and `matched_points` hold
-  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();  // eq. 2's, normalised
-  std::size_t matched_points = 0;                                                 // N_geo
-  bool velocity_measured = false;
-  bool standstill = false;
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s, radar frame
-  Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();
-};
-// Returns the pose to keep (for the map, the motion model and the record).
-using PoseFusion = std::function<SE3d(const ScanEstimate& estimate)>;
-
 // The scan matcher of a version of the active map: by default
 // MakeScanMatcher(options.match). RadarOdometry calls it once per
 // LocalMap::version() (the map changes on keyframes) and hands each scan its
@@ -145,19 +123,14 @@ MatcherFactory GaussianMatcherFactory();
 
 class RadarOdometry {
  public:
-  explicit RadarOdometry(const OdometryOptions& options = {});
-  RadarOdometry(const OdometryOptions& options, MatcherFactory matcher);
+  // `motion`: the motion model (odometry/motion_model.hpp; null: constant
+  // velocity); `matcher`: the matcher factory (null: GaussianMatcherFactory).
+  explicit RadarOdometry(const OdometryOptions& options = {}, std::unique_ptr<MotionModel> motion = nullptr,
+                         MatcherFactory matcher = nullptr);
 
   // Registers the next scan. Throws DataError when its stamp is not after the
   // previous one's or is not finite; every other fault becomes a reason.
   const OdometryStep& Register(const RadarScan& scan);
-  // Adds gyro samples (radar frame, time order) used from the next scan on.
-  void AddGyro(const std::vector<GyroSample>& samples);
-  // From the next scan on, each scan's pose is `fusion`'s answer to its estimate.
-  void SetPoseFusion(PoseFusion fusion) { fusion_ = std::move(fusion); }
-  // From the next scan on, removes an elevation bias estimated elsewhere (rad;
-  // the radar-inertial window) instead of following the Doppler velocity's.
-  void HoldElevationBias(double bias) { elevation_bias_.Hold(bias); }
   // From the next scan on, matches against `map`, fixed (nothing is
   // inserted), with the motion model carried into the map's frame by
   // `map_from_odometry`: localisation in a given map (relocalisation's tracking).
@@ -170,6 +143,7 @@ class RadarOdometry {
   // every point of a scan without Doppler; none when the prediction stood in).
   const std::vector<std::size_t>& last_static_points() const { return last_static_points_; }
   const OdometryOptions& options() const { return options_; }
+  const MotionModel& motion() const { return *motion_; }
   // The elevation bias removed from the points now (deg): the estimate.
   double elevation_bias_deg() const { return elevation_bias_.bias_deg(); }
   // How many matchers the factory has made: one per map version matched against.
@@ -193,7 +167,7 @@ class RadarOdometry {
     Eigen::Vector3d velocity;  // the last velocity, kept in the radar frame
     Eigen::Matrix3d velocity_covariance;
     double dt = 0.0;
-    bool gyro = false;  // the increment comes from gyro rates
+    bool gyro = false;  // the increment comes from the motion model
   };
   // The scan's ego velocity: measured (gated by the prediction), or the prediction's.
   struct Velocity {
@@ -217,8 +191,6 @@ class RadarOdometry {
   SE3d PredictedPose(const Prediction& prediction, const Eigen::Vector3d& velocity) const;
   // The translation since the last scan in its frame for a velocity of the new frame.
   static Eigen::Vector3d Displacement(const Prediction& prediction, const Eigen::Vector3d& velocity);
-  // The rotation between two stamps from the gyro samples, if they cover it.
-  std::optional<SO3d> GyroIncrement(double from, double to) const;
   Velocity MeasureVelocity(const RadarScan& scan, const std::optional<Prediction>& prediction) const;
   PoseEstimate EstimatePose(const RadarScan& scan, const std::optional<Prediction>& prediction,
                             const Velocity& velocity);
@@ -237,6 +209,7 @@ class RadarOdometry {
   OdometryOptions options_;
   SO3d vehicle_from_radar_;  // of options_.mounting_deg
   ElevationBias elevation_bias_;
+  std::unique_ptr<MotionModel> motion_;
   MatcherFactory factory_;
   std::shared_ptr<const ScanMatcher> matcher_;  // for map_ at matcher_version_
   std::size_t matcher_version_ = 0;
@@ -244,11 +217,9 @@ class RadarOdometry {
   LocalMap map_;
   std::vector<OdometryStep> steps_;  // the record of the run (the motion model reads state_)
   std::optional<MotionState> state_;
-  std::vector<GyroSample> gyro_;
   SE3d last_keyframe_;
   std::vector<std::size_t> last_static_points_;
   std::shared_ptr<const MatchingMap> fixed_map_;  // LocalizeIn's; null: the run's own map
-  PoseFusion fusion_;                             // null: the estimate's pose is kept
   std::size_t map_bytes_ = 0;                     // LocalMap::MemoryBytes after the last keyframe
 };
 
@@ -260,14 +231,12 @@ struct OdometrySummary {
 };
 OdometrySummary Summarise(const RadarOdometry& odometry);
 
-class InertialFusion;  // odometry/radar_inertial.hpp
-
 // Writes odometry.tum (T_world_radar), levelled.tum (when the mounting is
 // observable, odometry/mounting.hpp), per_scan.csv, summary.json, map.rgm
-// and map.ply into `dir` (created), each file whole or not at all. With the
-// odometry's `inertial` fusion also inertial.csv (the window's newest state
-// per scan) and summary.json's `calibration` (the tilt, the biases, the
+// and map.ply into `dir` (created), each file whole or not at all. With an
+// inertial window as the motion model also inertial.csv (the window's newest
+// state per scan) and summary.json's `calibration` (the tilt, the biases, the
 // extrinsic when estimated, each with its standard deviation).
-void WriteOdometry(const std::string& dir, const RadarOdometry& odometry, const InertialFusion* inertial = nullptr);
+void WriteOdometry(const std::string& dir, const RadarOdometry& odometry);
 
 }  // namespace radargauss

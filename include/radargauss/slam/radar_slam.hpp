@@ -32,8 +32,8 @@
 
 namespace radargauss {
 
-// One scan's time in Register (ms): the front end (the odometry, the IMU's
-// fusion) and the back end (closing a keyframe: its description, the place
+// One scan's time in Register (ms): the front end (the odometry with its
+// motion model) and the back end (closing a keyframe: its description, the place
 // search, verification and graph solves; only handing it over when the back
 // end is asynchronous); Finish's goes to the last scan.
 struct ScanTime {
@@ -46,14 +46,14 @@ class SerialWorker;
 
 class RadarSlam {
  public:
-  explicit RadarSlam(const SlamOptions& options = {}, const FalseLoopStudy& study = {});
+  // `motion`: the front end's motion model (odometry/motion_model.hpp; null:
+  // constant velocity), as RadarOdometry's.
+  explicit RadarSlam(const SlamOptions& options = {}, const FalseLoopStudy& study = {},
+                     std::unique_ptr<MotionModel> motion = nullptr);
   ~RadarSlam();
   RadarSlam(const RadarSlam&) = delete;  // the back end's thread holds `this`
   RadarSlam& operator=(const RadarSlam&) = delete;
 
-  // From the next scan on, the odometry is radar-inertial (odometry/radar_inertial.hpp):
-  // the IMU's samples on the scans' clock, T_radar_imu, the window's options.
-  void UseImu(const RadarInertialOptions& options, const SE3d& radar_from_imu, std::vector<ImuSample> imu);
   // As RadarOdometry::Register; a keyframe that closes is described and searched.
   const OdometryStep& Register(const RadarScan& scan);
   // Closes the last keyframe (described and searched) and waits for the back end.
@@ -63,7 +63,8 @@ class RadarSlam {
   bool asynchronous() const { return worker_ != nullptr; }
 
   const RadarOdometry& odometry() const { return odometry_; }
-  const InertialFusion* inertial() const { return inertial_.get(); }  // null without UseImu
+  // The front end's inertial window; null when its motion model is another.
+  const InertialMotion* inertial() const { return InertialMotionOf(odometry_); }
   // The back end's state: each waits until the keyframes handed over so far
   // are done; what they return holds until the next Register or Finish.
   const std::vector<Keyframe>& keyframes() const;
@@ -91,7 +92,6 @@ class RadarSlam {
   SlamOptions options_;
   // The front end.
   RadarOdometry odometry_;
-  std::unique_ptr<InertialFusion> inertial_;
   std::vector<std::size_t> scan_keyframe_;  // per scan
   std::vector<ScanTime> scan_times_;        // per scan
   Keyframe open_keyframe_;                  // the open keyframe (no points)
