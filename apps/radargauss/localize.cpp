@@ -107,7 +107,7 @@ std::vector<ConfigurationRun> RunConfigurations(const Sequence& sequence, const 
   const std::size_t total = maps.size() * s.solvers.size() * s.losses.size() * (s.w_rcs.size() + s.w_rcs_from_map);
   std::size_t done = 0;
   for (std::size_t m = 0; m < maps.size(); ++m) {
-    const MatchingMap matching(maps[m], s.MatchingOptions());
+    const MatchingMap matching(maps[m], s.matching_map);
     const std::vector<std::pair<double, bool>> weights = s.Weights(maps[m]);
     for (const std::string& solver : s.solvers) {
       if (solver.rfind("pcl-", 0) == 0) {

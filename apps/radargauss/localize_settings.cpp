@@ -35,41 +35,19 @@ std::string FormatWeight(double w) {
 
 namespace {
 
+// MatchOptionTable less the rows the sweep reads.
+const OptionTable<radargauss::MatchOptions>& UnsweptMatchRows() {
+  static const OptionTable<radargauss::MatchOptions> rows =
+      TableWithout(MatchOptionTable(), {"solver", "w_rcs", "loss"});
+  return rows;
+}
+
 void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
-  app->add_option("--w-rcs", s.w_rcs, "Weights w_rcs of eq. 2 to sweep (0..1)")
-      ->delimiter(',')
-      ->check(InRange(0.0, 1.0))
-      ->capture_default_str();
-  app->add_option("--solver", s.solvers,
-                  "Solvers: " + Joined(ScanMatcherNames()) +
-                      " (and pcl-ndt, pcl-gicp when built "
-                      "with RADARGAUSS_WITH_PCL)")
-      ->delimiter(',')
-      ->check(CLI::IsMember(SolverNames()).description("{" + Joined(ScanMatcherNames(), ",") + "[,pcl-ndt,pcl-gicp]}"))
-      ->capture_default_str();
-  app->add_option("--loss", s.losses, "Geometric losses: " + Joined(LossNames()))
-      ->delimiter(',')
-      ->check(CLI::IsMember(LossNames()))
-      ->capture_default_str();
-  app->add_option("--loss-scale", s.loss_scale, "Scale of the geometric loss")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--rcs-loss", s.rcs_loss, "RCS loss (the paper: cauchy)")
-      ->check(CLI::IsMember(LossNames()))
-      ->capture_default_str();
-  app->add_option("--rcs-loss-scale", s.rcs_loss_scale, "Scale of the RCS loss")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--rcs-likelihood", s.rcs_likelihood,
-                  "RCS residual: decibel (the paper), swerling1 or swerling3 (fluctuating RCS)")
-      ->check(CLI::IsMember(RcsLikelihoodNames()))
-      ->capture_default_str();
-  AddBoolFlag(app, "--rcs-confidence", s.rcs_confidence,
-              "Weigh each RCS term by its Gaussian's fit (spread and members)");
-  app->add_option("--rcs-expected-spread", s.rcs_expected_spread,
-                  "The spread (dB) the confidence expects (0: the likelihood's own)")
-      ->check(NonNegative())
-      ->capture_default_str();
+  const std::vector<std::string> peers = {"pcl-ndt", "pcl-gicp"};
+  AddSweepOption(app, MatchOptionTable(), "solver", s.solvers,
+                 SolverNames().size() > ScanMatcherNames().size() ? peers : std::vector<std::string>());
+  AddSweepOption(app, MatchOptionTable(), "w_rcs", s.w_rcs);
+  AddSweepOption(app, MatchOptionTable(), "loss", s.losses);
   AddBoolFlag(app, "--w-rcs-from-map", s.w_rcs_from_map,
               "Also match with each map's data-chosen w_rcs (configuration gn-wmap...)");
   app->add_option("--incidences", s.incidences, "Incidence models to sweep (map built here)")
@@ -78,6 +56,13 @@ void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
   app->add_option("--degrees", s.degrees, "SH degrees to sweep (map built here)")
       ->delimiter(',')
       ->check(InRange(0, kMaxShDegree));
+  AddTableOptions(app, UnsweptMatchRows(), s.match);
+  AddTableOptions(app, MatchingMapOptionTable(), s.matching_map);
+  AddDeprecatedAlias(app, UnsweptMatchRows(), s.match, "--coarse-voxel", "coarse_voxel_per_sigma");
+  AddDeprecatedAlias(app, UnsweptMatchRows(), s.match, "--loss-curvature", "gn_loss_curvature");
+  AddBoolFlag(
+      app, "--no-geometric-first", [&s](bool on) { s.match.matching.geometric_first = !on; },
+      "--geometric-first=false");
 }
 
 void AddInitialErrorOptions(CLI::App* app, LocalizeSettings& s) {
@@ -93,31 +78,6 @@ void AddInitialErrorOptions(CLI::App* app, LocalizeSettings& s) {
       ->capture_default_str();
 }
 
-void AddCoarseOptions(CLI::App* app, LocalizeSettings& s) {
-  app->add_option("--coarse-levels", s.coarse_levels,
-                  "Coarse-to-fine levels: merged (voxel merges, the default) or inflated (every Gaussian blurred)")
-      ->check(CLI::IsMember(CoarseLevelsNames()))
-      ->capture_default_str();
-  app->add_option("--coarse-voxel", s.coarse_voxel,
-                  "Coarse levels match the scan's voxel centroids, voxel side this times the level's blur "
-                  "(0: the points)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  app->add_option("--coarse-points", s.coarse_points, "Points used on the coarse levels (0: all)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  app->add_option("--coarse-gate", s.coarse_gate,
-                  "Association gate on the coarse levels (Mahalanobis; smaller: faster, less reach)")
-      ->check(InRange(kMinCoarseGate, kMaxCoarseGate))
-      ->capture_default_str();
-  AddBoolFlag(app, "--loss-curvature", s.loss_curvature,
-              "Own GN: the robust losses' curvature in the Hessian instead of IRLS weights alone");
-  AddBoolFlag(app, "--geometric-first", s.geometric_first,
-              "With 0 < w < 1: the exact map's geometric term alone first, then eq. 2 (default on)");
-  AddBoolFlag(
-      app, "--no-geometric-first", [&s](bool on) { s.geometric_first = !on; }, "--geometric-first=false");
-}
-
 }  // namespace
 
 const SequenceOptions& LocalizeSettings::CheckedSequenceOptions() const {
@@ -125,42 +85,31 @@ const SequenceOptions& LocalizeSettings::CheckedSequenceOptions() const {
   return sequence;
 }
 
-void LocalizeSettings::CheckAgainst(const Sequence& sequence) const { CheckRcsWeights(sequence, w_rcs); }
+void LocalizeSettings::CheckAgainst(const Sequence& sequence) const { CheckRcsWeights(sequence, SweptWeights()); }
 
-RcsTermOptions LocalizeSettings::RcsTerms() const {
-  RcsTermOptions options;
-  options.likelihood = RcsLikelihoodFromString(rcs_likelihood);
-  options.confidence = rcs_confidence;
-  options.expected_spread_db = rcs_expected_spread;
-  return options;
+std::vector<double> LocalizeSettings::SweptWeights() const {
+  std::vector<double> weights;
+  for (const std::string& word : w_rcs) {
+    radargauss::MatchOptions options;
+    SetRow(MatchOptionTable(), "w_rcs", word, options);
+    weights.push_back(options.matching.w_rcs);
+  }
+  return weights;
 }
 
 std::vector<std::pair<double, bool>> LocalizeSettings::Weights(const GaussianMap& map) const {
   std::vector<std::pair<double, bool>> weights;
-  for (const double w : w_rcs) weights.emplace_back(w, false);
-  if (w_rcs_from_map) weights.emplace_back(RcsWeightFromMap(SummariseRcs(map, RcsTerms())), true);
+  for (const double w : SweptWeights()) weights.emplace_back(w, false);
+  if (w_rcs_from_map) weights.emplace_back(RcsWeightFromMap(SummariseRcs(map, match.matching.rcs_terms)), true);
   return weights;
-}
-
-MatchingMapOptions LocalizeSettings::MatchingOptions() const {
-  MatchingMapOptions options;
-  options.coarse = CoarseLevelsFromString(coarse_levels);
-  options.coarse_gate = coarse_gate;
-  return options;
 }
 
 radargauss::MatchOptions LocalizeSettings::Configuration(const std::string& solver, double w,
                                                          const std::string& loss) const {
-  radargauss::MatchOptions options;
-  options.solver = SolverKindFromString(solver);
+  radargauss::MatchOptions options = match;
+  SetRow(MatchOptionTable(), "solver", solver, options);
   options.matching.w_rcs = w;
-  options.matching.geometric_loss = {LossTypeFromString(loss), loss_scale};
-  options.matching.rcs_loss = {LossTypeFromString(rcs_loss), rcs_loss_scale};
-  options.matching.rcs_terms = RcsTerms();
-  options.matching.coarse_voxel_per_sigma = coarse_voxel;
-  options.matching.coarse_points = coarse_points;
-  options.matching.geometric_first = geometric_first;
-  options.gauss_newton.loss_curvature = loss_curvature;
+  SetRow(MatchOptionTable(), "loss", loss, options);
   return options;
 }
 
@@ -183,7 +132,6 @@ void AddLocalizeOptions(CLI::App* app, LocalizeSettings& s) {
       });
   AddSweepOptions(app, s);
   AddInitialErrorOptions(app, s);
-  AddCoarseOptions(app, s);
   app->add_option("--ndt-resolution", s.ndt_resolution, "pcl-ndt: voxel of the NDT peer (m)")
       ->check(Positive())
       ->capture_default_str();

@@ -2,6 +2,7 @@
 #include "option_flags.hpp"
 
 #include <cctype>
+#include <cstdio>
 #include <map>
 #include <utility>
 
@@ -64,6 +65,10 @@ std::string HelpGroup(OptionGroup group) {
 }
 
 const char* const kListedElsewhereGroup = "Listed elsewhere";
+
+void WarnDeprecated(const std::string& old_flag, const std::string& flag) {
+  std::fprintf(stderr, "radargauss: warning: %s is deprecated: use %s\n", old_flag.c_str(), flag.c_str());
+}
 
 void AddFooterLine(CLI::App* app, const std::string& line) {
   const std::string footer = app->get_footer();

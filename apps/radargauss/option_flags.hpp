@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "radargauss/core/names.hpp"
 #include "radargauss/core/options.hpp"
 
 namespace radargauss::cli {
@@ -116,6 +118,105 @@ void AddTableOptions(CLI::App* app, const OptionTable<Options>& table, Options& 
   if (!ShowingEveryOption()) AddFooterLine(app, "--help-all lists every option (the tuning and study groups too)");
   if (left_out && ShowingEveryOption()) AddFooterLine(app, elsewhere.footer);
   app->formatter(std::make_shared<GroupedHelp>());
+}
+
+// `table` without the rows named in `names` (those a command reads otherwise,
+// as sweeps); the copy must outlive the parse (keep it static).
+template <typename Options>
+OptionTable<Options> TableWithout(const OptionTable<Options>& table, const std::vector<std::string>& names) {
+  OptionTable<Options> rest;
+  for (const Option<Options>& option : table) {
+    if (std::find(names.begin(), names.end(), option.name) == names.end()) rest.push_back(option);
+  }
+  return rest;
+}
+
+// A sweep over the row `name` of `table`: its flag (and YAML key) takes a
+// list, commas or words, each element parsed and checked by the row (or one
+// of `extra`, words the row does not know: the PCL peers of a solver sweep),
+// kept as written in `words` (whose contents are the default). Set one of
+// them on an options value with SetRow.
+template <typename Options>
+CLI::Option* AddSweepOption(CLI::App* app, const OptionTable<Options>& table, const std::string& name,
+                            std::vector<std::string>& words, const std::vector<std::string>& extra = {}) {
+  const Option<Options>* option = FindOption(table, name);
+  if (option == nullptr || option->kind == OptionKind::kFlag || option->kind == OptionKind::kReals) {
+    throw std::logic_error("AddSweepOption: no row '" + name + "' of one value");
+  }
+  std::string range = option->RangeText();
+  if (!extra.empty()) range.insert(range.size() - 1, "," + Joined(extra, ","));
+  CLI::Option* flag = app->add_option(
+      option->Flag(),
+      [option, &words, extra](const CLI::results_t& given) {
+        words.clear();
+        for (const std::string& word : given) {
+          if (std::find(extra.begin(), extra.end(), word) == extra.end()) {
+            try {
+              const std::string refused = option->Check(option->Parse({word}));
+              if (!refused.empty()) throw std::invalid_argument(refused);
+            } catch (const std::invalid_argument& e) {
+              throw CLI::ValidationError(option->Flag(), e.what());
+            }
+          }
+          words.push_back(word);
+        }
+        return true;
+      },
+      HelpText(*option) + "; a list sweeps it, one run per value");
+  flag->type_name(option->TypeText() + ":" + range + "...");
+  flag->expected(1, 1 << 16);
+  flag->delimiter(',');
+  flag->default_str(Joined(words, ","));
+  flag->group(HelpGroup(OptionGroup::kSensor));
+  return flag;
+}
+
+// Sets the row `name` of `table` on `options` to `word` (a sweep's element).
+template <typename Options>
+void SetRow(const OptionTable<Options>& table, const std::string& name, const std::string& word, Options& options) {
+  const Option<Options>* option = FindOption(table, name);
+  if (option == nullptr) throw std::logic_error("SetRow: no row '" + name + "'");
+  option->set(options, option->Parse({word}));
+}
+
+// Says on stderr that `old_flag` is deprecated for `flag`.
+void WarnDeprecated(const std::string& old_flag, const std::string& flag);
+
+// An old name of the row `name` of `table`: read as the row's flag, with a
+// warning that names the new one; left out of the help.
+template <typename Options>
+void AddDeprecatedAlias(CLI::App* app, const OptionTable<Options>& table, Options& options, const std::string& old_flag,
+                        const std::string& name) {
+  const Option<Options>* option = FindOption(table, name);
+  if (option == nullptr) throw std::logic_error("AddDeprecatedAlias: no row '" + name + "'");
+  CLI::Option* alias = nullptr;
+  if (option->kind == OptionKind::kFlag) {
+    alias = AddBoolFlag(
+        app, old_flag,
+        [&options, option, old_flag](bool on) {
+          WarnDeprecated(old_flag, option->Flag());
+          option->set(options, OptionValue(on));
+        },
+        "deprecated: " + option->Flag());
+  } else {
+    alias = app->add_option(
+        old_flag,
+        [&options, option, old_flag](const CLI::results_t& words) {
+          WarnDeprecated(old_flag, option->Flag());
+          try {
+            const OptionValue value = option->Parse(words);
+            const std::string refused = option->Check(value);
+            if (!refused.empty()) throw std::invalid_argument(refused);
+            option->set(options, value);
+          } catch (const std::invalid_argument& e) {
+            throw CLI::ValidationError(old_flag, e.what());
+          }
+          return true;
+        },
+        "deprecated: " + option->Flag());
+    alias->type_name(option->TypeText());
+  }
+  alias->group(kListedElsewhereGroup);
 }
 
 }  // namespace radargauss::cli

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "option_flags.hpp"
 #include "radargauss/core/atomic_file.hpp"
 #include "radargauss/core/error.hpp"
 #include "radargauss/experiment/evaluation.hpp"
@@ -81,25 +82,7 @@ Subcommand AddRefine(CLI::App& parent) {
   app->add_option("--gt", s->reference, "Reference trajectory (TUM) to evaluate against before and after");
   app->add_option("--map", s->map_path, "Map file (.rgm)")->required();
   app->add_option("--out", s->out, "Output folder (refined.tum, refined.rgm)")->required();
-  app->add_option("--w-rcs", s->refinement.matching.w_rcs, "Weight w_rcs of eq. 2 (0..1)")
-      ->check(InRange(0.0, 1.0))
-      ->capture_default_str();
-  app->add_option("--rounds", s->refinement.rounds, "Association rounds")->check(Positive())->capture_default_str();
-  app->add_option("--iterations", s->refinement.max_iterations_per_round, "Ceres iterations per round")
-      ->check(Positive())
-      ->capture_default_str();
-  app->add_option("--relative-pose-prior", s->refinement.relative_pose_prior,
-                  "Weight of the input's relative poses between consecutive scans (0: off)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  app->add_option("--coefficient-prior", s->refinement.coefficient_prior,
-                  "Weight of the map's SH coefficients (0: off)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  app->add_option("--min-associated-share", s->refinement.min_associated_share,
-                  "Refuse a map on which fewer of the scans' points lie at their poses (0..1; 0: never)")
-      ->check(InRange(0.0, 1.0))
-      ->capture_default_str();
+  AddTableOptions(app, JointRefinementOptionTable(), s->refinement);
   return {app, [s] { return RunRefine(*s); }};
 }
 

@@ -388,7 +388,7 @@ def odometry_options(**options: Unpack[OdometryOptions]) -> dict:
     """Every option of RadarOdometry, the given keywords set (checked), as a dict."""
 
 def option_fields(kind: str) -> list:
-    """The keywords of match, RadarOdometry, RadarSlam, Relocalizer or the radar-inertial window ('match', 'odometry', 'slam', 'relocalization', 'radar_inertial'): one dict per option with its keyword, the C++ member it sets (path), type, doc, default, group, unit and range."""
+    """The keywords of match, RadarOdometry, RadarSlam, Relocalizer or the radar-inertial window ('match', 'odometry', 'slam', 'relocalization', 'radar_inertial'), and the rows of the matching map's and the joint refinement's tables that localize and refine read ('matching_map', 'joint_refinement'): one dict per option with its keyword, the C++ member it sets (path), type, doc, default, group, unit and range."""
 
 def pose_matrices(poses: Any) -> numpy.ndarray:
     """Poses (N, 7) [x y z qx qy qz qw] (or (N, 4, 4)) as (N, 4, 4) matrices."""

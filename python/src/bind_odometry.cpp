@@ -16,6 +16,7 @@
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/slam/radar_slam.hpp"
+#include "radargauss/solvers/joint_refinement.hpp"
 #include "radargauss/slam/relocalization.hpp"
 
 namespace radargauss::python {
@@ -279,15 +280,18 @@ void BindOdometry(py::module_& m) {
         if (kind == "slam") return FieldsToList(SlamOptionTable());
         if (kind == "relocalization") return FieldsToList(RelocalizationOptionTable());
         if (kind == "radar_inertial") return FieldsToList(RadarInertialOptionTable());
+        if (kind == "matching_map") return FieldsToList(MatchingMapOptionTable());
+        if (kind == "joint_refinement") return FieldsToList(JointRefinementOptionTable());
         throw py::value_error(
-            "option_fields takes 'match', 'odometry', 'slam', 'relocalization' or 'radar_inertial', not '" + kind +
-            "'");
+            "option_fields takes 'match', 'odometry', 'slam', 'relocalization', 'radar_inertial', 'matching_map' or "
+            "'joint_refinement', not '" +
+            kind + "'");
       },
       py::arg("kind"),
       "The keywords of match, RadarOdometry, RadarSlam, Relocalizer or the radar-inertial window ('match', "
-      "'odometry', 'slam', 'relocalization', 'radar_inertial'): one dict per option with its keyword, the C++ member "
-      "it sets (path), type, doc, default, "
-      "group, unit and range.");
+      "'odometry', 'slam', 'relocalization', 'radar_inertial'), and the rows of the matching map's and the joint "
+      "refinement's tables that localize and refine read ('matching_map', 'joint_refinement'): one dict per option "
+      "with its keyword, the C++ member it sets (path), type, doc, default, group, unit and range.");
 }
 
 }  // namespace radargauss::python

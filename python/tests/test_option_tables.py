@@ -69,6 +69,20 @@ def test_the_flags_are_the_table(command, kind, own):
         assert flags[flag_of(field)] == kind_text + ":" + field["range"], field["keyword"]
 
 
+def test_localize_sweeps_table_rows_and_refine_reads_its_table():
+    """localize: every row of the match's and the matching map's tables is a flag, the solver, the weight
+    and the loss lists (sweeps) checked per element by their rows; refine: the joint refinement's table."""
+    localize = subprocess.run([CLI, "localize", "--help-all"], capture_output=True, text=True, check=True).stdout
+    flags = help_flags("localize")
+    for field in fields_of(("match", "matching_map")):
+        assert flag_of(field) in flags, field["keyword"]
+    assert "--w-rcs FLOAT:[0, 1]...=0,0.25,1" in localize and "--loss TEXT:{trivial," in localize
+    refine = set(help_flags("refine"))
+    table = {flag_of(field) for field in rg.option_fields("joint_refinement")}
+    assert table <= refine and "--gate" in table and "--max-iterations" not in table
+    assert refine - table <= RUN_FLAGS | {"--poses", "--map"}
+
+
 @pytest.mark.parametrize("command, kind, own", COMMANDS)
 def test_help_shows_the_sensor_group_and_help_all_the_rest(command, kind, own):
     shown = set(help_flags(command, "--help"))

@@ -62,20 +62,46 @@ double RcsResidualRms(const std::vector<RadarScan>& scans, const std::vector<SE3
   return n ? std::sqrt(sum / double(n)) : 0.0;
 }
 
+const OptionTable<JointRefinementOptions>& JointRefinementOptionTable() {
+  using O = JointRefinementOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {
+        RADARGAUSS_OPTION(O, "rounds", rounds).In(1, 1000).Help("association rounds"),
+        RADARGAUSS_OPTION(O, "iterations", max_iterations_per_round).In(1, 100000).Help("Ceres iterations per round"),
+        RADARGAUSS_OPTION(O, "relative_pose_prior", relative_pose_prior)
+            .AtLeast(0.0)
+            .Sensor()
+            .Help("weight of the input's relative poses between consecutive scans (0: off)"),
+        RADARGAUSS_OPTION(O, "coefficient_prior", coefficient_prior)
+            .AtLeast(0.0)
+            .Sensor()
+            .Help("weight of the map's SH coefficients (0: off)"),
+        RADARGAUSS_OPTION(O, "schur", schur).Help("SPARSE_SCHUR (the SH blocks first), else SPARSE_NORMAL_CHOLESKY"),
+        RADARGAUSS_OPTION(O, "refine_threads", threads).In(1, 1024).Help("Ceres: threads"),
+        RADARGAUSS_OPTION(O, "min_associated_share", min_associated_share)
+            .In(0.0, 1.0)
+            .Help("refuse a map on which fewer of the scans' points lie at their poses (0: never)"),
+    };
+    // The match's iterations, coarse levels and tolerances are not the joint problem's.
+    const std::vector<std::string> unread = {
+        "max_iterations",        "coarse_iterations",  "coarse_voxel_per_sigma",       "coarse_points",
+        "geometric_first",       "reassociate",        "reassociation_translation",    "reassociation_rotation",
+        "translation_tolerance", "rotation_tolerance", "coarse_translation_tolerance", "coarse_rotation_tolerance"};
+    AppendNested(
+        t, ScanMatchingOptionTable(), +[](O & o) -> auto& { return o.matching; }, "matching", "", unread);
+    return t;
+  }();
+  return table;
+}
+
 namespace {
 
-void CheckOptions(const std::vector<RadarScan>& scans, const std::vector<SE3d>& initial_poses,
-                  const JointRefinementOptions& options) {
+void CheckInputs(const std::vector<RadarScan>& scans, const std::vector<SE3d>& initial_poses,
+                 const JointRefinementOptions& options) {
+  CheckOptions(JointRefinementOptionTable(), options);
   ValidateOptions(options.matching);
   if (scans.size() != initial_poses.size() || scans.empty()) {
     throw std::invalid_argument("joint refinement needs one initial pose per scan (and a scan)");
-  }
-  if (options.rounds < 1 || options.max_iterations_per_round < 1 || options.relative_pose_prior < 0.0 ||
-      options.coefficient_prior < 0.0 ||
-      !(options.min_associated_share >= 0.0 && options.min_associated_share <= 1.0)) {
-    throw std::invalid_argument(
-        "joint refinement: rounds and iterations must be >= 1, priors >= 0, the associated "
-        "share in [0, 1]");
   }
 }
 
@@ -214,7 +240,7 @@ void CheckCoverage(std::size_t associated, std::size_t points, double min_share)
     char text[240];
     std::snprintf(text, sizeof(text),
                   "%.1f %% of the scans' points lie near the map at their poses "
-                  "(--min-associated-share: %.0f %%): a map of another sequence, or poses in another frame?",
+                  "(within --gate; --min-associated-share %.0f %%): another place's map, or another frame?",
                   100.0 * share, 100.0 * min_share);
     throw DataError(text);
   }
@@ -224,7 +250,7 @@ void CheckCoverage(std::size_t associated, std::size_t points, double min_share)
 
 JointRefinementResult RefineJointly(const std::vector<RadarScan>& scans, const std::vector<SE3d>& initial_poses,
                                     const GaussianMap& map, const JointRefinementOptions& options) {
-  CheckOptions(scans, initial_poses, options);
+  CheckInputs(scans, initial_poses, options);
   const auto start = std::chrono::steady_clock::now();
   JointRefinementResult result;
   result.map = map;

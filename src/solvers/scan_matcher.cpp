@@ -51,8 +51,10 @@ const OptionTable<ScanMatchingOptions>& ScanMatchingOptionTable() {
       RADARGAUSS_CHOICE(O, "jacobians", jacobians, JacobianModeNames(), JacobianModeFromString)
           .Help("closed-form Jacobians or Jets through the Ceres functors"),
       RADARGAUSS_OPTION(O, "gate", gate).Above(0.0).Help("association gate tau (Mahalanobis distance)"),
-      RADARGAUSS_OPTION(O, "max_iterations", max_iterations).AtLeast(1).Help("outer iterations on the exact map"),
-      RADARGAUSS_OPTION(O, "coarse_iterations", coarse_iterations).AtLeast(1).Help("outer iterations per coarse level"),
+      RADARGAUSS_OPTION(O, "max_iterations", max_iterations).In(1, 10000).Help("outer iterations on the exact map"),
+      RADARGAUSS_OPTION(O, "coarse_iterations", coarse_iterations)
+          .In(1, 10000)
+          .Help("outer iterations per coarse level"),
       RADARGAUSS_OPTION(O, "coarse_voxel_per_sigma", coarse_voxel_per_sigma)
           .AtLeast(0.0)
           .Help("coarse levels match voxel centroids of this many sigma_k (0: the points)"),

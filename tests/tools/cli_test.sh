@@ -123,7 +123,21 @@ expect_fail "localize with a zero coarse gate" "coarse-gate" -- \
   --coarse-gate 0 --out "$work/r6"
 expect_ok "localize with the scan's points on the coarse levels" "configurations" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
-  --w-rcs 0 --coarse-voxel 0 --out "$work/results_points"
+  --w-rcs 0 --coarse-voxel-per-sigma 0 --out "$work/results_points"
+# An old flag's name still works, warns, and gives the same results as the new one.
+expect_ok "localize with the deprecated --coarse-voxel" "configurations" -- \
+  "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
+  --w-rcs 0 --coarse-voxel 0 --out "$work/results_points_old"
+if grep -q "warning: --coarse-voxel is deprecated: use --coarse-voxel-per-sigma" "$work/err"; then
+  passed=$((passed + 1))
+else
+  failed=$((failed + 1)); echo "FAIL: --coarse-voxel does not say it is deprecated"; cat "$work/err"
+fi
+expect_same "localize under the old and the new coarse-voxel flag" "$work/results_points/reference.tum" \
+  "$work/results_points_old/reference.tum"
+expect_same "the old and the new coarse-voxel flag's trajectories" \
+  "$work/results_points/trajectories/gn-w0-trivial-offset-L3.tum" \
+  "$work/results_points_old/trajectories/gn-w0-trivial-offset-L3.tum"
 expect_ok "localize with eq. 2 throughout on the exact map" "configurations" -- \
   "$tool" localize --sequence "$work/seq" --gt "$work/seq/gt_radar_tum.txt" --map "$work/seq.rgm" \
   --w-rcs 0.25 --no-geometric-first --out "$work/results_throughout"

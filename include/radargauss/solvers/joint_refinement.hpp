@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "radargauss/core/options.hpp"
 #include "radargauss/solvers/scan_matcher.hpp"
 
 namespace radargauss {
@@ -31,6 +32,10 @@ struct JointRefinementOptions {
   // frame): refused before any work (0: never).
   double min_associated_share = 0.1;
 };
+
+// Its options (options.hpp): its own, then the rows of ScanMatchingOptions
+// the joint problem reads (the weight, the losses, the RCS terms, the gate).
+const OptionTable<JointRefinementOptions>& JointRefinementOptionTable();
 
 struct JointRefinementResult {
   std::vector<SE3d> poses;
