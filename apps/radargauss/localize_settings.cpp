@@ -13,20 +13,6 @@
 
 namespace radargauss::cli {
 
-namespace {
-
-// Our solvers, plus the PCL peers when built with RADARGAUSS_WITH_PCL.
-std::vector<std::string> SolverNames() {
-  std::vector<std::string> names = ScanMatcherNames();
-#ifdef RADARGAUSS_HAVE_PCL
-  names.push_back("pcl-ndt");
-  names.push_back("pcl-gicp");
-#endif
-  return names;
-}
-
-}  // namespace
-
 std::string FormatWeight(double w) {
   char text[32];
   std::snprintf(text, sizeof(text), "%g", w);
@@ -43,9 +29,9 @@ const OptionTable<radargauss::MatchOptions>& UnsweptMatchRows() {
 }
 
 void AddSweepOptions(CLI::App* app, LocalizeSettings& s) {
-  const std::vector<std::string> peers = {"pcl-ndt", "pcl-gicp"};
-  AddSweepOption(app, MatchOptionTable(), "solver", s.solvers,
-                 SolverNames().size() > ScanMatcherNames().size() ? peers : std::vector<std::string>());
+  // The PCL peers are named in every build (the help is the same); a build
+  // without PCL refuses them when the run reaches them.
+  AddSweepOption(app, MatchOptionTable(), "solver", s.solvers, {"pcl-ndt", "pcl-gicp"});
   AddSweepOption(app, MatchOptionTable(), "w_rcs", s.w_rcs);
   AddSweepOption(app, MatchOptionTable(), "loss", s.losses);
   AddBoolFlag(app, "--w-rcs-from-map", s.w_rcs_from_map,

@@ -190,6 +190,8 @@ void BindInertialOdometry(py::module_& m) {
            [](LockedInertial& odometry) { return odometry.With([](RadarOdometry& o) { return o.steps().size(); }); });
 }
 
+void BindOptionFunctions(py::module_& m);
+
 }  // namespace
 
 void BindOdometry(py::module_& m) {
@@ -252,6 +254,13 @@ void BindOdometry(py::module_& m) {
           "Matchers made so far: one per version of the local map matched against")
       .def("__len__",
            [](LockedOdometry& odometry) { return odometry.With([](RadarOdometry& o) { return o.steps().size(); }); });
+  BindOptionFunctions(m);
+}
+
+namespace {
+
+// The option dicts and option_fields: the tables as Python sees them.
+void BindOptionFunctions(py::module_& m) {
   m.def(
       "odometry_options",
       [](const py::kwargs& kwargs) { return OptionsToDict(OdometryOptionTable(), OdometryOptionsFrom(kwargs)); },
@@ -293,5 +302,7 @@ void BindOdometry(py::module_& m) {
       "refinement's tables that localize and refine read ('matching_map', 'joint_refinement'): one dict per option "
       "with its keyword, the C++ member it sets (path), type, doc, default, group, unit and range.");
 }
+
+}  // namespace
 
 }  // namespace radargauss::python

@@ -218,13 +218,13 @@ void SimulateImu(const SimulationConfig& config, const simulation::LoopPath& pat
     const Eigen::Vector3d acceleration = (imu_velocity(t + dt) - imu_velocity(t)) / dt;
     ImuSample sample;
     sample.stamp = config.start_time + t + config.imu_clock_offset;
-    sample.angular_velocity = rate + bias.gyro + draw(config.imu_gyro_noise_density / std::sqrt(dt));
+    sample.angular_velocity = rate + bias.gyro + draw(config.imu_noise.gyro_noise_density / std::sqrt(dt));
     sample.specific_force = at.rotation().Inverse() * (acceleration - gravity) + bias.accel +
-                            draw(config.imu_accel_noise_density / std::sqrt(dt));
+                            draw(config.imu_noise.accel_noise_density / std::sqrt(dt));
     sequence.imu.push_back(sample);
     sequence.imu_bias.push_back(bias);
-    bias.gyro += draw(config.imu_gyro_bias_random_walk * std::sqrt(dt));
-    bias.accel += draw(config.imu_accel_bias_random_walk * std::sqrt(dt));
+    bias.gyro += draw(config.imu_noise.gyro_bias_random_walk * std::sqrt(dt));
+    bias.accel += draw(config.imu_noise.accel_bias_random_walk * std::sqrt(dt));
   }
 }
 

@@ -186,7 +186,9 @@ TEST_F(SimulatorFiles, ConfigFileOverridesAndValidates) {
   };
   expect_error("scanz: 3\n", "unknown parameter 'scanz'");
   expect_error("scans: many\n", "wrong type");
-  expect_error("scans: 0\n", "scans must be >= 1");
+  expect_error("scans: 0\n", "scans = 0 is not in [1, ");
+  expect_error("seed: -1\n", "seed = -1 is not in [0, 4294967295]");
+  expect_error("max_detections: 100\n", "max_detections (100) must be at least min_detections (150)");
   expect_error("min_detections: 900\n", "min_detections");
   expect_error("materials: {glass: {diffuse: 1}}\n", "unknown material");
   expect_error("scans: [1, 2\n", "YAML");
@@ -224,8 +226,8 @@ TEST_F(SimulatorFiles, EveryNumberIsBoundedAndTheBoundsSimulate) {
   config.doppler_noise = config.range_noise = 100.0;
   config.rcs_noise_db = 200.0;
   config.imu_rate_hz = 2000.0;
-  config.imu_gyro_noise_density = config.imu_gyro_bias_random_walk = 0.1;
-  config.imu_accel_noise_density = config.imu_accel_bias_random_walk = 1.0;
+  config.imu_noise.gyro_noise_density = config.imu_noise.gyro_bias_random_walk = 0.1;
+  config.imu_noise.accel_noise_density = config.imu_noise.accel_bias_random_walk = 1.0;
   config.imu_gyro_bias_std = 1.0;
   config.imu_accel_bias_std = 10.0;
   config.imu_x = config.imu_y = config.imu_z = 10.0;

@@ -37,9 +37,9 @@ SimulationConfig ImuConfig() {
   config.imu_x = -1.2;
   config.imu_y = 0.3;
   config.imu_z = 0.4;
-  config.imu_gyro_noise_density = config.imu_accel_noise_density = 0.0;
+  config.imu_noise.gyro_noise_density = config.imu_noise.accel_noise_density = 0.0;
   config.imu_gyro_bias_std = config.imu_accel_bias_std = 0.0;
-  config.imu_gyro_bias_random_walk = config.imu_accel_bias_random_walk = 0.0;
+  config.imu_noise.gyro_bias_random_walk = config.imu_noise.accel_bias_random_walk = 0.0;
   return config;
 }
 
@@ -95,8 +95,8 @@ TEST(SimulatedImu, BiasesAndNoiseFollowTheirLaws) {
     EXPECT_LT((b.imu[i].specific_force - c.imu[i].specific_force - b.imu_bias.front().accel).norm(), 1e-9);
   }
   SimulationConfig noisy = biased;
-  noisy.imu_gyro_noise_density = 2e-3;
-  noisy.imu_gyro_bias_random_walk = 1e-3;
+  noisy.imu_noise.gyro_noise_density = 2e-3;
+  noisy.imu_noise.gyro_bias_random_walk = 1e-3;
   const SimulatedSequence n = Simulate(noisy);
   const double dt = 1.0 / noisy.imu_rate_hz;
   double noise = 0.0, walk = 0.0;

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "radargauss/core/options.hpp"
 #include "radargauss/io/imu.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/core/trajectory.hpp"
@@ -88,13 +89,10 @@ struct SimulationConfig {
   // imu_rate_hz 0. Noise densities and bias random walks as a datasheet
   // gives them (io/imu.hpp's ImuNoise); the turn-on biases drawn per axis.
   double imu_rate_hz = 0.0;
-  double imu_gyro_noise_density = 2.4e-4;      // rad/s/sqrt(Hz)
-  double imu_accel_noise_density = 1.5e-3;     // m/s^2/sqrt(Hz)
-  double imu_gyro_bias_std = 0.005;            // rad/s
-  double imu_accel_bias_std = 0.05;            // m/s^2
-  double imu_gyro_bias_random_walk = 2.0e-5;   // rad/s^2/sqrt(Hz)
-  double imu_accel_bias_random_walk = 3.0e-4;  // m/s^3/sqrt(Hz)
-  double imu_roll_deg = 0.0;                   // the IMU on the vehicle, as the radar's mounting
+  ImuNoise imu_noise;                // its noise densities and bias random walks (its ranges unused)
+  double imu_gyro_bias_std = 0.005;  // rad/s
+  double imu_accel_bias_std = 0.05;  // m/s^2
+  double imu_roll_deg = 0.0;         // the IMU on the vehicle, as the radar's mounting
   double imu_pitch_deg = 0.0;
   double imu_yaw_deg = 0.0;
   double imu_x = 0.0;  // m: its place on the vehicle (x forward, z up; the radar at the origin)
@@ -117,10 +115,16 @@ struct SimulationConfig {
   };
 };
 
+// Its options (options.hpp): the YAML keys of a simulation config, each
+// bounded at both ends (what has no meaning below, what no road radar sees
+// or what overflows a draw above), in the order simulation.yaml writes them.
+const OptionTable<SimulationConfig>& SimulationOptionTable();
+
 // Reads a YAML file over the defaults. Throws DataError naming the file for a
 // parse error, an unknown key, a wrong type or an invalid value.
 SimulationConfig LoadSimulationConfig(const std::string& path);
-// Throws DataError (source named) if a value is out of its valid range.
+// Throws DataError (source named) if a value is out of its row's range or
+// breaks a rule between keys (the loop's corners, the detections' bounds).
 void ValidateSimulationConfig(const SimulationConfig& config, const std::string& source);
 // The configuration as YAML (every key), as written next to a simulation.
 std::string SimulationConfigToYaml(const SimulationConfig& config);
