@@ -1,12 +1,16 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// SLAM's keyframe graph on its own (docs/design/slam.md, "SLAM"): nodes and
-// odometry edges as computed by hand, the paths through the graph with and
-// without a loop, a loop's local solve holding what it does not correct.
+// SLAM's parts on their own (docs/design/slam.md, "SLAM"): the keyframe
+// graph's nodes and odometry edges as computed by hand, the paths through
+// the graph with and without a loop, a loop's local solve holding what it
+// does not correct; the loop search finding a planted revisit and nothing
+// else, leaving the graph as it found it.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "radargauss/slam/keyframe_graph.hpp"
+#include "radargauss/slam/loop_search.hpp"
 
 namespace radargauss {
 namespace {
@@ -89,6 +93,68 @@ TEST(KeyframeGraph, ALoopSolvesWhatItCorrectsAndTheWholeSolveCompletesIt) {
   for (int k = 0; k < 30; ++k) {
     EXPECT_LT((local.graph().poses()[k].translation() - whole.graph().poses()[k].translation()).norm(), 1e-3) << k;
   }
+}
+
+// A place of its own for each seed: four walls (3 m high) and a dozen poles
+// at random within 40 m, 2,000 points, in the keyframe's frame.
+std::vector<RadarPoint> Place(std::uint32_t seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<RadarPoint> points;
+  const auto add = [&](const Eigen::Vector3d& at) {
+    RadarPoint point;
+    point.position = at;
+    point.rcs = 10.0 * unit(random);
+    points.push_back(point);
+  };
+  for (int wall = 0; wall < 4; ++wall) {
+    const double angle = 2.0 * M_PI * unit(random), range = 10.0 + 25.0 * unit(random);
+    const double heading = angle + M_PI / 2.0 + 0.6 * (unit(random) - 0.5), length = 10.0 + 15.0 * unit(random);
+    const Eigen::Vector3d centre(range * std::cos(angle), range * std::sin(angle), 0.0);
+    const Eigen::Vector3d along(std::cos(heading), std::sin(heading), 0.0);
+    for (int i = 0; i < 400; ++i)
+      add(centre + along * length * (unit(random) - 0.5) + Eigen::Vector3d(0, 0, 3.0 * unit(random)));
+  }
+  for (int pole = 0; pole < 12; ++pole) {
+    const double angle = 2.0 * M_PI * unit(random), range = 5.0 + 35.0 * unit(random);
+    for (int i = 0; i < 33; ++i) {
+      add(Eigen::Vector3d(range * std::cos(angle), range * std::sin(angle), 4.0 * unit(random)));
+    }
+  }
+  return points;
+}
+
+// Twenty keyframes 10 m apart on a straight road, each a place of its own,
+// then the first place again 200 m on, its odometry pose 2 m off the
+// first's: only the revisit finds a loop, to keyframe 0, at the identity
+// (the same points), among the keyframes at least min_loop_path back; the
+// search leaves the graph's edges and poses as it found them.
+TEST(LoopSearch, FindsAPlantedRevisitAndNothingElse) {
+  const SlamOptions options;
+  KeyframeGraph graph(options);
+  LoopSearch search(options);
+  for (int k = 0; k <= 20; ++k) {
+    Keyframe keyframe = At(10.0 * k);
+    keyframe.points = Place(k == 20 ? 1 : std::uint32_t(k + 1));
+    if (k == 20) keyframe.odometry_pose = SE3d(SO3d(), Eigen::Vector3d(2.0, 0.0, 0.0));
+    graph.Add(keyframe);
+    search.AddPlace(graph.keyframes()[std::size_t(k)].points);
+    const std::size_t edges = graph.graph().edges().size();
+    const LoopSearchResult found = search.Search(k, graph);
+    EXPECT_EQ(graph.graph().edges().size(), edges);
+    if (k < 20) {
+      EXPECT_FALSE(found.accepted.has_value()) << "keyframe " << k;
+      continue;
+    }
+    EXPECT_EQ(found.eligible, (std::vector<int>{0, 1, 2, 3, 4, 5}));
+    ASSERT_TRUE(found.accepted.has_value());
+    const LoopCandidate& loop = found.outcomes[*found.accepted];
+    EXPECT_EQ(loop.candidate, 0);
+    EXPECT_EQ(loop.query, 20);
+    EXPECT_LT(loop.check.relative.translation().norm(), 0.05);
+    EXPECT_LT(loop.check.relative.rotation().Log().norm(), 0.2 * M_PI / 180.0);
+  }
+  EXPECT_GT(search.candidates().size(), 0u);
 }
 
 }  // namespace
