@@ -39,8 +39,6 @@ std::optional<SO3d> GyroRates::Rotation(double from, double to) const {
   return increment;
 }
 
-GyroModel::GyroModel(const std::vector<GyroSample>& rates) { rates_.Add(rates); }
-
 GyroModel::GyroModel(std::vector<ImuSample> imu, const SE3d& radar_from_imu, const ImuNoise& noise) {
   screening_ = ScreenImuSamples(imu, noise);
   const SO3d rotation = radar_from_imu.rotation();

@@ -35,10 +35,7 @@ const OptionTable<RadarInertialOptions>& RadarInertialOptionTable() {
 
 InertialMotion::InertialMotion(const RadarInertialOptions& options, const SE3d& radar_from_imu,
                                std::vector<ImuSample> imu)
-    : options_(options),
-      radar_from_imu_(radar_from_imu),
-      imu_(std::move(imu)),
-      window_(std::make_unique<InertialWindow>(options.window, radar_from_imu)) {
+    : options_(options), radar_from_imu_(radar_from_imu), imu_(std::move(imu)) {
   CheckOptions(RadarInertialOptionTable(), options);
   if (imu_.empty()) throw DataError("the IMU has no sample");
   for (const ImuSample& sample : imu_) {
@@ -47,16 +44,14 @@ InertialMotion::InertialMotion(const RadarInertialOptions& options, const SE3d& 
   }
   screening_ = ScreenImuSamples(imu_, options.window.noise);
   if (imu_.empty()) throw DataError("no IMU sample within the IMU's range (--imu-gyro-range, --imu-accel-range)");
-  window_->AddImu(imu_);  // checks the order
 }
 
+// The window is made here, where the odometry's choice of the elevation bias is known.
 void InertialMotion::Bind(bool estimate_elevation_bias) {
-  if (started_) throw std::logic_error("InertialMotion::Bind after the window started");
-  if (estimate_elevation_bias != options_.window.estimate_elevation_bias) {
-    options_.window.estimate_elevation_bias = estimate_elevation_bias;
-    window_ = std::make_unique<InertialWindow>(options_.window, radar_from_imu_);
-    window_->AddImu(imu_);
-  }
+  if (window_) throw std::logic_error("InertialMotion::Bind: the model is bound to an odometry already");
+  options_.window.estimate_elevation_bias = estimate_elevation_bias;
+  window_ = std::make_unique<InertialWindow>(options_.window, radar_from_imu_);
+  window_->AddImu(imu_);  // checks the order
 }
 
 std::optional<double> InertialMotion::ElevationBias() const {

@@ -81,7 +81,6 @@ class ConstantVelocityModel : public MotionModel {
 // The gyro's rates for the rotation of the prediction; the scan's pose as matched.
 class GyroModel : public MotionModel {
  public:
-  explicit GyroModel(const std::vector<GyroSample>& rates);
   // The IMU's samples (its frame, time order) turned into the radar frame by
   // T_radar_imu's rotation, after ScreenImuSamples with `noise`'s ranges.
   GyroModel(std::vector<ImuSample> imu, const SE3d& radar_from_imu, const ImuNoise& noise);

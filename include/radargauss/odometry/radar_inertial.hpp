@@ -52,15 +52,15 @@ class InertialMotion : public MotionModel {
   // `imu`: the IMU's samples (time order) on the scans' clock, in its frame;
   // radar_from_imu = T_radar_imu. Samples beyond the IMU's ranges and
   // isolated spikes are dropped (ScreenImuSamples, counted in screening()).
-  // Throws DataError for no samples, samples out of order, a value past the
-  // physical limits (ImuSampleFault), or none within the ranges; the
-  // odometry's Register throws DataError when the IMU does not cover the
-  // time since the last scan.
+  // Throws DataError for no samples, a value past the physical limits
+  // (ImuSampleFault), or none within the ranges; the odometry that takes it
+  // throws DataError for samples out of order, and its Register when the
+  // IMU does not cover the time since the last scan.
   InertialMotion(const RadarInertialOptions& options, const SE3d& radar_from_imu, std::vector<ImuSample> imu);
 
   std::string name() const override { return "window"; }
-  // With the odometry's estimate_elevation_bias the window estimates the
-  // bias, and the odometry removes the window's estimate from each scan.
+  // Makes the window: with the odometry's estimate_elevation_bias it
+  // estimates the bias, and the odometry removes its estimate from each scan.
   void Bind(bool estimate_elevation_bias) override;
   void Advance(double stamp) override;
   std::optional<double> ElevationBias() const override;
@@ -81,7 +81,7 @@ class InertialMotion : public MotionModel {
   SE3d radar_from_imu_;
   std::vector<ImuSample> imu_;
   ImuScreening screening_;
-  std::unique_ptr<InertialWindow> window_;  // made again by Bind when the elevation bias is estimated
+  std::unique_ptr<InertialWindow> window_;  // made by Bind
   bool started_ = false;
   double elevation_bias_removed_ = 0.0;                         // rad: what the odometry removes from the scan now
   GyroRates rates_;                                             // less the gyro bias at the time they were handed on
