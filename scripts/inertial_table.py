@@ -43,7 +43,8 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENES = {"demo": [], "realistic": ["synthetic_realistic.yaml"], "motorway": ["synthetic_motorway.yaml"],
           "realistic_late": ["synthetic_realistic.yaml"],
-          "motorway_late": ["synthetic_motorway.yaml", "synthetic_realistic.yaml"]}
+          "motorway_late": ["synthetic_motorway.yaml", "synthetic_realistic.yaml"],
+          "yard": ["synthetic_yard.yaml"]}
 LATE = 0.020  # s: the IMU's stamps behind the radar's in the *_late scenes
 ELEVATION_BIAS = 0.5  # deg: synthetic_realistic.yaml's
 MOUNTED = ["--mounting", "0.5", "1.5", "-1", "--estimate-elevation-bias"]
@@ -64,7 +65,8 @@ def simulate(tool, work, scene):
         for name in SCENES[scene]:
             lines += [line for line in open(os.path.join(ROOT, "configs", name)).read().splitlines()
                       if line and not line.startswith("#")]
-        lines.append("imu_rate_hz: 200")
+        if not any(line.startswith("imu_rate_hz:") for line in lines):
+            lines.append("imu_rate_hz: 200")
         if scene.endswith("_late"):
             lines.append(f"imu_clock_offset: {LATE}")
         config = out + ".yaml"

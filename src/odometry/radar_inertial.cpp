@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include <Eigen/Cholesky>
+
 #include "radargauss/core/error.hpp"
 
 namespace radargauss {
@@ -18,9 +20,17 @@ const OptionTable<RadarInertialOptions>& RadarInertialOptionTable() {
             .Sensor()
             .Help("window: a sliding window of IMU states with the matches and Doppler velocities (biases, "
                   "gravity); gyro: the gyro's rates for the prediction only"),
+        RADARGAUSS_OPTION(O, "match_covariance", match_covariance)
+            .Choices({"information", "residuals"})
+            .Help("the match's covariance in the window: information, its Gauss-Newton matrix times "
+                  "match_information_scale; residuals, its residuals' own spread times "
+                  "match_covariance_inflation"),
+        RADARGAUSS_OPTION(O, "match_covariance_inflation", match_covariance_inflation)
+            .In(1.0, 1e6)
+            .Help("how many times over the window counts a match's own covariance (the map's shared error)"),
         RADARGAUSS_OPTION(O, "match_information_scale", match_information_scale)
             .In(0.0, 1.0)
-            .Help("the share of a match's information N_geo H the window trusts"),
+            .Help("with match_covariance information: the share of a match's N_geo H the window trusts"),
         RADARGAUSS_OPTION(O, "inertial_velocity_floor", velocity_floor)
             .In(0.0, 100.0)
             .Unit("m/s")
@@ -92,7 +102,13 @@ SE3d InertialMotion::Fuse(const ScanEstimate& e) {
   } else {
     window_->AddState(e.stamp);
   }
-  if (e.matched && e.matched_points > 0) {
+  if (e.matched && options_.match_covariance == "residuals") {
+    // A match of too few Gaussians to state its covariance is left out.
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> factor(e.covariance * options_.match_covariance_inflation);
+    if (factor.info() == Eigen::Success && factor.vectorD().minCoeff() > 0.0) {
+      window_->AddPose(e.pose, factor.solve(Eigen::Matrix<double, 6, 6>::Identity()));
+    }
+  } else if (e.matched && e.matched_points > 0) {
     window_->AddPose(e.pose, e.information * (double(e.matched_points) * options_.match_information_scale));
   }
   if (e.velocity_measured) {

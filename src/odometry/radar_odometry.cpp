@@ -333,6 +333,7 @@ ScanEstimate RadarOdometry::EstimateOf(const RadarScan& scan, const Velocity& ve
   if (estimate.matched) {
     e.information = estimate.match->information;
     e.matched_points = estimate.match->n_geo;
+    e.covariance = estimate.match->covariance;
   }
   e.velocity_measured = velocity.measured;
   e.standstill = velocity.standstill;

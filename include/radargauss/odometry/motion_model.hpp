@@ -32,6 +32,8 @@ struct ScanEstimate {
   bool matched = false;  // `information` and `matched_points` hold
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();  // eq. 2's, normalised
   std::size_t matched_points = 0;                                                 // N_geo
+  // The match's own covariance (ScanMatchingResult::covariance); zero when unknown.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool velocity_measured = false;
   bool standstill = false;
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s, radar frame

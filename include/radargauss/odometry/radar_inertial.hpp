@@ -31,8 +31,14 @@ namespace radargauss {
 
 struct RadarInertialOptions {
   InertialWindowOptions window;
-  // The match's points are not independent (the map was built from the
-  // same poses): its information N_geo * H counts for this fraction.
+  // The match's covariance in the window (docs/design/odometry.md, "The
+  // match in the window"): "information", the inverse of its Gauss-Newton
+  // matrix N_geo H times match_information_scale; or "residuals", its own
+  // (MatchCovariance) times match_covariance_inflation.
+  std::string match_covariance = "information";
+  // The map's error, shared by consecutive matches (the map was built at
+  // the poses the window kept), which one scan's residuals cannot see.
+  double match_covariance_inflation = 100.0;
   double match_information_scale = 0.003;
   double velocity_floor = 0.05;  // m/s: added in quadrature to the Doppler velocity's std
   // The motion model with an IMU (MakeMotionModel): "window", or "gyro" (the

@@ -50,4 +50,15 @@ CombinedSystem BuildCombinedSystem(const Correspondences& correspondences, const
 Eigen::Matrix<double, 6, 6> InformationMatrix(const Correspondences& correspondences, const SE3d& pose,
                                               const ScanMatchingOptions& options);
 
+// ScanMatchingResult::covariance: the pose's covariance over [dt; dphi] from
+// the geometric residuals themselves, A^-1 B A^-1 with A = sum w J^T S J
+// (S = Sigma^-1) and B = sum over Gaussians c of u_c u_c^T, u_c = sum over
+// the Gaussian's terms of w J^T S e: residuals sharing a Gaussian may be
+// correlated (its mean is one estimate), those of different Gaussians are
+// taken as independent (docs/design/solvers.md, "The match's covariance").
+// Scaled by G / (G - 1) for G Gaussians. Zero with fewer than 7 Gaussians
+// or a singular A.
+Eigen::Matrix<double, 6, 6> MatchCovariance(const Correspondences& correspondences, const SE3d& pose,
+                                            const ScanMatchingOptions& options);
+
 }  // namespace radargauss

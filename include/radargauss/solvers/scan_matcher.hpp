@@ -88,6 +88,11 @@ struct ScanMatchingResult {
   // was made. Multiply by N_geo (w = 0) for the information of the pose in
   // the Gaussians' units; docs/design/solvers.md, "The information matrix".
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+  // The pose's covariance over the same tangent from the geometric
+  // residuals' own spread (MatchCovariance, normal_equations.hpp): what the
+  // match knows of the pose against this map. Zero when no match was made
+  // or too few Gaussians were matched.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   // The velocity prior's Gauss-Newton matrix, weight J^T J on the translation
   // block (zero without the prior), kept apart from eq. 2's.
   Eigen::Matrix<double, 6, 6> velocity_information = Eigen::Matrix<double, 6, 6>::Zero();
