@@ -40,7 +40,12 @@ void PrintScreening(const ImuScreening& screening) {
 // The window's last estimate: the tilt of the odometry's world against
 // gravity, the biases, and its cost per scan.
 void PrintInertial(const InertialMotion& inertial) {
+  if (const std::optional<ImuFault>& fault = inertial.imu_fault()) {
+    std::fprintf(stderr, "radargauss: warning: the IMU was dropped at %.2f s, the radar alone from there: %s\n",
+                 fault->stamp, fault->cause.c_str());
+  }
   const auto& states = inertial.states();
+  if (inertial.imu_fault()) return;
   if (states.empty() || !states.back()) {
     std::printf("inertial: the window never started (no Doppler velocity)\n");
     return;

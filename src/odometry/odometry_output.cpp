@@ -192,6 +192,12 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
     summary["window"] = WindowSolves(*inertial);
     summary["imu_dropped"] = {{"beyond_range", inertial->screening().beyond_range},
                               {"spikes", inertial->screening().spikes}};
+    summary["imu_health"] = {{"checked", inertial->options().health_check}, {"dropped", false}};
+    if (const std::optional<ImuFault>& fault = inertial->imu_fault()) {
+      summary["imu_health"]["dropped"] = true;
+      summary["imu_health"]["cause"] = fault->cause;
+      summary["imu_health"]["at_s"] = fault->stamp;
+    }
     WriteInertialStates((out / "inertial.csv").string(), odometry, *inertial);
   }
   WriteFileAtomically((out / "summary.json").string(),

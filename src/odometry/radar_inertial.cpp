@@ -20,6 +20,9 @@ const OptionTable<RadarInertialOptions>& RadarInertialOptionTable() {
             .Sensor()
             .Help("window: a sliding window of IMU states with the matches and Doppler velocities (biases, "
                   "gravity); gyro: the gyro's rates for the prediction only"),
+        RADARGAUSS_OPTION(O, "imu_health_check", health_check)
+            .Help("check the IMU against the radar (gravity, the gyro's axes and scale, the clocks) and drop it "
+                  "on a fault"),
         RADARGAUSS_OPTION(O, "match_covariance", match_covariance)
             .Choices({"information", "residuals"})
             .Help("the match's covariance in the window: information, its Gauss-Newton matrix times "
@@ -54,6 +57,8 @@ InertialMotion::InertialMotion(const RadarInertialOptions& options, const SE3d& 
   }
   screening_ = ScreenImuSamples(imu_, options.window.noise);
   if (imu_.empty()) throw DataError("no IMU sample within the IMU's range (--imu-gyro-range, --imu-accel-range)");
+  health_.emplace(options.health_check ? imu_ : std::vector<ImuSample>{}, radar_from_imu.rotation(),
+                  options.window.clock_offset);
 }
 
 // The window is made here, where the odometry's choice of the elevation bias is known.
@@ -65,7 +70,7 @@ void InertialMotion::Bind(bool estimate_elevation_bias) {
 }
 
 std::optional<double> InertialMotion::ElevationBias() const {
-  if (!options_.window.estimate_elevation_bias) return std::nullopt;
+  if (!options_.window.estimate_elevation_bias || imu_fault()) return std::nullopt;
   return elevation_bias_removed_;
 }
 
@@ -73,6 +78,7 @@ std::optional<double> InertialMotion::ElevationBias() const {
 // needs one) to the prediction, less the window's gyro bias now, turned into
 // the radar frame.
 void InertialMotion::Advance(double stamp) {
+  if (imu_fault()) return;
   const Eigen::Vector3d bias = started_ ? window_->newest().bias.gyro : Eigen::Vector3d::Zero();
   const SO3d radar_from_imu = window_->radar_from_imu().rotation();
   const double offset = window_->clock_offset();  // the IMU's stamps minus the radar's
@@ -88,6 +94,10 @@ void InertialMotion::Advance(double stamp) {
 }
 
 SE3d InertialMotion::Fuse(const ScanEstimate& e) {
+  if (imu_fault()) {
+    states_.push_back(std::nullopt);
+    return e.pose;
+  }
   if (!started_) {
     // The window starts at the first scan with a Doppler velocity that the IMU covers.
     if (!e.velocity_measured || imu_.empty() || imu_.front().stamp > e.stamp + options_.window.clock_offset) {
@@ -117,6 +127,11 @@ SE3d InertialMotion::Fuse(const ScanEstimate& e) {
     window_->AddVelocity(e.velocity, covariance, elevation_bias_removed_);
   }
   solves_.push_back(window_->Solve());
+  if (e.matched && options_.health_check) health_->AddScan(e.stamp, e.pose);
+  if (imu_fault()) {
+    states_.push_back(std::nullopt);
+    return e.pose;
+  }
   states_.push_back(window_->newest());
   return window_->RadarPoseInMatcherWorld();
 }

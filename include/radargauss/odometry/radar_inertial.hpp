@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 
 #include "radargauss/io/imu.hpp"
+#include "radargauss/odometry/imu_health.hpp"
 #include "radargauss/odometry/motion_model.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/core/options.hpp"
@@ -44,6 +45,8 @@ struct RadarInertialOptions {
   // The motion model with an IMU (MakeMotionModel): "window", or "gyro" (the
   // gyro's rates for the prediction only).
   std::string fusion = "window";
+  // Check the IMU against the radar (ImuHealth) and drop it on a fault.
+  bool health_check = true;
 };
 
 // Its options (options.hpp): its own, then the window's.
@@ -81,6 +84,9 @@ class InertialMotion : public MotionModel {
   const RadarInertialOptions& options() const { return options_; }
   // The samples dropped before the window saw them.
   ImuScreening screening() const override { return screening_; }
+  // The fault for which the IMU was dropped (the scans from then on are the
+  // radar's alone); none while it holds.
+  const std::optional<ImuFault>& imu_fault() const { return health_->fault(); }
 
  private:
   RadarInertialOptions options_;
@@ -95,6 +101,7 @@ class InertialMotion : public MotionModel {
   double last_fed_ = -std::numeric_limits<double>::infinity();  // their last stamp, on the radar's clock
   std::vector<std::optional<InertialState>> states_;
   std::vector<WindowSolveSummary> solves_;
+  std::optional<ImuHealth> health_;
 };
 
 // The motion model named by options.fusion ("window": InertialMotion;
