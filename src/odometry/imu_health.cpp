@@ -66,12 +66,16 @@ ImuHealth::ImuHealth(const std::vector<ImuSample>& imu, const SO3d& radar_from_i
 }
 
 void ImuHealth::AddScan(double stamp, const SE3d& matched) {
-  if (fault_) return;
+  if (fault_ || confirmed_at_) return;
+  if (!first_scan_) first_scan_ = stamp;
   CheckRotations(stamp, matched);
   if (!fault_ && !clock_checked_) {
     history_.push_back({stamp, matched.rotation()});
     CheckClock(stamp);
   }
+  if (fault_) return;
+  verified_ = clock_checked_ && int(axis_angles_.size()) >= kMinTurns;
+  if (verified_ || stamp - *first_scan_ > kMaxProbation) confirmed_at_ = stamp;
 }
 
 // The radar's rotation over the last span against the gyro's, on spans that

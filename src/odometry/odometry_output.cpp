@@ -192,7 +192,12 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
     summary["window"] = WindowSolves(*inertial);
     summary["imu_dropped"] = {{"beyond_range", inertial->screening().beyond_range},
                               {"spikes", inertial->screening().spikes}};
-    summary["imu_health"] = {{"checked", inertial->options().health_check}, {"dropped", false}};
+    const ImuHealth& health = inertial->health();
+    summary["imu_health"] = {
+        {"checked", inertial->options().health_check},
+        {"dropped", false},
+        {"verified", health.verified()},
+        {"confirmed_at_s", health.confirmed_at() ? nlohmann::json(*health.confirmed_at()) : nlohmann::json(nullptr)}};
     if (const std::optional<ImuFault>& fault = inertial->imu_fault()) {
       summary["imu_health"]["dropped"] = true;
       summary["imu_health"]["cause"] = fault->cause;

@@ -127,13 +127,17 @@ SE3d InertialMotion::Fuse(const ScanEstimate& e) {
     window_->AddVelocity(e.velocity, covariance, elevation_bias_removed_);
   }
   solves_.push_back(window_->Solve());
-  if (e.matched && options_.health_check) health_->AddScan(e.stamp, e.pose);
-  if (imu_fault()) {
-    states_.push_back(std::nullopt);
-    return e.pose;
-  }
   states_.push_back(window_->newest());
   return window_->RadarPoseInMatcherWorld();
+}
+
+bool InertialMotion::OnProbation() const { return options_.health_check && !health_->fault() && !health_->confirmed(); }
+
+bool InertialMotion::Check(double stamp, const SE3d& radar_alone, bool matched) {
+  if (matched) health_->AddScan(stamp, radar_alone);
+  if (!health_->fault()) return true;
+  states_.push_back(std::nullopt);  // the scan is the radar's alone
+  return false;
 }
 
 std::unique_ptr<MotionModel> MakeMotionModel(const RadarInertialOptions& options, const SE3d& radar_from_imu,

@@ -198,8 +198,25 @@ RadarOdometry::Velocity RadarOdometry::MeasureVelocity(const RadarScan& scan,
 }
 
 // Kiss-icp's shape: each stage returns a value, the step is assembled at the end.
+bool RadarOdometry::RunBeside(const RadarScan& scan) {
+  if (!motion_->OnProbation() || fixed_map_) {
+    radar_alone_.reset();
+    return false;
+  }
+  if (!radar_alone_) radar_alone_ = std::make_unique<RadarOdometry>(options_, nullptr, factory_);
+  const OdometryStep& alone = radar_alone_->Register(scan);
+  if (motion_->Check(alone.stamp, alone.pose, alone.matched)) return false;
+  // The model failed: the radar alone's run goes on as this one, the model kept for its record.
+  std::unique_ptr<MotionModel> model = std::move(motion_);
+  std::unique_ptr<RadarOdometry> radar_alone = std::move(radar_alone_);
+  *this = std::move(*radar_alone);
+  motion_ = std::move(model);
+  return true;
+}
+
 const OdometryStep& RadarOdometry::Register(const RadarScan& input) {
   const auto start = std::chrono::steady_clock::now();
+  if (RunBeside(input)) return steps_.back();
   CheckStamp(input);
   motion_->Advance(input.timestamp);
   if (const std::optional<double> bias = motion_->ElevationBias()) elevation_bias_.Hold(*bias);

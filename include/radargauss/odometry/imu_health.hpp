@@ -31,14 +31,15 @@ class ImuHealth {
   // The thresholds (docs/design/odometry.md, "The IMU's health").
   static constexpr double kGravityTolerance = 3.0;  // m/s^2: |mean specific force| - g
   static constexpr double kMaxUpAngleDeg = 60.0;    // gravity's reaction from the radar's up
-  static constexpr double kSpan = 0.5;              // s: rotations compared over this
-  static constexpr double kMinTurnDeg = 3.0;        // a span turning less is not compared
-  static constexpr double kMaxAxisAngleDeg = 5.0;   // median angle between the two rotations' axes
+  static constexpr double kSpan = 1.0;              // s: rotations compared over this
+  static constexpr double kMinTurnDeg = 6.0;        // a span turning less is not compared
+  static constexpr double kMaxAxisAngleDeg = 12.0;  // median angle between the two rotations' axes
   static constexpr double kMaxRateRatio = 1.4;      // median ratio of their angles, either way
-  static constexpr int kMinTurns = 3;               // spans compared before judging
+  static constexpr int kMinTurns = 5;               // spans compared before judging
   static constexpr double kLagSearch = 1.5;         // s: the clock offsets the cross-correlation tries
   static constexpr double kMinHistory = 10.0;       // s of scans before the clocks are compared
   static constexpr double kClockTolerance = 0.15;   // s: a lag this far from the offset given is a fault
+  static constexpr double kMaxProbation = 60.0;     // s of scans: then the IMU is taken as it is
 
   // `imu`: its samples on the scans' clock less `clock_offset` (the IMU's
   // stamps minus the radar's); radar_from_imu: R_radar_imu. Checks the
@@ -48,6 +49,11 @@ class ImuHealth {
   // A scan's matched T_world_radar.
   void AddScan(double stamp, const SE3d& matched);
   const std::optional<ImuFault>& fault() const { return fault_; }
+  // No fault, and either every check has run (verified()) or kMaxProbation
+  // has passed without the turns they need.
+  bool confirmed() const { return confirmed_at_.has_value(); }
+  bool verified() const { return verified_; }
+  std::optional<double> confirmed_at() const { return confirmed_at_; }
 
  private:
   void CheckRotations(double stamp, const SE3d& matched);
@@ -65,6 +71,8 @@ class ImuHealth {
   double last_compared_ = -1e300;
   std::vector<double> axis_angles_, rate_ratios_;
   bool clock_checked_ = false;
+  std::optional<double> first_scan_, confirmed_at_;
+  bool verified_ = false;
   std::optional<ImuFault> fault_;
 };
 

@@ -72,6 +72,14 @@ class MotionModel {
   virtual SE3d Fuse(const ScanEstimate& estimate) { return estimate.pose; }
   // The IMU samples dropped before use (ScreenImuSamples); none without an IMU.
   virtual ImuScreening screening() const { return {}; }
+  // While true, the odometry runs the radar alone beside the model and
+  // hands it each scan's pose from there (Check): a reference the model's
+  // sensor cannot bend, until the sensor has proved itself.
+  virtual bool OnProbation() const { return false; }
+  // The radar alone's pose of the scan at `stamp` (matched or predicted).
+  // False: the model failed; the odometry goes on as the radar alone from
+  // this scan, whose Fuse the model does not see.
+  virtual bool Check(double /*stamp*/, const SE3d& /*radar_alone*/, bool /*matched*/) { return true; }
 };
 
 // The last velocity kept and the last yaw rate: the odometry's own prediction.

@@ -73,7 +73,9 @@ class InertialMotion : public MotionModel {
   void Bind(bool estimate_elevation_bias) override;
   void Advance(double stamp) override;
   std::optional<double> ElevationBias() const override;
-  std::optional<SO3d> Rotation(double from, double to) const override { return rates_.Rotation(from, to); }
+  std::optional<SO3d> Rotation(double from, double to) const override {
+    return imu_fault() ? std::nullopt : rates_.Rotation(from, to);
+  }
   SE3d Fuse(const ScanEstimate& estimate) override;
 
   // The window's newest state after each scan; empty before the window started.
@@ -84,6 +86,10 @@ class InertialMotion : public MotionModel {
   const RadarInertialOptions& options() const { return options_; }
   // The samples dropped before the window saw them.
   ImuScreening screening() const override { return screening_; }
+  // On probation until the IMU's health is confirmed (ImuHealth).
+  bool OnProbation() const override;
+  bool Check(double stamp, const SE3d& radar_alone, bool matched) override;
+  const ImuHealth& health() const { return *health_; }
   // The fault for which the IMU was dropped (the scans from then on are the
   // radar's alone); none while it holds.
   const std::optional<ImuFault>& imu_fault() const { return health_->fault(); }

@@ -187,6 +187,9 @@ class RadarOdometry {
   };
 
   void CheckStamp(const RadarScan& scan) const;
+  // The radar alone beside a model on probation; true when the model failed
+  // on this scan and the radar alone's run has become this one.
+  bool RunBeside(const RadarScan& scan);
   Prediction Predict(double stamp) const;
   SE3d PredictedPose(const Prediction& prediction, const Eigen::Vector3d& velocity) const;
   // The translation since the last scan in its frame for a velocity of the new frame.
@@ -221,6 +224,8 @@ class RadarOdometry {
   std::vector<std::size_t> last_static_points_;
   std::shared_ptr<const MatchingMap> fixed_map_;  // LocalizeIn's; null: the run's own map
   std::size_t map_bytes_ = 0;                     // LocalMap::MemoryBytes after the last keyframe
+  // The radar alone, run beside while the motion model is on probation.
+  std::unique_ptr<RadarOdometry> radar_alone_;
 };
 
 // Per-scan time (median, p90 in ms), scan and keyframe counts, fallbacks.
