@@ -98,6 +98,33 @@ nlohmann::json Calibration(const InertialMotion& inertial) {
     c["elevation_bias_deg"] = window.elevation_bias() * kDeg;
     c["elevation_bias_std_deg"] = u.elevation_bias * kDeg;
   }
+  // Calibration only where the motion shows it: per parameter, the share
+  // of the solves whose data observed every direction, and the last solve's.
+  const auto observed = [&](const char* name, const auto& directions, int size) {
+    std::size_t all = 0;
+    for (const WindowSolveSummary& solve : inertial.solves()) all += directions(solve.calibration) == size;
+    const int last = inertial.solves().empty() ? 0 : directions(inertial.solves().back().calibration);
+    c["observed"][name] = {{"share", inertial.solves().empty() ? 0.0 : double(all) / inertial.solves().size()},
+                           {"directions_now", last},
+                           {"status", last == size ? "observed"
+                                      : last > 0   ? "partly observed"
+                                                   : "not observed yet"}};
+  };
+  if (o.estimate_clock_offset)
+    observed(
+        "clock_offset", [](const CalibrationObservation& c) { return c.clock_offset; }, 1);
+  if (o.estimate_elevation_bias) {
+    observed(
+        "elevation_bias", [](const CalibrationObservation& c) { return c.elevation_bias; }, 1);
+  }
+  if (o.estimate_extrinsic_rotation) {
+    observed(
+        "extrinsic_rotation", [](const CalibrationObservation& c) { return c.extrinsic_rotation; }, 3);
+  }
+  if (o.estimate_extrinsic_translation) {
+    observed(
+        "extrinsic_translation", [](const CalibrationObservation& c) { return c.extrinsic_translation; }, 3);
+  }
   if (o.estimate_extrinsic_rotation || o.estimate_extrinsic_translation) {
     const SE3d radar_from_imu = window.radar_from_imu();
     c["radar_from_imu_rotation_vector_deg"] = Values(radar_from_imu.rotation().Log(), kDeg);

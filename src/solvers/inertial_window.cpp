@@ -20,6 +20,7 @@
 #include "radargauss/residuals/imu_residual.hpp"
 #include "radargauss/residuals/radar_inertial_residuals.hpp"
 #include "radargauss/residuals/rotation_residual.hpp"
+#include "radargauss/solvers/calibration_gate.hpp"
 #include "radargauss/solvers/marginalization.hpp"
 #include "radargauss/solvers/window_solvers.hpp"
 
@@ -28,6 +29,11 @@ namespace radargauss {
 namespace {
 
 constexpr double kClockRelinearisation = 0.002;  // s
+// The first state's priors on the calibration (std).
+constexpr double kClockPrior = 0.05;                            // s: held near its start until the drive turns
+constexpr double kExtrinsicRotationPrior = 3.0 * M_PI / 180.0;  // rad: a mounting is known to a few degrees
+constexpr double kElevationBiasPrior = 2.0 * M_PI / 180.0;      // rad: a radar's bias is a fraction of a degree
+constexpr double kDeg = M_PI / 180.0;
 
 // W with W^T W = information, for a positive semi-definite information.
 Eigen::MatrixXd SqrtInformation(const Eigen::MatrixXd& information) {
@@ -234,6 +240,85 @@ struct InertialWindow::Impl {
     if (prior) ids.push_back(problem.AddResidualBlock(prior.get(), nullptr, prior->parameter_blocks()));
     if (oldest_terms != nullptr) *oldest_terms = ids;
   }
+
+  // The window's Gauss-Newton matrix over VariableBlocks' tangent, and each block's first column.
+  Eigen::MatrixXd Information(ceres::Problem& problem, const std::vector<double*>& blocks,
+                              std::vector<int>& offset) const {
+    ceres::Problem::EvaluateOptions evaluate;
+    evaluate.parameter_blocks = blocks;
+    ceres::CRSMatrix crs;
+    problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+    offset.assign(blocks.size() + 1, 0);
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      const ceres::Manifold* manifold = problem.GetManifold(blocks[b]);
+      offset[b + 1] = offset[b] + (manifold ? manifold->TangentSize() : problem.ParameterBlockSize(blocks[b]));
+    }
+    const Eigen::MatrixXd J = DenseJacobian(crs);
+    return J.transpose() * J;
+  }
+
+  // The calibration gate: each estimated calibration block's observation,
+  // and a term in `problem` holding it along what the data do not observe.
+  CalibrationObservation HoldUnobserved(ceres::Problem& problem, const InertialWindowOptions& options,
+                                        std::vector<std::unique_ptr<ceres::CostFunction>>& holds) {
+    CalibrationObservation result;
+    const std::vector<double*> blocks = VariableBlocks(options);
+    std::vector<int> offset;
+    const Eigen::MatrixXd H = Information(problem, blocks, offset);
+    const auto observe = [&](double* data, int size, double prior_std, double observed_std) {
+      const std::size_t b = std::find(blocks.begin(), blocks.end(), data) - blocks.begin();
+      CalibrationBlock block;
+      block.offset = offset[b];
+      block.size = size;
+      block.prior_information =
+          Eigen::MatrixXd::Identity(size, size) * (prior_std > 0.0 ? 1.0 / (prior_std * prior_std) : 0.0);
+      block.observed_std = observed_std;
+      return ObserveBlock(H, block);
+    };
+    const auto hold = [&](std::unique_ptr<ceres::CostFunction> term, double* data) {
+      holds.push_back(std::move(term));
+      problem.AddResidualBlock(holds.back().get(), nullptr, data);
+    };
+    constexpr double kHold = 1e3;  // the held directions' weight: 1/1000 of their observed std
+    if (options.estimate_extrinsic_rotation) {
+      const double needed = options.observed_rotation_std_deg * kDeg;
+      const BlockObservation o = observe(extrinsic_rotation.data(), 3, kExtrinsicRotationPrior, needed);
+      result.extrinsic_rotation = 3 - int(o.unobserved.cols());
+      result.extrinsic_rotation_std = o.std();
+      if (!o.observed() && options.calibration_gate) {
+        hold(HoldRotationAlong(SO3d::FromXyzw(extrinsic_rotation.data()), o.unobserved, kHold / needed),
+             extrinsic_rotation.data());
+      }
+    }
+    if (options.estimate_extrinsic_translation) {
+      const BlockObservation o = observe(extrinsic_translation.data(), 3, 0.0, options.observed_translation_std);
+      result.extrinsic_translation = 3 - int(o.unobserved.cols());
+      result.extrinsic_translation_std = o.std();
+      if (!o.observed() && options.calibration_gate) {
+        hold(HoldAlong(extrinsic_translation, o.unobserved, kHold / options.observed_translation_std),
+             extrinsic_translation.data());
+      }
+    }
+    if (options.estimate_clock_offset) {
+      const BlockObservation o = observe(clock_offset, 1, kClockPrior, options.observed_clock_std);
+      result.clock_offset = 1 - int(o.unobserved.cols());
+      result.clock_offset_std = o.std()(0);
+      if (!o.observed() && options.calibration_gate) {
+        hold(HoldAlong(Eigen::VectorXd::Constant(1, clock_offset[0]), o.unobserved, kHold / options.observed_clock_std),
+             clock_offset);
+      }
+    }
+    if (options.estimate_elevation_bias) {
+      const double needed = options.observed_elevation_bias_std_deg * kDeg;
+      const BlockObservation o = observe(elevation_bias, 1, kElevationBiasPrior, needed);
+      result.elevation_bias = 1 - int(o.unobserved.cols());
+      result.elevation_bias_std = o.std()(0);
+      if (!o.observed() && options.calibration_gate) {
+        hold(HoldAlong(Eigen::VectorXd::Constant(1, elevation_bias[0]), o.unobserved, kHold / needed), elevation_bias);
+      }
+    }
+    return result;
+  }
 };
 
 InertialWindow::InertialWindow(const InertialWindowOptions& options, const SE3d& radar_from_imu)
@@ -284,19 +369,16 @@ void InertialWindow::Start(const InertialState& state) {
   first.first_priors.push_back({std::make_shared<DiagonalPrior>(mean, sigmas), {first.motion.data()}});
   if (options_.estimate_clock_offset) {
     // Unobservable while the drive is straight and even: held near its start until it turns.
-    constexpr double kClockPrior = 0.05;  // s
     first.first_priors.push_back({std::make_shared<DiagonalPrior>(Eigen::VectorXd::Constant(1, impl_->clock_offset[0]),
                                                                   Eigen::VectorXd::Constant(1, kClockPrior)),
                                   {impl_->clock_offset}});
   }
   if (options_.estimate_extrinsic_rotation) {
-    constexpr double kExtrinsicRotationPrior = 3.0 * M_PI / 180.0;  // rad: a mounting is known to a few degrees
     const RotationPrior prior{SO3d::FromXyzw(impl_->extrinsic_rotation.data()),
                               Eigen::Matrix3d::Identity() / kExtrinsicRotationPrior};
     first.first_priors.push_back({std::make_shared<RotationCostFunction>(prior), {impl_->extrinsic_rotation.data()}});
   }
   if (options_.estimate_elevation_bias) {
-    constexpr double kElevationBiasPrior = 2.0 * M_PI / 180.0;  // rad: a radar's bias is a fraction of a degree
     first.first_priors.push_back(
         {std::make_shared<DiagonalPrior>(Eigen::VectorXd::Constant(1, impl_->elevation_bias[0]),
                                          Eigen::VectorXd::Constant(1, kElevationBiasPrior)),
@@ -417,10 +499,19 @@ WindowSolveSummary InertialWindow::Solve() {
   }
   ceres::Problem problem(BorrowingProblem());
   impl_->Build(problem, options_, nullptr);
+  std::vector<std::unique_ptr<ceres::CostFunction>> holds;  // the gate's terms, for this solve only
+  const bool calibrating = options_.estimate_extrinsic_rotation || options_.estimate_extrinsic_translation ||
+                           options_.estimate_clock_offset || options_.estimate_elevation_bias;
+  const CalibrationObservation calibration =
+      calibrating ? impl_->HoldUnobserved(problem, options_, holds) : CalibrationObservation{};
   WindowSolveSummary summary =
       options_.solver == WindowSolver::kGaussNewton
           ? SolveWithGaussNewton(problem, impl_->VariableBlocks(options_), options_.max_iterations)
           : SolveWithCeres(problem, options_);
+  summary.calibration = calibration;
+  summary.calibration.radar_from_imu = radar_from_imu();
+  summary.calibration.clock_offset_value = impl_->clock_offset[0];
+  summary.calibration.elevation_bias_value = impl_->elevation_bias[0];
   summary.reintegrated = reintegrated;
   const bool held_after = options_.estimate_clock_offset && impl_->HoldClockOffsetInBounds();
   summary.clock_offset_held = std::exchange(impl_->clock_held, false) || held_after;

@@ -63,6 +63,24 @@ const OptionTable<InertialWindowOptions>& InertialWindowOptionTable() {
             .Help("the IMU's stamps minus the radar's clock (the start when estimated)"),
         RADARGAUSS_OPTION(O, "estimate_clock_offset", estimate_clock_offset)
             .Help("estimate the IMU-radar clock offset online"),
+        RADARGAUSS_OPTION(O, "calibration_gate", calibration_gate)
+            .Help("estimate a calibration only along the directions the motion observes, hold the rest"),
+        RADARGAUSS_OPTION(O, "observed_rotation_std", observed_rotation_std_deg)
+            .In(1e-6, 90.0)
+            .Unit("deg")
+            .Help("the extrinsic rotation's data std below which a direction counts as observed"),
+        RADARGAUSS_OPTION(O, "observed_translation_std", observed_translation_std)
+            .In(1e-6, 100.0)
+            .Unit("m")
+            .Help("the extrinsic translation's data std below which a direction counts as observed"),
+        RADARGAUSS_OPTION(O, "observed_clock_std", observed_clock_std)
+            .In(1e-6, 1.0)
+            .Unit("s")
+            .Help("the clock offset's data std below which it counts as observed"),
+        RADARGAUSS_OPTION(O, "observed_elevation_bias_std", observed_elevation_bias_std_deg)
+            .In(1e-6, 90.0)
+            .Unit("deg")
+            .Help("the elevation bias's data std below which it counts as observed"),
         RADARGAUSS_OPTION(O, "vehicle_motion_std", vehicle_motion_std)
             .AtLeast(0.0)
             .Unit("m/s")

@@ -60,6 +60,16 @@ struct InertialWindowOptions {
   // m/s: std of the IMU's lateral and vertical velocity in its own frame, a
   // ground vehicle's with the IMU aligned to it (VehicleMotionResidual); 0: no such term.
   double vehicle_motion_std = 0.0;
+  // Calibration only where the motion shows it (docs/design/solvers.md, "The
+  // calibration gate"): at each solve an estimated calibration block is
+  // held along the directions its data do not pin to within these stds.
+  // Off by default: on the simulated worlds it held the elevation bias and
+  // the clock where the free estimate found them (odometry's figures).
+  bool calibration_gate = false;
+  double observed_rotation_std_deg = 0.3;
+  double observed_translation_std = 0.05;  // m
+  double observed_clock_std = 0.003;       // s
+  double observed_elevation_bias_std_deg = 0.1;
 };
 
 // Its options (options.hpp), named window_*, imu_* (the noise) and estimate_*.
@@ -87,6 +97,18 @@ struct WindowUncertainty {
   double elevation_bias = 0.0;                                      // rad
 };
 
+// The estimated calibration at a solve: its value after it, its std before
+// it (the window's marginal, prior included) and how many of its
+// directions the data observed (the rest held; -1: not estimated).
+struct CalibrationObservation {
+  int extrinsic_rotation = -1, extrinsic_translation = -1, clock_offset = -1, elevation_bias = -1;
+  Eigen::Vector3d extrinsic_rotation_std = Eigen::Vector3d::Zero();     // rad, on the right of R_imu_radar
+  Eigen::Vector3d extrinsic_translation_std = Eigen::Vector3d::Zero();  // m
+  double clock_offset_std = 0.0, elevation_bias_std = 0.0;              // s, rad
+  SE3d radar_from_imu;
+  double clock_offset_value = 0.0, elevation_bias_value = 0.0;  // s, rad
+};
+
 struct WindowSolveSummary {
   int iterations = 0;
   double initial_cost = 0.0, final_cost = 0.0;
@@ -95,6 +117,7 @@ struct WindowSolveSummary {
   // The clock offset's estimate left its bounds (kMaxClockOffset, or the
   // IMU's data beyond the window's ends) and was held at the bound.
   bool clock_offset_held = false;
+  CalibrationObservation calibration;
   double time_ms = 0.0;
 };
 
