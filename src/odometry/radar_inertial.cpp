@@ -134,7 +134,7 @@ SE3d InertialMotion::Fuse(const ScanEstimate& e) {
 bool InertialMotion::OnProbation() const { return options_.health_check && !health_->fault() && !health_->confirmed(); }
 
 bool InertialMotion::Check(double stamp, const SE3d& radar_alone, bool matched) {
-  if (matched) health_->AddScan(stamp, radar_alone);
+  health_->AddScan(stamp, radar_alone, matched);
   if (!health_->fault()) return true;
   states_.push_back(std::nullopt);  // the scan is the radar's alone
   return false;
