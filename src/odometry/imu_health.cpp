@@ -5,18 +5,15 @@
 #include <cmath>
 #include <cstdio>
 
+#include "radargauss/core/stats.hpp"
+
 namespace radargauss {
 
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
+constexpr double kDegreesPerRadian = 180.0 / M_PI;
 
-double Median(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
-
-std::string Format(const char* format, double a, double b = 0.0) {
+std::string HealthCause(const char* format, double a, double b = 0.0) {
   char line[256];
   std::snprintf(line, sizeof line, format, a, b);
   return line;
@@ -53,12 +50,12 @@ ImuHealth::ImuHealth(const std::vector<ImuSample>& imu, const SO3d& radar_from_i
   mean /= n;
   const double magnitude = mean.norm();
   if (magnitude > 0.5 && magnitude < 1.5) {
-    fault_ =
-        ImuFault{imu.front().stamp - clock_offset,
-                 Format("the accelerometer reads %.2f against gravity's 9.81: it reads in g, not m/s^2", magnitude)};
+    fault_ = ImuFault{
+        imu.front().stamp - clock_offset,
+        HealthCause("the accelerometer reads %.2f against gravity's 9.81: it reads in g, not m/s^2", magnitude)};
   } else if (std::abs(magnitude - kGravity) > kGravityTolerance) {
     fault_ = ImuFault{imu.front().stamp - clock_offset,
-                      Format("the accelerometer reads %.2f m/s^2 at rest against gravity's 9.81", magnitude)};
+                      HealthCause("the accelerometer reads %.2f m/s^2 at rest against gravity's 9.81", magnitude)};
   }
 }
 
@@ -104,7 +101,7 @@ void ImuHealth::CheckTurns(double stamp, const SE3d& pose) {
   const Scan& old = recent_.front();
   if (stamp - old.stamp < kSpan || old.stamp < last_compared_) return;
   const Eigen::Vector3d radar = (old.pose.rotation().Inverse() * pose.rotation()).Log();
-  if (radar.norm() * kDeg < kMinTurnDeg) return;
+  if (radar.norm() * kDegreesPerRadian < kMinTurnDeg) return;
   const std::optional<SO3d> gyro_rotation = rates_.Rotation(old.stamp, stamp);
   if (!gyro_rotation) return;
   last_compared_ = stamp;
@@ -139,11 +136,12 @@ void ImuHealth::CheckTurns(double stamp, const SE3d& pose) {
       fault_ = ImuFault{stamp, clock->Cause(clock_offset_)};
       return;
     }
-    fault_ = ImuFault{stamp, Format("the gyro's turns differ from the radar's by %.2f of their angle: its axes, "
-                                    "its unit or the extrinsic rotation are wrong",
-                                    disagreement)};
+    fault_ = ImuFault{stamp, HealthCause("the gyro's turns differ from the radar's by %.2f of their angle: its axes, "
+                                         "its unit or the extrinsic rotation are wrong",
+                                         disagreement)};
   } else if (int(force_cosines_.size()) >= kMinTurns && Median(force_cosines_) < 0.0) {
-    fault_ = ImuFault{stamp, Format("the accelerometer's sign or axes are wrong: in the turns it reads against the "
+    fault_ =
+        ImuFault{stamp, HealthCause("the accelerometer's sign or axes are wrong: in the turns it reads against the "
                                     "radar's acceleration (median cosine %.2f)",
                                     Median(force_cosines_))};
   }
@@ -166,7 +164,8 @@ bool ImuHealth::ClockCorrelation::Off(double given) const {
 }
 
 std::string ImuHealth::ClockCorrelation::Cause(double given) const {
-  return Format("the IMU's clock is %.2f s off the radar's (given %.3f s): more than the window estimates", lag, given);
+  return HealthCause("the IMU's clock is %.2f s off the radar's (given %.3f s): more than the window estimates", lag,
+                     given);
 }
 
 std::optional<ImuHealth::ClockCorrelation> ImuHealth::CorrelateClocks() const {

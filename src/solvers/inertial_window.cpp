@@ -33,7 +33,7 @@ constexpr double kClockRelinearisation = 0.002;  // s
 constexpr double kClockPrior = 0.05;                            // s: held near its start until the drive turns
 constexpr double kExtrinsicRotationPrior = 3.0 * M_PI / 180.0;  // rad: a mounting is known to a few degrees
 constexpr double kElevationBiasPrior = 2.0 * M_PI / 180.0;      // rad: a radar's bias is a fraction of a degree
-constexpr double kDeg = M_PI / 180.0;
+constexpr double kRadiansPerDegree = M_PI / 180.0;
 
 // W with W^T W = information, for a positive semi-definite information.
 Eigen::MatrixXd SqrtInformation(const Eigen::MatrixXd& information) {
@@ -281,7 +281,7 @@ struct InertialWindow::Impl {
     };
     constexpr double kHold = 1e3;  // the held directions' weight: 1/1000 of their observed std
     if (options.estimate_extrinsic_rotation) {
-      const double needed = options.observed_rotation_std_deg * kDeg;
+      const double needed = options.observed_rotation_std_deg * kRadiansPerDegree;
       const BlockObservation o = observe(extrinsic_rotation.data(), 3, kExtrinsicRotationPrior, needed);
       result.extrinsic_rotation = 3 - int(o.unobserved.cols());
       result.extrinsic_rotation_std = o.std();
@@ -309,7 +309,7 @@ struct InertialWindow::Impl {
       }
     }
     if (options.estimate_elevation_bias) {
-      const double needed = options.observed_elevation_bias_std_deg * kDeg;
+      const double needed = options.observed_elevation_bias_std_deg * kRadiansPerDegree;
       const BlockObservation o = observe(elevation_bias, 1, kElevationBiasPrior, needed);
       result.elevation_bias = 1 - int(o.unobserved.cols());
       result.elevation_bias_std = o.std()(0);
