@@ -31,6 +31,7 @@ class MatchOptions(TypedDict, total=False):
     rotation_tolerance: float  # 0.0001
     coarse_translation_tolerance: float  # 0.01
     coarse_rotation_tolerance: float  # 0.001
+    pose_covariance: bool  # False
     gn_max_step_halvings: int  # 8
     gn_loss_curvature: bool  # False
     ceres_dogleg: bool  # False
@@ -157,6 +158,7 @@ class PlaceSearchOptions(TypedDict, total=False):
     verify_rotation_tolerance: float  # 0.0001
     verify_coarse_translation_tolerance: float  # 0.01
     verify_coarse_rotation_tolerance: float  # 0.001
+    verify_pose_covariance: bool  # False
     verify_gn_max_step_halvings: int  # 8
     verify_gn_loss_curvature: bool  # False
     verify_ceres_dogleg: bool  # False

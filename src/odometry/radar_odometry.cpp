@@ -95,6 +95,7 @@ RadarOdometry::RadarOdometry(const OdometryOptions& options, std::unique_ptr<Mot
       map_(options.map) {
   ValidateOptions(options_);
   motion_->Bind(options_.elevation_bias.estimate);
+  if (motion_->UsesMatchCovariance()) options_.match.matching.pose_covariance = true;
 }
 
 const ScanMatcher& RadarOdometry::MatcherForMap() {
@@ -203,7 +204,11 @@ bool RadarOdometry::RunBeside(const RadarScan& scan) {
     radar_alone_.reset();
     return false;
   }
-  if (!radar_alone_) radar_alone_ = std::make_unique<RadarOdometry>(options_, nullptr, factory_);
+  if (!radar_alone_) {
+    OdometryOptions alone = options_;
+    alone.match.matching.pose_covariance = false;  // the constant-velocity model reads no covariance
+    radar_alone_ = std::make_unique<RadarOdometry>(alone, nullptr, factory_);
+  }
   const OdometryStep& alone = radar_alone_->Register(scan);
   if (motion_->Check(alone.stamp, alone.pose, alone.matched)) return false;
   // The model failed: the radar alone's run goes on as this one, the model kept for its record.

@@ -120,7 +120,7 @@ void CoarseToFine::FinishCounts(ScanMatchingResult& result) const {
       last_is_final && c.index == &map.index() && evaluated_.known && SamePose(evaluated_.pose, result.pose);
   result.final_cost = known ? evaluated_.cost : EvaluateCost(final_c, result.pose, options, priors);
   result.information = InformationMatrix(final_c, result.pose, options);
-  result.covariance = MatchCovariance(final_c, result.pose, options);
+  if (options.pose_covariance) result.covariance = MatchCovariance(final_c, result.pose, options);
   if (priors.velocity && priors.velocity->weight > 0.0) {
     const Eigen::Matrix3d J = priors.velocity->Jacobian();
     result.velocity_information.block<3, 3>(kTranslationOffset, kTranslationOffset) =

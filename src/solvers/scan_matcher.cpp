@@ -86,6 +86,8 @@ const OptionTable<ScanMatchingOptions>& ScanMatchingOptionTable() {
           .Above(0.0)
           .Unit("rad")
           .Help("the same on coarse levels"),
+      RADARGAUSS_OPTION(O, "pose_covariance", pose_covariance)
+          .Help("also state the pose's covariance from the residuals' own spread"),
   };
   return table;
 }

@@ -253,6 +253,7 @@ TEST(MatchCovariance, PredictsTheSpreadOfThePoseOverNoiseDraws) {
   options.gate = 6.0;
   options.translation_tolerance = 1e-7;
   options.rotation_tolerance = 1e-8;
+  options.pose_covariance = true;
   const GaussNewtonSolver solver(options);
   constexpr double kPointNoise = 0.08;  // m
   for (const double shared : {0.0, 0.06}) {

@@ -62,6 +62,9 @@ class MotionModel {
   // Called once by the odometry that takes the model: whether it estimates
   // an elevation bias (the inertial window then estimates it instead).
   virtual void Bind(bool /*estimate_elevation_bias*/) {}
+  // Whether Fuse reads ScanEstimate::covariance (the odometry then asks the
+  // matcher for it: ScanMatchingOptions::pose_covariance).
+  virtual bool UsesMatchCovariance() const { return false; }
   // The scan at `stamp` arrives: the model brings its sources up to it.
   virtual void Advance(double /*stamp*/) {}
   // The elevation bias (rad) to remove from the scan; none: the odometry's own estimate.

@@ -66,6 +66,9 @@ struct ScanMatchingOptions {
   double rotation_tolerance = 1e-4;            // rad ... in both parts, on the exact map
   double coarse_translation_tolerance = 1e-2;  // m: the same on coarse levels, which
   double coarse_rotation_tolerance = 1e-3;     // rad only steer into the exact map's basin
+  // Also state ScanMatchingResult::covariance (MatchCovariance): one more
+  // pass over the final residuals, which a match that only needs its pose skips.
+  bool pose_covariance = false;
 };
 
 // Its options (options.hpp); ValidateOptions throws std::invalid_argument naming the bad one.
@@ -90,8 +93,9 @@ struct ScanMatchingResult {
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
   // The pose's covariance over the same tangent from the geometric
   // residuals' own spread (MatchCovariance, normal_equations.hpp): what the
-  // match knows of the pose against this map. Zero when no match was made
-  // or too few Gaussians were matched.
+  // match knows of the pose against this map. Zero unless asked for
+  // (ScanMatchingOptions::pose_covariance), no match was made or too few
+  // Gaussians were matched.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   // The velocity prior's Gauss-Newton matrix, weight J^T J on the translation
   // block (zero without the prior), kept apart from eq. 2's.
