@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/solvers/calibration_gate.hpp"
 
+#include <algorithm>
+#include <stdexcept>
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
 #include "radargauss/residuals/priors.hpp"
 #include "radargauss/residuals/rotation_residual.hpp"
+#include "radargauss/solvers/marginalization.hpp"
 
 namespace radargauss {
 
@@ -72,6 +76,37 @@ std::unique_ptr<ceres::CostFunction> HoldRotationAlong(const SO3d& anchor, const
   prior.predicted = anchor;
   prior.sqrt_information = weight * directions * directions.transpose();
   return std::make_unique<RotationCostFunction>(prior);
+}
+
+std::vector<BlockObservation> GateCalibration(ceres::Problem& problem, const std::vector<double*>& blocks,
+                                              const std::vector<GatedBlock>& gated, bool hold,
+                                              std::vector<std::unique_ptr<ceres::CostFunction>>& holds) {
+  std::vector<int> offset;
+  const Eigen::MatrixXd H = GaussNewtonMatrix(problem, blocks, offset);
+  std::vector<BlockObservation> observations;
+  for (const GatedBlock& g : gated) {
+    const std::size_t b = std::find(blocks.begin(), blocks.end(), g.data) - blocks.begin();
+    if (b == blocks.size()) throw std::invalid_argument("GateCalibration: a gated block is not a variable block");
+    CalibrationBlock block;
+    block.offset = offset[b];
+    block.size = g.size;
+    block.prior_information =
+        Eigen::MatrixXd::Identity(g.size, g.size) * (g.prior_std > 0.0 ? 1.0 / (g.prior_std * g.prior_std) : 0.0);
+    block.observed_std = g.observed_std;
+    observations.push_back(ObserveBlock(H, block));
+  }
+  if (!hold) return observations;
+  constexpr double kHold = 1e3;  // the held directions' weight: 1/1000 of their observed std
+  for (std::size_t k = 0; k < gated.size(); ++k) {
+    const GatedBlock& g = gated[k];
+    const Eigen::MatrixXd& unobserved = observations[k].unobserved;
+    if (unobserved.cols() == 0) continue;
+    holds.push_back(
+        g.rotation ? HoldRotationAlong(SO3d::FromXyzw(g.data), unobserved, kHold / g.observed_std)
+                   : HoldAlong(Eigen::Map<const Eigen::VectorXd>(g.data, g.size), unobserved, kHold / g.observed_std));
+    problem.AddResidualBlock(holds.back().get(), nullptr, g.data);
+  }
+  return observations;
 }
 
 }  // namespace radargauss

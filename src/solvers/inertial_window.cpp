@@ -7,7 +7,6 @@
 #include <stdexcept>
 #include <utility>
 
-#include <ceres/crs_matrix.h>
 #include <ceres/problem.h>
 
 #include <Eigen/Cholesky>
@@ -241,81 +240,50 @@ struct InertialWindow::Impl {
     if (oldest_terms != nullptr) *oldest_terms = ids;
   }
 
-  // The window's Gauss-Newton matrix over VariableBlocks' tangent, and each block's first column.
-  Eigen::MatrixXd Information(ceres::Problem& problem, const std::vector<double*>& blocks,
-                              std::vector<int>& offset) const {
-    ceres::Problem::EvaluateOptions evaluate;
-    evaluate.parameter_blocks = blocks;
-    ceres::CRSMatrix crs;
-    problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
-    offset.assign(blocks.size() + 1, 0);
-    for (std::size_t b = 0; b < blocks.size(); ++b) {
-      const ceres::Manifold* manifold = problem.GetManifold(blocks[b]);
-      offset[b + 1] = offset[b] + (manifold ? manifold->TangentSize() : problem.ParameterBlockSize(blocks[b]));
-    }
-    const Eigen::MatrixXd J = DenseJacobian(crs);
-    return J.transpose() * J;
-  }
-
   // The calibration gate: each estimated calibration block's observation,
-  // and a term in `problem` holding it along what the data do not observe.
-  CalibrationObservation HoldUnobserved(ceres::Problem& problem, const InertialWindowOptions& options,
-                                        std::vector<std::unique_ptr<ceres::CostFunction>>& holds) {
+  // and with options.calibration_gate a term in `problem` holding it along
+  // what the data do not observe.
+  CalibrationObservation ObserveCalibration(ceres::Problem& problem, const InertialWindowOptions& options,
+                                            std::vector<std::unique_ptr<ceres::CostFunction>>& holds) {
     CalibrationObservation result;
-    const std::vector<double*> blocks = VariableBlocks(options);
-    std::vector<int> offset;
-    const Eigen::MatrixXd H = Information(problem, blocks, offset);
-    const auto observe = [&](double* data, int size, double prior_std, double observed_std) {
-      const std::size_t b = std::find(blocks.begin(), blocks.end(), data) - blocks.begin();
-      CalibrationBlock block;
-      block.offset = offset[b];
-      block.size = size;
-      block.prior_information =
-          Eigen::MatrixXd::Identity(size, size) * (prior_std > 0.0 ? 1.0 / (prior_std * prior_std) : 0.0);
-      block.observed_std = observed_std;
-      return ObserveBlock(H, block);
+    struct Estimated {
+      bool on;
+      GatedBlock block;
+      int* directions;  // where the result goes
+      double* std;
     };
-    const auto hold = [&](std::unique_ptr<ceres::CostFunction> term, double* data) {
-      holds.push_back(std::move(term));
-      problem.AddResidualBlock(holds.back().get(), nullptr, data);
+    const Estimated table[] = {
+        {options.estimate_extrinsic_rotation,
+         {extrinsic_rotation.data(), 3, true, kExtrinsicRotationPrior,
+          options.observed_rotation_std_deg * kRadiansPerDegree},
+         &result.extrinsic_rotation,
+         result.extrinsic_rotation_std.data()},
+        {options.estimate_extrinsic_translation,
+         {extrinsic_translation.data(), 3, false, 0.0, options.observed_translation_std},
+         &result.extrinsic_translation,
+         result.extrinsic_translation_std.data()},
+        {options.estimate_clock_offset,
+         {clock_offset, 1, false, kClockPrior, options.observed_clock_std},
+         &result.clock_offset,
+         &result.clock_offset_std},
+        {options.estimate_elevation_bias,
+         {elevation_bias, 1, false, kElevationBiasPrior, options.observed_elevation_bias_std_deg * kRadiansPerDegree},
+         &result.elevation_bias,
+         &result.elevation_bias_std},
     };
-    constexpr double kHold = 1e3;  // the held directions' weight: 1/1000 of their observed std
-    if (options.estimate_extrinsic_rotation) {
-      const double needed = options.observed_rotation_std_deg * kRadiansPerDegree;
-      const BlockObservation o = observe(extrinsic_rotation.data(), 3, kExtrinsicRotationPrior, needed);
-      result.extrinsic_rotation = 3 - int(o.unobserved.cols());
-      result.extrinsic_rotation_std = o.std();
-      if (!o.observed() && options.calibration_gate) {
-        hold(HoldRotationAlong(SO3d::FromXyzw(extrinsic_rotation.data()), o.unobserved, kHold / needed),
-             extrinsic_rotation.data());
-      }
+    std::vector<GatedBlock> gated;
+    std::vector<const Estimated*> estimated;
+    for (const Estimated& e : table) {
+      if (!e.on) continue;
+      gated.push_back(e.block);
+      estimated.push_back(&e);
     }
-    if (options.estimate_extrinsic_translation) {
-      const BlockObservation o = observe(extrinsic_translation.data(), 3, 0.0, options.observed_translation_std);
-      result.extrinsic_translation = 3 - int(o.unobserved.cols());
-      result.extrinsic_translation_std = o.std();
-      if (!o.observed() && options.calibration_gate) {
-        hold(HoldAlong(extrinsic_translation, o.unobserved, kHold / options.observed_translation_std),
-             extrinsic_translation.data());
-      }
-    }
-    if (options.estimate_clock_offset) {
-      const BlockObservation o = observe(clock_offset, 1, kClockPrior, options.observed_clock_std);
-      result.clock_offset = 1 - int(o.unobserved.cols());
-      result.clock_offset_std = o.std()(0);
-      if (!o.observed() && options.calibration_gate) {
-        hold(HoldAlong(Eigen::VectorXd::Constant(1, clock_offset[0]), o.unobserved, kHold / options.observed_clock_std),
-             clock_offset);
-      }
-    }
-    if (options.estimate_elevation_bias) {
-      const double needed = options.observed_elevation_bias_std_deg * kRadiansPerDegree;
-      const BlockObservation o = observe(elevation_bias, 1, kElevationBiasPrior, needed);
-      result.elevation_bias = 1 - int(o.unobserved.cols());
-      result.elevation_bias_std = o.std()(0);
-      if (!o.observed() && options.calibration_gate) {
-        hold(HoldAlong(Eigen::VectorXd::Constant(1, elevation_bias[0]), o.unobserved, kHold / needed), elevation_bias);
-      }
+    const std::vector<BlockObservation> observed =
+        GateCalibration(problem, VariableBlocks(options), gated, options.calibration_gate, holds);
+    for (std::size_t k = 0; k < estimated.size(); ++k) {
+      const int size = estimated[k]->block.size;
+      *estimated[k]->directions = size - int(observed[k].unobserved.cols());
+      Eigen::Map<Eigen::VectorXd>(estimated[k]->std, size) = observed[k].std();
     }
     return result;
   }
@@ -503,7 +471,7 @@ WindowSolveSummary InertialWindow::Solve() {
   const bool calibrating = options_.estimate_extrinsic_rotation || options_.estimate_extrinsic_translation ||
                            options_.estimate_clock_offset || options_.estimate_elevation_bias;
   const CalibrationObservation calibration =
-      calibrating ? impl_->HoldUnobserved(problem, options_, holds) : CalibrationObservation{};
+      calibrating ? impl_->ObserveCalibration(problem, options_, holds) : CalibrationObservation{};
   WindowSolveSummary summary =
       options_.solver == WindowSolver::kGaussNewton
           ? SolveWithGaussNewton(problem, impl_->VariableBlocks(options_), options_.max_iterations)
@@ -523,19 +491,10 @@ WindowUncertainty InertialWindow::Uncertainty() const {
   if (impl_->nodes.empty()) throw std::logic_error("InertialWindow::Uncertainty before Start");
   ceres::Problem problem(BorrowingProblem());
   impl_->Build(problem, options_, nullptr);
-  const std::vector<double*> blocks = impl_->VariableBlocks(options_);
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.parameter_blocks = blocks;
-  ceres::CRSMatrix crs;
-  problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
-  const Eigen::MatrixXd J = DenseJacobian(crs);
-  const Eigen::MatrixXd covariance = (J.transpose() * J).completeOrthogonalDecomposition().pseudoInverse();
-  // The tangent offset of each block, in VariableBlocks' order.
-  std::vector<int> offset(blocks.size() + 1, 0);
-  for (std::size_t b = 0; b < blocks.size(); ++b) {
-    const ceres::Manifold* manifold = problem.GetManifold(blocks[b]);
-    offset[b + 1] = offset[b] + (manifold ? manifold->TangentSize() : problem.ParameterBlockSize(blocks[b]));
-  }
+  std::vector<int> offset;
+  const Eigen::MatrixXd covariance = GaussNewtonMatrix(problem, impl_->VariableBlocks(options_), offset)
+                                         .completeOrthogonalDecomposition()
+                                         .pseudoInverse();
   const auto std_of = [&](std::size_t block, int first, int n) {
     Eigen::VectorXd s(n);
     for (int i = 0; i < n; ++i)

@@ -77,6 +77,21 @@ Eigen::MatrixXd DenseJacobian(const ceres::CRSMatrix& crs) {
   return J;
 }
 
+Eigen::MatrixXd GaussNewtonMatrix(ceres::Problem& problem, const std::vector<double*>& blocks,
+                                  std::vector<int>& offset) {
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = blocks;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+  offset.assign(blocks.size() + 1, 0);
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const ceres::Manifold* manifold = problem.GetManifold(blocks[b]);
+    offset[b + 1] = offset[b] + (manifold ? manifold->TangentSize() : problem.ParameterBlockSize(blocks[b]));
+  }
+  const Eigen::MatrixXd J = DenseJacobian(crs);
+  return J.transpose() * J;
+}
+
 namespace {
 
 int TangentSize(const ceres::Problem& problem, double* block) {

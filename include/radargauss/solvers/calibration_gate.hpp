@@ -6,8 +6,10 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include <ceres/cost_function.h>
+#include <ceres/problem.h>
 #include <Eigen/Core>
 
 #include "radargauss/lie/so3.hpp"
@@ -36,6 +38,24 @@ struct BlockObservation {
   bool observed() const { return unobserved.cols() == 0; }
 };
 BlockObservation ObserveBlock(const Eigen::MatrixXd& information, const CalibrationBlock& block);
+
+// One estimated calibration block of a window: its parameters, the std of
+// its first-state prior (0: none) and the std below which a direction
+// counts as observed.
+struct GatedBlock {
+  double* data = nullptr;
+  int size = 0;
+  bool rotation = false;  // x y z w with a right perturbation; else Euclidean
+  double prior_std = 0.0;
+  double observed_std = 0.0;
+};
+// Each gated block's observation in `problem`, whose variable blocks are
+// `blocks` in the order of its Gauss-Newton matrix; with `hold`, a term
+// added to `problem` (owned by `holds`, for one solve) holds each block along
+// its unobserved directions at 1/1000 of its observed_std.
+std::vector<BlockObservation> GateCalibration(ceres::Problem& problem, const std::vector<double*>& blocks,
+                                              const std::vector<GatedBlock>& gated, bool hold,
+                                              std::vector<std::unique_ptr<ceres::CostFunction>>& holds);
 
 // r = w P (x - anchor) with P = V V^T: holds a Euclidean block at `anchor`
 // along the columns of V (orthonormal), free across them.

@@ -52,6 +52,10 @@ class MarginalizationPrior final : public ceres::CostFunction {
 
 // The Jacobian Ceres's Problem::Evaluate gives (tangent columns), dense.
 Eigen::MatrixXd DenseJacobian(const ceres::CRSMatrix& crs);
+// J^T J of `problem` over the tangent of `blocks` (its variable blocks, in
+// this order); offset[b] is block b's first column, offset.back() the size.
+Eigen::MatrixXd GaussNewtonMatrix(ceres::Problem& problem, const std::vector<double*>& blocks,
+                                  std::vector<int>& offset);
 
 // The prior left by removing `leaving` and the residual blocks `factors` (all
 // those of `problem` that touch `leaving`, and maybe more) from `problem`,
