@@ -61,7 +61,7 @@ ImuHealth::ImuHealth(const std::vector<ImuSample>& imu, const SO3d& radar_from_i
 
 void ImuHealth::AddScan(double stamp, const SE3d& pose, bool matched) {
   if (fault_ || confirmed_at_) return;
-  if (!first_scan_) first_scan_ = stamp;
+  if (!probation_start_) probation_start_ = stamp;
   if (!matched) {
     recent_.clear();  // a span must be matched throughout
   } else {
@@ -73,7 +73,7 @@ void ImuHealth::AddScan(double stamp, const SE3d& pose, bool matched) {
   }
   if (fault_) return;
   verified_ = clock_checked_ && turns_ >= kMinTurns && int(force_cosines_.size()) >= kMinTurns;
-  if (verified_ || stamp - *first_scan_ > kMaxProbation) confirmed_at_ = stamp;
+  if (verified_ || stamp - *probation_start_ > kMaxProbation) confirmed_at_ = stamp;
 }
 
 // The IMU's mean specific force over [a, b] on the radar's clock, in the radar's frame.
@@ -95,7 +95,7 @@ std::optional<Eigen::Vector3d> ImuHealth::MeanForce(double a, double b) const {
 // the window estimated could hide a wrong axis), and the radar's
 // acceleration against what the specific force gained over its mean.
 void ImuHealth::CheckTurns(double stamp, const SE3d& pose) {
-  if (!first_scan_stamp_) first_scan_stamp_ = stamp;
+  if (!first_matched_) first_matched_ = stamp;
   recent_.push_back({stamp, pose});
   while (recent_.size() > 2 && recent_[1].stamp <= stamp - kSpan) recent_.pop_front();
   const Scan& old = recent_.front();
@@ -115,7 +115,7 @@ void ImuHealth::CheckTurns(double stamp, const SE3d& pose) {
     return std::abs(a.stamp - 0.5 * (old.stamp + stamp)) < std::abs(b.stamp - 0.5 * (old.stamp + stamp));
   });
   const std::optional<Eigen::Vector3d> span_force = MeanForce(old.stamp, stamp);
-  const std::optional<Eigen::Vector3d> all_force = MeanForce(*first_scan_stamp_, stamp);
+  const std::optional<Eigen::Vector3d> all_force = MeanForce(*first_matched_, stamp);
   if (middle.stamp > old.stamp && middle.stamp < stamp && span_force && all_force) {
     const Eigen::Vector3d v1 = (middle.pose.translation() - old.pose.translation()) / (middle.stamp - old.stamp);
     const Eigen::Vector3d v2 = (pose.translation() - middle.pose.translation()) / (stamp - middle.stamp);

@@ -34,7 +34,6 @@ class ImuHealth {
   static constexpr double kSpan = 1.0;                 // s: rotations compared over this
   static constexpr double kMinTurnDeg = 6.0;           // a span turning less is not compared
   static constexpr double kMaxDisagreement = 0.25;     // |w_gyro - w_radar| summed over the turns, per turned
-  static constexpr double kMaxRateRatio = 1.4;         // median ratio of their angles, either way
   static constexpr int kMinTurns = 5;                  // spans compared before judging
   static constexpr double kLagSearch = 1.5;            // s: the clock offsets the cross-correlation tries
   static constexpr double kMinHistory = 20.0;          // s of scans before the clocks are compared
@@ -83,9 +82,10 @@ class ImuHealth {
   int turns_ = 0;
   double disagreement_ = 0.0, turned_ = 0.0;  // sum |w_gyro - w_radar|, sum |w_radar| (rad)
   std::vector<double> force_cosines_;
-  std::optional<double> first_scan_stamp_;
   bool clock_checked_ = false;
-  std::optional<double> first_scan_, confirmed_at_;
+  std::optional<double> probation_start_;  // the first scan's stamp
+  std::optional<double> first_matched_;    // the first matched scan's: the specific force's mean from here
+  std::optional<double> confirmed_at_;
   bool verified_ = false;
   std::optional<ImuFault> fault_;
 };
