@@ -10,20 +10,13 @@
 #include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/simulator/simulator.hpp"
+#include "support/inertial_drive.hpp"
 
 namespace radargauss {
 namespace {
 
 // 30 s of the demo world (two corners), an IMU at 200 Hz.
-const SimulatedSequence& Drive() {
-  static const SimulatedSequence* sequence = [] {
-    SimulationConfig config;
-    config.scans = 300;
-    config.imu_rate_hz = 200.0;
-    return new SimulatedSequence(Simulate(config));
-  }();
-  return *sequence;
-}
+const SimulatedSequence& Drive() { return testing::DemoDriveWithImu(300); }
 
 struct Outcome {
   double rpe = 0.0;

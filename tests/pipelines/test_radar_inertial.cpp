@@ -12,20 +12,13 @@
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/simulator/simulator.hpp"
 #include "radargauss/slam/radar_slam.hpp"
+#include "support/inertial_drive.hpp"
 
 namespace radargauss {
 namespace {
 
-// 20 s of the demo world (its attitude wobble and elevation noise), an IMU at 200 Hz.
-const SimulatedSequence& Drive() {
-  static const SimulatedSequence* sequence = [] {
-    SimulationConfig config;
-    config.scans = 200;
-    config.imu_rate_hz = 200.0;
-    return new SimulatedSequence(Simulate(config));
-  }();
-  return *sequence;
-}
+// 20 s of the demo world, an IMU at 200 Hz.
+const SimulatedSequence& Drive() { return testing::DemoDriveWithImu(200); }
 
 // The radar odometry with the inertial window as its motion model.
 RadarOdometry WindowOdometry(const OdometryOptions& odometry, const RadarInertialOptions& options,
