@@ -25,6 +25,7 @@ Subcommand AddConvert(CLI::App& parent);
 Subcommand AddExport(CLI::App& parent);
 Subcommand AddMerge(CLI::App& parent);
 Subcommand AddSimulate(CLI::App& parent);
+Subcommand AddSimulateImu(CLI::App& parent);
 Subcommand AddBuildMap(CLI::App& parent);
 Subcommand AddMapInfo(CLI::App& parent);
 Subcommand AddLocalize(CLI::App& parent);

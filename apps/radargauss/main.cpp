@@ -62,10 +62,10 @@ int main(int argc, char** argv) {
   argv = args.data();
   CLI::App app{"radargauss: 4D radar Gaussian-RCS maps and scan matching"};
   app.require_subcommand(1);
-  const std::vector<Subcommand> subcommands = {AddInfo(app),     AddSimulate(app),   AddBuildMap(app), AddMapInfo(app),
-                                               AddLocalize(app), AddEvaluate(app),   AddRefine(app),   AddOdometry(app),
-                                               AddSlam(app),     AddRelocalize(app), AddMerge(app),    AddConvert(app),
-                                               AddExport(app)};
+  const std::vector<Subcommand> subcommands = {
+      AddInfo(app),       AddSimulate(app), AddSimulateImu(app), AddBuildMap(app), AddMapInfo(app),
+      AddLocalize(app),   AddEvaluate(app), AddRefine(app),      AddOdometry(app), AddSlam(app),
+      AddRelocalize(app), AddMerge(app),    AddConvert(app),     AddExport(app)};
   std::vector<std::string> names;
   for (const Subcommand& command : subcommands) names.push_back(command.app->get_name());
   int threads = 0;

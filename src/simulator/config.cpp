@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The simulator's configuration file and outputs.
 #include "radargauss/simulator/simulator.hpp"
+#include "radargauss/simulator/imu_from_reference.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -306,43 +307,6 @@ Sequence AsSequence(const SimulatedSequence& simulated) {
   return sequence;
 }
 
-namespace {
-
-// imu.txt, imu_extrinsic.txt and imu_biases.txt of docs/design/simulator.md, "The synthetic world".
-void WriteSimulatedImu(const std::string& dir, const SimulatedSequence& sequence) {
-  namespace fs = std::filesystem;
-  WriteFileAtomically((fs::path(dir) / "imu.txt").string(), [&](std::ostream& out) {
-    out << "# stamp wx wy wz ax ay az (s, rad/s, m/s^2; the IMU's frame)\n";
-    char line[256];
-    for (const ImuSample& s : sequence.imu) {
-      std::snprintf(line, sizeof(line), "%.9f %.17g %.17g %.17g %.17g %.17g %.17g\n", s.stamp, s.angular_velocity.x(),
-                    s.angular_velocity.y(), s.angular_velocity.z(), s.specific_force.x(), s.specific_force.y(),
-                    s.specific_force.z());
-      out << line;
-    }
-  });
-  WriteFileAtomically((fs::path(dir) / "imu_extrinsic.txt").string(), [&](std::ostream& out) {
-    const Eigen::Vector3d& t = sequence.radar_from_imu.translation();
-    const Eigen::Quaterniond& q = sequence.radar_from_imu.rotation().quaternion();
-    char line[256];
-    std::snprintf(line, sizeof(line), "%.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", t.x(), t.y(), t.z(), q.x(), q.y(),
-                  q.z(), q.w());
-    out << "# x y z qx qy qz qw: T_radar_imu\n" << line;
-  });
-  WriteFileAtomically((fs::path(dir) / "imu_biases.txt").string(), [&](std::ostream& out) {
-    out << "# stamp bgx bgy bgz bax bay baz: the true biases (rad/s, m/s^2), for evaluation only\n";
-    char line[256];
-    for (std::size_t k = 0; k < sequence.imu.size(); ++k) {
-      const ImuBias& b = sequence.imu_bias[k];
-      std::snprintf(line, sizeof(line), "%.9f %.9g %.9g %.9g %.9g %.9g %.9g\n", sequence.imu[k].stamp, b.gyro.x(),
-                    b.gyro.y(), b.gyro.z(), b.accel.x(), b.accel.y(), b.accel.z());
-      out << line;
-    }
-  });
-}
-
-}  // namespace
-
 void WriteSimulatedSequence(const std::string& dir, const SimulatedSequence& sequence) {
   namespace fs = std::filesystem;
   const fs::path points = fs::path(dir) / "ars548" / "points";
@@ -357,7 +321,7 @@ void WriteSimulatedSequence(const std::string& dir, const SimulatedSequence& seq
   }
   WriteFileAtomically((points / "times.txt").string(), [&](std::ostream& out) { out << times; });
   WriteTum((fs::path(dir) / "gt_radar_tum.txt").string(), sequence.ground_truth);
-  if (!sequence.imu.empty()) WriteSimulatedImu(dir, sequence);
+  if (!sequence.imu.empty()) WriteImuFiles(dir, {sequence.imu, sequence.imu_bias}, sequence.radar_from_imu);
   WriteFileAtomically((fs::path(dir) / "simulation.yaml").string(), [&](std::ostream& out) {
     out << "# radargauss simulate: the configuration that produced this sequence\n"
         << SimulationConfigToYaml(sequence.config);

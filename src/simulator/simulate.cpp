@@ -7,6 +7,7 @@
 #include <random>
 
 #include "radargauss/simulator/simulator.hpp"
+#include "radargauss/simulator/imu_from_reference.hpp"
 #include "scene.hpp"
 
 namespace radargauss {
@@ -178,54 +179,22 @@ struct ScanStamp {
   double since_start = 0.0;
 };
 
-// The IMU's samples over the drive (docs/design/simulator.md, "The synthetic world"):
-// the IMU frame's mean rate and specific force over the interval from each
-// sample to the next (delta angle and delta velocity over dt), plus turn-on biases, their random walks and white noise,
-// drawn from a generator of their own so that the scans are the same with an
-// IMU or without.
+// The IMU's samples over the drive (docs/design/simulator.md, "The synthetic
+// world"): the model of SimulateImuAlong on the vehicle's path.
 void SimulateImu(const SimulationConfig& config, const simulation::LoopPath& path, const SE3d& vehicle_from_radar,
                  SimulatedSequence& sequence) {
-  const SE3d vehicle_from_imu(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, config.imu_yaw_deg * kDeg)) *
-                                  SO3d::Exp(Eigen::Vector3d(0.0, config.imu_pitch_deg * kDeg, 0.0)) *
-                                  SO3d::Exp(Eigen::Vector3d(config.imu_roll_deg * kDeg, 0.0, 0.0)),
-                              Eigen::Vector3d(config.imu_x, config.imu_y, config.imu_z));
+  const SE3d vehicle_from_imu = ImuOnVehicle(config);
   sequence.radar_from_imu = vehicle_from_radar.Inverse() * vehicle_from_imu;
-  std::mt19937 rng(config.seed ^ 0x9e3779b9u);
-  std::normal_distribution<double> normal;
-  const auto draw = [&](double std) -> Eigen::Vector3d {
-    return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)) * std;
-  };
-  ImuBias bias{draw(config.imu_gyro_bias_std), draw(config.imu_accel_bias_std)};
-  const double dt = 1.0 / config.imu_rate_hz;
-  const double h = 1e-3;
-  const Eigen::Vector3d gravity(0.0, 0.0, -kGravity);
-  const auto imu_pose = [&](double t) {
-    SE3d pose;
-    Eigen::Vector3d velocity;
-    SensorState(config, path, t, pose, velocity);
-    return pose * vehicle_from_imu;
-  };
-  // The IMU frame's velocity by central differences (h): continuous except
-  // where the path's curvature steps and the IMU sits off the vehicle's origin.
-  const auto imu_velocity = [&](double t) -> Eigen::Vector3d {
-    return (imu_pose(t + h).translation() - imu_pose(t - h).translation()) / (2.0 * h);
-  };
-  const std::size_t count = ImuSampleCount(config);
-  for (std::size_t k = 0; k < count; ++k) {
-    const double t = double(k) * dt;
-    const SE3d at = imu_pose(t), next = imu_pose(t + dt);
-    const Eigen::Vector3d rate = (at.rotation().Inverse() * next.rotation()).Log() / dt;
-    const Eigen::Vector3d acceleration = (imu_velocity(t + dt) - imu_velocity(t)) / dt;
-    ImuSample sample;
-    sample.stamp = config.start_time + t + config.imu_clock_offset;
-    sample.angular_velocity = rate + bias.gyro + draw(config.imu_noise.gyro_noise_density / std::sqrt(dt));
-    sample.specific_force = at.rotation().Inverse() * (acceleration - gravity) + bias.accel +
-                            draw(config.imu_noise.accel_noise_density / std::sqrt(dt));
-    sequence.imu.push_back(sample);
-    sequence.imu_bias.push_back(bias);
-    bias.gyro += draw(config.imu_noise.gyro_bias_random_walk * std::sqrt(dt));
-    bias.accel += draw(config.imu_noise.accel_bias_random_walk * std::sqrt(dt));
-  }
+  SimulatedImu imu = SimulateImuAlong(
+      [&](double t) {
+        SE3d pose;
+        Eigen::Vector3d velocity;
+        SensorState(config, path, t, pose, velocity);
+        return pose * vehicle_from_imu;
+      },
+      ImuSampleCount(config), config);
+  sequence.imu = std::move(imu.samples);
+  sequence.imu_bias = std::move(imu.bias);
 }
 
 ScanStamp TimeOfScan(const SimulationConfig& config, int k) {

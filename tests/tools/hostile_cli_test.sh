@@ -251,6 +251,14 @@ for args in "odometry" "slam" "relocalize --map $work/slam/map.rgm" "localize --
 done
 expect_fail "evaluate into a sticky shared folder" "shared: is a shared folder (sticky bit" -- \
   "$tool" evaluate --est "$work/seq/gt_radar_tum.txt" --ref "$work/seq/gt_radar_tum.txt" --out "$work/shared"
+# An IMU from a reference: one too short to smooth, one that is not TUM.
+expect_fail "simulate-imu on a reference too short" "a smooth motion needs four" -- \
+  "$tool" simulate-imu --gt "$work/seq/gt_radar_tum.txt" --out "$work/imu_short"
+printf '0 0 0 0 0 0 0 1\nnot a pose\n' >"$work/not_tum.txt"
+expect_fail "simulate-imu on a reference that is not TUM" "not_tum.txt" -- \
+  "$tool" simulate-imu --gt "$work/not_tum.txt" --out "$work/imu_bad"
+[ ! -e "$work/imu_short/imu.txt" ] && [ ! -e "$work/imu_bad/imu.txt" ] ||
+  { echo "FAIL: simulate-imu left an imu.txt behind a refusal"; failed=$((failed + 1)); }
 expect_fail "simulate into a sticky shared folder" "shared: is a shared folder (sticky bit" -- \
   "$tool" simulate --scans 2 --out "$work/shared"
 [ -z "$(ls -A "$work/shared")" ] || { echo "FAIL: a refused run wrote into the shared folder"; failed=$((failed + 1)); }

@@ -93,6 +93,9 @@ def main():
     subprocess.run([tool, "simulate", "--out", sequence, "--scans", "6", "--seed", "2"], check=True,
                    stdout=subprocess.DEVNULL)
     gt = os.path.join(sequence, "gt_radar_tum.txt")
+    drive = os.path.join(work, "drive_tum.txt")  # 4 s, long enough for simulate-imu's default knots
+    with open(drive, "w") as out:
+        out.writelines("%.2f %.2f 0 0 0 0 0 1\n" % (0.1 * k, 0.6 * k) for k in range(41))
     world_map = os.path.join(work, "world.rgm")
     subprocess.run([tool, "build-map", "--sequence", sequence, "--gt", gt, "--out", world_map], check=True,
                    stdout=subprocess.DEVNULL)
@@ -110,6 +113,7 @@ def main():
                    "--out", os.path.join(work, "f")],
         "evaluate": ["--est", gt, "--ref", gt, "--out", os.path.join(work, "e")],
         "simulate": ["--out", os.path.join(work, "sim"), "--force"],
+        "simulate-imu": ["--gt", drive, "--out", os.path.join(work, "imu"), "--force"],
     }
     passed, failures = 0, []
     lock, runs = threading.Lock(), itertools.count()
