@@ -2,6 +2,7 @@
 // Odometry's outputs (docs/cli.md, "odometry").
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
 #include <optional>
 #include <system_error>
@@ -155,11 +156,57 @@ nlohmann::json WindowSolves(const InertialMotion& inertial) {
           {"clock_offset_held", clock_offset_held}};
 }
 
-// inertial.csv: the window's newest state per scan (empty fields before it started).
+constexpr double kDegreesPerRadian = 180.0 / M_PI;
+
+// inertial.csv: the window's newest state per scan (empty fields before it
+// started), then each estimated calibration parameter as that scan's solve
+// left it, its std as the window stated it before the solve and how many of
+// its directions the data observed (docs/design/odometry.md, "Radar-inertial
+// odometry").
 void WriteInertialStates(const std::string& path, const RadarOdometry& odometry, const InertialMotion& inertial) {
+  const InertialWindowOptions& o = inertial.options().window;
+  using Columns = std::vector<double>;
+  // Per estimated parameter: its header, and its values from one solve.
+  std::vector<std::pair<std::string, std::function<Columns(const CalibrationObservation&)>>> calibration;
+  if (o.estimate_extrinsic_rotation) {
+    calibration.push_back(
+        {"rotation_x_deg,rotation_y_deg,rotation_z_deg,rotation_std_x_deg,rotation_std_y_deg,"
+         "rotation_std_z_deg,rotation_observed",
+         [](const CalibrationObservation& c) {
+           const Eigen::Vector3d r = c.radar_from_imu.rotation().Log() * kDegreesPerRadian;
+           const Eigen::Vector3d s = c.extrinsic_rotation_std * kDegreesPerRadian;
+           return Columns{r.x(), r.y(), r.z(), s.x(), s.y(), s.z(), double(c.extrinsic_rotation)};
+         }});
+  }
+  if (o.estimate_extrinsic_translation) {
+    calibration.push_back(
+        {"translation_x,translation_y,translation_z,translation_std_x,translation_std_y,"
+         "translation_std_z,translation_observed",
+         [](const CalibrationObservation& c) {
+           const Eigen::Vector3d t = c.radar_from_imu.translation();
+           const Eigen::Vector3d s = c.extrinsic_translation_std;
+           return Columns{t.x(), t.y(), t.z(), s.x(), s.y(), s.z(), double(c.extrinsic_translation)};
+         }});
+  }
+  if (o.estimate_clock_offset) {
+    calibration.push_back(
+        {"clock_offset_s,clock_offset_std_s,clock_offset_observed", [](const CalibrationObservation& c) {
+           return Columns{c.clock_offset_value, c.clock_offset_std, double(c.clock_offset)};
+         }});
+  }
+  if (o.estimate_elevation_bias) {
+    calibration.push_back(
+        {"elevation_bias_deg,elevation_bias_std_deg,elevation_bias_observed", [](const CalibrationObservation& c) {
+           return Columns{c.elevation_bias_value * kDegreesPerRadian, c.elevation_bias_std * kDegreesPerRadian,
+                          double(c.elevation_bias)};
+         }});
+  }
   WriteFileAtomically(path, [&](std::ostream& out) {
-    out << "stamp,vx,vy,vz,bgx,bgy,bgz,bax,bay,baz\n" << std::setprecision(9);
+    out << "stamp,vx,vy,vz,bgx,bgy,bgz,bax,bay,baz";
+    for (const auto& [header, values] : calibration) out << ',' << header;
+    out << '\n' << std::setprecision(9);
     const std::vector<OdometryStep>& steps = odometry.steps();
+    std::size_t solve = 0;  // a scan with a state is a scan the window solved
     for (std::size_t k = 0; k < steps.size() && k < inertial.states().size(); ++k) {
       out << std::fixed << std::setprecision(9) << steps[k].stamp << std::defaultfloat << std::setprecision(9);
       const std::optional<InertialState>& s = inertial.states()[k];
@@ -167,6 +214,15 @@ void WriteInertialStates(const std::string& path, const RadarOdometry& odometry,
         out << ',';
         if (!s) continue;
         out << (i < 3 ? s->velocity(i) : i < 6 ? s->bias.gyro(i - 3) : s->bias.accel(i - 6));
+      }
+      const WindowSolveSummary* solved = s && solve < inertial.solves().size() ? &inertial.solves()[solve++] : nullptr;
+      for (const auto& [header, values] : calibration) {
+        const std::size_t count = std::count(header.begin(), header.end(), ',') + 1;
+        const Columns columns = solved ? values(solved->calibration) : Columns(count);
+        for (const double v : columns) {
+          out << ',';
+          if (solved) out << v;
+        }
       }
       out << '\n';
     }

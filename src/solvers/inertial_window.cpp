@@ -476,13 +476,13 @@ WindowSolveSummary InertialWindow::Solve() {
       options_.solver == WindowSolver::kGaussNewton
           ? SolveWithGaussNewton(problem, impl_->VariableBlocks(options_), options_.max_iterations)
           : SolveWithCeres(problem, options_);
-  summary.calibration = calibration;
-  summary.calibration.radar_from_imu = radar_from_imu();
-  summary.calibration.clock_offset_value = impl_->clock_offset[0];
-  summary.calibration.elevation_bias_value = impl_->elevation_bias[0];
   summary.reintegrated = reintegrated;
   const bool held_after = options_.estimate_clock_offset && impl_->HoldClockOffsetInBounds();
   summary.clock_offset_held = std::exchange(impl_->clock_held, false) || held_after;
+  summary.calibration = calibration;  // the values the window goes on with
+  summary.calibration.radar_from_imu = radar_from_imu();
+  summary.calibration.clock_offset_value = impl_->clock_offset[0];
+  summary.calibration.elevation_bias_value = impl_->elevation_bias[0];
   summary.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

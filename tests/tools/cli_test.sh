@@ -270,6 +270,22 @@ for file in odometry.tum inertial.csv; do
   cmp -s "$work/inertial_1/$file" "$work/inertial_2/$file" ||
     { echo "FAIL: radar-inertial $file differs between 1 and 2 threads"; failed=1; }
 done
+# Calibrating: each estimated parameter per scan in inertial.csv, its last row summary.json's value.
+expect_ok "radar-inertial odometry, calibrating" "inertial.csv" -- \
+  "$tool" odometry --sequence "$work/seq_imu" --imu "$work/seq_imu/imu.txt" \
+  --imu-extrinsic "$work/seq_imu/imu_extrinsic.txt" --estimate-clock-offset --estimate-elevation-bias \
+  --out "$work/inertial_calibrating"
+python3 - "$work/inertial_calibrating" <<'PY' || failed=1
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1] + "/inertial.csv")))
+summary = json.load(open(sys.argv[1] + "/summary.json"))["calibration"]
+last = rows[-1]
+for column, key in (("clock_offset_s", "clock_offset_s"), ("elevation_bias_deg", "elevation_bias_deg")):
+    if abs(float(last[column]) - summary[key]) > 1e-7:
+        sys.exit("FAIL: inertial.csv's last %s %s against summary.json's %s" % (column, last[column], summary[key]))
+if not all(row["clock_offset_std_s"] for row in rows if row["bgx"]):
+    sys.exit("FAIL: a solved scan without its clock offset's std")
+PY
 expect_fail "evaluate with a missing reference" "cannot open" -- \
   "$tool" evaluate --est "$work/results/reference.tum" --ref "$work/absent.tum"
 expect_fail "evaluate with an unknown alignment" "align" -- \
