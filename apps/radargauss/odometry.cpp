@@ -89,7 +89,7 @@ int RunOdometry(const OdometrySettings& s) {
   StagedFolder folder = RunFolder(s, {"odometry.tum", "levelled.tum", "map.rgm", "map.ply"});  // before the run
   const ImuInput imu = ImuOf(s);  // before the run: a bad IMU leaves nothing behind
   if (!imu.samples.empty()) CheckOverlap(imu.samples, sequence, s.imu_topic.empty() ? "" : "; try --imu-stamps record");
-  std::unique_ptr<MotionModel> motion = MakeMotionModel(s.inertial, imu.radar_from_imu, imu.samples);
+  std::unique_ptr<MotionModel> motion = MakeMotionModel(imu.inertial, imu.radar_from_imu, imu.samples);
   if (motion->name() == "window" && s.matcher != "gaussians") {
     throw DataError("--imu-fusion window needs --matcher gaussians");
   }

@@ -44,6 +44,31 @@ Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw) {
   return q.normalized().toRotationMatrix();
 }
 
+namespace {
+
+// An extrinsic file's stated accuracy: each calibration estimated where it
+// is rough and held where exact (unless its flag was given), its std the prior.
+void ApplyStatedAccuracy(const ExtrinsicAccuracy& accuracy, const OdometrySettings& s, InertialWindowOptions& window) {
+  const auto decide = [&](const char* flag, double stated, double observed, bool& estimate, double& prior) {
+    if (stated > 0.0) prior = stated;
+    if (s.app == nullptr || s.app->count(flag) == 0) estimate = stated > observed;
+  };
+  decide("--estimate-extrinsic-rotation", accuracy.rotation_deg, window.observed_rotation_std_deg,
+         window.estimate_extrinsic_rotation, window.extrinsic_rotation_prior_deg);
+  decide("--estimate-extrinsic-translation", accuracy.translation, window.observed_translation_std,
+         window.estimate_extrinsic_translation, window.extrinsic_translation_prior);
+  decide("--estimate-clock-offset", accuracy.clock_offset, window.observed_clock_std, window.estimate_clock_offset,
+         window.clock_offset_prior);
+  std::printf(
+      "imu extrinsic: stated to %g deg, %g m and %g s; estimating the rotation %s, the translation %s, "
+      "the clock offset %s\n",
+      accuracy.rotation_deg, accuracy.translation, accuracy.clock_offset,
+      window.estimate_extrinsic_rotation ? "yes" : "no", window.estimate_extrinsic_translation ? "yes" : "no",
+      window.estimate_clock_offset ? "yes" : "no");
+}
+
+}  // namespace
+
 // The IMU's samples (the bag's topic or the IMU file) and T_radar_imu
 // (--imu-extrinsic, else the rotation of --imu-rotation); none without an IMU.
 ImuInput ImuOf(const OdometrySettings& s) {
@@ -57,9 +82,14 @@ ImuInput ImuOf(const OdometrySettings& s) {
     throw DataError("--imu-extrinsic and --imu-rotation: the IMU's rotation once");
   }
   ImuInput input;
-  input.radar_from_imu = s.imu_extrinsic.empty()
-                             ? SE3d(SO3d::FromMatrix(ImuRotation(s.imu_rotation)), Eigen::Vector3d::Zero())
-                             : ReadExtrinsicFile(s.imu_extrinsic);
+  input.inertial = s.inertial;
+  if (s.imu_extrinsic.empty()) {
+    input.radar_from_imu = SE3d(SO3d::FromMatrix(ImuRotation(s.imu_rotation)), Eigen::Vector3d::Zero());
+  } else {
+    const StatedExtrinsic stated = ReadStatedExtrinsicFile(s.imu_extrinsic);
+    input.radar_from_imu = stated.pose;
+    if (stated.accuracy) ApplyStatedAccuracy(*stated.accuracy, s, input.inertial.window);
+  }
   input.samples =
       s.imu_file.empty() ? ReadBagImu(s.sequence.bag, s.imu_topic, s.imu_stamps == "record") : ReadImuFile(s.imu_file);
   return input;
@@ -102,6 +132,7 @@ void AddOdometryOptions(CLI::App* app, OdometrySettings& s) {
   AddImuOptions(app, s);
   AddTableOptions(app, RadarInertialOptionTable(), s.inertial);
   AddRunOptions(app, s);
+  s.app = app;
 }
 
 ListedElsewhere OdometryListedElsewhere() {

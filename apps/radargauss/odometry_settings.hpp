@@ -34,6 +34,7 @@ struct OdometrySettings {
   std::string matcher = "gaussians";  // or a PCL peer
   RadarInertialOptions inertial;      // the IMU's motion model (--imu-fusion) and the window's
   std::string mcap;                   // --mcap: the run for a viewer (run_mcap.hpp)
+  const CLI::App* app = nullptr;      // the command's, to tell a flag given from its default
 };
 
 // The matcher of a map version: the Gaussian solvers, or a PCL peer.
@@ -42,9 +43,15 @@ MatcherFactory MatcherOf(const std::string& matcher);
 Eigen::Matrix3d ImuRotation(const std::vector<double>& xyzw);
 // The IMU's samples (the bag's topic or the IMU file) and T_radar_imu
 // (--imu-extrinsic, else --imu-rotation); none without an IMU.
+// With an --imu-extrinsic file that states its accuracy, `inertial` is the
+// settings' with each calibration estimated where the file says it is
+// rough (its std above the window's observed_*_std) and not where exact,
+// unless its --estimate-* flag was given, and the stated stds as the
+// window's priors (docs/design/odometry.md, "Radar-inertial odometry").
 struct ImuInput {
   std::vector<ImuSample> samples;
   SE3d radar_from_imu;
+  RadarInertialOptions inertial;
 };
 ImuInput ImuOf(const OdometrySettings& s);
 // IMU samples that cover none of the scans' time span are a clock mismatch

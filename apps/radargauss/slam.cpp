@@ -42,7 +42,7 @@ int RunSlam(const SlamSettings& s) {
   if (!imu.samples.empty()) {
     CheckOverlap(imu.samples, sequence, s.odometry.imu_topic.empty() ? "" : "; try --imu-stamps record");
   }
-  RadarSlam slam(options, s.study, MakeMotionModel(s.odometry.inertial, imu.radar_from_imu, imu.samples));
+  RadarSlam slam(options, s.study, MakeMotionModel(imu.inertial, imu.radar_from_imu, imu.samples));
   RegisterScans(sequence, "slam", [&](const RadarScan& scan) { slam.Register(scan); });
   slam.Finish();
   GaussianMap map;
@@ -101,6 +101,7 @@ Subcommand AddSlam(CLI::App& parent) {
   AddImuOptions(app, s->odometry);
   AddTableOptions(app, RadarInertialOptionTable(), s->odometry.inertial);
   AddRunOptions(app, s->odometry);
+  s->odometry.app = app;
   AddBoolFlag(app, "--no-map", s->no_map, "Write no map of the place (trajectories and loops only)");
   app->add_option("--map-tiles", s->map_tiles,
                   "Also write the map as square tiles of this many metres (map_tiles/, for relocalize and localize)")

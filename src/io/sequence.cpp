@@ -67,34 +67,65 @@ SE3d ResolveExtrinsic(const std::string& spec, const std::string& ground_truth_p
   return ReadExtrinsicFile(spec);
 }
 
-SE3d ReadExtrinsicFile(const std::string& path) {
+SE3d ReadExtrinsicFile(const std::string& path) { return ReadStatedExtrinsicFile(path).pose; }
+
+namespace {
+
+// The numbers of `line`'s words after the first `skip`, each finite; `what` names them in errors.
+std::vector<double> ExtrinsicNumbers(const std::string& line, std::size_t skip, std::size_t count,
+                                     const std::string& what, const std::string& path) {
+  std::istringstream tokens(line);
+  std::string word;
+  for (std::size_t k = 0; k < skip; ++k) tokens >> word;
+  std::vector<double> values;
+  while (tokens >> word) {
+    char* end = nullptr;
+    const double value = std::strtod(word.c_str(), &end);
+    if (*end != '\0') throw FileError(path, "extrinsic holds '" + Printable(word) + "', not a number");
+    if (!std::isfinite(value)) throw FileError(path, "extrinsic holds " + word + ", a value that is not finite");
+    values.push_back(value);
+  }
+  if (values.size() < count) throw FileError(path, "extrinsic needs '" + what + "'");
+  if (values.size() > count) {
+    throw FileError(path, "extrinsic needs exactly " + std::to_string(count) + " numbers" +
+                              (skip > 0 ? " in '" + what + "'" : std::string()));
+  }
+  return values;
+}
+
+}  // namespace
+
+StatedExtrinsic ReadStatedExtrinsicFile(const std::string& path) {
   std::istringstream in(ReadFileBytes(path, "pose file (extrinsic)", 1 << 16));
+  std::optional<StatedExtrinsic> stated;
   std::string line;
   while (std::getline(in, line)) {
     const auto first = line.find_first_not_of(" \t\r");
     if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream tokens(line);
-    double v[7];
-    std::string word;
-    for (double& value : v) {
-      if (!(tokens >> word)) throw FileError(path, "extrinsic needs 'x y z qx qy qz qw'");
-      char* end = nullptr;
-      value = std::strtod(word.c_str(), &end);
-      if (*end != '\0') throw FileError(path, "extrinsic holds '" + Printable(word) + "', not a number");
-      if (!std::isfinite(value)) throw FileError(path, "extrinsic holds " + word + ", a value that is not finite");
+    if (!stated) {
+      const std::vector<double> v = ExtrinsicNumbers(line, 0, 7, "x y z qx qy qz qw", path);
+      if (Eigen::Vector3d(v[0], v[1], v[2]).norm() > kMaxLeverArm) {
+        throw FileError(path, "extrinsic's translation is past " + std::to_string(int(kMaxLeverArm)) +
+                                  " m (a sensor's mounting on its vehicle)");
+      }
+      const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+      if (std::abs(q.norm() - 1.0) > kTumQuaternionNormTolerance) {
+        throw FileError(path, "extrinsic quaternion is not unit");
+      }
+      stated = StatedExtrinsic{SE3d(SO3d(q), Eigen::Vector3d(v[0], v[1], v[2])), std::nullopt};
+    } else if (line.compare(first, 4, "std ") == 0 || line.compare(first, 4, "std\t") == 0) {
+      if (stated->accuracy) throw FileError(path, "extrinsic states its accuracy twice");
+      const std::vector<double> v =
+          ExtrinsicNumbers(line.substr(first), 1, 3, "std <rotation deg> <translation m> <clock offset s>", path);
+      if (v[0] < 0.0 || v[1] < 0.0 || v[2] < 0.0 || v[0] > 180.0 || v[1] > kMaxLeverArm || v[2] > 1.0) {
+        throw FileError(path, "extrinsic's stds must be 0 to 180 deg, 0 to " + std::to_string(int(kMaxLeverArm)) +
+                                  " m and 0 to 1 s");
+      }
+      stated->accuracy = ExtrinsicAccuracy{v[0], v[1], v[2]};
     }
-    if (tokens >> word) throw FileError(path, "extrinsic needs exactly 7 numbers");
-    if (Eigen::Vector3d(v[0], v[1], v[2]).norm() > kMaxLeverArm) {
-      throw FileError(path, "extrinsic's translation is past " + std::to_string(int(kMaxLeverArm)) +
-                                " m (a sensor's mounting on its vehicle)");
-    }
-    const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
-    if (std::abs(q.norm() - 1.0) > kTumQuaternionNormTolerance) {
-      throw FileError(path, "extrinsic quaternion is not unit");
-    }
-    return SE3d(SO3d(q), Eigen::Vector3d(v[0], v[1], v[2]));
   }
-  throw FileError(path, "extrinsic file is empty");
+  if (!stated) throw FileError(path, "extrinsic file is empty");
+  return *stated;
 }
 
 namespace {

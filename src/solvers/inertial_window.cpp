@@ -28,10 +28,8 @@ namespace radargauss {
 namespace {
 
 constexpr double kClockRelinearisation = 0.002;  // s
-// The first state's priors on the calibration (std).
-constexpr double kClockPrior = 0.05;                            // s: held near its start until the drive turns
-constexpr double kExtrinsicRotationPrior = 3.0 * M_PI / 180.0;  // rad: a mounting is known to a few degrees
-constexpr double kElevationBiasPrior = 2.0 * M_PI / 180.0;      // rad: a radar's bias is a fraction of a degree
+// The first state's prior on the elevation bias (std).
+constexpr double kElevationBiasPrior = 2.0 * M_PI / 180.0;  // rad: a radar's bias is a fraction of a degree
 constexpr double kRadiansPerDegree = M_PI / 180.0;
 
 // W with W^T W = information, for a positive semi-definite information.
@@ -254,16 +252,17 @@ struct InertialWindow::Impl {
     };
     const Estimated table[] = {
         {options.estimate_extrinsic_rotation,
-         {extrinsic_rotation.data(), 3, true, kExtrinsicRotationPrior,
+         {extrinsic_rotation.data(), 3, true, options.extrinsic_rotation_prior_deg * M_PI / 180.0,
           options.observed_rotation_std_deg * kRadiansPerDegree},
          &result.extrinsic_rotation,
          result.extrinsic_rotation_std.data()},
         {options.estimate_extrinsic_translation,
-         {extrinsic_translation.data(), 3, false, 0.0, options.observed_translation_std},
+         {extrinsic_translation.data(), 3, false, options.extrinsic_translation_prior,
+          options.observed_translation_std},
          &result.extrinsic_translation,
          result.extrinsic_translation_std.data()},
         {options.estimate_clock_offset,
-         {clock_offset, 1, false, kClockPrior, options.observed_clock_std},
+         {clock_offset, 1, false, options.clock_offset_prior, options.observed_clock_std},
          &result.clock_offset,
          &result.clock_offset_std},
         {options.estimate_elevation_bias,
@@ -337,14 +336,21 @@ void InertialWindow::Start(const InertialState& state) {
   first.first_priors.push_back({std::make_shared<DiagonalPrior>(mean, sigmas), {first.motion.data()}});
   if (options_.estimate_clock_offset) {
     // Unobservable while the drive is straight and even: held near its start until it turns.
-    first.first_priors.push_back({std::make_shared<DiagonalPrior>(Eigen::VectorXd::Constant(1, impl_->clock_offset[0]),
-                                                                  Eigen::VectorXd::Constant(1, kClockPrior)),
-                                  {impl_->clock_offset}});
+    first.first_priors.push_back(
+        {std::make_shared<DiagonalPrior>(Eigen::VectorXd::Constant(1, impl_->clock_offset[0]),
+                                         Eigen::VectorXd::Constant(1, options_.clock_offset_prior)),
+         {impl_->clock_offset}});
   }
   if (options_.estimate_extrinsic_rotation) {
     const RotationPrior prior{SO3d::FromXyzw(impl_->extrinsic_rotation.data()),
-                              Eigen::Matrix3d::Identity() / kExtrinsicRotationPrior};
+                              Eigen::Matrix3d::Identity() / (options_.extrinsic_rotation_prior_deg * M_PI / 180.0)};
     first.first_priors.push_back({std::make_shared<RotationCostFunction>(prior), {impl_->extrinsic_rotation.data()}});
+  }
+  if (options_.estimate_extrinsic_translation && options_.extrinsic_translation_prior > 0.0) {
+    first.first_priors.push_back(
+        {std::make_shared<DiagonalPrior>(impl_->extrinsic_translation,
+                                         Eigen::Vector3d::Constant(options_.extrinsic_translation_prior)),
+         {impl_->extrinsic_translation.data()}});
   }
   if (options_.estimate_elevation_bias) {
     first.first_priors.push_back(

@@ -51,6 +51,20 @@ const OptionTable<InertialWindowOptions>& InertialWindowOptionTable() {
             .Above(0.0)
             .Unit("m/s")
             .Help("std of the first state's velocity about the start's"),
+        RADARGAUSS_OPTION(O, "window_extrinsic_rotation_prior", extrinsic_rotation_prior_deg)
+            .In(0.0, 180.0)
+            .Above(0.0)
+            .Unit("deg")
+            .Help("std of an estimated radar-IMU rotation about its start"),
+        RADARGAUSS_OPTION(O, "window_extrinsic_translation_prior", extrinsic_translation_prior)
+            .In(0.0, 1000.0)
+            .Unit("m")
+            .Help("std of an estimated radar-IMU translation about its start (0: none)"),
+        RADARGAUSS_OPTION(O, "window_clock_offset_prior", clock_offset_prior)
+            .In(0.0, 1.0)
+            .Above(0.0)
+            .Unit("s")
+            .Help("std of an estimated clock offset about its start"),
         RADARGAUSS_OPTION(O, "estimate_tilt", estimate_tilt)
             .Help("estimate the roll and pitch of the matcher's world against gravity"),
         RADARGAUSS_OPTION(O, "estimate_extrinsic_rotation", estimate_extrinsic_rotation)

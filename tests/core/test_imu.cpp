@@ -113,6 +113,20 @@ TEST_F(ImuFile, ExtrinsicFileIsAPose) {
   EXPECT_EQ(refusal("1e300 0 0 0 0 0 1\n"),
             path + ": extrinsic's translation is past 1000 m (a sensor's mounting on its vehicle)");
   EXPECT_EQ(refusal("0 0 0 0 0 0 1 0\n"), path + ": extrinsic needs exactly 7 numbers");
+  // A stated accuracy: read when there, none when not; out of its ranges refused.
+  WriteFile("T_radar_imu.txt", "0 0 0 0 0 0 1\n# rough\nstd 2 0.05 0.02\n");
+  const StatedExtrinsic rough = ReadStatedExtrinsicFile(path);
+  ASSERT_TRUE(rough.accuracy.has_value());
+  EXPECT_EQ(rough.accuracy->rotation_deg, 2.0);
+  EXPECT_EQ(rough.accuracy->translation, 0.05);
+  EXPECT_EQ(rough.accuracy->clock_offset, 0.02);
+  WriteFile("T_radar_imu.txt", "0 0 0 0 0 0 1\n");
+  EXPECT_FALSE(ReadStatedExtrinsicFile(path).accuracy.has_value());
+  EXPECT_EQ(refusal("0 0 0 0 0 0 1\nstd 2 0.05\n"),
+            path + ": extrinsic needs 'std <rotation deg> <translation m> <clock offset s>'");
+  EXPECT_EQ(refusal("0 0 0 0 0 0 1\nstd -1 0 0\n"),
+            path + ": extrinsic's stds must be 0 to 180 deg, 0 to 1000 m and 0 to 1 s");
+  EXPECT_EQ(refusal("0 0 0 0 0 0 1\nstd 1 0 0\nstd 1 0 0\n"), path + ": extrinsic states its accuracy twice");
 }
 
 // A drive's samples with one glitched sample on each sensor and two beyond

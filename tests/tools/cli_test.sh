@@ -286,6 +286,18 @@ for column, key in (("clock_offset_s", "clock_offset_s"), ("elevation_bias_deg",
 if not all(row["clock_offset_std_s"] for row in rows if row["bgx"]):
     sys.exit("FAIL: a solved scan without its clock offset's std")
 PY
+# An extrinsic file that states its accuracy: rough parts estimated, exact ones held, a given flag obeyed.
+{ cat "$work/seq_imu/imu_extrinsic.txt"; echo "std 2 0 0.03"; } >"$work/rough_extrinsic.txt"
+{ cat "$work/seq_imu/imu_extrinsic.txt"; echo "std 0 0 0"; } >"$work/exact_extrinsic.txt"
+expect_ok "an extrinsic stated rough" "estimating the rotation yes, the translation no, the clock offset yes" -- \
+  "$tool" odometry --sequence "$work/seq_imu" --imu "$work/seq_imu/imu.txt" \
+  --imu-extrinsic "$work/rough_extrinsic.txt" --out "$work/inertial_rough"
+expect_ok "an extrinsic stated exact, the clock's flag given" \
+  "estimating the rotation no, the translation no, the clock offset yes" -- \
+  "$tool" odometry --sequence "$work/seq_imu" --imu "$work/seq_imu/imu.txt" \
+  --imu-extrinsic "$work/exact_extrinsic.txt" --estimate-clock-offset --out "$work/inertial_exact"
+grep -q clock_offset_s "$work/inertial_rough/inertial.csv" ||
+  { echo "FAIL: a rough extrinsic's run has no clock offset in inertial.csv"; failed=1; }
 expect_fail "evaluate with a missing reference" "cannot open" -- \
   "$tool" evaluate --est "$work/results/reference.tum" --ref "$work/absent.tum"
 expect_fail "evaluate with an unknown alignment" "align" -- \

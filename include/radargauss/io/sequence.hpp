@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,5 +69,22 @@ constexpr double kMaxLeverArm = 1000.0;  // m
 // file for a word that is not a number, a value that is not finite, a
 // quaternion that is not unit or a translation past kMaxLeverArm.
 SE3d ReadExtrinsicFile(const std::string& path);
+
+// How well an extrinsic is known, as its file may state it on a line after
+// the pose: `std <rotation deg> <translation m> <clock offset s>` (each std
+// about the pose given; 0: exact).
+struct ExtrinsicAccuracy {
+  double rotation_deg = 0.0;
+  double translation = 0.0;   // m
+  double clock_offset = 0.0;  // s
+};
+struct StatedExtrinsic {
+  SE3d pose;
+  std::optional<ExtrinsicAccuracy> accuracy;  // none: the file does not say
+};
+// ReadExtrinsicFile's pose with the stated accuracy; a `std` line that is
+// not three finite numbers of at most 180 deg, kMaxLeverArm m and 1 s, none
+// negative, is a DataError naming the file.
+StatedExtrinsic ReadStatedExtrinsicFile(const std::string& path);
 
 }  // namespace radargauss

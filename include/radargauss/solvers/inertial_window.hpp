@@ -47,7 +47,12 @@ struct InertialWindowOptions {
   double gyro_bias_prior = 0.01;  // rad/s
   double accel_bias_prior = 0.2;  // m/s^2
   double velocity_prior = 1.0;    // m/s
-  bool estimate_tilt = true;      // the matcher's world's roll and pitch against gravity
+  // The first state's prior on an estimated calibration (std) about its
+  // start: an extrinsic file's stated accuracy sets them (ReadStatedExtrinsicFile).
+  double extrinsic_rotation_prior_deg = 3.0;  // a mounting is known to a few degrees
+  double extrinsic_translation_prior = 0.0;   // m; 0: none
+  double clock_offset_prior = 0.05;           // s: held near its start until the drive turns
+  bool estimate_tilt = true;                  // the matcher's world's roll and pitch against gravity
   bool estimate_extrinsic_rotation = false;
   bool estimate_extrinsic_translation = false;
   // s: the IMU's stamps minus the radar's clock (the start when estimated).
