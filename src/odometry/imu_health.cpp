@@ -5,13 +5,12 @@
 #include <cmath>
 #include <cstdio>
 
+#include "radargauss/core/conventions.hpp"
 #include "radargauss/core/stats.hpp"
 
 namespace radargauss {
 
 namespace {
-
-constexpr double kDegreesPerRadian = 180.0 / M_PI;
 
 std::string HealthCause(const char* format, double a, double b = 0.0) {
   char line[256];

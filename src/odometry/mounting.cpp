@@ -4,13 +4,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "radargauss/core/conventions.hpp"
 #include "radargauss/core/stats.hpp"
 
 namespace radargauss {
 
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 // 1.4826 x the median absolute deviation from `median`: a robust std.
 double Spread(const std::vector<double>& values, double median) {
@@ -51,11 +50,11 @@ std::optional<Mounting> EstimateMounting(const std::vector<OdometryStep>& steps,
     // A turn adds the lever arm's velocity sideways: the elevation holds, the azimuth not.
     // The direction of travel in the radar frame is R_vehicle_radar^T e_x =
     // (cos p cos y, -sin y, sin p cos y).
-    pitch.push_back(std::atan2(v.z(), v.x()) / kDegree);
+    pitch.push_back(std::atan2(v.z(), v.x()) / kRadiansPerDegree);
     const double dt = step.stamp - steps[k - 1].stamp;
     const SO3d turn = steps[k - 1].pose.rotation().Inverse() * step.pose.rotation();
-    if (!(dt > 0.0) || std::abs(turn.Log().z()) / dt > options.max_yaw_rate_deg * kDegree) continue;
-    yaw.push_back(std::atan2(-v.y(), std::hypot(v.x(), v.z())) / kDegree);
+    if (!(dt > 0.0) || std::abs(turn.Log().z()) / dt > options.max_yaw_rate_deg * kRadiansPerDegree) continue;
+    yaw.push_back(std::atan2(-v.y(), std::hypot(v.x(), v.z())) / kRadiansPerDegree);
   }
   if (yaw.size() < options.min_scans) return std::nullopt;
   Mounting mounting;

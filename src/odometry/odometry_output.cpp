@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/conventions.hpp"
 #include "radargauss/core/error.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/odometry/mounting.hpp"
@@ -155,8 +156,6 @@ nlohmann::json WindowSolves(const InertialMotion& inertial) {
           {"reintegrated", reintegrated},
           {"clock_offset_held", clock_offset_held}};
 }
-
-constexpr double kDegreesPerRadian = 180.0 / M_PI;
 
 // inertial.csv: the window's newest state per scan (empty fields before it
 // started), then each estimated calibration parameter as that scan's solve

@@ -11,13 +11,12 @@
 #include <Eigen/SparseCore>
 
 #include "radargauss/core/atomic_file.hpp"
+#include "radargauss/core/conventions.hpp"
 #include "radargauss/core/error.hpp"
 
 namespace radargauss {
 
 namespace {
-
-constexpr double kDegree = M_PI / 180.0;
 
 // The uniform cubic B-spline's four weights at s in [0, 1] of an interval.
 Eigen::Vector4d CubicWeights(double s) {
@@ -41,9 +40,9 @@ double Unwrapped(double angle, double previous) {
 }  // namespace
 
 SE3d ImuOnVehicle(const SimulationConfig& config) {
-  return SE3d(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, config.imu_yaw_deg * kDegree)) *
-                  SO3d::Exp(Eigen::Vector3d(0.0, config.imu_pitch_deg * kDegree, 0.0)) *
-                  SO3d::Exp(Eigen::Vector3d(config.imu_roll_deg * kDegree, 0.0, 0.0)),
+  return SE3d(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, config.imu_yaw_deg * kRadiansPerDegree)) *
+                  SO3d::Exp(Eigen::Vector3d(0.0, config.imu_pitch_deg * kRadiansPerDegree, 0.0)) *
+                  SO3d::Exp(Eigen::Vector3d(config.imu_roll_deg * kRadiansPerDegree, 0.0, 0.0)),
               Eigen::Vector3d(config.imu_x, config.imu_y, config.imu_z));
 }
 
@@ -140,7 +139,7 @@ SmoothTrajectory::SmoothTrajectory(const Trajectory& reference, double knot_spac
   Eigen::Vector3d previous = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < reference.size(); ++k) {
     const Eigen::Matrix3d R = reference[k].pose.rotation().Matrix();
-    if (std::abs(R(2, 0)) > std::sin(89.0 * kDegree)) {
+    if (std::abs(R(2, 0)) > std::sin(89.0 * kRadiansPerDegree)) {
       throw DataError("the reference pitches to 90 deg at " + std::to_string(reference[k].time) +
                       " s, where roll and yaw are one");
     }

@@ -13,6 +13,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
+#include "radargauss/core/conventions.hpp"
 #include "radargauss/core/error.hpp"
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/residuals/imu_preintegration.hpp"
@@ -30,7 +31,6 @@ namespace {
 constexpr double kClockRelinearisation = 0.002;  // s
 // The first state's prior on the elevation bias (std).
 constexpr double kElevationBiasPrior = 2.0 * M_PI / 180.0;  // rad: a radar's bias is a fraction of a degree
-constexpr double kRadiansPerDegree = M_PI / 180.0;
 
 // W with W^T W = information, for a positive semi-definite information.
 Eigen::MatrixXd SqrtInformation(const Eigen::MatrixXd& information) {

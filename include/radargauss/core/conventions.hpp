@@ -3,6 +3,8 @@
 // (docs/design.md, "Conventions"). Every other file refers here instead of restating.
 #pragma once
 
+#include <cmath>
+
 namespace radargauss {
 
 // Frames. The radar frame is x forward, y left, z up. A pose
@@ -23,5 +25,7 @@ inline constexpr int kRotationOffset = 3;     // phi (or dphi) in a 6-vector
 //
 // Units. RCS in dBsm, time in seconds (double), lengths in metres, angles in
 // radians inside the library (degrees only in user-facing tables and flags).
+inline constexpr double kRadiansPerDegree = M_PI / 180.0;
+inline constexpr double kDegreesPerRadian = 180.0 / M_PI;
 
 }  // namespace radargauss
