@@ -95,12 +95,13 @@ RadarOdometry::RadarOdometry(const OdometryOptions& options, std::unique_ptr<Mot
       map_(options.map) {
   ValidateOptions(options_);
   motion_->Bind(options_.elevation_bias.estimate);
-  if (motion_->UsesMatchCovariance()) options_.match.matching.pose_covariance = true;
 }
 
 const ScanMatcher& RadarOdometry::MatcherForMap() {
   if (!matcher_ || matcher_version_ != map_.version()) {
-    matcher_ = factory_(map_, options_.match);
+    MatchOptions match = options_.match;  // the pose's covariance too when the model reads it
+    match.matching.pose_covariance = match.matching.pose_covariance || motion_->UsesMatchCovariance();
+    matcher_ = factory_(map_, match);
     if (!matcher_) throw std::invalid_argument("the matcher factory returned no matcher");
     matcher_version_ = map_.version();
     ++matchers_made_;
@@ -204,11 +205,7 @@ bool RadarOdometry::RunBeside(const RadarScan& scan) {
     radar_alone_.reset();
     return false;
   }
-  if (!radar_alone_) {
-    OdometryOptions alone = options_;
-    alone.match.matching.pose_covariance = false;  // the constant-velocity model reads no covariance
-    radar_alone_ = std::make_unique<RadarOdometry>(alone, nullptr, factory_);
-  }
+  if (!radar_alone_) radar_alone_ = std::make_unique<RadarOdometry>(options_, nullptr, factory_);
   const OdometryStep& alone = radar_alone_->Register(scan);
   if (motion_->Check(alone.stamp, alone.pose, alone.matched)) return false;
   // The model failed: the radar alone's run goes on as this one, the model kept for its record.

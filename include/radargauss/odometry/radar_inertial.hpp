@@ -71,7 +71,7 @@ class InertialMotion : public MotionModel {
   // Makes the window: with the odometry's estimate_elevation_bias it
   // estimates the bias, and the odometry removes its estimate from each scan.
   void Bind(bool estimate_elevation_bias) override;
-  bool UsesMatchCovariance() const override { return options_.match_covariance == "residuals"; }
+  bool UsesMatchCovariance() const override { return options_.match_covariance == "residuals" && !imu_fault(); }
   void Advance(double stamp) override;
   std::optional<double> ElevationBias() const override;
   std::optional<SO3d> Rotation(double from, double to) const override {
