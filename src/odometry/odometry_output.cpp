@@ -216,8 +216,7 @@ void WriteInertialStates(const std::string& path, const RadarOdometry& odometry,
       }
       const WindowSolveSummary* solved = s && solve < inertial.solves().size() ? &inertial.solves()[solve++] : nullptr;
       for (const auto& [header, values] : calibration) {
-        const std::size_t count = std::count(header.begin(), header.end(), ',') + 1;
-        const Columns columns = solved ? values(solved->calibration) : Columns(count);
+        const Columns columns = values(solved ? solved->calibration : CalibrationObservation{});
         for (const double v : columns) {
           out << ',';
           if (solved) out << v;
