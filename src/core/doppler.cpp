@@ -5,6 +5,9 @@
 #include <cmath>
 #include <random>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
@@ -128,11 +131,8 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     const std::vector<std::uint32_t>& members = voxels[voxel];
     return int(members[std::uniform_int_distribution<std::size_t>(0, members.size() - 1)(rng)]);
   };
-  std::size_t best_size = 0;
-  Eigen::Vector3d best_velocity = Eigen::Vector3d::Zero();
-  std::vector<double> residual(n);
   // |y - H v| at each position (a loop the compiler vectorises).
-  const auto residuals = [&](const Eigen::Vector3d& v) {
+  const auto residuals = [&rows, n](const Eigen::Vector3d& v, std::vector<double>& residual) {
     const double *hx = rows.hx.data(), *hy = rows.hy.data(), *hz = rows.hz.data(), *y0 = rows.y.data();
     for (int k = 0; k < n; ++k) residual[k] = std::abs(y0[k] - (hx[k] * v.x() + hy[k] * v.y() + hz[k] * v.z()));
   };
@@ -140,6 +140,7 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
   // times as many draws find the world's hypotheses among a car's.
   constexpr int kGatedDrawFactor = 50;
   int counted = 0;
+  std::vector<Eigen::Vector3d> hypotheses;
   for (int draw = 0; counted < iterations && draw < kGatedDrawFactor * iterations; ++draw) {
     int a, b, c;
     if (by_voxel) {
@@ -162,30 +163,50 @@ std::vector<int> LargestConsensus(const Eigen::MatrixX3d& H, const Eigen::Vector
     const Eigen::Vector3d v = lu.solve(Eigen::Vector3d(y[a], y[b], y[c]));
     if (gate && !gate->Admits(v)) continue;
     ++counted;
-    // The support without branches (whether a row is an inlier is a coin
-    // toss to the branch predictor); the rows are listed for the winner only.
-    residuals(v);
+    hypotheses.push_back(v);
+  }
+  // The draws depend on the generator and the gate alone, so their supports
+  // are counted side by side. Without branches (whether a row is an inlier
+  // is a coin toss to the branch predictor).
+  struct Support {
     std::size_t size = 0;
     int covered = 0;
-    int voxel_has_inlier = 0;
-    for (int k = 0; k < n; ++k) {
-      const int inlier = residual[k] < options.inlier_threshold;
-      voxel_has_inlier &= rows.opens[k] ^ 1;
-      size += std::size_t(inlier);
-      covered += inlier & (voxel_has_inlier ^ 1);
-      voxel_has_inlier |= inlier;
+  };
+  std::vector<Support> support(hypotheses.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hypotheses.size(), 8), [&](const auto& range) {
+    std::vector<double> residual(n);
+    for (std::size_t h = range.begin(); h < range.end(); ++h) {
+      residuals(hypotheses[h], residual);
+      std::size_t size = 0;
+      int covered = 0;
+      int voxel_has_inlier = 0;
+      for (int k = 0; k < n; ++k) {
+        const int inlier = residual[k] < options.inlier_threshold;
+        voxel_has_inlier &= rows.opens[k] ^ 1;
+        size += std::size_t(inlier);
+        covered += inlier & (voxel_has_inlier ^ 1);
+        voxel_has_inlier |= inlier;
+      }
+      support[h] = {size, covered};
     }
+  });
+  // The first of largest support, as counting one after another finds it.
+  std::size_t best_size = 0;
+  Eigen::Vector3d best_velocity = Eigen::Vector3d::Zero();
+  for (std::size_t h = 0; h < hypotheses.size(); ++h) {
+    const auto [size, covered] = support[h];
     const bool wins =
         voxels.empty() ? size > best_size : covered > best_voxels || (covered == best_voxels && size > best_size);
     if (!wins) continue;
     best_voxels = covered;
     best_size = size;
-    best_velocity = v;
+    best_velocity = hypotheses[h];
   }
   // The winner's rows, in row order.
   std::vector<int> best;
   if (best_size == 0) return best;
-  residuals(best_velocity);
+  std::vector<double> residual(n);
+  residuals(best_velocity, residual);
   std::vector<char> inlier(n, 0);
   for (int k = 0; k < n; ++k) inlier[rows.row_of[k]] = residual[k] < options.inlier_threshold;
   for (int row = 0; row < n; ++row) {

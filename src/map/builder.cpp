@@ -142,6 +142,16 @@ std::vector<std::vector<std::uint32_t>> BisectingKMeans(const std::vector<Eigen:
   return result;
 }
 
+// A fit of few points (a local map's region) indexes only the cells its
+// points are in (GaussianIndex's `only`); a large one indexes every cell.
+constexpr std::size_t kFewPoints = 4096;
+std::vector<VoxelKey> QueryCells(const std::vector<Eigen::Vector3d>& points, double cell) {
+  return points.size() <= kFewPoints ? GaussianIndex::CellsOf(points, cell) : std::vector<VoxelKey>();
+}
+const std::vector<VoxelKey>* QueriedOnly(const std::vector<VoxelKey>& cells) {
+  return cells.empty() ? nullptr : &cells;
+}
+
 // Hard EM from an initial partition; returns the final Gaussians.
 std::vector<Gaussian> HardEm(const std::vector<Eigen::Vector3d>& points,
                              std::vector<std::vector<std::uint32_t>> partition, const GaussianMapOptions& options,
@@ -152,8 +162,9 @@ std::vector<Gaussian> HardEm(const std::vector<Eigen::Vector3d>& points,
     for (const std::uint32_t i : members) label[i] = int(gaussians.size());
     gaussians.push_back(FitGaussian(points, members, options.min_std));
   }
+  const std::vector<VoxelKey> cells = QueryCells(points, options.index_cell);
   for (int iteration = 0; iteration < options.em_iterations; ++iteration) {
-    const GaussianIndex index(gaussians, options.index_cell);
+    const GaussianIndex index(gaussians, options.index_cell, GaussianIndex::kExtentSigmas, QueriedOnly(cells));
     std::vector<double> half_log_det(gaussians.size());
     for (std::size_t g = 0; g < gaussians.size(); ++g) {
       half_log_det[g] = 0.5 * std::log(gaussians[g].covariance.determinant());
@@ -271,7 +282,8 @@ std::vector<Gaussian> BuildGaussians(const std::vector<Eigen::Vector3d>& points,
     gaussians = HardEm(downsampled, BisectingKMeans(downsampled, k, options, progress), options, progress);
   }
   // Members: every input point, associated by smallest Mahalanobis^2 within the gate.
-  const GaussianIndex index(gaussians, options.index_cell);
+  const std::vector<VoxelKey> cells = QueryCells(points, options.index_cell);
+  const GaussianIndex index(gaussians, options.index_cell, GaussianIndex::kExtentSigmas, QueriedOnly(cells));
   std::vector<int> members = AssociatePoints(points, index, options.association_gate);
   for (const int g : members) {
     if (g >= 0) ++gaussians[g].point_count;

@@ -4,8 +4,12 @@
 // entries (or rewritten in place when they fit the old), and the entries are
 // compacted once stale ones outnumber the live.
 #include <algorithm>
+#include <exception>
 #include <stdexcept>
 #include <utility>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "radargauss/map/gaussian_map.hpp"
 
@@ -58,15 +62,34 @@ void GaussianIndex::ListingChanges(const std::vector<Gaussian>& gaussians, const
     for (const std::int64_t key : listed_cells_[id]) leaving.emplace_back(key, id);
     std::vector<std::int64_t>().swap(listed_cells_[id]);  // frees the capacity (`= {}` keeps it)
   }
-  // A changed Gaussian leaves the cells it has moved out of and joins the new
-  // ones; the cells it meets before and after keep their lists.
-  std::vector<std::int64_t> cells;
+  // Each changed Gaussian's cells (apart for each, so side by side; a
+  // failure is reported as the first failing one's in `changed`).
+  std::vector<std::uint32_t> relisted;
   for (const std::uint32_t id : changed) {
     if (state[id] != 1) continue;
     state[id] = 2;
-    cells.clear();
-    Index(gaussians[id], id, cells);
-    std::sort(cells.begin(), cells.end());
+    relisted.push_back(id);
+  }
+  std::vector<std::vector<std::int64_t>> cells_of(relisted.size());
+  std::vector<std::exception_ptr> failures(relisted.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, relisted.size(), 16), [&](const auto& range) {
+    for (std::size_t r = range.begin(); r < range.end(); ++r) {
+      try {
+        Index(gaussians[relisted[r]], relisted[r], cells_of[r]);
+        std::sort(cells_of[r].begin(), cells_of[r].end());
+      } catch (...) {
+        failures[r] = std::current_exception();
+      }
+    }
+  });
+  for (const std::exception_ptr& failure : failures) {
+    if (failure) std::rethrow_exception(failure);
+  }
+  // A changed Gaussian leaves the cells it has moved out of and joins the new
+  // ones; the cells it meets before and after keep their lists.
+  for (std::size_t r = 0; r < relisted.size(); ++r) {
+    const std::uint32_t id = relisted[r];
+    const std::vector<std::int64_t>& cells = cells_of[r];
     const std::vector<std::int64_t>& before = listed_cells_[id];
     auto old = before.begin();
     auto now = cells.begin();

@@ -155,7 +155,13 @@ class ColumnBound {
 // the keys' span, 11 bits a pass, linear where a comparison sort of a
 // map's millions of listings is not.
 void SortListingsByKey(std::vector<std::pair<std::int64_t, std::uint32_t>>& listings) {
-  if (listings.size() < 2) return;
+  // A few thousand listings (a region's fit) sort faster by comparison than
+  // by passes over 2^11 buckets each.
+  constexpr std::size_t kComparisonSortBelow = 4096;
+  if (listings.size() < kComparisonSortBelow) {
+    std::sort(listings.begin(), listings.end());
+    return;
+  }
   std::uint64_t low = ~std::uint64_t(0), high = 0;
   for (const auto& listing : listings) {
     low = std::min(low, std::uint64_t(listing.first));
@@ -184,7 +190,8 @@ std::int64_t GaussianIndex::Key(const Eigen::Vector3d& p) const {
   return PackVoxelKey(v.x, v.y, v.z);
 }
 
-std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys) {
+std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys,
+                                 const std::vector<VoxelKey>* only) {
   IndexedGaussian& entry = gaussians_[id];
   entry.mean = g.mean;
   const Eigen::Matrix3d information = g.covariance.inverse();
@@ -209,25 +216,66 @@ std::size_t GaussianIndex::Index(const Gaussian& g, std::uint32_t id, std::vecto
   // per query, the same answers). Each column of cells is bounded first
   // (ColumnBound), and only the cells within its bound are tested.
   const ColumnBound column(g, information, extent_sigmas_);
+  // The cells of column (x, y) within its bound: [first, last].
+  const auto column_cells = [&](std::int64_t x, std::int64_t y, std::int64_t& first, std::int64_t& last) {
+    double z_low, z_high;
+    if (!column.Bounds(double(x) * cell_size_, double(y) * cell_size_, cell_size_, z_low, z_high)) return false;
+    first = std::int64_t(std::max(double(lo.z), std::floor(z_low / cell_size_)));
+    last = std::int64_t(std::min(double(hi.z), std::floor(z_high / cell_size_)));
+    return true;
+  };
+  const auto meets = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+    const Eigen::Vector3d corner = Eigen::Vector3d(double(x), double(y), double(z)) * cell_size_;
+    return CellMeetsEllipsoid(corner, corner.array() + cell_size_, g.mean, g.covariance, information, extent_sigmas_);
+  };
+  if (only != nullptr && double(only->size()) < box) {  // the queries' cells in the box, each tested alike
+    for (const VoxelKey& c : *only) {
+      if (c.x < lo.x || c.x > hi.x || c.y < lo.y || c.y > hi.y) continue;
+      std::int64_t first, last;
+      if (column_cells(c.x, c.y, first, last) && c.z >= first && c.z <= last && meets(c.x, c.y, c.z)) {
+        cell_keys.push_back(PackVoxelKey(c.x, c.y, c.z));
+      }
+    }
+    return std::size_t(box);
+  }
   for (auto x = lo.x; x <= hi.x; ++x) {
     for (auto y = lo.y; y <= hi.y; ++y) {
-      double z_low, z_high;
-      if (!column.Bounds(double(x) * cell_size_, double(y) * cell_size_, cell_size_, z_low, z_high)) continue;
-      const auto first = decltype(lo.z)(std::max(double(lo.z), std::floor(z_low / cell_size_)));
-      const auto last = decltype(hi.z)(std::min(double(hi.z), std::floor(z_high / cell_size_)));
+      std::int64_t first, last;
+      if (!column_cells(x, y, first, last)) continue;
       for (auto z = first; z <= last; ++z) {
-        const Eigen::Vector3d corner = Eigen::Vector3d(double(x), double(y), double(z)) * cell_size_;
-        if (CellMeetsEllipsoid(corner, corner.array() + cell_size_, g.mean, g.covariance, information,
-                               extent_sigmas_)) {
-          cell_keys.push_back(PackVoxelKey(x, y, z));
-        }
+        if (meets(x, y, z)) cell_keys.push_back(PackVoxelKey(x, y, z));
       }
     }
   }
   return std::size_t(box);
 }
 
+std::vector<VoxelKey> GaussianIndex::CellsOf(const std::vector<Eigen::Vector3d>& points, double cell_size) {
+  // Sorted as packed keys (integers sort fast) and unpacked; cells beyond
+  // the packing's range (+-2^20 cells) would wrap, so none are given then.
+  constexpr std::int64_t kReach = (std::int64_t(1) << 20) - 1;
+  constexpr std::int64_t kMask = (std::int64_t(1) << 21) - 1;
+  std::vector<std::int64_t> keys;
+  keys.reserve(points.size());
+  for (const Eigen::Vector3d& p : points) {
+    if (!p.allFinite()) continue;
+    const VoxelKey v = VoxelOf(p, cell_size);
+    if (std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}) > kReach) return {};
+    keys.push_back(PackVoxelKey(v));
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<VoxelKey> cells(keys.size());
+  const auto axis = [](std::int64_t key, int shift) { return ((key >> shift) & kMask) - (kReach + 1); };
+  for (std::size_t k = 0; k < keys.size(); ++k) cells[k] = {axis(keys[k], 0), axis(keys[k], 21), axis(keys[k], 42)};
+  return cells;
+}
+
 GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size, double extent_sigmas)
+    : GaussianIndex(gaussians, cell_size, extent_sigmas, nullptr) {}
+
+GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size, double extent_sigmas,
+                             const std::vector<VoxelKey>* only)
     : cell_size_(cell_size), extent_sigmas_(extent_sigmas) {
   if (!(cell_size > 0.0)) throw std::invalid_argument("index cell size must be > 0");
   if (!(extent_sigmas > 0.0)) throw std::invalid_argument("index extent must be > 0 standard deviations");
@@ -238,7 +286,7 @@ GaussianIndex::GaussianIndex(const std::vector<Gaussian>& gaussians, double cell
   std::size_t box_cells = 0;
   for (std::size_t i = 0; i < n; ++i) {
     cell_keys.clear();
-    box_cells += Index(gaussians[i], std::uint32_t(i), cell_keys);
+    box_cells += Index(gaussians[i], std::uint32_t(i), cell_keys, only);
     if (box_cells > kMaxIndexCells) {
       throw DataError("the map spans more than " + std::to_string(kMaxIndexCells) + " index cells of " +
                       Brief(cell_size_) + " m: too many large Gaussians, or too small an index cell");

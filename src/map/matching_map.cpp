@@ -2,7 +2,10 @@
 #include "radargauss/map/matching_map.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <stdexcept>
+
+#include <tbb/parallel_for.h>
 
 #include "radargauss/map/builder.hpp"
 #include "radargauss/core/names.hpp"
@@ -129,8 +132,23 @@ void MatchingMap::Update(const std::vector<std::uint32_t>& changed, const std::v
     if (id < live_.size() && !live_[id]) ++indexed_;
     if (id < live_.size()) live_[id] = 1;
   }
-  for (std::size_t level = 0; level < sigmas_.size(); ++level) UpdateCoarse(level, changed, removed);
-  levels_.back().Update(map_->gaussians, changed, removed);
+  // The levels are apart (each its own index and state), so they update
+  // side by side; a failure is reported as the coarsest failing level's.
+  std::vector<std::exception_ptr> failures(levels_.size());
+  tbb::parallel_for(std::size_t(0), levels_.size(), [&](std::size_t level) {
+    try {
+      if (level < sigmas_.size()) {
+        UpdateCoarse(level, changed, removed);
+      } else {
+        levels_.back().Update(map_->gaussians, changed, removed);
+      }
+    } catch (...) {
+      failures[level] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& failure : failures) {
+    if (failure) std::rethrow_exception(failure);
+  }
 }
 
 void MatchingMap::UpdateCoarse(std::size_t level, const std::vector<std::uint32_t>& changed,

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include <tbb/parallel_for.h>
+
 #include "radargauss/map/map_cloud.hpp"
 #include "radargauss/core/names.hpp"
 
@@ -133,6 +135,7 @@ std::size_t LocalMap::Insert(const std::vector<Eigen::Vector3d>& points, const s
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   std::vector<std::uint32_t> changed, removed;
   std::size_t refitted = 0;
+  std::vector<Region*> due;
   for (const VoxelKey& key : touched) {
     Region& region = regions_[key];
     if (incremental) {
@@ -141,22 +144,24 @@ std::size_t LocalMap::Insert(const std::vector<Eigen::Vector3d>& points, const s
       refitted += changed.size() + removed.size() > before;
       continue;
     }
-    const bool due = region.fitted == 0 ? region.points.size() >= options_.min_points
-                                        : double(region.added) >= options_.refit_growth * double(region.fitted);
-    if (!due) continue;
-    Refit(region, changed, removed);
-    ++refitted;
+    if (region.fitted == 0 ? region.points.size() >= options_.min_points
+                           : double(region.added) >= options_.refit_growth * double(region.fitted)) {
+      due.push_back(&region);
+    }
   }
+  // Each due region's fit reads only its own points and the poses, so the
+  // fits run side by side; their slots are then given in region order, as
+  // one region after another would give them.
+  std::vector<GaussianMap> fits(due.size());
+  tbb::parallel_for(std::size_t(0), due.size(), [&](std::size_t r) { fits[r] = Fit(*due[r]); });
+  for (std::size_t r = 0; r < due.size(); ++r) Replace(*due[r], std::move(fits[r]), changed, removed);
+  refitted += due.size();
   if (!changed.empty() || !removed.empty()) matching_->Update(changed, removed);
   ++version_;  // the points changed, refitted or not
   return refitted;
 }
 
-void LocalMap::Refit(Region& region, std::vector<std::uint32_t>& changed, std::vector<std::uint32_t>& removed) {
-  for (const std::uint32_t slot : region.gaussians) FreeSlot(slot, removed);
-  region.gaussians.clear();
-  region.fitted = region.points.size();
-  region.added = 0;
+GaussianMap LocalMap::Fit(const Region& region) const {
   std::vector<int> association;
   GaussianMap fitted;
   fitted.gaussians = BuildGaussians(region.points, options_.gaussians, {}, &association);
@@ -175,9 +180,18 @@ void LocalMap::Refit(Region& region, std::vector<std::uint32_t>& changed, std::v
     }
     FitRcsModels(fitted, cloud, association, options_.rcs);
   }
+  return fitted;
+}
+
+void LocalMap::Replace(Region& region, GaussianMap fitted, std::vector<std::uint32_t>& changed,
+                       std::vector<std::uint32_t>& removed) {
+  for (const std::uint32_t slot : region.gaussians) FreeSlot(slot, removed);
+  region.gaussians.clear();
+  region.fitted = region.points.size();
+  region.added = 0;
   for (Gaussian& g : fitted.gaussians) {
     const std::uint32_t slot = NewSlot();
-    map_->gaussians[slot] = g;
+    map_->gaussians[slot] = std::move(g);
     region.gaussians.push_back(slot);
     changed.push_back(slot);
   }

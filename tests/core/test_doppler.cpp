@@ -2,6 +2,7 @@
 #include "radargauss/core/doppler.hpp"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -235,6 +236,34 @@ TEST(EgoVelocity, SimulatedCarFillingTheViewNeedsTheGateOrVoxelSupport) {
     car_inliers += gated.inlier[i] && drive.truth[0][i].kind == DetectionKind::kDynamic;
   }
   EXPECT_LT(car_inliers, moving / 10);
+}
+
+// The hypotheses' supports are counted side by side: the same velocity,
+// covariance and inliers for 1, 2 and 8 threads, with and without voxels
+// and the gate (equal supports go to the first hypothesis drawn).
+TEST(EgoVelocity, SameEstimateForAnyThreadCount) {
+  std::mt19937 rng(33);
+  const Eigen::Vector3d sensor(8.0, -1.0, 0.2);
+  RadarScan scan = PlantedScan(sensor, 300, 200, 0.05, rng);
+  EgoVelocityOptions voxels;
+  voxels.consensus_voxel = 1.0;
+  const VelocityGate gate{sensor + Eigen::Vector3d(0.3, 0.2, 0.0), 1.0};
+  for (const auto& [options, with_gate] :
+       {std::pair{EgoVelocityOptions(), false}, std::pair{voxels, false}, std::pair{EgoVelocityOptions(), true}}) {
+    const auto estimate = [&](std::size_t threads) {
+      const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+      return with_gate ? EstimateEgoVelocity(scan, options, gate) : EstimateEgoVelocity(scan, options);
+    };
+    const EgoVelocityResult one = estimate(1);
+    ASSERT_TRUE(one.success) << one.reason;
+    EXPECT_LT((one.velocity - sensor).norm(), 0.05);
+    for (const std::size_t threads : {2, 8}) {
+      const EgoVelocityResult more = estimate(threads);
+      EXPECT_EQ(more.velocity, one.velocity) << threads;
+      EXPECT_EQ(more.covariance, one.covariance) << threads;
+      EXPECT_EQ(more.inlier, one.inlier) << threads;
+    }
+  }
 }
 
 // A radar pitched 1.5 deg down and yawed 0.8 deg right on a vehicle driving a

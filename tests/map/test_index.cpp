@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <set>
 
 #include "radargauss/core/error.hpp"
 #include "radargauss/map/builder.hpp"
@@ -192,6 +193,44 @@ TEST(GaussianIndexTest, ListsAGaussianInTheCellsItsEllipsoidMeets) {
 // A point exactly on the gate is associated, one just beyond it is not, and
 // of two equally close Gaussians the one with the smaller id wins (the
 // branch-free selection keeps both rules).
+// An index of the queries' cells alone (a region's fit) lists each Gaussian
+// in fewer cells and answers every one of those queries as the full index:
+// the same candidates, in the same order.
+TEST(GaussianIndexTest, AnIndexOfTheQueriesCellsAnswersThemAsTheFullOne) {
+  const Planted planted = PlantGaussians(10, 5);
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> uniform(-2.0, 20.0);
+  std::vector<Eigen::Vector3d> points = planted.points;  // fewer cells than a Gaussian's box of 0.3 m cells
+  for (int k = 0; k < 20; ++k) points.emplace_back(uniform(rng), uniform(rng), 0.2 * uniform(rng));
+  points.emplace_back(Eigen::Vector3d::Constant(std::nan("")));  // no cell, no candidates
+  const std::vector<VoxelKey> cells = GaussianIndex::CellsOf(points, 0.3);
+  ASSERT_EQ(cells.size(), std::set<VoxelKey>(cells.begin(), cells.end()).size());
+  std::set<VoxelKey> expected_cells;
+  for (const Eigen::Vector3d& p : points) {
+    if (p.allFinite()) expected_cells.insert(VoxelOf(p, 0.3));
+  }
+  ASSERT_EQ(std::set<VoxelKey>(cells.begin(), cells.end()), expected_cells);
+
+  const GaussianIndex full(planted.gaussians, 0.3);
+  const GaussianIndex sparse(planted.gaussians, 0.3, GaussianIndex::kExtentSigmas, &cells);
+  EXPECT_LT(sparse.MemoryBytes(), full.MemoryBytes() / 2);
+  int associated = 0;
+  for (const Eigen::Vector3d& p : points) {
+    std::size_t full_count = 0, sparse_count = 0;
+    const std::uint32_t* full_candidates = full.Candidates(p, full_count);
+    const std::uint32_t* sparse_candidates = sparse.Candidates(p, sparse_count);
+    ASSERT_EQ(std::vector<std::uint32_t>(sparse_candidates, sparse_candidates + sparse_count),
+              std::vector<std::uint32_t>(full_candidates, full_candidates + full_count))
+        << p.transpose();
+    EXPECT_EQ(sparse.Associate(p, 9.0), full.Associate(p, 9.0));
+    associated += full.Associate(p, 9.0) >= 0;
+  }
+  EXPECT_GT(associated, 150);
+  // Cells beyond the packing's reach would wrap: none are given.
+  EXPECT_TRUE(GaussianIndex::CellsOf({Eigen::Vector3d(2e6, 0.0, 0.0)}, 1.0).empty());
+  EXPECT_EQ(GaussianIndex::CellsOf({Eigen::Vector3d(-1e6, 0.0, 0.0)}, 1.0).front(), VoxelKey({-1000000, 0, 0}));
+}
+
 TEST(GaussianIndexTest, GateIsInclusiveAndTiesGoToTheSmallestId) {
   Gaussian unit;
   unit.mean.setZero();

@@ -261,14 +261,16 @@ expect_fail "odometry with an IMU topic but no bag" "needs --bag" -- \
 # Radar-inertial odometry: the same trajectory and states for any thread count.
 printf 'scans: 30\nimu_rate_hz: 200\n' >"$work/imu_world.yaml"
 "$tool" simulate --config "$work/imu_world.yaml" --out "$work/seq_imu" >/dev/null
-for threads in 1 2; do
+for threads in 1 2 8; do
   expect_ok "radar-inertial odometry, $threads threads" "inertial.csv" -- \
     "$tool" --threads "$threads" odometry --sequence "$work/seq_imu" --imu "$work/seq_imu/imu.txt" \
     --imu-extrinsic "$work/seq_imu/imu_extrinsic.txt" --out "$work/inertial_$threads"
 done
-for file in odometry.tum inertial.csv; do
-  cmp -s "$work/inertial_1/$file" "$work/inertial_2/$file" ||
-    { echo "FAIL: radar-inertial $file differs between 1 and 2 threads"; failed=1; }
+for threads in 2 8; do
+  for file in odometry.tum inertial.csv; do
+    cmp -s "$work/inertial_1/$file" "$work/inertial_$threads/$file" ||
+      { echo "FAIL: radar-inertial $file differs between 1 and $threads threads"; failed=1; }
+  done
 done
 # Calibrating: each estimated parameter per scan in inertial.csv, its last row summary.json's value.
 expect_ok "radar-inertial odometry, calibrating" "inertial.csv" -- \

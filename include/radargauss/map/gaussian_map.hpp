@@ -109,11 +109,22 @@ class GaussianIndex {
   GaussianIndex() = default;
   // Throws DataError when a Gaussian, or all of them, span more cells than
   // the bounds above.
-  GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size = 1.0, double extent_sigmas = 3.0);
+  // A Gaussian is listed in the cells its ellipsoid of this many standard deviations meets.
+  static constexpr double kExtentSigmas = 3.0;
+  GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size = 1.0, double extent_sigmas = kExtentSigmas);
+  // An index that answers only for points in `only` (sorted cells, CellsOf),
+  // as the full index answers there, listing each Gaussian in those cells
+  // alone: a fit's E steps on a region's few hundred points index a few
+  // dozen cells rather than every cell each Gaussian meets.
+  GaussianIndex(const std::vector<Gaussian>& gaussians, double cell_size, double extent_sigmas,
+                const std::vector<VoxelKey>* only);
+  // The cells (of `cell_size`) of the finite `points`, each once, sorted by
+  // packed key; none when one lies beyond the packing's +-2^20 cells.
+  static std::vector<VoxelKey> CellsOf(const std::vector<Eigen::Vector3d>& points, double cell_size);
 
   // An empty index that Update can change (docs/design/odometry.md, "Odometry"): it
   // also keeps the cells each Gaussian is listed in.
-  static GaussianIndex Updatable(double cell_size = 1.0, double extent_sigmas = 3.0);
+  static GaussianIndex Updatable(double cell_size = 1.0, double extent_sigmas = kExtentSigmas);
   // Lists gaussians[id] anew for every id of `changed` (ids may grow the
   // index) and takes every id of `removed` out of all cells: then the index
   // answers as one built from the listed Gaussians would. Only the cells of
@@ -170,7 +181,9 @@ class GaussianIndex {
   // The entry of `g` (mean, L^T) and the keys of the cells its ellipsoid of
   // extent_sigmas_ meets, in key order of the box's cells. Returns the
   // number of the box's cells; throws DataError beyond kMaxIndexCellsPerGaussian.
-  std::size_t Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys);
+  // With `only`, the cells of `only` among them (the same test, cell by cell).
+  std::size_t Index(const Gaussian& g, std::uint32_t id, std::vector<std::int64_t>& cell_keys,
+                    const std::vector<VoxelKey>* only = nullptr);
   // Rebuilds the cell lists without stale entries or empty cells, with room
   // for `extra_cells` more.
   void Compact(std::size_t extra_cells);
@@ -182,7 +195,7 @@ class GaussianIndex {
                       std::vector<Listing>& joining);
 
   double cell_size_ = 1.0;
-  double extent_sigmas_ = 3.0;
+  double extent_sigmas_ = kExtentSigmas;
   bool updatable_ = false;
   std::vector<std::vector<std::int64_t>> listed_cells_;  // updatable: the cells of each Gaussian
   std::size_t cell_count_ = 0;                           // occupied slots of cells_ (updatable)

@@ -143,8 +143,12 @@ class LocalMap {
     std::size_t pending_at_seeding = 0;
     std::unordered_map<std::int64_t, std::uint32_t> voxels;
   };
-  // Fits the Gaussians of `region` again; their slots go to changed/removed.
-  void Refit(Region& region, std::vector<std::uint32_t>& changed, std::vector<std::uint32_t>& removed);
+  // The Gaussians of `region` fitted again from its points (build-map's
+  // estimator, floored at range, their RCS models).
+  GaussianMap Fit(const Region& region) const;
+  // `fitted` in place of the region's Gaussians; their slots go to changed/removed.
+  void Replace(Region& region, GaussianMap fitted, std::vector<std::uint32_t>& changed,
+               std::vector<std::uint32_t>& removed);
   // Widens each fitted Gaussian to the angular noise at its members' mean
   // range from the poses they were seen from.
   void FloorAtRange(const Region& region, const std::vector<int>& association, GaussianMap& fitted) const;
