@@ -60,6 +60,7 @@ class OdometryOptions(MatchOptions, total=False):
     min_static_points: int  # 10
     keyframe_distance: float  # 0.5
     keyframe_angle: float  # 2.0
+    background_map_update: bool  # True
     min_matched_points: int  # 10
     initial_pose: ArrayLike  # identity
     ego_min_range: float  # 0.25

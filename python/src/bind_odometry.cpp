@@ -43,6 +43,7 @@ py::dict StepToDict(const OdometryStep& s) {
   d["active_gaussians"] = s.active_gaussians;
   d["active_map_bytes"] = s.active_map_bytes;
   d["time_ms"] = s.time_ms;
+  d["map_update_ms"] = s.map_update_ms;
   d["information"] = MatrixToArray<6, 6>(s.information);
   d["velocity_information"] = MatrixToArray<6, 6>(s.velocity_information);
   d["rotation_information"] = MatrixToArray<6, 6>(s.rotation_information);

@@ -51,7 +51,8 @@ namespace {
 
 void WritePerScan(std::ostream& out, const std::vector<OdometryStep>& steps) {
   out << "scan,stamp,points,static_points,velocity_measured,vx,vy,vz,vx_std,vy_std,vz_std,standstill,gyro,matched,"
-         "iterations,final_cost,converged,reason,keyframe,active_gaussians,active_map_bytes,time_ms\n";
+         "iterations,final_cost,converged,reason,keyframe,active_gaussians,active_map_bytes,time_ms,"
+         "map_update_ms\n";
   out << std::setprecision(9);
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const OdometryStep& s = steps[k];
@@ -63,7 +64,7 @@ void WritePerScan(std::ostream& out, const std::vector<OdometryStep>& steps) {
         << s.velocity.y() << ',' << s.velocity.z() << ',' << velocity_std.x() << ',' << velocity_std.y() << ','
         << velocity_std.z() << ',' << s.standstill << ',' << s.gyro << ',' << s.matched << ',' << s.iterations << ','
         << s.final_cost << ',' << s.converged << ",\"" << reason << "\"," << s.keyframe << ',' << s.active_gaussians
-        << ',' << s.active_map_bytes << ',' << s.time_ms << '\n';
+        << ',' << s.active_map_bytes << ',' << s.time_ms << ',' << s.map_update_ms << '\n';
   }
 }
 

@@ -6,6 +6,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
 #include <Eigen/Eigenvalues>
 
 #include "radargauss/core/conventions.hpp"
@@ -59,6 +62,8 @@ const OptionTable<OdometryOptions>& OdometryOptionTable() {
             .AtLeast(0.0)
             .Unit("deg")
             .Help("... or this rotation"),
+        RADARGAUSS_OPTION(O, "background_map_update", background_map_update)
+            .Help("a keyframe's map update behind the scan's step, on its own thread (the same results)"),
         RADARGAUSS_OPTION(O, "min_matched_points", min_matched_points)
             .AtLeast(3)
             .Help("fewer associated points: the prediction stands in"),
@@ -95,6 +100,18 @@ RadarOdometry::RadarOdometry(const OdometryOptions& options, std::unique_ptr<Mot
       map_(options.map) {
   ValidateOptions(options_);
   motion_->Bind(options_.elevation_bias.estimate);
+  const std::size_t threads =
+      std::min<std::size_t>(std::size_t(std::max(1, tbb::this_task_arena::max_concurrency())),
+                            tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  if (options_.background_map_update && threads > 1) map_update_.reset(new tbb::task_group);
+}
+
+void RadarOdometry::WaitingGroup::operator()(tbb::task_group* group) const {
+  try {
+    group->wait();
+  } catch (...) {  // a failed update of a run that is going: nothing reads its map
+  }
+  delete group;
 }
 
 const ScanMatcher& RadarOdometry::MatcherForMap() {
@@ -111,6 +128,7 @@ const ScanMatcher& RadarOdometry::MatcherForMap() {
 
 void RadarOdometry::LocalizeIn(std::shared_ptr<const MatchingMap> map, const SE3d& map_from_odometry) {
   if (!map) throw std::invalid_argument("LocalizeIn: no map");
+  FinishMapUpdate();
   fixed_map_ = std::move(map);
   if (state_) {
     state_->pose = map_from_odometry * state_->pose;
@@ -209,6 +227,8 @@ bool RadarOdometry::RunBeside(const RadarScan& scan) {
   const OdometryStep& alone = radar_alone_->Register(scan);
   if (motion_->Check(alone.stamp, alone.pose, alone.matched)) return false;
   // The model failed: the radar alone's run goes on as this one, the model kept for its record.
+  radar_alone_->FinishMapUpdate();
+  FinishMapUpdate();
   std::unique_ptr<MotionModel> model = std::move(motion_);
   std::unique_ptr<RadarOdometry> radar_alone = std::move(radar_alone_);
   *this = std::move(*radar_alone);
@@ -229,16 +249,20 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& input) {
   if (state_) prediction = Predict(scan.timestamp);
   const Velocity velocity = MeasureVelocity(scan, prediction);
   if (velocity.measured && !velocity.standstill) elevation_bias_.Observe(velocity.value);
+  FinishMapUpdate();  // the map is read from here on
   PoseEstimate estimate = EstimatePose(scan, prediction, velocity);
   estimate.pose = motion_->Fuse(EstimateOf(scan, velocity, estimate));
   const bool keyframe = !fixed_map_ && IsKeyframe(estimate.pose, velocity);
-  if (keyframe) InsertKeyframe(scan, velocity.static_points, estimate.pose);
-  last_static_points_ = velocity.static_points;
   OdometryStep step = StepOf(scan, prediction, velocity, estimate, keyframe);
+  const std::size_t index = steps_.size();
+  if (keyframe) InsertKeyframe(scan, velocity.static_points, estimate.pose, index);
+  last_static_points_ = velocity.static_points;
   step.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  // Counted outside the step's time: the map changes on keyframes only.
-  if (keyframe || !state_) map_bytes_ = map_.MemoryBytes();
-  step.active_map_bytes = map_bytes_;
+  if (!keyframe) {
+    if (!state_) map_bytes_ = map_.MemoryBytes();
+    step.active_gaussians = map_.gaussians();
+    step.active_map_bytes = map_bytes_;
+  }
   MotionState next;
   next.stamp = step.stamp;
   next.pose = step.pose;
@@ -249,6 +273,8 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& input) {
                                     : (state_ ? state_->measured : std::nullopt);
   state_ = next;
   steps_.push_back(step);
+  // Counted outside the step's time: the map changes on keyframes only.
+  if (keyframe && !pending_step_) RecordMap(index, pending_update_ms_);
   return steps_.back();
 }
 
@@ -331,7 +357,7 @@ bool RadarOdometry::IsKeyframe(const SE3d& pose, const Velocity& velocity) const
 }
 
 void RadarOdometry::InsertKeyframe(const RadarScan& scan, const std::vector<std::size_t>& static_points,
-                                   const SE3d& pose) {
+                                   const SE3d& pose, std::size_t step) {
   std::vector<Eigen::Vector3d> points;
   std::vector<double> rcs;
   points.reserve(static_points.size());
@@ -339,9 +365,41 @@ void RadarOdometry::InsertKeyframe(const RadarScan& scan, const std::vector<std:
     points.push_back(pose * scan.points[i].position);
     if (scan.has_rcs) rcs.push_back(scan.points[i].rcs);
   }
-  map_.Insert(points, rcs, pose);
-  map_.Evict(pose.translation());
   last_keyframe_ = pose;
+  const auto update = [this, points = std::move(points), rcs = std::move(rcs), pose] {
+    const auto start = std::chrono::steady_clock::now();
+    map_.Insert(points, rcs, pose);
+    map_.Evict(pose.translation());
+    pending_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  };
+  if (!map_update_) {
+    update();
+    return;
+  }
+  pending_step_ = step;
+  map_update_->run([this, update = std::move(update)] {
+    update();
+    map_bytes_ = map_.MemoryBytes();  // off the path too
+  });
+}
+
+void RadarOdometry::FinishMapUpdate() const {
+  if (!pending_step_) return;
+  const std::size_t step = *pending_step_;
+  pending_step_.reset();
+  map_update_->wait();  // the waiting thread helps with the update's own parallel loops
+  OdometryStep& s = steps_.at(step);
+  s.active_gaussians = map_.gaussians();
+  s.active_map_bytes = map_bytes_;
+  s.map_update_ms = pending_update_ms_;
+}
+
+void RadarOdometry::RecordMap(std::size_t step, double update_ms) const {
+  map_bytes_ = map_.MemoryBytes();
+  OdometryStep& s = steps_.at(step);
+  s.active_gaussians = map_.gaussians();
+  s.active_map_bytes = map_bytes_;
+  s.map_update_ms = update_ms;
 }
 
 ScanEstimate RadarOdometry::EstimateOf(const RadarScan& scan, const Velocity& velocity, const PoseEstimate& estimate) {
@@ -387,7 +445,6 @@ OdometryStep RadarOdometry::StepOf(const RadarScan& scan, const std::optional<Pr
   step.reason = velocity.reason;
   if (!estimate.reason.empty()) step.reason += (step.reason.empty() ? "" : "; ") + estimate.reason;
   step.keyframe = keyframe;
-  step.active_gaussians = map_.gaussians();
   return step;
 }
 

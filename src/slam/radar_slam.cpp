@@ -111,12 +111,12 @@ RadarSlam::~RadarSlam() = default;
 
 const OdometryStep& RadarSlam::Register(const RadarScan& scan) {
   const auto start = std::chrono::steady_clock::now();
-  const std::size_t index = odometry_.steps().size();
+  const std::size_t index = odometry_.scans();  // not steps(): it would wait for the map update behind the last
   const OdometryStep& step = odometry_.Register(scan);
   ScanTime time;
   time.front_end_ms = MillisecondsSince(start);
   const auto back_end = std::chrono::steady_clock::now();
-  if (index > 0) path_ += (step.pose.translation() - odometry_.steps()[index - 1].pose.translation()).norm();
+  if (index > 0) path_ += (step.pose.translation() - odometry_.pose(index - 1).translation()).norm();
   if (!open_) {
     OpenKeyframe(index, step.pose, step.stamp);
   } else if (path_ - open_keyframe_.path >= options_.submap_distance) {

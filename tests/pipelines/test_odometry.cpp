@@ -81,30 +81,53 @@ TEST(RadarOdometry, DriftsLittleOnASimulatedDriveWithoutItsGroundTruth) { Expect
 // The same bounds with the map that updates its Gaussians' statistics.
 TEST(RadarOdometry, DriftsLittleWithTheIncrementalMap) { ExpectLittleDrift(MapEstimator::kIncremental); }
 
+// Each step's pose and the map after it (its Gaussians and bytes), and the global map at the end.
+struct Run {
+  std::vector<OdometryStep> steps;
+  GaussianMap map;
+  bool behind = false;
+};
+
 void ExpectDeterministic(MapEstimator estimator) {
   const SimulatedSequence& drive = Drive();
-  const auto run = [&](std::size_t threads) {
+  const auto run = [&](std::size_t threads, bool background) {
     const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     OdometryOptions options = StartingAtTruth(drive);
     options.map.estimator = estimator;
+    options.background_map_update = background;
     RadarOdometry odometry(options);
     for (std::size_t k = 0; k < 40; ++k) odometry.Register(drive.scans[k]);
-    return odometry.trajectory();
+    return Run{odometry.steps(), odometry.map().GlobalMap(), odometry.map_update_behind()};
   };
-  const Trajectory one = run(1);
-  for (const std::size_t threads : {2, 8, 8}) {
-    const Trajectory more = run(threads);
-    ASSERT_EQ(one.size(), more.size());
-    for (std::size_t k = 0; k < one.size(); ++k) {
-      ASSERT_EQ(one[k].pose.translation(), more[k].pose.translation()) << threads << " threads, scan " << k;
-      ASSERT_EQ(one[k].pose.rotation().quaternion().coeffs(), more[k].pose.rotation().quaternion().coeffs()) << k;
+  const Run one = run(1, true);
+  EXPECT_FALSE(one.behind);  // one thread: the update on the scan's path
+  for (const auto& [threads, background] :
+       {std::pair{2, true}, std::pair{8, true}, std::pair{8, true}, std::pair{8, false}}) {
+    const Run more = run(threads, background);
+    EXPECT_EQ(more.behind, background) << threads;
+    ASSERT_EQ(one.steps.size(), more.steps.size());
+    for (std::size_t k = 0; k < one.steps.size(); ++k) {
+      const OdometryStep &a = one.steps[k], &b = more.steps[k];
+      ASSERT_EQ(a.pose.translation(), b.pose.translation()) << threads << " threads, scan " << k;
+      ASSERT_EQ(a.pose.rotation().quaternion().coeffs(), b.pose.rotation().quaternion().coeffs()) << k;
+      ASSERT_EQ(a.keyframe, b.keyframe) << k;
+      ASSERT_EQ(a.active_gaussians, b.active_gaussians) << threads << " threads, scan " << k;
+      ASSERT_EQ(a.active_map_bytes, b.active_map_bytes) << k;
+      EXPECT_EQ(a.map_update_ms > 0.0, a.keyframe) << k;
+    }
+    ASSERT_EQ(one.map.gaussians.size(), more.map.gaussians.size());
+    for (std::size_t g = 0; g < one.map.gaussians.size(); ++g) {
+      ASSERT_EQ(one.map.gaussians[g].mean, more.map.gaussians[g].mean) << g;
+      ASSERT_EQ(one.map.gaussians[g].covariance, more.map.gaussians[g].covariance) << g;
     }
   }
 }
 
 // The same run for 1, 2 and 8 threads (the Doppler's hypotheses, the
-// association, the region fits and the index levels run side by side), and
-// again for the same options, with either map estimator.
+// association, the region fits and the index levels run side by side; with
+// more than one, each keyframe's map update behind its step), again for the
+// same options, and with the update on the path, with either map estimator:
+// the same poses, the same map after every keyframe.
 TEST(RadarOdometry, DeterministicForAnyThreadCount) {
   for (const MapEstimator estimator : {MapEstimator::kRefit, MapEstimator::kIncremental}) {
     SCOPED_TRACE(ToString(estimator));

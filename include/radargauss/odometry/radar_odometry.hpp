@@ -20,6 +20,8 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/task_group.h>
+
 #include <Eigen/Core>
 
 #include "radargauss/core/doppler.hpp"
@@ -63,8 +65,13 @@ struct OdometryOptions {
   Eigen::Vector3d rotation_rate_std_deg{1.0, 1.0, 90.0};  // deg/s: rate changes the prediction allows
   MatchOptions match;                                     // solver and eq. 2 (w_rcs, losses, incidence via map.rcs)
   LocalMapOptions map;
-  double keyframe_distance = 0.5;       // m since the last keyframe ...
-  double keyframe_angle_deg = 2.0;      // ... or deg: the scan enters the map
+  double keyframe_distance = 0.5;   // m since the last keyframe ...
+  double keyframe_angle_deg = 2.0;  // ... or deg: the scan enters the map
+  // A keyframe's map update runs on a thread of its own behind the scan's
+  // step, finished before the next scan's match reads the map, when more
+  // than one thread is allowed (docs/design/odometry.md, "The map update
+  // behind the step"): the same map and trajectory either way.
+  bool background_map_update = true;
   std::size_t min_matched_points = 10;  // fewer associated points: the prediction stands in
   SE3d initial_pose;                    // T_world_radar of the first scan
   // The radar on the vehicle, roll / pitch / yaw in deg (VehicleFromRadar;
@@ -105,7 +112,10 @@ struct OdometryStep {
   bool keyframe = false;
   std::size_t active_gaussians = 0;  // after the map update
   std::size_t active_map_bytes = 0;  // LocalMap::MemoryBytes after the map update
-  double time_ms = 0.0;              // the whole step, map update included
+  // The step until its pose was known and, on the scan's path, its map
+  // update; with the update behind the step, the wait for the last one.
+  double time_ms = 0.0;
+  double map_update_ms = 0.0;  // a keyframe's map update (LocalMap::Insert and Evict), wherever it ran
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();           // eq. 2's
   Eigen::Matrix<double, 6, 6> velocity_information = Eigen::Matrix<double, 6, 6>::Zero();  // the term's
   Eigen::Matrix<double, 6, 6> rotation_information = Eigen::Matrix<double, 6, 6>::Zero();  // the rotation term's
@@ -136,9 +146,24 @@ class RadarOdometry {
   // `map_from_odometry`: localisation in a given map (relocalisation's tracking).
   void LocalizeIn(std::shared_ptr<const MatchingMap> map, const SE3d& map_from_odometry);
 
-  const std::vector<OdometryStep>& steps() const { return steps_; }
+  // The steps and the map finish a map update still behind the last step first.
+  const std::vector<OdometryStep>& steps() const {
+    FinishMapUpdate();
+    return steps_;
+  }
+  // Without waiting for the map: the number of steps, and step k's pose.
+  std::size_t scans() const { return steps_.size(); }
+  const SE3d& pose(std::size_t k) const { return steps_.at(k).pose; }
   Trajectory trajectory() const;
-  const LocalMap& map() const { return map_; }
+  const LocalMap& map() const {
+    FinishMapUpdate();
+    return map_;
+  }
+  // Waits for the map update behind the last step (rethrowing what it threw)
+  // and completes that step's map fields.
+  void FinishMapUpdate() const;
+  // Whether keyframes' map updates run behind the steps (background_map_update and more than one thread).
+  bool map_update_behind() const { return map_update_ != nullptr; }
   // The indices of the last registered scan's static points (Doppler inliers;
   // every point of a scan without Doppler; none when the prediction stood in).
   const std::vector<std::size_t>& last_static_points() const { return last_static_points_; }
@@ -204,7 +229,11 @@ class RadarOdometry {
   const ScanMatcher& MatcherForMap();
   // Whether the scan at `pose` enters the map (the first, or far or turned enough since the last keyframe).
   bool IsKeyframe(const SE3d& pose, const Velocity& velocity) const;
-  void InsertKeyframe(const RadarScan& scan, const std::vector<std::size_t>& static_points, const SE3d& pose);
+  // Runs the keyframe's map update, or posts it behind the step `step`.
+  void InsertKeyframe(const RadarScan& scan, const std::vector<std::size_t>& static_points, const SE3d& pose,
+                      std::size_t step);
+  // Records the map after an update: its Gaussians and bytes in step `step` (and map_bytes_).
+  void RecordMap(std::size_t step, double update_ms) const;
   static ScanEstimate EstimateOf(const RadarScan& scan, const Velocity& velocity, const PoseEstimate& estimate);
   OdometryStep StepOf(const RadarScan& scan, const std::optional<Prediction>& prediction, const Velocity& velocity,
                       const PoseEstimate& estimate, bool keyframe) const;
@@ -218,14 +247,24 @@ class RadarOdometry {
   std::size_t matcher_version_ = 0;
   std::size_t matchers_made_ = 0;
   LocalMap map_;
-  std::vector<OdometryStep> steps_;  // the record of the run (the motion model reads state_)
+  // The record of the run (the motion model reads state_); a step's map
+  // fields are completed when a map update behind it finishes.
+  mutable std::vector<OdometryStep> steps_;
   std::optional<MotionState> state_;
   SE3d last_keyframe_;
   std::vector<std::size_t> last_static_points_;
   std::shared_ptr<const MatchingMap> fixed_map_;  // LocalizeIn's; null: the run's own map
-  std::size_t map_bytes_ = 0;                     // LocalMap::MemoryBytes after the last keyframe
+  mutable std::size_t map_bytes_ = 0;             // LocalMap::MemoryBytes after the last keyframe
   // The radar alone, run beside while the motion model is on probation.
   std::unique_ptr<RadarOdometry> radar_alone_;
+  // The step whose map update is behind it, and the update's time (ms, the worker's).
+  mutable std::optional<std::size_t> pending_step_;
+  double pending_update_ms_ = 0.0;
+  // The map update's task; it is waited for before it goes (last: before the map it updates).
+  struct WaitingGroup {
+    void operator()(tbb::task_group* group) const;
+  };
+  mutable std::unique_ptr<tbb::task_group, WaitingGroup> map_update_;
 };
 
 // Per-scan time (median, p90 in ms), scan and keyframe counts, fallbacks.
