@@ -2,6 +2,7 @@
 // Data in: load throughput (points/s) per format, and Doppler ego velocity
 // per 800-point scan.
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include <filesystem>
 #include <fstream>
@@ -170,12 +171,17 @@ void BM_ReadBagFiltered(benchmark::State& state) {
 }
 BENCHMARK(BM_ReadBagFiltered)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 
+// Odometry's Doppler RANSAC (support counted in voxels) on 1 and 2 threads:
+// the hypotheses' supports are counted side by side.
 void BM_EgoVelocity800(benchmark::State& state) {
   const RadarScan& scan = BenchmarkScan();
-  for (auto _ : state) benchmark::DoNotOptimize(EstimateEgoVelocity(scan).velocity);
+  const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(0)));
+  EgoVelocityOptions options;
+  options.consensus_voxel = 1.0;
+  for (auto _ : state) benchmark::DoNotOptimize(EstimateEgoVelocity(scan, options).velocity);
   state.counters["points"] = double(scan.points.size());
 }
-BENCHMARK(BM_EgoVelocity800)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_EgoVelocity800)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 }  // namespace
 }  // namespace radargauss

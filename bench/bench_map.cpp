@@ -3,11 +3,13 @@
 // association of one point, the RCS fit of one Gaussian, and the memory of
 // a Gaussian (map entry + spatial index).
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include <random>
 #include <vector>
 
 #include "radargauss/map/pipeline.hpp"
+#include "radargauss/solvers/correspondences.hpp"
 
 namespace radargauss {
 namespace {
@@ -97,6 +99,42 @@ void BM_AssociatePointsBatched(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * kBatch);
 }
 BENCHMARK(BM_AssociatePointsBatched);
+
+// A scan of 3000 points associated against the map (AssociateScan: blocks
+// of 256 points side by side), on 1 and 2 threads: time per scan.
+void BM_AssociateScan(benchmark::State& state) {
+  const BuiltMap& b = Built();
+  const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(0)));
+  RadarScan scan;
+  for (std::size_t k = 0, i = 0; k < 3000; ++k, i = (i + 7919) % b.cloud.points.size()) {
+    RadarPoint point;
+    point.position = b.cloud.points[i];
+    scan.points.push_back(point);
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(AssociateScan(scan, b.index, SE3d(), 3.0).data());
+  state.SetItemsProcessed(state.iterations() * std::int64_t(scan.points.size()));
+}
+BENCHMARK(BM_AssociateScan)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+// One region's refit in the local map: build-map's estimator on 256 points
+// (a region's capacity) in a 4 m cube, its E steps on an index of the
+// points' cells alone.
+void BM_FitRegion(benchmark::State& state) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uniform(0.0, 4.0);
+  std::normal_distribution<double> normal(0.0, 0.05);
+  std::vector<Eigen::Vector3d> points;
+  for (int k = 0; k < 256; ++k) {  // two walls and a floor
+    const double u = uniform(rng), v = uniform(rng);
+    points.emplace_back(k % 3 == 0
+                            ? Eigen::Vector3d(u, v, normal(rng))
+                            : (k % 3 == 1 ? Eigen::Vector3d(u, normal(rng), v) : Eigen::Vector3d(normal(rng), u, v)));
+  }
+  GaussianMapOptions options;
+  options.points_per_gaussian = double(state.range(0));
+  for (auto _ : state) benchmark::DoNotOptimize(BuildGaussians(points, options).size());
+}
+BENCHMARK(BM_FitRegion)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
 
 void BM_FitRcsModelDegree3(benchmark::State& state) {
   std::mt19937 rng(3);

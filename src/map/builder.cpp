@@ -145,6 +145,7 @@ std::vector<std::vector<std::uint32_t>> BisectingKMeans(const std::vector<Eigen:
 // A fit of few points (a local map's region) indexes only the cells its
 // points are in (GaussianIndex's `only`); a large one indexes every cell.
 constexpr std::size_t kFewPoints = 4096;
+constexpr std::size_t kEStepBlock = 1024;
 std::vector<VoxelKey> QueryCells(const std::vector<Eigen::Vector3d>& points, double cell) {
   return points.size() <= kFewPoints ? GaussianIndex::CellsOf(points, cell) : std::vector<VoxelKey>();
 }
@@ -152,7 +153,9 @@ const std::vector<VoxelKey>* QueriedOnly(const std::vector<VoxelKey>& cells) {
   return cells.empty() ? nullptr : &cells;
 }
 
-// Hard EM from an initial partition; returns the final Gaussians.
+// Hard EM from an initial partition; returns the final Gaussians. Their ids
+// stay fixed across the rounds (an emptied one leaves, the rest keep
+// theirs), so a round refits only the Gaussians whose members changed.
 std::vector<Gaussian> HardEm(const std::vector<Eigen::Vector3d>& points,
                              std::vector<std::vector<std::uint32_t>> partition, const GaussianMapOptions& options,
                              const ProgressCallback& progress) {
@@ -162,49 +165,67 @@ std::vector<Gaussian> HardEm(const std::vector<Eigen::Vector3d>& points,
     for (const std::uint32_t i : members) label[i] = int(gaussians.size());
     gaussians.push_back(FitGaussian(points, members, options.min_std));
   }
+  std::vector<std::vector<std::uint32_t>> members = std::move(partition);  // each Gaussian's, as last fitted
+  std::vector<char> alive(gaussians.size(), 1);
   const std::vector<VoxelKey> cells = QueryCells(points, options.index_cell);
   for (int iteration = 0; iteration < options.em_iterations; ++iteration) {
-    const GaussianIndex index(gaussians, options.index_cell, GaussianIndex::kExtentSigmas, QueriedOnly(cells));
+    // This round's index of the Gaussians left (id_of: their ids).
+    std::vector<Gaussian> live;
+    std::vector<std::uint32_t> id_of;
+    for (std::size_t g = 0; g < gaussians.size(); ++g) {
+      if (!alive[g]) continue;
+      id_of.push_back(std::uint32_t(g));
+      live.push_back(gaussians[g]);
+    }
+    const GaussianIndex index(live, options.index_cell, GaussianIndex::kExtentSigmas, QueriedOnly(cells));
     std::vector<double> half_log_det(gaussians.size());
     for (std::size_t g = 0; g < gaussians.size(); ++g) {
-      half_log_det[g] = 0.5 * std::log(gaussians[g].covariance.determinant());
+      if (alive[g]) half_log_det[g] = 0.5 * std::log(gaussians[g].covariance.determinant());
     }
-    // E step (hard): the Gaussian of highest likelihood among the candidates.
+    // E step (hard): the Gaussian of highest likelihood among the candidates,
+    // in blocks of kEStepBlock points: a region's few hundred run as one,
+    // with no tasks to hand out (their cost passed the fit's own).
     std::vector<int> next(points.size());
-    tbb::parallel_for(std::size_t(0), points.size(), [&](std::size_t i) {
-      std::size_t count = 0;
-      const std::uint32_t* candidates = index.Candidates(points[i], count);
-      int best = label[i];
-      double best_cost = INFINITY;
-      for (std::size_t c = 0; c < count; ++c) {
-        const std::uint32_t g = candidates[c];
-        const Eigen::Vector3d e = points[i] - index.Mean(g);
-        const double cost = 0.5 * index.MahalanobisSq(g, e) + half_log_det[g];
-        if (cost < best_cost) {
-          best_cost = cost;
-          best = int(g);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), kEStepBlock), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+        std::size_t count = 0;
+        const std::uint32_t* candidates = index.Candidates(points[i], count);
+        int best = label[i];
+        double best_cost = INFINITY;
+        for (std::size_t c = 0; c < count; ++c) {
+          const std::uint32_t g = id_of[candidates[c]];
+          const Eigen::Vector3d e = points[i] - index.Mean(candidates[c]);
+          const double cost = 0.5 * index.MahalanobisSq(candidates[c], e) + half_log_det[g];
+          if (cost < best_cost) {
+            best_cost = cost;
+            best = int(g);
+          }
         }
+        next[i] = best;
       }
-      next[i] = best;
     });
-    const bool changed = next != label;
+    const bool relabelled = next != label;
     label.swap(next);
-    // M step: refit every Gaussian from its points; drop empty ones.
-    std::vector<std::vector<std::uint32_t>> members(gaussians.size());
-    for (std::size_t i = 0; i < points.size(); ++i) members[label[i]].push_back(std::uint32_t(i));
-    std::vector<Gaussian> refit;
-    std::vector<int> renumber(gaussians.size(), -1);
+    // M step: refit the Gaussians whose members changed; the emptied ones leave.
+    std::vector<std::vector<std::uint32_t>> now(gaussians.size());
+    for (std::size_t i = 0; i < points.size(); ++i) now[label[i]].push_back(std::uint32_t(i));
     for (std::size_t g = 0; g < gaussians.size(); ++g) {
-      if (members[g].empty()) continue;
-      renumber[g] = int(refit.size());
-      refit.push_back(FitGaussian(points, members[g], options.min_std));
+      if (!alive[g] || now[g] == members[g]) continue;
+      if (now[g].empty()) {
+        alive[g] = 0;
+      } else {
+        gaussians[g] = FitGaussian(points, now[g], options.min_std);
+      }
+      members[g].swap(now[g]);
     }
-    for (int& l : label) l = renumber[l];
-    gaussians.swap(refit);
     if (progress) progress("hard EM", std::size_t(iteration + 1), std::size_t(options.em_iterations));
-    if (!changed) break;
+    if (!relabelled) break;
   }
-  return gaussians;
+  std::vector<Gaussian> result;
+  for (std::size_t g = 0; g < gaussians.size(); ++g) {
+    if (alive[g]) result.push_back(std::move(gaussians[g]));
+  }
+  return result;
 }
 
 std::vector<Gaussian> VoxelGaussians(const std::vector<Eigen::Vector3d>& points, const GaussianMapOptions& options) {
