@@ -137,7 +137,8 @@ void BindInertialOdometry(py::module_& m) {
           "register",
           [](LockedInertial& odometry, const RadarScan& scan) {
             const auto [step, state] = odometry.With([&](RadarOdometry& o) {
-              const OdometryStep s = o.Register(scan);
+              o.Register(scan);
+              const OdometryStep s = o.steps().back();  // its map fields complete
               const InertialMotion* window = InertialMotionOf(o);
               return std::make_pair(s, window ? window->states().back() : std::nullopt);
             });
@@ -226,7 +227,10 @@ void BindOdometry(py::module_& m) {
       .def(
           "register",
           [](LockedOdometry& odometry, const RadarScan& scan) {
-            return StepToDict(odometry.With([&](RadarOdometry& o) { return o.Register(scan); }));
+            return StepToDict(odometry.With([&](RadarOdometry& o) {
+              o.Register(scan);
+              return o.steps().back();  // its map fields complete: the map update behind it finished
+            }));
           },
           py::arg("scan"),
           "Adds the next scan (stamps must increase); returns what happened to it as a dict: pose (4x4), "

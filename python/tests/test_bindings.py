@@ -153,6 +153,12 @@ def test_odometry_and_evaluate():
     steps = [odometry.register(scan) for scan in sequence.scans]
     assert len(odometry) == 60 and sum(step["matched"] for step in steps) > 50
     assert all(np.isfinite(step["pose"]).all() for step in steps)
+    # A keyframe's dict has its map update's time and the map after it, whether
+    # the update ran on the scan's path or behind it.
+    keyframes = [step for step in steps if step["keyframe"]]
+    assert len(keyframes) > 10 and all(step["map_update_ms"] > 0 for step in keyframes)
+    assert all(step["active_gaussians"] > 0 for step in keyframes[1:])
+    assert all(step["map_update_ms"] == 0 for step in steps if not step["keyframe"])
     evaluation = rg.evaluate(odometry.trajectory(), (sequence.stamps, sequence.poses))
     assert evaluation["matched"] == 60 and evaluation["rpe"]["horizontal_percent"] < 2.0
     perfect = rg.evaluate((sequence.stamps, sequence.poses), (sequence.stamps, sequence.poses))

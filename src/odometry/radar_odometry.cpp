@@ -8,6 +8,7 @@
 
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -90,6 +91,10 @@ MatcherFactory GaussianMatcherFactory() {
   };
 }
 
+struct RadarOdometry::MapUpdateTask {
+  tbb::task_group group;
+};
+
 RadarOdometry::RadarOdometry(const OdometryOptions& options, std::unique_ptr<MotionModel> motion,
                              MatcherFactory factory)
     : options_(options),
@@ -103,15 +108,15 @@ RadarOdometry::RadarOdometry(const OdometryOptions& options, std::unique_ptr<Mot
   const std::size_t threads =
       std::min<std::size_t>(std::size_t(std::max(1, tbb::this_task_arena::max_concurrency())),
                             tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  if (options_.background_map_update && threads > 1) map_update_.reset(new tbb::task_group);
+  if (options_.background_map_update && threads > 1) map_update_.reset(new MapUpdateTask);
 }
 
-void RadarOdometry::WaitingGroup::operator()(tbb::task_group* group) const {
+void RadarOdometry::WaitAndDelete::operator()(MapUpdateTask* task) const {
   try {
-    group->wait();
+    task->group.wait();
   } catch (...) {  // a failed update of a run that is going: nothing reads its map
   }
-  delete group;
+  delete task;
 }
 
 const ScanMatcher& RadarOdometry::MatcherForMap() {
@@ -377,7 +382,7 @@ void RadarOdometry::InsertKeyframe(const RadarScan& scan, const std::vector<std:
     return;
   }
   pending_step_ = step;
-  map_update_->run([this, update = std::move(update)] {
+  map_update_->group.run([this, update = std::move(update)] {
     update();
     map_bytes_ = map_.MemoryBytes();  // off the path too
   });
@@ -387,7 +392,7 @@ void RadarOdometry::FinishMapUpdate() const {
   if (!pending_step_) return;
   const std::size_t step = *pending_step_;
   pending_step_.reset();
-  map_update_->wait();  // the waiting thread helps with the update's own parallel loops
+  map_update_->group.wait();  // the waiting thread helps with the update's own parallel loops
   OdometryStep& s = steps_.at(step);
   s.active_gaussians = map_.gaussians();
   s.active_map_bytes = map_bytes_;

@@ -20,8 +20,6 @@
 #include <utility>
 #include <vector>
 
-#include <tbb/task_group.h>
-
 #include <Eigen/Core>
 
 #include "radargauss/core/doppler.hpp"
@@ -140,6 +138,9 @@ class RadarOdometry {
 
   // Registers the next scan. Throws DataError when its stamp is not after the
   // previous one's or is not finite; every other fault becomes a reason.
+  // With the map update behind the step (map_update_behind()), a keyframe's
+  // map fields (active_gaussians, active_map_bytes, map_update_ms) are
+  // completed when it finishes: steps(), map() or FinishMapUpdate().
   const OdometryStep& Register(const RadarScan& scan);
   // From the next scan on, matches against `map`, fixed (nothing is
   // inserted), with the motion model carried into the map's frame by
@@ -260,11 +261,13 @@ class RadarOdometry {
   // The step whose map update is behind it, and the update's time (ms, the worker's).
   mutable std::optional<std::size_t> pending_step_;
   double pending_update_ms_ = 0.0;
-  // The map update's task; it is waited for before it goes (last: before the map it updates).
-  struct WaitingGroup {
-    void operator()(tbb::task_group* group) const;
+  // The map update's task (a tbb::task_group, kept out of this header); it
+  // is waited for before it goes (last: before the map it updates).
+  struct MapUpdateTask;
+  struct WaitAndDelete {
+    void operator()(MapUpdateTask* task) const;
   };
-  mutable std::unique_ptr<tbb::task_group, WaitingGroup> map_update_;
+  mutable std::unique_ptr<MapUpdateTask, WaitAndDelete> map_update_;
 };
 
 // Per-scan time (median, p90 in ms), scan and keyframe counts, fallbacks.
