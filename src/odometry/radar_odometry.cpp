@@ -8,7 +8,6 @@
 
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
-#include <tbb/task_group.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -91,10 +90,6 @@ MatcherFactory GaussianMatcherFactory() {
   };
 }
 
-struct RadarOdometry::MapUpdateTask {
-  tbb::task_group group;
-};
-
 RadarOdometry::RadarOdometry(const OdometryOptions& options, std::unique_ptr<MotionModel> motion,
                              MatcherFactory factory)
     : options_(options),
@@ -108,15 +103,7 @@ RadarOdometry::RadarOdometry(const OdometryOptions& options, std::unique_ptr<Mot
   const std::size_t threads =
       std::min<std::size_t>(std::size_t(std::max(1, tbb::this_task_arena::max_concurrency())),
                             tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  if (options_.background_map_update && threads > 1) map_update_.reset(new MapUpdateTask);
-}
-
-void RadarOdometry::WaitAndDelete::operator()(MapUpdateTask* task) const {
-  try {
-    task->group.wait();
-  } catch (...) {  // a failed update of a run that is going: nothing reads its map
-  }
-  delete task;
+  if (options_.background_map_update && threads > 1) map_update_ = NewMapUpdateTask();
 }
 
 const ScanMatcher& RadarOdometry::MatcherForMap() {
@@ -279,7 +266,7 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& input) {
   state_ = next;
   steps_.push_back(step);
   // Counted outside the step's time: the map changes on keyframes only.
-  if (keyframe && !pending_step_) RecordMap(index, pending_update_ms_);
+  if (keyframe && !pending_step_) RecordMap(index, true);
   return steps_.back();
 }
 
@@ -359,52 +346,6 @@ bool RadarOdometry::IsKeyframe(const SE3d& pose, const Velocity& velocity) const
   const SE3d moved = last_keyframe_.Inverse() * pose;
   return moved.translation().norm() >= options_.keyframe_distance ||
          moved.rotation().Log().norm() >= options_.keyframe_angle_deg * M_PI / 180.0;
-}
-
-void RadarOdometry::InsertKeyframe(const RadarScan& scan, const std::vector<std::size_t>& static_points,
-                                   const SE3d& pose, std::size_t step) {
-  std::vector<Eigen::Vector3d> points;
-  std::vector<double> rcs;
-  points.reserve(static_points.size());
-  for (const std::size_t i : static_points) {
-    points.push_back(pose * scan.points[i].position);
-    if (scan.has_rcs) rcs.push_back(scan.points[i].rcs);
-  }
-  last_keyframe_ = pose;
-  const auto update = [this, points = std::move(points), rcs = std::move(rcs), pose] {
-    const auto start = std::chrono::steady_clock::now();
-    map_.Insert(points, rcs, pose);
-    map_.Evict(pose.translation());
-    pending_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  };
-  if (!map_update_) {
-    update();
-    return;
-  }
-  pending_step_ = step;
-  map_update_->group.run([this, update = std::move(update)] {
-    update();
-    map_bytes_ = map_.MemoryBytes();  // off the path too
-  });
-}
-
-void RadarOdometry::FinishMapUpdate() const {
-  if (!pending_step_) return;
-  const std::size_t step = *pending_step_;
-  pending_step_.reset();
-  map_update_->group.wait();  // the waiting thread helps with the update's own parallel loops
-  OdometryStep& s = steps_.at(step);
-  s.active_gaussians = map_.gaussians();
-  s.active_map_bytes = map_bytes_;
-  s.map_update_ms = pending_update_ms_;
-}
-
-void RadarOdometry::RecordMap(std::size_t step, double update_ms) const {
-  map_bytes_ = map_.MemoryBytes();
-  OdometryStep& s = steps_.at(step);
-  s.active_gaussians = map_.gaussians();
-  s.active_map_bytes = map_bytes_;
-  s.map_update_ms = update_ms;
 }
 
 ScanEstimate RadarOdometry::EstimateOf(const RadarScan& scan, const Velocity& velocity, const PoseEstimate& estimate) {

@@ -233,8 +233,9 @@ class RadarOdometry {
   // Runs the keyframe's map update, or posts it behind the step `step`.
   void InsertKeyframe(const RadarScan& scan, const std::vector<std::size_t>& static_points, const SE3d& pose,
                       std::size_t step);
-  // Records the map after an update: its Gaussians and bytes in step `step` (and map_bytes_).
-  void RecordMap(std::size_t step, double update_ms) const;
+  // Records the map after an update in step `step`: its Gaussians, bytes
+  // (measured now when `measure`, else the update's) and the update's time.
+  void RecordMap(std::size_t step, bool measure) const;
   static ScanEstimate EstimateOf(const RadarScan& scan, const Velocity& velocity, const PoseEstimate& estimate);
   OdometryStep StepOf(const RadarScan& scan, const std::optional<Prediction>& prediction, const Velocity& velocity,
                       const PoseEstimate& estimate, bool keyframe) const;
@@ -267,6 +268,7 @@ class RadarOdometry {
   struct WaitAndDelete {
     void operator()(MapUpdateTask* task) const;
   };
+  static std::unique_ptr<MapUpdateTask, WaitAndDelete> NewMapUpdateTask();
   mutable std::unique_ptr<MapUpdateTask, WaitAndDelete> map_update_;
 };
 
