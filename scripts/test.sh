@@ -21,15 +21,15 @@ phase() {
   last=$SECONDS
 }
 jobs=$(nproc)
-# CI must end within its time: its sanitize tree builds without line tables
-# and the library in unity batches, and leaves the long drives (label drive)
-# to the release tree.
+# CI must end within its time: both trees build the library in unity
+# batches, the sanitize tree without line tables, and it leaves the long
+# drives (label drive) to the release tree.
 sanitize_debug_info=-g1
-sanitize_unity=OFF
+unity=OFF
 sanitize_labels=()
 if [ "${CI:-}" = true ]; then
   sanitize_debug_info=-g0
-  sanitize_unity=ON
+  unity=ON
   sanitize_labels=(-LE drive)
 fi
 trees=${RADARGAUSS_TEST_TREES:-"release sanitize"}
@@ -61,7 +61,7 @@ for tree in $trees; do
   case "$tree" in
     release)
       cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DRADARGAUSS_WITH_ROSBAG=ON \
-        -DRADARGAUSS_WITH_PCL=ON -DRADARGAUSS_WITH_PYTHON=ON ;;
+        -DRADARGAUSS_WITH_PCL=ON -DRADARGAUSS_WITH_PYTHON=ON -DRADARGAUSS_UNITY_LIBRARY="$unity" ;;
     sanitize)
       # Debug keeps Eigen's and our assertions on; -O1 keeps it fast enough;
       # -g1 (line tables) gives the sanitizers' reports file:line at a
@@ -70,7 +70,7 @@ for tree in $trees; do
       # slowly under ASan.) The algebra's tests run in the release tree.
       cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Debug \
         -DCMAKE_CXX_FLAGS_DEBUG="-O1 $sanitize_debug_info" -DRADARGAUSS_SANITIZE=ON \
-        -DRADARGAUSS_UNITY_LIBRARY="$sanitize_unity" \
+        -DRADARGAUSS_UNITY_LIBRARY="$unity" \
         -DRADARGAUSS_BUILD_ALGEBRA_TESTS=OFF -DRADARGAUSS_BUILD_BENCHMARKS=OFF -DRADARGAUSS_BUILD_EXAMPLES=OFF \
         -DRADARGAUSS_WITH_ROSBAG=ON ;;
     *)

@@ -173,23 +173,44 @@ std::string SequenceName(const SequenceOptions& sequence) {
   return sequence.bag.empty() ? sequence.sequence_dir : sequence.bag + " (topic " + sequence.topic + ")";
 }
 
-RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs) {
+RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs, bool hold_points) {
   SequenceOptions sequence_options = s.sequence;
   sequence_options.ground_truth.clear();
-  RunInputs inputs{LoadSequence(sequence_options), std::nullopt};
+  RunInputs inputs;
+  std::vector<bool> has_points;  // per scan
+  if (hold_points) {
+    inputs.sequence = LoadSequence(sequence_options);
+    for (const RadarScan& scan : inputs.sequence.scans) has_points.push_back(!scan.points.empty());
+  } else {
+    Sequence& sequence = inputs.sequence;
+    sequence.layout = ForEachScan(sequence_options, [&](RadarScan& scan, const std::string& source) {
+      has_points.push_back(!scan.points.empty());
+      scan.points = {};
+      sequence.scans.push_back(std::move(scan));
+      sequence.scan_sources.push_back(source);
+      return true;
+    });
+    sequence.total_scans = sequence.scans.size();
+    if (sequence.scans.empty()) throw DataError("sequence has no scans");
+    ResolveExtrinsic(sequence_options.extrinsic, "");  // as LoadSequence: a file given is checked
+  }
   std::vector<RadarScan>& scans = inputs.sequence.scans;
   std::vector<std::string>& sources = inputs.sequence.scan_sources;
   const std::size_t first = std::min(s.first_scan, scans.size());
   scans.erase(scans.begin(), scans.begin() + std::ptrdiff_t(first));
   sources.erase(sources.begin(), sources.begin() + std::ptrdiff_t(std::min(first, sources.size())));
-  if (s.max_scans > 0 && scans.size() > s.max_scans) scans.resize(s.max_scans);
+  has_points.erase(has_points.begin(), has_points.begin() + std::ptrdiff_t(first));
+  if (s.max_scans > 0 && scans.size() > s.max_scans) {
+    scans.resize(s.max_scans);
+    has_points.resize(s.max_scans);
+  }
   const std::string name = SequenceName(s.sequence);
   if (scans.empty()) {
     throw DataError(first > 0 ? "--first-scan " + std::to_string(s.first_scan) + " skips every one of the " +
                                     std::to_string(first) + " scans of " + name
                               : name + ": the sequence has no scans");
   }
-  if (std::all_of(scans.begin(), scans.end(), [](const RadarScan& scan) { return scan.points.empty(); })) {
+  if (std::none_of(has_points.begin(), has_points.end(), [](bool points) { return points; })) {
     throw DataError(name + ": every one of the " + std::to_string(scans.size()) + " scans has no points");
   }
   CheckRcsWeights(inputs.sequence, {w_rcs});
@@ -199,6 +220,30 @@ RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs) {
     CheckReferenceCovers(*inputs.reference, inputs.sequence, s.sequence.ground_truth);
   }
   return inputs;
+}
+
+void StreamScans(const OdometrySettings& s, const char* stage, std::size_t total,
+                 const std::function<void(const RadarScan&)>& register_scan) {
+  SequenceOptions sequence_options = s.sequence;
+  sequence_options.ground_truth.clear();
+  ProgressBar bar;
+  std::size_t read = 0, done = 0;
+  ForEachScan(sequence_options, [&](RadarScan& scan, const std::string& source) {
+    if (read++ < s.first_scan) return true;
+    try {
+      register_scan(scan);
+    } catch (const DataError& e) {
+      throw DataError(source + ": " + e.what());
+    }
+    if (++done % 16 == 0) bar.Update(stage, done, total);
+    return done < total;
+  });
+  if (done != total) {
+    throw DataError(SequenceName(s.sequence) + " changed while it was read: " + std::to_string(done) + " scans of " +
+                    std::to_string(total));
+  }
+  bar.Update(stage, total, total);
+  bar.Finish();
 }
 
 StagedFolder RunFolder(const OdometrySettings& s, std::vector<std::string> outputs) {

@@ -4,6 +4,8 @@
 // the gyro against the sequence.
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -64,11 +66,20 @@ void CheckReferenceCovers(const Trajectory& reference, const Sequence& sequence,
 // refused when none is left or when `w_rcs` needs RCS they lack; and with
 // --gt the reference, read and checked before the run, so that a bad one
 // fails early and leaves nothing behind.
+// With `hold_points` false the scans keep their stamps and fields but not
+// their points: the checks see the whole run, and the run reads the points
+// again with StreamScans (memory bounded by a scan, not the drive).
 struct RunInputs {
   Sequence sequence;
   std::optional<Trajectory> reference;
 };
-RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs);
+RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs, bool hold_points = true);
+
+// The scans of LoadRunInputs(s, ...) read again one at a time, passed in
+// order to register_scan with a progress bar named `stage` (`total`: their
+// count); a DataError names the scan's file.
+void StreamScans(const OdometrySettings& s, const char* stage, std::size_t total,
+                 const std::function<void(const RadarScan&)>& register_scan);
 
 // The sequence as messages name it: its folder, or its bag and topic.
 std::string SequenceName(const SequenceOptions& sequence);

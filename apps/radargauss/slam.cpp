@@ -30,10 +30,16 @@ struct SlamSettings {
   double map_tiles = 0.0;  // m; 0: no tiles
 };
 
-int RunSlam(const SlamSettings& s) {
+int RunSlam(const SlamSettings& settings) {
+  SlamSettings s = settings;
+  s.no_map = s.no_map || !s.slam.hold_map_points;  // --hold-map-points=false: no map to build
+  s.slam.hold_map_points = !s.no_map;
   const SlamOptions& options = s.slam;
   ValidateOptions(options);
-  RunInputs inputs = LoadRunInputs(s.odometry, options.odometry.match.matching.w_rcs);
+  // The scans are read twice: for the checks, then one at a time into the
+  // run, so memory is bounded by the place, not the drive (--mcap holds them).
+  const bool stream = s.odometry.mcap.empty();
+  RunInputs inputs = LoadRunInputs(s.odometry, options.odometry.match.matching.w_rcs, !stream);
   const Sequence& sequence = inputs.sequence;
   const std::optional<Trajectory>& reference = inputs.reference;
   if (s.map_tiles > 0.0 && s.no_map) throw DataError("--map-tiles writes the map: drop --no-map");
@@ -43,11 +49,16 @@ int RunSlam(const SlamSettings& s) {
     CheckOverlap(imu.samples, sequence, s.odometry.imu_topic.empty() ? "" : "; try --imu-stamps record");
   }
   RadarSlam slam(options, s.study, MakeMotionModel(imu.inertial, imu.radar_from_imu, imu.samples));
-  RegisterScans(sequence, "slam", [&](const RadarScan& scan) { slam.Register(scan); });
+  const auto register_scan = [&](const RadarScan& scan) { slam.Register(scan); };
+  if (stream) {
+    StreamScans(s.odometry, "slam", sequence.scans.size(), register_scan);
+  } else {
+    RegisterScans(sequence, "slam", register_scan);
+  }
   slam.Finish();
   GaussianMap map;
   try {
-    if (!s.no_map) map = BuildPlaceMap(sequence.scans, slam);
+    if (!s.no_map) map = BuildPlaceMap(slam);
   } catch (const DataError& e) {  // no static point in the whole run: known only now
     throw DataError(std::string(e.what()) + " in " + SequenceName(s.odometry.sequence) +
                     " (static: Doppler inliers within --ego-min-range to --ego-max-range; --no-map writes the "

@@ -196,6 +196,8 @@ class SlamOptions(OdometryOptions, PlaceSearchOptions, total=False):
     asynchronous_back_end: bool  # True
     place_merge_distance: float  # 0.0
     place_merge_angle: float  # 45.0
+    hold_map_points: bool  # True
+    place_map_revisits: bool  # False
     local_solve_margin: float  # 100.0
     loop_rejection: str  # 'graduated'
     loop_loss: str  # 'geman-mcclure'
@@ -315,8 +317,10 @@ class RadarSlam:
         """Every compared candidate as a dict: query, candidate, distance, yaw, verified, accepted, relative, reason"""
     def odometry_trajectory(self: RadarSlam) -> tuple:
         """(stamps (N,), poses (N, 7)) of the odometry alone"""
-    def place_map(self: RadarSlam, scans: list[Scan]) -> GaussianMap:
-        """The map of the place from the registered scans (in order), with the keyframes as places"""
+    def place_map(self: RadarSlam, scans: Optional[list[Scan]] = None) -> GaussianMap:
+        """The map of the place, with the keyframes as places: from the registered scans (in order), or without them from the static points the SLAM holds (hold_map_points; a revisit within place_merge_distance holds none)"""
+    @property
+    def place_map_bytes(self) -> Any: ...
     def register(self: RadarSlam, scan: Scan) -> None:
         """Adds the next scan (stamps must increase)."""
     def trajectory(self: RadarSlam) -> tuple:

@@ -2,6 +2,7 @@
 // Radar SLAM and relocalisation in Python (docs/design/slam.md, "SLAM", "Relocalisation").
 #include <pybind11/stl.h>
 
+#include <optional>
 #include <string>
 
 #include "bindings.hpp"
@@ -94,10 +95,18 @@ void BindSlam(py::module_& m) {
           "keyframes", [](LockedSlam& slam) { return slam.With([](RadarSlam& s) { return s.keyframes().size(); }); })
       .def(
           "place_map",
-          [](LockedSlam& slam, const std::vector<RadarScan>& scans) {
-            return std::make_shared<PyMap>(slam.With([&](RadarSlam& s) { return BuildPlaceMap(scans, s); }));
+          [](LockedSlam& slam, std::optional<std::vector<RadarScan>> scans) {
+            return std::make_shared<PyMap>(
+                slam.With([&](RadarSlam& s) { return scans ? BuildPlaceMap(*scans, s) : BuildPlaceMap(s); }));
           },
-          py::arg("scans"), "The map of the place from the registered scans (in order), with the keyframes as places");
+          py::arg("scans") = py::none(),
+          "The map of the place, with the keyframes as places: from the registered scans (in order), or without "
+          "them from the static points the SLAM holds (hold_map_points; a revisit within place_merge_distance "
+          "holds none)")
+      .def_property_readonly(
+          "place_map_bytes",
+          [](LockedSlam& slam) { return slam.With([](RadarSlam& s) { return s.place_map_bytes(); }); },
+          "Bytes of the static points held for the map of the place");
   py::class_<LockedRelocalizer>(m, "Relocalizer", RelocalizerDoc())
       .def(py::init(&MakeRelocalizer), py::arg("map"))
       .def(

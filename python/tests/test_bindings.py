@@ -276,6 +276,9 @@ def test_slam_closes_the_yard_and_relocalizes_a_second_run(tmp_path):
     odometry = rg.evaluate(slam.odometry_trajectory(), (drive.stamps, drive.poses))
     assert corrected["ate_translation_m"]["rmse"] < odometry["ate_translation_m"]["rmse"]
     place_map = slam.place_map(drive.scans)
+    # The points the SLAM held give the same map (no revisit merged by default).
+    held = slam.place_map()
+    assert slam.place_map_bytes > 0 and np.array_equal(held.means, place_map.means)
     second = rg.simulate(seed=7, scans=120, config=str(tmp_path / "second.yaml"))
     relocalizer = rg.Relocalizer(place_map, descriptor="radon", candidates=20)
     steps = [relocalizer.register(scan) for scan in second.scans]

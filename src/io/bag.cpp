@@ -117,16 +117,28 @@ void AppendBagImuSample(std::vector<ImuSample>& samples, const ImuSample& sample
 
 std::vector<BagTopic> ListBagTopics(const std::string& bag_path) { return OpenBag(bag_path)->Topics(); }
 
-std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
-                                    const FieldMapping& mapping) {
-  std::vector<RadarScan> scans;
+void ForEachBagScan(const std::string& bag_path, const std::string& topic, const FieldMapping& mapping,
+                    const std::function<bool(RadarScan&, const std::string&)>& visit) {
   PointCloud2Data cloud;
+  std::size_t index = 0;
+  bool reading = true;
   ReadTopic(bag_path, topic, [&](const BagMessage& m) {
-    const std::string source = SourceOf(bag_path, m, scans.size());
+    if (!reading) return;  // the reader has no stop: the rest pass undecoded
+    const std::string source = SourceOf(bag_path, m, index++);
     RequireType(m, source, "sensor_msgs", "PointCloud2");
     const double header = m.codec->PointCloud2(m, source, cloud);
     const double stamp = header != 0.0 ? header : m.codec->RecordStamp(m.log_time);
-    scans.push_back(DecodePointCloud2(cloud, stamp, mapping, source));
+    RadarScan scan = DecodePointCloud2(cloud, stamp, mapping, source);
+    reading = visit(scan, source);
+  });
+}
+
+std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
+                                    const FieldMapping& mapping) {
+  std::vector<RadarScan> scans;
+  ForEachBagScan(bag_path, topic, mapping, [&](RadarScan& scan, const std::string&) {
+    scans.push_back(std::move(scan));
+    return true;
   });
   return scans;
 }

@@ -2,6 +2,7 @@
 #include "radargauss/io/sequence.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -185,48 +186,56 @@ ScanFolder FindScanFolder(const std::string& sequence_dir) {
 
 }  // namespace
 
+std::string ForEachScan(const SequenceOptions& options,
+                        const std::function<bool(RadarScan&, const std::string&)>& visit) {
+  if (!(std::abs(options.elevation_bias_deg) < 45.0)) throw DataError("the elevation bias must be within +/-45 deg");
+  const double elevation_bias = options.elevation_bias_deg * M_PI / 180.0;
+  bool first = true;
+  double last_time = 0.0;
+  // Each scan as LoadSequence holds it: its elevation bias removed, its time after the last's.
+  const auto deliver = [&](RadarScan& scan, const std::string& source) {
+    if (!first && !(scan.timestamp > last_time)) {
+      throw FileError(source, "scan time does not increase (missing or repeated timestamps)");
+    }
+    first = false;
+    last_time = scan.timestamp;
+    if (elevation_bias != 0.0) LowerElevations(scan, elevation_bias);
+    return visit(scan, source);
+  };
+  if (!options.bag.empty()) {
+    if (options.topic.empty()) throw FileError(options.bag, "a bag needs --topic");
+    ForEachBagScan(options.bag, options.topic, options.fields, deliver);
+    return "rosbag";
+  }
+  if (options.sequence_dir.empty()) throw DataError("no sequence given (--sequence DIR or --bag FILE)");
+  const ScanFolder folder = FindScanFolder(options.sequence_dir);
+  std::vector<std::string> layout;
+  if (folder.extension == ".bin") {
+    try {
+      layout = ParseBinLayout(options.bin_layout);
+    } catch (const std::invalid_argument& e) {
+      throw DataError(e.what());
+    }
+  }
+  for (const std::string& path : ListScanFiles(folder.path, folder.extension)) {
+    RadarScan scan =
+        folder.extension == ".pcd" ? ReadPcdScan(path, options.fields) : ReadKittiBin(path, layout, options.fields);
+    if (!deliver(scan, path)) break;
+  }
+  return folder.layout;
+}
+
 Sequence LoadSequence(const SequenceOptions& options) {
   Sequence sequence;
   std::vector<RadarScan> scans;
   std::vector<std::string> sources;
-  if (!options.bag.empty()) {
-    if (options.topic.empty()) throw FileError(options.bag, "a bag needs --topic");
-    sequence.layout = "rosbag";
-    scans = ReadBagScans(options.bag, options.topic, options.fields);
-    for (std::size_t i = 0; i < scans.size(); ++i) {
-      sources.push_back(options.bag + ":" + options.topic + "#" + std::to_string(i));
-    }
-  } else {
-    if (options.sequence_dir.empty()) throw DataError("no sequence given (--sequence DIR or --bag FILE)");
-    const ScanFolder folder = FindScanFolder(options.sequence_dir);
-    sequence.layout = folder.layout;
-    const fs::path& points = folder.path;
-    const std::string& extension = folder.extension;
-    sources = ListScanFiles(points, extension);
-    std::vector<std::string> layout;
-    if (extension == ".bin") {
-      try {
-        layout = ParseBinLayout(options.bin_layout);
-      } catch (const std::invalid_argument& e) {
-        throw DataError(e.what());
-      }
-    }
-    for (const std::string& path : sources) {
-      scans.push_back(extension == ".pcd" ? ReadPcdScan(path, options.fields)
-                                          : ReadKittiBin(path, layout, options.fields));
-    }
-  }
+  sequence.layout = ForEachScan(options, [&](RadarScan& scan, const std::string& source) {
+    scans.push_back(std::move(scan));
+    sources.push_back(source);
+    return true;
+  });
   sequence.total_scans = scans.size();
   if (scans.empty()) throw DataError("sequence has no scans");
-  if (!(std::abs(options.elevation_bias_deg) < 45.0)) throw DataError("the elevation bias must be within +/-45 deg");
-  if (options.elevation_bias_deg != 0.0) {
-    for (RadarScan& scan : scans) LowerElevations(scan, options.elevation_bias_deg * M_PI / 180.0);
-  }
-  for (std::size_t i = 1; i < scans.size(); ++i) {
-    if (!(scans[i].timestamp > scans[i - 1].timestamp)) {
-      throw FileError(sources[i], "scan time does not increase (missing or repeated timestamps)");
-    }
-  }
 
   if (options.ground_truth.empty()) {
     ResolveExtrinsic(options.extrinsic, "");  // a file given is checked though no reference uses it

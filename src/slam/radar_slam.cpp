@@ -2,6 +2,7 @@
 #include "radargauss/slam/radar_slam.hpp"
 
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -57,12 +58,17 @@ const OptionTable<SlamOptions>& SlamOptionTable() {
         RADARGAUSS_OPTION(O, "place_merge_distance", place_merge_distance)
             .AtLeast(0.0)
             .Unit("m")
-            .Help(
-                "a keyframe this near a place of the map already (and turned less than the angle) adds none (0: all)"),
+            .Help("a keyframe this near a place of the map already (and turned less than the angle) adds no place "
+                  "and no points (0: all)"),
         RADARGAUSS_OPTION(O, "place_merge_angle", place_merge_angle_deg)
             .In(0.0, 180.0)
             .Unit("deg")
             .Help("the same, turned"),
+        RADARGAUSS_OPTION(O, "hold_map_points", hold_map_points)
+            .Help("hold each keyframe's static points for the map of the place (false: no map, less memory)"),
+        RADARGAUSS_OPTION(O, "place_map_revisits", place_map_revisits)
+            .Help("a keyframe within the merge distance of a place adds its points to the map too (memory grows with "
+                  "the drive)"),
         RADARGAUSS_OPTION(O, "local_solve_margin", local_solve_margin)
             .AtLeast(0.0)
             .Unit("m")
@@ -126,6 +132,7 @@ const OdometryStep& RadarSlam::Register(const RadarScan& scan) {
   }
   scan_keyframe_.push_back(opened_ - 1);
   const SE3d keyframe_from_scan = open_keyframe_.odometry_pose.Inverse() * step.pose;
+  if (options_.hold_map_points) open_scans_.push_back(scan);
   for (const std::size_t i : odometry_.last_static_points()) {
     RadarPoint point = scan.points[i];
     point.position = keyframe_from_scan * point.position;
@@ -157,12 +164,16 @@ void RadarSlam::OpenKeyframe(std::size_t scan, const SE3d& pose, double stamp) {
   ++opened_;
   ToBackEnd([this, keyframe = open_keyframe_] { graph_.Add(keyframe); });
   open_points_.clear();
+  open_scans_.clear();
   open_ = true;
 }
 
 void RadarSlam::CloseKeyframe() {
-  ToBackEnd([this, submap = std::move(open_points_)]() mutable { DescribeAndSearch(std::move(submap)); });
+  ToBackEnd([this, submap = std::move(open_points_), scans = std::move(open_scans_)]() mutable {
+    DescribeAndSearch(std::move(submap), std::move(scans));
+  });
   open_points_.clear();
+  open_scans_.clear();
   open_ = false;
 }
 
@@ -193,7 +204,7 @@ const PoseGraph& RadarSlam::graph() const {
   return graph_.graph();
 }
 
-void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap) {
+void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap, std::vector<RadarScan> scans) {
   const auto start = std::chrono::steady_clock::now();
   Keyframe& keyframe = graph_.last();
   keyframe.points = DownsampleSubmap(submap, options_.place_recognition.submap_voxel);
@@ -206,11 +217,53 @@ void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap) {
     const LoopCandidate& loop = found.outcomes[*found.accepted];
     graph_.CloseLoop(loop.candidate, query, loop.check.relative, loop.check.sqrt_information, found.path);
   }
-  if (!found.searched) return;
-  graph_.last().search_ms = MillisecondsSince(search);
-  if (const std::optional<LoopCandidate> injected = false_loops_.Inject(query, found.eligible, graph_)) {
-    search_.Record(*injected);
+  if (found.searched) {
+    graph_.last().search_ms = MillisecondsSince(search);
+    if (const std::optional<LoopCandidate> injected = false_loops_.Inject(query, found.eligible, graph_)) {
+      search_.Record(*injected);
+    }
   }
+  if (options_.hold_map_points) {  // at the poses the loop just corrected; its time counts as the description's
+    const auto hold = std::chrono::steady_clock::now();
+    HoldMapPoints(std::move(scans));
+    graph_.last().describe_ms += MillisecondsSince(hold);
+  }
+}
+
+void RadarSlam::HoldMapPoints(std::vector<RadarScan> scans) {
+  const std::size_t query = graph_.keyframes().size() - 1;
+  const std::vector<SE3d>& poses = graph_.graph().poses();
+  const double merge_angle = options_.place_merge_angle_deg * M_PI / 180.0;
+  const bool revisit =
+      !options_.place_map_revisits && options_.place_merge_distance > 0.0 &&
+      std::any_of(place_map_.begin(), place_map_.end(), [&](const PlaceMapPart& held) {
+        const SE3d& place = poses[held.keyframe];
+        return (place.translation() - poses[query].translation()).norm() <= options_.place_merge_distance &&
+               (place.rotation().Inverse() * poses[query].rotation()).Log().norm() <= merge_angle;
+      });
+  if (revisit) return;
+  PlaceMapPart part;
+  part.keyframe = query;
+  part.first_scan = graph_.last().scan;
+  part.scans.resize(scans.size());
+  MapCloudOptions filter;
+  filter.ego_velocity = options_.odometry.ego_velocity;
+  tbb::parallel_for(std::size_t(0), scans.size(),
+                    [&](std::size_t k) { part.scans[k] = StaticPointsOf(scans[k], filter); });
+  place_map_.push_back(std::move(part));
+}
+
+const std::vector<PlaceMapPart>& RadarSlam::place_map_parts() const {
+  Wait();
+  return place_map_;
+}
+
+std::size_t RadarSlam::place_map_bytes() const {
+  std::size_t bytes = 0;
+  for (const PlaceMapPart& part : place_map_parts()) {
+    for (const StaticScanPoints& scan : part.scans) bytes += scan.MemoryBytes();
+  }
+  return bytes;
 }
 
 std::size_t RadarSlam::loops() const {

@@ -57,17 +57,15 @@ void WriteScanTimes(std::ostream& out, const RadarSlam& slam) {
 
 }  // namespace
 
-GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& slam) {
-  const std::vector<SE3d> poses = slam.Poses();
-  if (scans.size() != poses.size()) {
-    throw DataError("the map of the place needs the " + std::to_string(poses.size()) +
-                    " registered scans in order, not " + std::to_string(scans.size()));
-  }
+namespace {
+
+// The map of the place from its static cloud: the Gaussians, their RCS
+// models and the keyframes as places, a revisit merged into the place there.
+GaussianMap PlaceMapOf(MapCloud cloud, const RadarSlam& slam) {
   MapOptions options;
-  options.cloud.ego_velocity = slam.options().odometry.ego_velocity;
   options.gaussians = slam.options().odometry.map.gaussians;
   options.rcs = slam.options().odometry.map.rcs;
-  MapGeometry geometry = BuildMapGeometry(scans, poses, options);
+  MapGeometry geometry = BuildMapGeometry(std::move(cloud), options);
   FitRcsModels(geometry.map, geometry.cloud, geometry.association, options.rcs);  // as BuildMap
   GaussianMap map = std::move(geometry.map);
   const SlamOptions& o = slam.options();
@@ -82,6 +80,33 @@ GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& 
     if (!revisit) map.places.push_back({pose, slam.keyframes()[k].points});
   }
   return map;
+}
+
+}  // namespace
+
+GaussianMap BuildPlaceMap(const RadarSlam& slam) {
+  if (!slam.options().hold_map_points) throw DataError("the map of the place needs hold_map_points");
+  const std::vector<SE3d> poses = slam.Poses();
+  std::vector<const StaticScanPoints*> scans;
+  std::vector<SE3d> scan_poses;
+  for (const PlaceMapPart& part : slam.place_map_parts()) {
+    for (std::size_t i = 0; i < part.scans.size(); ++i) {
+      scans.push_back(&part.scans[i]);
+      scan_poses.push_back(poses[part.first_scan + i]);
+    }
+  }
+  return PlaceMapOf(MergeStaticPoints(scans, scan_poses), slam);
+}
+
+GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& slam) {
+  const std::vector<SE3d> poses = slam.Poses();
+  if (scans.size() != poses.size()) {
+    throw DataError("the map of the place needs the " + std::to_string(poses.size()) +
+                    " registered scans in order, not " + std::to_string(scans.size()));
+  }
+  MapCloudOptions filter;
+  filter.ego_velocity = slam.options().odometry.ego_velocity;
+  return PlaceMapOf(BuildMapCloud(scans, poses, filter), slam);
 }
 
 SlamSummary Summarise(const RadarSlam& slam) {

@@ -172,6 +172,8 @@ TEST(RadarSlam, SameRunForAnyThreadCount) {
     EXPECT_TRUE(b->asynchronous()) << threads;
     ExpectScanTimes(*b);
     EXPECT_EQ(a->loops(), b->loops()) << threads;
+    EXPECT_EQ(a->place_map_bytes(), b->place_map_bytes()) << threads;
+    EXPECT_EQ(a->place_map_parts().size(), b->place_map_parts().size()) << threads;
     const std::vector<SE3d> pb = b->Poses();
     ASSERT_EQ(pa.size(), pb.size());
     for (std::size_t s = 0; s < pa.size(); ++s) {
@@ -363,6 +365,58 @@ TEST(RadarSlam, KeptVerificationTargetsChangeNothing) {
     ASSERT_EQ(pa[s].translation(), pb[s].translation()) << s;
     ASSERT_EQ(pa[s].rotation().quaternion().coeffs(), pb[s].rotation().quaternion().coeffs()) << s;
   }
+}
+
+// The bytes of the points held by the keyframes that opened before scan `end`.
+std::size_t HeldBytesBefore(const RadarSlam& slam, std::size_t end) {
+  std::size_t bytes = 0;
+  for (const PlaceMapPart& part : slam.place_map_parts()) {
+    if (part.first_scan >= end) continue;
+    for (const StaticScanPoints& scan : part.scans) bytes += scan.MemoryBytes();
+  }
+  return bytes;
+}
+
+constexpr std::size_t kYardLapScans = 277;  // 166 m at 0.6 m per scan
+
+// Every keyframe holding its points (place_map_revisits): the map from the
+// held points is the map from every registered scan, Gaussian for Gaussian,
+// and the points held grow with the drive (1.8 laps: over 1.6x the first's).
+TEST(RadarSlam, TheHeldPointsGiveTheMapOfEveryScan) {
+  SlamOptions options = YardOptions();
+  options.place_map_revisits = true;
+  const std::unique_ptr<RadarSlam> slam = RunYard(options);
+  ASSERT_EQ(slam->place_map_parts().size(), slam->keyframes().size());
+  const GaussianMap held = BuildPlaceMap(*slam), scanned = BuildPlaceMap(Yard().scans, *slam);
+  ASSERT_GT(held.gaussians.size(), 100u);
+  ASSERT_EQ(held.gaussians.size(), scanned.gaussians.size());
+  for (std::size_t g = 0; g < held.gaussians.size(); ++g) {
+    ASSERT_EQ(held.gaussians[g].mean, scanned.gaussians[g].mean) << g;
+    ASSERT_EQ(held.gaussians[g].covariance, scanned.gaussians[g].covariance) << g;
+    ASSERT_EQ(held.gaussians[g].rcs.coefficients, scanned.gaussians[g].rcs.coefficients) << g;
+  }
+  ASSERT_EQ(held.places.size(), scanned.places.size());
+  EXPECT_GT(double(slam->place_map_bytes()), 1.6 * double(HeldBytesBefore(*slam, kYardLapScans)));
+}
+
+// A keyframe that closes within place_merge_distance of a held one holds no
+// points: after the loops of the second lap the memory stays the first
+// lap's (within a quarter), and the map still covers the whole yard.
+TEST(RadarSlam, ARevisitHoldsNoPointsSoItsMemoryIsBoundedByThePlace) {
+  const RadarSlam& slam = YardSlam();
+  ASSERT_GT(slam.loops(), 0u);
+  const std::size_t first_lap = HeldBytesBefore(slam, kYardLapScans);
+  ASSERT_GT(first_lap, 0u);
+  EXPECT_LT(slam.place_map_parts().size(), slam.keyframes().size() * 3 / 4);
+  EXPECT_LE(double(slam.place_map_bytes()), 1.25 * double(first_lap));
+  const GaussianMap map = BuildPlaceMap(slam);
+  const GaussianMap every = BuildPlaceMap(Yard().scans, slam);
+  EXPECT_GT(map.gaussians.size(), every.gaussians.size() / 2);
+  EXPECT_EQ(map.places.size(), every.places.size());
+  SlamOptions none = YardOptions();
+  none.hold_map_points = false;
+  const RadarSlam empty(none);
+  EXPECT_THROW(BuildPlaceMap(empty), DataError);
 }
 
 TEST(RadarSlam, RefusesBadOptions) {

@@ -198,6 +198,21 @@ expect_fail "relocalize with both --w-rcs and --w-rcs-from-map" "excludes" -- \
   "$tool" relocalize --map "$work/slam/map.rgm" --sequence "$work/seq10" --w-rcs 0.25 --w-rcs-from-map \
   --out "$work/relocalized_x"
 # The map as tiles: map-info and relocalize read the folder as they read the file.
+# slam reads the scans one at a time; with --mcap it holds them all (the
+# viewer file draws them): the same trajectory and map either way.
+expect_ok "slam holding its scans for --mcap" "wrote $work/slam_held" -- \
+  "$tool" slam --sequence "$work/seq10" --gt "$work/seq10/gt_radar_tum.txt" --submap-distance 2 \
+  --out "$work/slam_held" --mcap "$work/slam_held.mcap"
+for file in slam.tum map.rgm keyframes.csv odometry/odometry.tum; do
+  if [[ "$file" == keyframes.csv ]]; then
+    same=$(diff <(cut -d, -f1-12 "$work/slam/$file") <(cut -d, -f1-12 "$work/slam_held/$file") > /dev/null && echo yes)
+  else
+    same=$(cmp -s "$work/slam/$file" "$work/slam_held/$file" && echo yes)
+  fi
+  [[ "$same" == yes ]] || { echo "FAIL: slam streamed and slam holding its scans differ in $file"; failed=1; }
+done
+expect_fail "slam --hold-map-points=false with --map-tiles" "drop --no-map" -- \
+  "$tool" slam --sequence "$work/seq10" --map-tiles 20 --hold-map-points=false --out "$work/slam_unheld"
 expect_ok "slam writes the map as tiles" "map_tiles/" -- \
   "$tool" slam --sequence "$work/seq10" --submap-distance 2 --map-tiles 20 --out "$work/slam_tiles"
 [[ -s "$work/slam_tiles/map_tiles/tiles.json" ]] || { echo "FAIL: slam --map-tiles wrote no tiles.json"; failed=1; }

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,10 @@ PointCloud2Data EncodePointCloud2(const RadarScan& scan);
 // (the ti_mmwave driver leaves it zero).
 std::vector<RadarScan> ReadBagScans(const std::string& bag_path, const std::string& topic,
                                     const FieldMapping& mapping = {});
+// The same scans one at a time, each with its source (`BAG:TOPIC#index`);
+// `visit` may move the scan away, and returns false to read no more.
+void ForEachBagScan(const std::string& bag_path, const std::string& topic, const FieldMapping& mapping,
+                    const std::function<bool(RadarScan&, const std::string&)>& visit);
 
 // Every sensor_msgs/Imu message of `topic` (its angular velocity and linear
 // acceleration as ImuSample's), in bag order, stamped by the

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -49,6 +50,15 @@ struct Sequence {
 
 // Throws DataError (one line naming the file and fault) on any bad input.
 Sequence LoadSequence(const SequenceOptions& options);
+
+// LoadSequence's scans one at a time, in time order, without holding them
+// (a long drive in bounded memory): each with its elevation bias removed and
+// its source (file, or BAG:TOPIC#index); `visit` may move the scan away, and
+// returns false to read no more. The ground truth is not read. A scan whose
+// time does not increase is a DataError when it is reached. Returns the
+// layout (Sequence::layout).
+std::string ForEachScan(const SequenceOptions& options,
+                        const std::function<bool(RadarScan&, const std::string&)>& visit);
 
 // T_xt32_ars548 of the Snail-Radar 2023-12-13 sequences (docs/design/formats.md, "Data in and out").
 SE3d SnailRadar20231213Extrinsic();

@@ -5,6 +5,7 @@
 // vectors are formed.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -41,6 +42,24 @@ struct MapCloudStats {
 // the scans the filter is skipped (every point kept).
 MapCloud BuildMapCloud(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
                        const MapCloudOptions& options = {}, MapCloudStats* stats = nullptr);
+// One scan's part of a map cloud: its static points in the radar frame (the
+// Doppler filter's inliers, or every point), as BuildMapCloud keeps them.
+struct StaticScanPoints {
+  std::vector<Eigen::Vector3d> positions;  // radar frame
+  std::vector<double> rcs;                 // dBsm
+  std::size_t points_in = 0;               // the scan's points
+  bool has_rcs = false;
+  std::size_t MemoryBytes() const {
+    return positions.capacity() * sizeof(Eigen::Vector3d) + rcs.capacity() * sizeof(double);
+  }
+};
+StaticScanPoints StaticPointsOf(const RadarScan& scan, const MapCloudOptions& options = {});
+// The cloud of scans' static points at their poses T_world_radar (one per
+// scan; `scans` point into caller-held parts): BuildMapCloud's cloud of the
+// scans the parts came from.
+MapCloud MergeStaticPoints(const std::vector<const StaticScanPoints*>& scans, const std::vector<SE3d>& poses,
+                           MapCloudStats* stats = nullptr);
+
 inline MapCloud BuildMapCloud(const Sequence& sequence, const MapCloudOptions& options = {},
                               MapCloudStats* stats = nullptr) {
   return BuildMapCloud(sequence.scans, sequence.poses, options, stats);

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "radargauss/map/map_cloud.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/slam/keyframe_graph.hpp"
@@ -43,6 +44,13 @@ struct ScanTime {
 };
 
 class SerialWorker;
+
+// A keyframe's part of the map of the place: the static points of its scans
+// (StaticPointsOf with the odometry's Doppler filter), from scan first_scan on.
+struct PlaceMapPart {
+  std::size_t keyframe = 0, first_scan = 0;
+  std::vector<StaticScanPoints> scans;
+};
 
 class RadarSlam {
  public:
@@ -75,6 +83,10 @@ class RadarSlam {
   std::size_t loops() const;  // accepted (injected false loops not counted)
   // Verification targets built (each kept one is reused: verify_kept_targets).
   std::size_t verification_targets_built() const;
+  // The keyframes' parts of the map of the place (hold_map_points), in
+  // keyframe order, and the bytes their points hold.
+  const std::vector<PlaceMapPart>& place_map_parts() const;
+  std::size_t place_map_bytes() const;
   // T_world_radar of every scan: its keyframe's optimised pose times the odometry since.
   std::vector<SE3d> Poses() const;
   Trajectory trajectory() const;
@@ -87,7 +99,9 @@ class RadarSlam {
   void Wait() const;  // rethrows what the back end threw
   // The back end's side: the closed keyframe's place, its loop search, the
   // accepted loop into the graph, and the study's false loop.
-  void DescribeAndSearch(std::vector<RadarPoint> submap);
+  void DescribeAndSearch(std::vector<RadarPoint> submap, std::vector<RadarScan> scans);
+  // Holds the closed keyframe's static points unless it revisits a held place.
+  void HoldMapPoints(std::vector<RadarScan> scans);
 
   SlamOptions options_;
   // The front end.
@@ -96,6 +110,7 @@ class RadarSlam {
   std::vector<ScanTime> scan_times_;        // per scan
   Keyframe open_keyframe_;                  // the open keyframe (no points)
   std::vector<RadarPoint> open_points_;     // its submap so far
+  std::vector<RadarScan> open_scans_;       // its scans (hold_map_points)
   std::size_t opened_ = 0;                  // keyframes opened
   double path_ = 0.0;
   bool open_ = false;
@@ -103,6 +118,7 @@ class RadarSlam {
   KeyframeGraph graph_;
   LoopSearch search_;
   FalseLoops false_loops_;
+  std::vector<PlaceMapPart> place_map_;
   std::unique_ptr<SerialWorker> worker_;  // the back end's thread; null: in Register
 };
 
@@ -121,10 +137,14 @@ struct SlamSummary {
 SlamSummary Summarise(const RadarSlam& slam);
 
 // The map of the place: build-map's estimator (the odometry map's Gaussian
-// and RCS options, its Doppler filter) over every scan at its optimised pose,
-// with the keyframes as places at their optimised poses, a revisit merged
-// into the place already there (place_merge_distance). `scans` are the ones
-// registered, in order.
+// and RCS options, its Doppler filter) over the points the slam holds
+// (place_map_parts) at their scans' optimised poses, with the keyframes as
+// places at their optimised poses, a revisit merged into the place already
+// there (place_merge_distance). Throws DataError without held points
+// (hold_map_points false, or no static point).
+GaussianMap BuildPlaceMap(const RadarSlam& slam);
+// The same over every one of `scans`, the ones registered, in order (as
+// BuildPlaceMap(slam) with place_merge_distance 0).
 GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& slam);
 
 // Writes slam.tum (each scan's optimised T_world_radar), keyframes.csv,

@@ -39,6 +39,13 @@ struct SlamOptions {
   // revisit adds no place. 0 (the default): every keyframe is a place.
   double place_merge_distance = 0.0;  // m
   double place_merge_angle_deg = 45.0;
+  // RadarSlam holds each keyframe's static points for the map of the place
+  // (BuildPlaceMap(slam)); false: a run that writes no map. A keyframe that
+  // closes within the merge distance and angle of a held keyframe (at the
+  // poses estimated then) holds none unless place_map_revisits: the memory
+  // is bounded by the place, not the drive.
+  bool hold_map_points = true;
+  bool place_map_revisits = false;
 };
 
 // Robustness studies, apart from what a user sets: after each keyframe's
