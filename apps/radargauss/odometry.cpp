@@ -113,9 +113,9 @@ int RunOdometry(const OdometrySettings& s) {
   }
   if (inertial) PrintInertial(*inertial);
   std::printf("%s", table.c_str());
-  std::printf("wrote %s (odometry.tum, %sper_scan.csv, summary.json, map.rgm, map.ply%s%s)\n", s.out.c_str(),
-              mounting ? "levelled.tum, " : "", inertial ? ", inertial.csv" : "",
-              evaluation ? ", evaluation.json, evaluation.md" : "");
+  std::printf("wrote %s (odometry.tum, %sper_scan.csv, summary.json%s%s%s)\n", s.out.c_str(),
+              mounting ? "levelled.tum, " : "", s.odometry.map.keep_evicted ? ", map.rgm, map.ply" : "",
+              inertial ? ", inertial.csv" : "", evaluation ? ", evaluation.json, evaluation.md" : "");
   return 0;
 }
 

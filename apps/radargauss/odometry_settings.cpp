@@ -185,7 +185,7 @@ RunInputs LoadRunInputs(const OdometrySettings& s, double w_rcs, bool hold_point
     Sequence& sequence = inputs.sequence;
     sequence.layout = ForEachScan(sequence_options, [&](RadarScan& scan, const std::string& source) {
       has_points.push_back(!scan.points.empty());
-      scan.points = {};
+      std::vector<RadarPoint>().swap(scan.points);  // its memory too, not only its size
       sequence.scans.push_back(std::move(scan));
       sequence.scan_sources.push_back(source);
       return true;

@@ -75,6 +75,7 @@ class OdometryOptions(MatchOptions, total=False):
     azimuth_std: float  # 0.0
     elevation_std: float  # 0.0
     active_radius: float  # 100.0
+    keep_evicted: bool  # True
     region: float  # 4.0
     region_capacity: int  # 256
     region_min_points: int  # 8
@@ -198,6 +199,7 @@ class SlamOptions(OdometryOptions, PlaceSearchOptions, total=False):
     place_merge_angle: float  # 45.0
     hold_map_points: bool  # True
     place_map_revisits: bool  # False
+    revisit_candidates: bool  # True
     local_solve_margin: float  # 100.0
     loop_rejection: str  # 'graduated'
     loop_loss: str  # 'geman-mcclure'

@@ -44,6 +44,9 @@ const OptionTable<LocalMapOptions>& LocalMapOptionTable() {
             .Above(0.0)
             .Unit("m")
             .Help("radius of the active map around the radar"),
+        RADARGAUSS_OPTION(O, "keep_evicted", keep_evicted)
+            .Help("keep the Gaussians that leave the active map for the odometry's map file (false: memory bounded "
+                  "by the active map, no map file)"),
         RADARGAUSS_OPTION(O, "region", region).Above(0.0).Unit("m").Help("edge of the map regions fitted together"),
         RADARGAUSS_OPTION(O, "region_capacity", region_capacity)
             .In(4, 1e6)
@@ -236,7 +239,7 @@ std::size_t LocalMap::Evict(const Eigen::Vector3d& position) {
       continue;
     }
     for (const std::uint32_t slot : it->second.gaussians) {
-      evicted_.push_back(map_->gaussians[slot]);
+      if (options_.keep_evicted) evicted_.push_back(map_->gaussians[slot]);
       map_->gaussians[slot] = Gaussian();
       removed.push_back(slot);
       free_slots_.push_back(slot);

@@ -289,6 +289,7 @@ void WriteOdometry(const std::string& dir, const RadarOdometry& odometry) {
   }
   WriteFileAtomically((out / "summary.json").string(),
                       [&](std::ostream& stream) { stream << summary.dump(2) << "\n"; });
+  if (!odometry.options().map.keep_evicted) return;  // the map is only the active one: no map file
   const GaussianMap map = odometry.map().GlobalMap();
   WriteMap((out / "map.rgm").string(), map);
   ExportPly((out / "map.ply").string(), map);

@@ -26,7 +26,7 @@ LoopSearch::LoopSearch(const SlamOptions& options)
 // (against the same graph: the search reads it, the caller adds the
 // accepted loop), so that the accepted loop and every outcome are those of
 // one thread; a wave may match some that one thread would not have reached.
-LoopSearchResult LoopSearch::Search(int query, const KeyframeGraph& graph) {
+LoopSearchResult LoopSearch::Search(int query, const KeyframeGraph& graph, const std::vector<bool>* candidates) {
   const std::vector<Keyframe>& keyframes = graph.keyframes();
   LoopSearchResult result;
   if (last_loop_path_ >= 0.0 && options_.loop_spacing > 0.0 &&
@@ -36,7 +36,7 @@ LoopSearchResult LoopSearch::Search(int query, const KeyframeGraph& graph) {
   result.searched = true;
   std::vector<int>& eligible = result.eligible;  // far enough back along the path
   for (int c = 0; c < query && keyframes[query].path - keyframes[c].path >= options_.min_loop_path; ++c) {
-    eligible.push_back(c);
+    if (!candidates || (*candidates)[std::size_t(c)]) eligible.push_back(c);
   }
   std::vector<PlaceMatch> ranked = places_.Rank(places_.place(std::size_t(query)), eligible);
   const std::vector<double> paths = graph.PathsFrom(query);

@@ -69,6 +69,9 @@ const OptionTable<SlamOptions>& SlamOptionTable() {
         RADARGAUSS_OPTION(O, "place_map_revisits", place_map_revisits)
             .Help("a keyframe within the merge distance of a place adds its points to the map too (memory grows with "
                   "the drive)"),
+        RADARGAUSS_OPTION(O, "revisit_candidates", revisit_candidates)
+            .Help("a keyframe within the merge distance of a place is a loop candidate of later searches (false: "
+                  "each place answered by its first keyframe)"),
         RADARGAUSS_OPTION(O, "local_solve_margin", local_solve_margin)
             .AtLeast(0.0)
             .Unit("m")
@@ -208,11 +211,12 @@ void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap, std::vector<Ra
   const auto start = std::chrono::steady_clock::now();
   Keyframe& keyframe = graph_.last();
   keyframe.points = DownsampleSubmap(submap, options_.place_recognition.submap_voxel);
+  keyframe.submap_points = keyframe.points.size();
   search_.AddPlace(keyframe.points);
   keyframe.describe_ms = MillisecondsSince(start);
   const auto search = std::chrono::steady_clock::now();
   const int query = int(graph_.keyframes().size()) - 1;
-  const LoopSearchResult found = search_.Search(query, graph_);
+  const LoopSearchResult found = search_.Search(query, graph_, options_.revisit_candidates ? nullptr : &first_visit_);
   if (found.accepted) {
     const LoopCandidate& loop = found.outcomes[*found.accepted];
     graph_.CloseLoop(loop.candidate, query, loop.check.relative, loop.check.sqrt_information, found.path);
@@ -223,27 +227,35 @@ void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap, std::vector<Ra
       search_.Record(*injected);
     }
   }
-  if (options_.hold_map_points) {  // at the poses the loop just corrected; its time counts as the description's
-    const auto hold = std::chrono::steady_clock::now();
+  // At the poses the loop just corrected; the time counts as the description's.
+  const auto hold = std::chrono::steady_clock::now();
+  first_visit_.push_back(!RevisitsAPlace(std::size_t(query)));
+  if (options_.hold_map_points && (first_visit_.back() || options_.place_map_revisits)) {
     HoldMapPoints(std::move(scans));
-    graph_.last().describe_ms += MillisecondsSince(hold);
   }
+  if (!first_visit_.back() && !options_.revisit_candidates) {  // no place and no candidate: its submap is done
+    std::vector<RadarPoint>().swap(graph_.last().points);
+  }
+  graph_.last().describe_ms += MillisecondsSince(hold);
+}
+
+bool RadarSlam::RevisitsAPlace(std::size_t keyframe) const {
+  if (options_.place_merge_distance <= 0.0) return false;
+  const std::vector<SE3d>& poses = graph_.graph().poses();
+  const double merge_angle = options_.place_merge_angle_deg * M_PI / 180.0;
+  for (std::size_t k = 0; k < keyframe; ++k) {
+    if (!first_visit_[k]) continue;
+    if ((poses[k].translation() - poses[keyframe].translation()).norm() <= options_.place_merge_distance &&
+        (poses[k].rotation().Inverse() * poses[keyframe].rotation()).Log().norm() <= merge_angle) {
+      return true;
+    }
+  }
+  return false;
 }
 
 void RadarSlam::HoldMapPoints(std::vector<RadarScan> scans) {
-  const std::size_t query = graph_.keyframes().size() - 1;
-  const std::vector<SE3d>& poses = graph_.graph().poses();
-  const double merge_angle = options_.place_merge_angle_deg * M_PI / 180.0;
-  const bool revisit =
-      !options_.place_map_revisits && options_.place_merge_distance > 0.0 &&
-      std::any_of(place_map_.begin(), place_map_.end(), [&](const PlaceMapPart& held) {
-        const SE3d& place = poses[held.keyframe];
-        return (place.translation() - poses[query].translation()).norm() <= options_.place_merge_distance &&
-               (place.rotation().Inverse() * poses[query].rotation()).Log().norm() <= merge_angle;
-      });
-  if (revisit) return;
   PlaceMapPart part;
-  part.keyframe = query;
+  part.keyframe = graph_.keyframes().size() - 1;
   part.first_scan = graph_.last().scan;
   part.scans.resize(scans.size());
   MapCloudOptions filter;
@@ -251,6 +263,11 @@ void RadarSlam::HoldMapPoints(std::vector<RadarScan> scans) {
   tbb::parallel_for(std::size_t(0), scans.size(),
                     [&](std::size_t k) { part.scans[k] = StaticPointsOf(scans[k], filter); });
   place_map_.push_back(std::move(part));
+}
+
+const std::vector<bool>& RadarSlam::first_visits() const {
+  Wait();
+  return first_visit_;
 }
 
 const std::vector<PlaceMapPart>& RadarSlam::place_map_parts() const {

@@ -24,7 +24,7 @@ void WriteKeyframes(std::ostream& out, const RadarSlam& slam) {
     const SE3d& pose = slam.graph().poses()[k];
     const Eigen::Quaterniond& q = pose.rotation().quaternion();
     out << k << ',' << keyframe.scan << ',' << std::fixed << keyframe.stamp << std::defaultfloat << ',' << keyframe.path
-        << ',' << keyframe.points.size() << ',' << pose.translation().x() << ',' << pose.translation().y() << ','
+        << ',' << keyframe.submap_points << ',' << pose.translation().x() << ',' << pose.translation().y() << ','
         << pose.translation().z() << ',' << q.x() << ',' << q.y() << ',' << q.z() << ',' << q.w() << ','
         << keyframe.describe_ms << ',' << keyframe.search_ms << '\n';
   }
@@ -60,7 +60,7 @@ void WriteScanTimes(std::ostream& out, const RadarSlam& slam) {
 namespace {
 
 // The map of the place from its static cloud: the Gaussians, their RCS
-// models and the keyframes as places, a revisit merged into the place there.
+// models and the first visits as places.
 GaussianMap PlaceMapOf(MapCloud cloud, const RadarSlam& slam) {
   MapOptions options;
   options.gaussians = slam.options().odometry.map.gaussians;
@@ -68,16 +68,9 @@ GaussianMap PlaceMapOf(MapCloud cloud, const RadarSlam& slam) {
   MapGeometry geometry = BuildMapGeometry(std::move(cloud), options);
   FitRcsModels(geometry.map, geometry.cloud, geometry.association, options.rcs);  // as BuildMap
   GaussianMap map = std::move(geometry.map);
-  const SlamOptions& o = slam.options();
-  const double merge_angle = o.place_merge_angle_deg * M_PI / 180.0;
-  for (std::size_t k = 0; k < slam.keyframes().size(); ++k) {
-    const SE3d& pose = slam.graph().poses()[k];
-    const bool revisit =
-        o.place_merge_distance > 0.0 && std::any_of(map.places.begin(), map.places.end(), [&](const MapPlace& place) {
-          return (place.pose.translation() - pose.translation()).norm() <= o.place_merge_distance &&
-                 (place.pose.rotation().Inverse() * pose.rotation()).Log().norm() <= merge_angle;
-        });
-    if (!revisit) map.places.push_back({pose, slam.keyframes()[k].points});
+  const std::vector<bool>& first_visits = slam.first_visits();
+  for (std::size_t k = 0; k < slam.keyframes().size() && k < first_visits.size(); ++k) {
+    if (first_visits[k]) map.places.push_back({slam.graph().poses()[k], slam.keyframes()[k].points});
   }
   return map;
 }

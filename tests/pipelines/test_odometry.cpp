@@ -305,6 +305,39 @@ TEST(LocalMap, ActiveRadiusBoundsTheMap) {
   EXPECT_GT(map.gaussians(), 0u);
 }
 
+// Without keep_evicted the Gaussians that leave are dropped: the global map
+// is the active one, and the active map is the same Gaussian for Gaussian
+// as when they are kept.
+TEST(LocalMap, WithoutKeepEvictedTheMemoryIsTheActiveMaps) {
+  LocalMapOptions options;
+  options.active_radius = 30.0;
+  LocalMapOptions dropping = options;
+  dropping.keep_evicted = false;
+  LocalMap kept(options), dropped(dropping);
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> spread(-10.0, 10.0);
+  for (int step = 0; step < 200; ++step) {
+    const Eigen::Vector3d position(2.0 * step, 0.0, 0.0);
+    std::vector<Eigen::Vector3d> points;
+    for (int k = 0; k < 200; ++k) points.emplace_back(position.x() + spread(rng), spread(rng), 0.2 * spread(rng));
+    for (LocalMap* map : {&kept, &dropped}) {
+      map->Insert(points, {}, SE3d(SO3d(), position));
+      map->Evict(position);
+    }
+    ASSERT_EQ(dropped.global_gaussians(), dropped.gaussians()) << step;
+    ASSERT_EQ(dropped.gaussians(), kept.gaussians()) << step;
+  }
+  EXPECT_GT(kept.global_gaussians(), 4 * kept.gaussians());
+  const GaussianMap a = kept.GlobalMap(), b = dropped.GlobalMap();
+  ASSERT_EQ(b.gaussians.size(), dropped.gaussians());
+  ASSERT_LT(b.gaussians.size(), a.gaussians.size());
+  const std::size_t offset = a.gaussians.size() - b.gaussians.size();  // the active ones come last
+  for (std::size_t g = 0; g < b.gaussians.size(); ++g) {
+    ASSERT_EQ(a.gaussians[offset + g].mean, b.gaussians[g].mean) << g;
+    ASSERT_EQ(a.gaussians[offset + g].covariance, b.gaussians[g].covariance) << g;
+  }
+}
+
 // A tight cluster 45 m ahead: with the radar's angular noise its Gaussian is
 // 45 m x tan(noise) wide, horizontally by the azimuth's and vertically by the
 // elevation's; without, min_std (0.05 m) holds.

@@ -9,6 +9,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -417,6 +418,31 @@ TEST(RadarSlam, ARevisitHoldsNoPointsSoItsMemoryIsBoundedByThePlace) {
   none.hold_map_points = false;
   const RadarSlam empty(none);
   EXPECT_THROW(BuildPlaceMap(empty), DataError);
+}
+
+bool HoldsPoints(const RadarSlam& slam, int keyframe) {
+  const std::vector<PlaceMapPart>& parts = slam.place_map_parts();
+  return std::any_of(parts.begin(), parts.end(),
+                     [&](const PlaceMapPart& part) { return part.keyframe == std::size_t(keyframe); });
+}
+
+// Without revisit_candidates a search compares only first visits of places
+// (the keyframes that hold points), where the default compares revisits
+// too; the yard's loops still close and correct the drift.
+TEST(RadarSlam, WithoutRevisitCandidatesEachPlaceIsAnsweredByItsFirstVisit) {
+  const RadarSlam& every = YardSlam();
+  const std::vector<LoopCandidate>& all = every.candidates();
+  EXPECT_TRUE(std::any_of(all.begin(), all.end(),
+                          [&](const LoopCandidate& c) { return !c.injected && !HoldsPoints(every, c.candidate); }));
+  SlamOptions options = YardOptions();
+  options.revisit_candidates = false;
+  const std::unique_ptr<RadarSlam> slam = RunYard(options);
+  ASSERT_GT(slam->loops(), 0u);
+  EXPECT_LT(slam->candidates().size(), all.size());
+  for (const LoopCandidate& c : slam->candidates()) EXPECT_TRUE(HoldsPoints(*slam, c.candidate)) << c.candidate;
+  const Evaluation odometry = EvaluateTrajectory(slam->odometry().trajectory(), Yard().ground_truth);
+  const Evaluation corrected = EvaluateTrajectory(slam->trajectory(), Yard().ground_truth);
+  EXPECT_LT(corrected.ate_translation.rmse, 0.5 * odometry.ate_translation.rmse);
 }
 
 TEST(RadarSlam, RefusesBadOptions) {

@@ -63,7 +63,11 @@ struct LocalMapOptions {
   std::size_t min_points = 8;         // points a region needs for its first fit
   double refit_growth = 0.5;          // refit once the points added since the last fit reach this share of those fitted
   double active_radius = 100.0;       // m: regions whose centre is farther from the radar leave
-  double republish_kl = 2.0;          // nats: KL(updated || published) that republishes a Gaussian (kIncremental)
+  // Whether the Gaussians that leave stay for the odometry's global map
+  // (GlobalMap, odometry's map.rgm); false: memory bounded by the active
+  // radius, not the drive, and no global map beyond the active one.
+  bool keep_evicted = true;
+  double republish_kl = 2.0;  // nats: KL(updated || published) that republishes a Gaussian (kIncremental)
   // The radar's angular noise: a Gaussian is at least this angle times the
   // mean range its members were seen at wide, horizontally (azimuth) and
   // vertically (elevation), and at least min_std, so that far, sparse
@@ -105,7 +109,7 @@ class LocalMap {
   std::vector<Eigen::Vector3d> ActivePoints() const;
   // Changes with every Insert or Evict that changed the map.
   std::size_t version() const { return version_; }
-  // The Gaussians that left the active map, then the active ones.
+  // The Gaussians that left the active map (keep_evicted), then the active ones.
   GaussianMap GlobalMap() const;
   std::size_t global_gaussians() const { return evicted_.size() + gaussians(); }
   // Points, Gaussians and indexes held (bytes, approximate).

@@ -282,7 +282,8 @@ OdometrySummary Summarise(const RadarOdometry& odometry);
 
 // Writes odometry.tum (T_world_radar), levelled.tum (when the mounting is
 // observable, odometry/mounting.hpp), per_scan.csv, summary.json, map.rgm
-// and map.ply into `dir` (created), each file whole or not at all. With an
+// and map.ply (when the map keeps its evicted Gaussians) into `dir`
+// (created), each file whole or not at all. With an
 // inertial window as the motion model also inertial.csv (the window's newest
 // state per scan) and summary.json's `calibration` (the tilt, the biases, the
 // extrinsic when estimated, each with its standard deviation).

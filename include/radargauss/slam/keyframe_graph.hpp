@@ -19,9 +19,12 @@ namespace radargauss {
 struct Keyframe {
   std::size_t scan = 0;  // the scan that opened it
   double stamp = 0.0;
-  SE3d odometry_pose;              // the odometry's T_world_radar at that scan
-  double path = 0.0;               // m driven to it
-  std::vector<RadarPoint> points;  // its submap, in its frame (closed keyframes)
+  SE3d odometry_pose;  // the odometry's T_world_radar at that scan
+  double path = 0.0;   // m driven to it
+  // Its submap, in its frame (closed keyframes; released after its search
+  // when it is a revisit that no later search compares: revisit_candidates).
+  std::vector<RadarPoint> points;
+  std::size_t submap_points = 0;  // the submap's size, released or not
   // Place recognition's time (describe_ms: with the keyframe's map points held).
   double describe_ms = 0.0, search_ms = 0.0;
   double back_end_ms() const { return describe_ms + search_ms; }

@@ -45,8 +45,10 @@ class LoopSearch {
   // The place of the graph's last keyframe, from its submap.
   void AddPlace(const std::vector<RadarPoint>& submap) { places_.Add(places_.Describe(submap)); }
   // The loops of keyframe `query` (the last with a place), as one thread
-  // would find them whatever the threads; the outcomes are kept (candidates()).
-  LoopSearchResult Search(int query, const KeyframeGraph& graph);
+  // would find them whatever the threads; the outcomes are kept
+  // (candidates()). `candidates`: per keyframe before the query, whether it
+  // may be one (null: every one).
+  LoopSearchResult Search(int query, const KeyframeGraph& graph, const std::vector<bool>* candidates = nullptr);
   // Every compared pair so far, injected false loops among them.
   const std::vector<LoopCandidate>& candidates() const { return candidates_; }
   void Record(const LoopCandidate& candidate) { candidates_.push_back(candidate); }

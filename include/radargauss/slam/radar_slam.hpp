@@ -83,6 +83,11 @@ class RadarSlam {
   std::size_t loops() const;  // accepted (injected false loops not counted)
   // Verification targets built (each kept one is reused: verify_kept_targets).
   std::size_t verification_targets_built() const;
+  // Per closed keyframe: whether it is the first visit of its place (no
+  // earlier first visit within place_merge_distance and angle at the poses
+  // of its closing; every one when the distance is 0). The first visits are
+  // the map's places and hold its points.
+  const std::vector<bool>& first_visits() const;
   // The keyframes' parts of the map of the place (hold_map_points), in
   // keyframe order, and the bytes their points hold.
   const std::vector<PlaceMapPart>& place_map_parts() const;
@@ -100,7 +105,10 @@ class RadarSlam {
   // The back end's side: the closed keyframe's place, its loop search, the
   // accepted loop into the graph, and the study's false loop.
   void DescribeAndSearch(std::vector<RadarPoint> submap, std::vector<RadarScan> scans);
-  // Holds the closed keyframe's static points unless it revisits a held place.
+  // Whether the keyframe lies within place_merge_distance and angle of a
+  // first visit before it, at the graph's poses now.
+  bool RevisitsAPlace(std::size_t keyframe) const;
+  // Holds the closed keyframe's static points (a PlaceMapPart).
   void HoldMapPoints(std::vector<RadarScan> scans);
 
   SlamOptions options_;
@@ -119,6 +127,7 @@ class RadarSlam {
   LoopSearch search_;
   FalseLoops false_loops_;
   std::vector<PlaceMapPart> place_map_;
+  std::vector<bool> first_visit_;         // per closed keyframe: no earlier first visit within the merge distance
   std::unique_ptr<SerialWorker> worker_;  // the back end's thread; null: in Register
 };
 
@@ -138,13 +147,12 @@ SlamSummary Summarise(const RadarSlam& slam);
 
 // The map of the place: build-map's estimator (the odometry map's Gaussian
 // and RCS options, its Doppler filter) over the points the slam holds
-// (place_map_parts) at their scans' optimised poses, with the keyframes as
-// places at their optimised poses, a revisit merged into the place already
-// there (place_merge_distance). Throws DataError without held points
-// (hold_map_points false, or no static point).
+// (place_map_parts) at their scans' optimised poses, with the first visits
+// (first_visits) as places at their optimised poses. Throws DataError
+// without held points (hold_map_points false, or no static point).
 GaussianMap BuildPlaceMap(const RadarSlam& slam);
 // The same over every one of `scans`, the ones registered, in order (as
-// BuildPlaceMap(slam) with place_merge_distance 0).
+// BuildPlaceMap(slam) with place_map_revisits).
 GaussianMap BuildPlaceMap(const std::vector<RadarScan>& scans, const RadarSlam& slam);
 
 // Writes slam.tum (each scan's optimised T_world_radar), keyframes.csv,

@@ -46,6 +46,10 @@ struct SlamOptions {
   // is bounded by the place, not the drive.
   bool hold_map_points = true;
   bool place_map_revisits = false;
+  // Whether such a revisit is a loop candidate of later searches; false:
+  // each place is answered by its first keyframe, so a search's candidates,
+  // and the back end's cost, stay flat over laps of the same places.
+  bool revisit_candidates = true;
 };
 
 // Robustness studies, apart from what a user sets: after each keyframe's
