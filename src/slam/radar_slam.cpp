@@ -70,8 +70,8 @@ const OptionTable<SlamOptions>& SlamOptionTable() {
             .Help("a keyframe within the merge distance of a place adds its points to the map too (memory grows with "
                   "the drive)"),
         RADARGAUSS_OPTION(O, "revisit_candidates", revisit_candidates)
-            .Help("a keyframe within the merge distance of a place is a loop candidate of later searches (false: "
-                  "each place answered by its first keyframe)"),
+            .Help("every visit of a place is a loop candidate of later searches (false: each place answered by its "
+                  "newest visit within the merge distance)"),
         RADARGAUSS_OPTION(O, "local_solve_margin", local_solve_margin)
             .AtLeast(0.0)
             .Unit("m")
@@ -216,7 +216,7 @@ void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap, std::vector<Ra
   keyframe.describe_ms = MillisecondsSince(start);
   const auto search = std::chrono::steady_clock::now();
   const int query = int(graph_.keyframes().size()) - 1;
-  const LoopSearchResult found = search_.Search(query, graph_, options_.revisit_candidates ? nullptr : &first_visit_);
+  const LoopSearchResult found = search_.Search(query, graph_, options_.revisit_candidates ? nullptr : &candidate_);
   if (found.accepted) {
     const LoopCandidate& loop = found.outcomes[*found.accepted];
     graph_.CloseLoop(loop.candidate, query, loop.check.relative, loop.check.sqrt_information, found.path);
@@ -229,28 +229,41 @@ void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap, std::vector<Ra
   }
   // At the poses the loop just corrected; the time counts as the description's.
   const auto hold = std::chrono::steady_clock::now();
-  first_visit_.push_back(!RevisitsAPlace(std::size_t(query)));
+  first_visit_.push_back(!Near(std::size_t(query), first_visit_));
   if (options_.hold_map_points && (first_visit_.back() || options_.place_map_revisits)) {
     HoldMapPoints(std::move(scans));
   }
-  if (!first_visit_.back() && !options_.revisit_candidates) {  // no place and no candidate: its submap is done
-    std::vector<RadarPoint>().swap(graph_.last().points);
-  }
+  if (!options_.revisit_candidates) Represent(std::size_t(query));
   graph_.last().describe_ms += MillisecondsSince(hold);
 }
 
-bool RadarSlam::RevisitsAPlace(std::size_t keyframe) const {
+bool RadarSlam::Near(std::size_t keyframe, const std::vector<bool>& among) const {
   if (options_.place_merge_distance <= 0.0) return false;
   const std::vector<SE3d>& poses = graph_.graph().poses();
   const double merge_angle = options_.place_merge_angle_deg * M_PI / 180.0;
   for (std::size_t k = 0; k < keyframe; ++k) {
-    if (!first_visit_[k]) continue;
-    if ((poses[k].translation() - poses[keyframe].translation()).norm() <= options_.place_merge_distance &&
+    if (among[k] && (poses[k].translation() - poses[keyframe].translation()).norm() <= options_.place_merge_distance &&
         (poses[k].rotation().Inverse() * poses[keyframe].rotation()).Log().norm() <= merge_angle) {
       return true;
     }
   }
   return false;
+}
+
+void RadarSlam::Represent(std::size_t keyframe) {
+  const std::vector<SE3d>& poses = graph_.graph().poses();
+  const double merge_angle = options_.place_merge_angle_deg * M_PI / 180.0;
+  candidate_.push_back(true);
+  if (options_.place_merge_distance <= 0.0) return;
+  for (std::size_t k = 0; k < keyframe; ++k) {
+    if (!candidate_[k] ||
+        (poses[k].translation() - poses[keyframe].translation()).norm() > options_.place_merge_distance ||
+        (poses[k].rotation().Inverse() * poses[keyframe].rotation()).Log().norm() > merge_angle) {
+      continue;
+    }
+    candidate_[k] = false;  // the newest visit answers for the place
+    if (!first_visit_[k]) std::vector<RadarPoint>().swap(graph_.keyframe(k).points);  // no place either: done
+  }
 }
 
 void RadarSlam::HoldMapPoints(std::vector<RadarScan> scans) {
@@ -263,6 +276,11 @@ void RadarSlam::HoldMapPoints(std::vector<RadarScan> scans) {
   tbb::parallel_for(std::size_t(0), scans.size(),
                     [&](std::size_t k) { part.scans[k] = StaticPointsOf(scans[k], filter); });
   place_map_.push_back(std::move(part));
+}
+
+const std::vector<bool>& RadarSlam::loop_candidates() const {
+  Wait();
+  return candidate_;
 }
 
 const std::vector<bool>& RadarSlam::first_visits() const {

@@ -426,10 +426,11 @@ bool HoldsPoints(const RadarSlam& slam, int keyframe) {
                      [&](const PlaceMapPart& part) { return part.keyframe == std::size_t(keyframe); });
 }
 
-// Without revisit_candidates a search compares only first visits of places
-// (the keyframes that hold points), where the default compares revisits
-// too; the yard's loops still close and correct the drift.
-TEST(RadarSlam, WithoutRevisitCandidatesEachPlaceIsAnsweredByItsFirstVisit) {
+// Without revisit_candidates each place has one loop candidate, its newest
+// visit, where the default compares every visit: fewer candidates compared,
+// the replaced visits' submaps released unless they are places, and the
+// yard's loops still close and correct the drift.
+TEST(RadarSlam, WithoutRevisitCandidatesEachPlaceIsAnsweredByItsNewestVisit) {
   const RadarSlam& every = YardSlam();
   const std::vector<LoopCandidate>& all = every.candidates();
   EXPECT_TRUE(std::any_of(all.begin(), all.end(),
@@ -439,7 +440,19 @@ TEST(RadarSlam, WithoutRevisitCandidatesEachPlaceIsAnsweredByItsFirstVisit) {
   const std::unique_ptr<RadarSlam> slam = RunYard(options);
   ASSERT_GT(slam->loops(), 0u);
   EXPECT_LT(slam->candidates().size(), all.size());
-  for (const LoopCandidate& c : slam->candidates()) EXPECT_TRUE(HoldsPoints(*slam, c.candidate)) << c.candidate;
+  const std::vector<bool>& candidates = slam->loop_candidates();
+  const std::vector<bool>& first_visits = slam->first_visits();
+  const std::vector<Keyframe>& keyframes = slam->keyframes();
+  ASSERT_EQ(candidates.size(), keyframes.size());
+  std::size_t replaced = 0;
+  for (std::size_t k = 0; k < keyframes.size(); ++k) {
+    EXPECT_GT(keyframes[k].submap_points, 0u) << k;
+    if (candidates[k]) continue;
+    ++replaced;
+    EXPECT_EQ(keyframes[k].points.empty(), !first_visits[k]) << k;
+  }
+  EXPECT_GT(replaced, keyframes.size() / 4);
+  EXPECT_TRUE(every.loop_candidates().empty());  // the default keeps none apart: every keyframe is one
   const Evaluation odometry = EvaluateTrajectory(slam->odometry().trajectory(), Yard().ground_truth);
   const Evaluation corrected = EvaluateTrajectory(slam->trajectory(), Yard().ground_truth);
   EXPECT_LT(corrected.ate_translation.rmse, 0.5 * odometry.ate_translation.rmse);

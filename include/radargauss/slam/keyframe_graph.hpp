@@ -38,6 +38,7 @@ class KeyframeGraph {
   void Add(Keyframe keyframe);
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   Keyframe& last() { return keyframes_.back(); }
+  Keyframe& keyframe(std::size_t k) { return keyframes_[k]; }
   const PoseGraph& graph() const { return graph_; }
 
   // The metres driven from keyframe `from` to each keyframe along the

@@ -88,6 +88,10 @@ class RadarSlam {
   // of its closing; every one when the distance is 0). The first visits are
   // the map's places and hold its points.
   const std::vector<bool>& first_visits() const;
+  // Per closed keyframe, without revisit_candidates: whether it is its
+  // place's loop candidate now (the newest visit within the merge distance
+  // of the others); empty with revisit_candidates (every one is).
+  const std::vector<bool>& loop_candidates() const;
   // The keyframes' parts of the map of the place (hold_map_points), in
   // keyframe order, and the bytes their points hold.
   const std::vector<PlaceMapPart>& place_map_parts() const;
@@ -105,9 +109,12 @@ class RadarSlam {
   // The back end's side: the closed keyframe's place, its loop search, the
   // accepted loop into the graph, and the study's false loop.
   void DescribeAndSearch(std::vector<RadarPoint> submap, std::vector<RadarScan> scans);
-  // Whether the keyframe lies within place_merge_distance and angle of a
-  // first visit before it, at the graph's poses now.
-  bool RevisitsAPlace(std::size_t keyframe) const;
+  // Whether the keyframe lies within place_merge_distance and angle of one
+  // of `among` before it, at the graph's poses now.
+  bool Near(std::size_t keyframe, const std::vector<bool>& among) const;
+  // Without revisit_candidates: the closed keyframe becomes its place's
+  // loop candidate, in place of the candidates within the merge distance.
+  void Represent(std::size_t keyframe);
   // Holds the closed keyframe's static points (a PlaceMapPart).
   void HoldMapPoints(std::vector<RadarScan> scans);
 
@@ -127,7 +134,8 @@ class RadarSlam {
   LoopSearch search_;
   FalseLoops false_loops_;
   std::vector<PlaceMapPart> place_map_;
-  std::vector<bool> first_visit_;         // per closed keyframe: no earlier first visit within the merge distance
+  std::vector<bool> candidate_;    // per closed keyframe: a loop candidate of later searches (revisit_candidates false)
+  std::vector<bool> first_visit_;  // per closed keyframe: no earlier first visit within the merge distance
   std::unique_ptr<SerialWorker> worker_;  // the back end's thread; null: in Register
 };
 

@@ -46,9 +46,9 @@ struct SlamOptions {
   // is bounded by the place, not the drive.
   bool hold_map_points = true;
   bool place_map_revisits = false;
-  // Whether such a revisit is a loop candidate of later searches; false:
-  // each place is answered by its first keyframe, so a search's candidates,
-  // and the back end's cost, stay flat over laps of the same places.
+  // Whether every visit of a place is a loop candidate of later searches;
+  // false: each place is answered by its newest visit, so a search's
+  // candidates, and the back end's cost, stay flat over laps of a place.
   bool revisit_candidates = true;
 };
 
