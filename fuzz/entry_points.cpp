@@ -17,6 +17,7 @@
 #include "radargauss/io/kitti_bin.hpp"
 #include "radargauss/io/mcap.hpp"
 #include "radargauss/io/pcd.hpp"
+#include "radargauss/io/rig.hpp"
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/map/map_file.hpp"
@@ -203,6 +204,11 @@ void CliYaml(const std::uint8_t* data, std::size_t size) {
   }
 }
 
+void RigYaml(const std::uint8_t* data, std::size_t size) {
+  const std::string path = WriteInput(data, size, "rig.yaml");
+  Expecting([&] { ReadRig(path); });
+}
+
 // One shard folder merged alone: every field of shard.json is read.
 void ShardJson(const std::uint8_t* data, std::size_t size) {
   const std::string dir = InputPath("shard");
@@ -256,7 +262,8 @@ const std::vector<Target>& Targets() {
                                               {"map_places", MapPlaces},
                                               {"mcap", Mcap},
                                               {"cdr", Cdr},
-                                              {"map_tiles", MapTiles}};
+                                              {"map_tiles", MapTiles},
+                                              {"rig_yaml", RigYaml}};
   return targets;
 }
 

@@ -22,7 +22,7 @@ struct Target {
 };
 
 // pcd, kitti_bin, tum, map_file, pointcloud2, simulator_yaml, cli_yaml,
-// shard_json, map_places, mcap, cdr.
+// shard_json, map_places, mcap, cdr, map_tiles, rig_yaml.
 const std::vector<Target>& Targets();
 
 }  // namespace radargauss::fuzz

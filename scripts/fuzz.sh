@@ -13,7 +13,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 which=${1:-all}
 seconds=${2:-60}
-targets=(pcd kitti_bin tum map_file pointcloud2 simulator_yaml cli_yaml shard_json map_places mcap cdr map_tiles)
+targets=(pcd kitti_bin tum map_file pointcloud2 simulator_yaml cli_yaml shard_json map_places mcap cdr map_tiles rig_yaml)
 if [ "$which" != all ]; then
   if [[ ! " ${targets[*]} " =~ " $which " ]]; then
     echo "fuzz.sh: unknown target '$which' (all, ${targets[*]})" >&2

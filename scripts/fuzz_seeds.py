@@ -243,6 +243,19 @@ def map_tiles_seeds(rng):
     yield "reordered.json", json.dumps(index, indent=1).encode()
 
 
+def rig_yaml_seeds(rng):
+    """A rig of folders with a quaternion and a matrix mounting, and one of a bag's topics."""
+    yield "folders.yaml", (b"radars:\n"
+                           b"  - {name: front, sequence: front, extrinsic: [3.7, 0, 0.5, 0, 0, 0, 1]}\n"
+                           b"  - name: rear_left\n    sequence: rear_left\n"
+                           b"    rotation: [[-0.7071067811865476, -0.7071067811865476, 0],"
+                           b" [0.7071067811865476, -0.7071067811865476, 0], [0, 0, 1]]\n"
+                           b"    translation: [-0.9, 0.9, 0.6]\n    clock_offset: -0.012\n")
+    yield "bag.yaml", (b"bag: drive.mcap\nradars:\n"
+                       b"  - {name: a, topic: /a/points, extrinsic: [1, 0, 0, 0, 0, 0, 1], clock_offset: 0.02}\n"
+                       b"  - {name: b, topic: /b/points, extrinsic: [-1, 0, 0, 0, 0, 1, 0]}\n")
+
+
 def files(*patterns):
     for path in sorted(p for pattern in patterns for p in glob.glob(os.path.join(ROOT, pattern))):
         with open(path, "rb") as f:
@@ -259,6 +272,7 @@ def main():
         "cli_yaml": files("configs/*_localize.yaml", "configs/*_odometry.yaml"),
         "shard_json": shard_json_seeds(rng), "map_places": map_places_seeds(rng),
         "mcap": mcap_seeds(rng), "cdr": cdr_seeds(rng), "map_tiles": map_tiles_seeds(rng),
+        "rig_yaml": rig_yaml_seeds(rng),
     }
     for target, items in seeds.items():
         folder = os.path.join(sys.argv[1], target)

@@ -1,13 +1,16 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss info: summarise a sequence and an IMU file, or list a bag's topics.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
 
 #include "commands.hpp"
 #include "radargauss/core/error.hpp"
+#include "radargauss/core/rig_twist.hpp"
 #include "radargauss/io/imu.hpp"
+#include "radargauss/io/rig.hpp"
 #include "radargauss/io/rosbag.hpp"
 #include "radargauss/core/stats.hpp"
 
@@ -38,6 +41,7 @@ int ListTopics(const std::string& bag) {
 
 struct InfoSettings {
   SequenceOptions sequence;
+  std::string rig;
   std::string imu;
   std::string imu_topic;  // a sensor_msgs/Imu topic of --bag
 };
@@ -55,8 +59,57 @@ void PrintImu(const std::vector<ImuSample>& samples) {
               s.mean_specific_force.norm());
 }
 
+// Each radar of a rig: its scans, their span and rate, its mounting and
+// clock; then which rotations the rig's Doppler cannot observe.
+int RigInfo(const std::string& path) {
+  const Rig rig = ReadRig(path);
+  std::printf("rig: %s, %zu radars\n", path.c_str(), rig.radars.size());
+  std::vector<SE3d> mountings;
+  for (const RigRadar& radar : rig.radars) {
+    Sequence sequence;
+    try {
+      sequence = LoadSequence(radar.scans);
+    } catch (const DataError& e) {
+      throw DataError("radar '" + radar.name + "': " + e.what());
+    }
+    std::vector<double> counts;
+    for (const RadarScan& scan : sequence.scans) counts.push_back(double(scan.points.size()));
+    const double first = sequence.scans.front().timestamp, last = sequence.scans.back().timestamp;
+    const double rate = last > first ? double(sequence.scans.size() - 1) / (last - first) : 0.0;
+    const Eigen::Vector3d& t = radar.body_from_radar.translation();
+    const Eigen::Matrix3d R = radar.body_from_radar.rotation().Matrix();  // R = Rz(yaw) Ry(pitch) Rx(roll)
+    const Eigen::Vector3d rpy =
+        Eigen::Vector3d(std::atan2(R(2, 1), R(2, 2)), -std::asin(std::clamp(R(2, 0), -1.0, 1.0)),
+                        std::atan2(R(1, 0), R(0, 0))) *
+        180.0 / M_PI;
+    std::printf(
+        "  %s: %zu scans (%s), %.3f .. %.3f s, %.1f Hz, median %.0f points; at %.3f %.3f %.3f m, "
+        "roll/pitch/yaw %.2f %.2f %.2f deg; clock offset %.4f s\n",
+        Printable(radar.name).c_str(), sequence.scans.size(), sequence.layout.c_str(), first - radar.clock_offset,
+        last - radar.clock_offset, rate, Median(counts), t.x(), t.y(), t.z(), rpy.x(), rpy.y(), rpy.z(),
+        radar.clock_offset);
+    mountings.push_back(radar.body_from_radar);
+  }
+  const Eigen::Matrix3Xd unobserved = UnobservedRotations(mountings);
+  if (unobserved.cols() == 0) {
+    std::printf("doppler observes: the body's velocity and angular velocity (lever arms not on one line)\n");
+  } else if (unobserved.cols() == 1) {
+    std::printf("doppler observes: all but the rotation about the line through the radars (%.3f %.3f %.3f)\n",
+                unobserved(0, 0), unobserved(1, 0), unobserved(2, 0));
+  } else {
+    std::printf("doppler observes: each radar's velocity, not the angular velocity (the radars share one place)\n");
+  }
+  return 0;
+}
+
 int RunInfo(const InfoSettings& settings) {
   const SequenceOptions& options = settings.sequence;
+  if (!settings.rig.empty()) {
+    if (!options.sequence_dir.empty() || !options.bag.empty()) {
+      throw DataError("--rig names the radars' scans itself: drop --sequence and --bag");
+    }
+    return RigInfo(settings.rig);
+  }
   if (!settings.imu.empty()) {
     PrintImu(ReadImuFile(settings.imu));
     if (options.sequence_dir.empty() && options.bag.empty()) return 0;
@@ -109,8 +162,11 @@ int RunInfo(const InfoSettings& settings) {
 
 Subcommand AddInfo(CLI::App& parent) {
   auto settings = std::make_shared<InfoSettings>();
-  CLI::App* app = parent.add_subcommand("info", "Summarise a sequence and an IMU file (or list a bag's topics)");
+  CLI::App* app = parent.add_subcommand("info", "Summarise a sequence, a rig and an IMU file (or list a bag's topics)");
   AddSequenceOptions(app, settings->sequence);
+  app->add_option("--rig", settings->rig,
+                  "Rig file (radars, their scans, mountings and clocks): each radar's scans, and what the rig's "
+                  "Doppler observes");
   app->add_option("--imu", settings->imu, "IMU file of lines 'stamp wx wy wz ax ay az': its rate, gaps, mean rates");
   app->add_option("--imu-topic", settings->imu_topic, "sensor_msgs/Imu topic of --bag: its rate, gaps, mean rates");
   return {app, [settings] { return RunInfo(*settings); }};

@@ -213,6 +213,17 @@ for file in slam.tum map.rgm keyframes.csv odometry/odometry.tum; do
 done
 expect_fail "slam --hold-map-points=false with --map-tiles" "drop --no-map" -- \
   "$tool" slam --sequence "$work/seq10" --map-tiles 20 --hold-map-points=false --out "$work/slam_unheld"
+# A rig of two radars (two simulated folders) on the vehicle's axis.
+"$tool" simulate --out "$work/seq10b" --scans 10 --seed 3 >/dev/null
+printf 'radars:\n  - {name: front, sequence: seq10, extrinsic: [3.7, 0, 0.5, 0, 0, 0, 1]}\n  - {name: rear, sequence: seq10b, extrinsic: [-1, 0, 0.5, 0, 0, 1, 0], clock_offset: 0.02}\n' \
+  > "$work/rig.yaml"
+expect_ok "info on a rig" "rear: 10 scans .*clock offset 0.0200 s" -- "$tool" info --rig "$work/rig.yaml"
+expect_ok "info on a rig says what its Doppler observes" "all but the rotation about the line through the radars (1.000" -- \
+  "$tool" info --rig "$work/rig.yaml"
+printf 'radars:\n  - {name: front, sequence: seq10, extrinsic: [3.7, 0, 0.5, 0, 0, 0, 1]}\n  - {name: rear, sequence: seq10, extrinsic: [-1, 0, 0.5, 0, 0, 1, 0]}\n' \
+  > "$work/rig_shared.yaml"
+expect_fail "a rig whose radars share a folder" "radar 'rear' reads the folder" -- "$tool" info --rig "$work/rig_shared.yaml"
+expect_fail "a rig and a sequence" "drop --sequence" -- "$tool" info --rig "$work/rig.yaml" --sequence "$work/seq10"
 expect_ok "slam writes the map as tiles" "map_tiles/" -- \
   "$tool" slam --sequence "$work/seq10" --submap-distance 2 --map-tiles 20 --out "$work/slam_tiles"
 [[ -s "$work/slam_tiles/map_tiles/tiles.json" ]] || { echo "FAIL: slam --map-tiles wrote no tiles.json"; failed=1; }
