@@ -18,6 +18,7 @@ namespace {
 struct SimulateSettings {
   std::string out;
   std::string config;
+  std::string rig_config;  // a rig of radars instead of one
   std::uint32_t seed = 1;
   bool seed_given = false;
   int scans = 0;
@@ -25,7 +26,39 @@ struct SimulateSettings {
   std::string bag;  // --mcap: the sequence as a ROS 2 bag too
 };
 
+// One simulation per radar of the rig config, written as a rig file's folders.
+int RunSimulateRig(const SimulateSettings& s) {
+  if (!s.config.empty()) throw DataError("--rig-config holds the world (world:): drop --config");
+  if (!s.bag.empty()) throw DataError("--mcap writes one radar's sequence: a rig is written as folders");
+  RigSimulationConfig config = LoadRigSimulationConfig(s.rig_config);
+  if (s.seed_given) {
+    for (std::size_t r = 0; r < config.radars.size(); ++r) config.radars[r].second.seed += s.seed - config.world.seed;
+    config.world.seed = s.seed;
+  }
+  if (s.scans > 0) config.world.scans = s.scans;
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!s.force && fs::exists(fs::path(s.out) / "rig.yaml", error)) {
+    throw FileError(s.out, "already holds a rig (use --force to overwrite)");
+  }
+  StagedFolder folder(s.out);
+  const SimulatedRig rig = SimulateRig(config);
+  WriteSimulatedRig(folder.path(), rig);
+  folder.Commit();
+  std::printf("simulated a rig of %zu radars over %.1f s into %s (rig.yaml, gt_body_tum.txt)\n", rig.radars.size(),
+              double(config.world.scans) / config.world.rate_hz, s.out.c_str());
+  for (std::size_t r = 0; r < rig.radars.size(); ++r) {
+    std::size_t detections = 0;
+    for (const RadarScan& scan : rig.radars[r].scans) detections += scan.points.size();
+    std::printf("  %s: %zu scans at %g Hz, %zu detections, clock offset %g s\n", rig.names[r].c_str(),
+                rig.radars[r].scans.size(), rig.radars[r].config.rate_hz, detections,
+                rig.radars[r].config.clock_offset);
+  }
+  return 0;
+}
+
 int RunSimulate(const SimulateSettings& s) {
+  if (!s.rig_config.empty()) return RunSimulateRig(s);
   SimulationConfig config = s.config.empty() ? SimulationConfig{} : LoadSimulationConfig(s.config);
   if (s.seed_given) config.seed = s.seed;
   if (s.scans > 0) config.scans = s.scans;
@@ -73,6 +106,9 @@ Subcommand AddSimulate(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand("simulate", "Write a synthetic 4D radar sequence");
   app->add_option("--out", s->out, "Output folder (Snail-Radar layout)")->required();
   app->add_option("--config", s->config, "YAML parameters (see configs/synthetic_world.yaml)");
+  app->add_option("--rig-config", s->rig_config,
+                  "A rig of radars instead (see configs/rig_five_radars.yaml): a folder per radar, rig.yaml, "
+                  "gt_body_tum.txt");
   CLI::Option* seed = app->add_option("--seed", s->seed, "Random seed");
   app->add_option("--scans", s->scans, "Number of scans (overrides the config)")->check(Positive());
   AddBoolFlag(app, "--force", s->force, "Overwrite an existing sequence in --out");

@@ -3,6 +3,7 @@
 #include "radargauss/simulator/simulator.hpp"
 #include "radargauss/simulator/imu_from_reference.hpp"
 
+#include <algorithm>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -102,7 +103,17 @@ const OptionTable<SimulationConfig>& SimulationOptionTable() {
           .In(-45.0, 45.0)
           .Unit("deg")
           .Help("its pitch (positive: looking down)"),
-      RADARGAUSS_OPTION(O, "mounting_yaw_deg", mounting_yaw_deg).In(-45.0, 45.0).Unit("deg").Help("its yaw"),
+      RADARGAUSS_OPTION(O, "mounting_yaw_deg", mounting_yaw_deg)
+          .In(-180.0, 180.0)
+          .Unit("deg")
+          .Help("its yaw (a corner radar's is 45 to 135)"),
+      RADARGAUSS_OPTION(O, "mounting_x", mounting_x).In(-10.0, 10.0).Unit("m").Help("its place: forward"),
+      RADARGAUSS_OPTION(O, "mounting_y", mounting_y).In(-10.0, 10.0).Unit("m").Help("to the left"),
+      RADARGAUSS_OPTION(O, "mounting_z", mounting_z).In(-10.0, 10.0).Unit("m").Help("up"),
+      RADARGAUSS_OPTION(O, "clock_offset", clock_offset)
+          .In(-0.5, 0.5)
+          .Unit("s")
+          .Help("the radar's stamps minus the true time"),
       RADARGAUSS_OPTION(O, "rcs_swerling", rcs_swerling).In(0, 3).Help("RCS fluctuation: 0 none, 1 or 3 Swerling"),
       RADARGAUSS_OPTION(O, "multipath_probability", multipath_probability)
           .In(0.0, 1.0)
@@ -139,7 +150,7 @@ const OptionTable<SimulationConfig>& SimulationOptionTable() {
       RADARGAUSS_OPTION(O, "imu_roll_deg", imu_roll_deg).In(-180.0, 180.0).Unit("deg").Help("the IMU on the vehicle"),
       RADARGAUSS_OPTION(O, "imu_pitch_deg", imu_pitch_deg).In(-180.0, 180.0).Unit("deg").Help("its pitch"),
       RADARGAUSS_OPTION(O, "imu_yaw_deg", imu_yaw_deg).In(-180.0, 180.0).Unit("deg").Help("its yaw"),
-      RADARGAUSS_OPTION(O, "imu_x", imu_x).In(-10.0, 10.0).Unit("m").Help("its place: forward of the radar"),
+      RADARGAUSS_OPTION(O, "imu_x", imu_x).In(-10.0, 10.0).Unit("m").Help("its place: forward of the vehicle's origin"),
       RADARGAUSS_OPTION(O, "imu_y", imu_y).In(-10.0, 10.0).Unit("m").Help("to the left"),
       RADARGAUSS_OPTION(O, "imu_z", imu_z).In(-10.0, 10.0).Unit("m").Help("up"),
       RADARGAUSS_OPTION(O, "imu_clock_offset", imu_clock_offset)
@@ -227,10 +238,12 @@ OptionValue ReadValue(const OptionSpec& option, const YAML::Node& node) {
 
 }  // namespace
 
-SimulationConfig LoadSimulationConfig(const std::string& path) {
-  SimulationConfig config;
-  const YAML::Node root = ReadYamlDocument(path, "simulation config");
-  if (root.IsNull()) return config;
+namespace {
+
+// The keys of the map `root` set on `config`; a key in `refused` is an error
+// saying `why`.
+void ApplySimulationKeys(const YAML::Node& root, const std::string& path, SimulationConfig& config,
+                         const std::vector<std::string>& refused = {}, const std::string& why = "") {
   if (!root.IsMap()) throw FileError(path, "expected a map of parameters");
   const OptionTable<SimulationConfig>& table = SimulationOptionTable();
   for (const auto& entry : root) {
@@ -238,6 +251,7 @@ SimulationConfig LoadSimulationConfig(const std::string& path) {
       throw FileError(path, entry.first.Mark().line + 1, "a key must be a parameter name");
     }
     const std::string key = entry.first.Scalar();
+    if (std::find(refused.begin(), refused.end(), key) != refused.end()) throw FileError(path, key + ": " + why);
     try {
       if (key == "materials") {
         if (!entry.second.IsMap()) throw FileError(path, "materials must be a map");
@@ -273,8 +287,76 @@ SimulationConfig LoadSimulationConfig(const std::string& path) {
       throw FileError(path, e.mark.line + 1, "parameter '" + key + "' has the wrong type");
     }
   }
+}
+
+}  // namespace
+
+SimulationConfig LoadSimulationConfig(const std::string& path) {
+  SimulationConfig config;
+  const YAML::Node root = ReadYamlDocument(path, "simulation config");
+  if (root.IsNull()) return config;
+  ApplySimulationKeys(root, path, config);
   ValidateSimulationConfig(config, path);
   return config;
+}
+
+const std::vector<std::string>& RigSharedSimulationKeys() {
+  static const std::vector<std::string> keys = {"world_seed",
+                                                "start_offset",
+                                                "scans",
+                                                "start_time",
+                                                "speed",
+                                                "loop_length",
+                                                "loop_width",
+                                                "corner_radius",
+                                                "sensor_height",
+                                                "attitude_wobble_deg",
+                                                "scene",
+                                                "traffic_min_speed",
+                                                "traffic_max_speed",
+                                                "poles",
+                                                "parked_cars",
+                                                "moving_cars",
+                                                "moving_car_speed",
+                                                "object_rcs_spread_db",
+                                                "materials",
+                                                "imu_rate_hz"};
+  return keys;
+}
+
+RigSimulationConfig LoadRigSimulationConfig(const std::string& path) {
+  const YAML::Node root = ReadYamlDocument(path, "rig simulation config");
+  if (!root.IsMap()) throw FileError(path, "a rig simulation config is a map of world: and radars:");
+  for (const auto& entry : root) {
+    const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
+    if (key != "world" && key != "radars") throw FileError(path, "unknown key '" + key + "' (world, radars)");
+  }
+  RigSimulationConfig rig;
+  if (root["world"]) ApplySimulationKeys(root["world"], path, rig.world);
+  if (rig.world.imu_rate_hz > 0.0) throw FileError(path, "imu_rate_hz: a rig is simulated without an IMU");
+  ValidateSimulationConfig(rig.world, path);
+  const YAML::Node radars = root["radars"];
+  if (!radars || !radars.IsSequence() || radars.size() == 0) throw FileError(path, "no radars: (a list of radars)");
+  if (radars.size() > 16) throw FileError(path, std::to_string(radars.size()) + " radars (at most 16)");
+  for (std::size_t i = 0; i < radars.size(); ++i) {
+    const YAML::Node radar = radars[i];
+    if (!radar.IsMap() || !radar["name"] || !radar["name"].IsScalar() || radar["name"].Scalar().empty()) {
+      throw FileError(path, "radar " + std::to_string(i + 1) + " needs a name");
+    }
+    const std::string name = radar["name"].Scalar();
+    for (const auto& [other, unused] : rig.radars) {
+      if (other == name) throw FileError(path, "two radars are named '" + name + "'");
+    }
+    YAML::Node keys = YAML::Clone(radar);
+    keys.remove("name");
+    SimulationConfig config = rig.world;
+    config.seed = rig.world.seed + std::uint32_t(i);
+    ApplySimulationKeys(keys, path, config, RigSharedSimulationKeys(),
+                        "radar '" + name + "' sets a key of the rig's drive and world (set it under world:)");
+    ValidateSimulationConfig(config, path + " (radar '" + name + "')");
+    rig.radars.emplace_back(name, config);
+  }
+  return rig;
 }
 
 std::string SimulationConfigToYaml(const SimulationConfig& config) {

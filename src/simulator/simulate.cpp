@@ -197,9 +197,11 @@ void SimulateImu(const SimulationConfig& config, const simulation::LoopPath& pat
   sequence.imu_bias = std::move(imu.bias);
 }
 
+// On the radar's clock: the true time plus its clock offset.
 ScanStamp TimeOfScan(const SimulationConfig& config, int k) {
-  const long long start_seconds = static_cast<long long>(std::floor(config.start_time));
-  const long long start_nanoseconds = std::llround((config.start_time - static_cast<double>(start_seconds)) * 1e9);
+  const double start = config.start_time + config.clock_offset;
+  const long long start_seconds = static_cast<long long>(std::floor(start));
+  const long long start_nanoseconds = std::llround((start - static_cast<double>(start_seconds)) * 1e9);
   const long long offset_nanoseconds = std::llround(k * 1e9 / config.rate_hz);
   const long long total = start_nanoseconds + offset_nanoseconds;
   const long long seconds = start_seconds + total / 1000000000LL;
@@ -219,12 +221,13 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
   Draws draws(config.seed);
   std::mt19937 world_rng(config.world_seed);
   const Scene scene = BuildScene(config, path, config.world_seed == 0 ? draws.rng : world_rng);
-  const bool mounted =
-      config.mounting_roll_deg != 0.0 || config.mounting_pitch_deg != 0.0 || config.mounting_yaw_deg != 0.0;
+  const Eigen::Vector3d lever_arm(config.mounting_x, config.mounting_y, config.mounting_z);
+  const bool mounted = config.mounting_roll_deg != 0.0 || config.mounting_pitch_deg != 0.0 ||
+                       config.mounting_yaw_deg != 0.0 || !lever_arm.isZero(0.0);
   const SE3d mounting(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, config.mounting_yaw_deg * kDeg)) *
                           SO3d::Exp(Eigen::Vector3d(0.0, config.mounting_pitch_deg * kDeg, 0.0)) *
                           SO3d::Exp(Eigen::Vector3d(config.mounting_roll_deg * kDeg, 0.0, 0.0)),
-                      Eigen::Vector3d::Zero());
+                      lever_arm);
   ScanState state;
   state.stds = {float(config.range_noise), float(config.azimuth_noise_deg * kDeg),
                 float(config.elevation_noise_deg * kDeg), float(config.doppler_noise)};
@@ -233,6 +236,14 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
     sequence.file_stems.push_back(time.stem);
     Eigen::Vector3d velocity_world;
     SensorState(config, path, time.since_start, state.pose, velocity_world);
+    if (!lever_arm.isZero(0.0)) {     // the radar's own velocity: the vehicle's plus its turn times the lever arm
+      constexpr double kStep = 1e-4;  // s, central differences of the radar's place
+      SE3d before, after;
+      Eigen::Vector3d unused;
+      SensorState(config, path, time.since_start - kStep, before, unused);
+      SensorState(config, path, time.since_start + kStep, after, unused);
+      velocity_world = (after * lever_arm - before * lever_arm) / (2.0 * kStep);
+    }
     if (mounted) state.pose = state.pose * mounting;  // T_world_vehicle T_vehicle_radar
     state.R = state.pose.rotation().Matrix();
     state.velocity_radar = state.R.transpose() * velocity_world;

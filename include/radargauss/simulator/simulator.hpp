@@ -82,6 +82,13 @@ struct SimulationConfig {
   double mounting_roll_deg = 0.0;       // the radar on the vehicle: T_vehicle_radar = Rz(yaw) Ry(pitch) Rx(roll)
   double mounting_pitch_deg = 0.0;      // positive: the x axis looking down (about the vehicle's y)
   double mounting_yaw_deg = 0.0;
+  // Its place on the vehicle (m, from the vehicle's origin on the path: x
+  // forward, y left, z up; a lever arm moves it with the turns as well), and
+  // its clock: its stamps minus the true time (s).
+  double mounting_x = 0.0;
+  double mounting_y = 0.0;
+  double mounting_z = 0.0;
+  double clock_offset = 0.0;
   int rcs_swerling = 0;                // RCS fluctuation per detection: 0 none, 1 Swerling I, 3 Swerling III
   double multipath_probability = 0.0;  // a ray that meets a wall or guardrail also returns a ghost
   double multipath_loss_db = 6.0;      // the ghost's RCS below its target's
@@ -95,7 +102,7 @@ struct SimulationConfig {
   double imu_roll_deg = 0.0;         // the IMU on the vehicle, as the radar's mounting
   double imu_pitch_deg = 0.0;
   double imu_yaw_deg = 0.0;
-  double imu_x = 0.0;  // m: its place on the vehicle (x forward, z up; the radar at the origin)
+  double imu_x = 0.0;  // m: its place on the vehicle (x forward, z up; from the vehicle's origin)
   double imu_y = 0.0;
   double imu_z = 0.0;
   double imu_clock_offset = 0.0;  // s: the IMU's stamps minus the true time (the radar's clock)
@@ -175,6 +182,38 @@ Sequence AsSequence(const SimulatedSequence& simulated);
 // with an IMU, <dir>/imu.txt and <dir>/imu_extrinsic.txt (io/imu.hpp's
 // formats) and the true biases <dir>/imu_biases.txt (stamp bg bg bg ba ba ba).
 void WriteSimulatedSequence(const std::string& dir, const SimulatedSequence& sequence);
+
+// A rig of radars on one vehicle (docs/design/rig.md, "A simulated rig"):
+// every radar is a simulation of the same drive through the same world with
+// its own settings (mounting and lever arm, field of view, range, rate,
+// clock offset, faults, noise seed). `world` holds what they share and each
+// radar's defaults; a radar's map holds its own keys.
+struct RigSimulationConfig {
+  SimulationConfig world;
+  std::vector<std::pair<std::string, SimulationConfig>> radars;  // name, settings
+};
+// The keys a radar may not set: the drive, the world and the IMU are the rig's.
+const std::vector<std::string>& RigSharedSimulationKeys();
+// A YAML file `world: {keys}` and `radars: [{name: ..., keys}]`. Throws
+// DataError naming the file for a radar without a name or with the rig's
+// keys, a name given twice, an IMU (not simulated on a rig), and what
+// LoadSimulationConfig refuses.
+RigSimulationConfig LoadRigSimulationConfig(const std::string& path);
+
+struct SimulatedRig {
+  std::vector<std::string> names;
+  std::vector<SimulatedSequence> radars;  // each on its own clock, its ground truth T_world_radar
+  std::vector<SE3d> body_from_radar;      // T_body_radar of each
+  Trajectory body;                        // T_world_body on the true clock, at the first radar's scans
+};
+// Each radar simulated over the world's drive: its scans number its rate
+// times the drive's duration (world.scans / world.rate_hz), its noise seed
+// is world.seed plus its index unless it sets one, and the world's objects
+// are one for all (world_seed, or world.seed when that is 0).
+SimulatedRig SimulateRig(const RigSimulationConfig& config);
+// <dir>/<name>/ per radar (WriteSimulatedSequence), <dir>/rig.yaml (io/rig.hpp:
+// the folders, mountings and clock offsets) and <dir>/gt_body_tum.txt.
+void WriteSimulatedRig(const std::string& dir, const SimulatedRig& rig);
 
 // "<secs>.<nsecs>" with nine decimals: the Snail-Radar file stem of a time,
 // to the nearest nanosecond of the double (whose own resolution near 1.7e9 s

@@ -1,0 +1,143 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// A simulated rig: its radars' scans on their own clocks over one drive,
+// the rig file it writes, and the rig's twist from their Doppler against the
+// radars' true velocities; its config's refusals.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "radargauss/core/error.hpp"
+#include "radargauss/core/rig_twist.hpp"
+#include "radargauss/io/rig.hpp"
+#include "radargauss/simulator/simulator.hpp"
+#include "support/temp_dir.hpp"
+
+namespace radargauss {
+namespace {
+
+SimulationConfig Corner(double x, double y, double yaw_deg) {
+  SimulationConfig c;
+  c.mounting_x = x;
+  c.mounting_y = y;
+  c.mounting_z = 0.5;
+  c.mounting_yaw_deg = yaw_deg;
+  c.azimuth_fov_deg = 75.0;
+  c.max_range = 80.0;
+  c.min_detections = 80;
+  c.max_detections = 200;
+  return c;
+}
+
+// Four corner radars scanning together (10 Hz, no clock offsets).
+RigSimulationConfig FourCorners(int scans) {
+  RigSimulationConfig rig;
+  rig.world.scans = scans;
+  rig.radars = {{"front_left", Corner(3.4, 0.9, 45.0)},
+                {"front_right", Corner(3.4, -0.9, -45.0)},
+                {"rear_left", Corner(-0.9, 0.9, 135.0)},
+                {"rear_right", Corner(-0.9, -0.9, -135.0)}};
+  for (std::size_t r = 0; r < rig.radars.size(); ++r) rig.radars[r].second.seed = std::uint32_t(10 + r);
+  return rig;
+}
+
+// At every instant of the drive the rig's twist from the four radars'
+// Doppler gives each radar's true velocity (R_i^T (v + w x t_i), the
+// simulator's own, lever arm included) to a few centimetres per second:
+// within 3 sigma of the twist's covariance for 97 % of the scans.
+TEST(SimulatedRig, TheRigsTwistGivesEachRadarsTrueVelocity) {
+  const SimulatedRig rig = SimulateRig(FourCorners(120));
+  ASSERT_EQ(rig.radars.size(), 4u);
+  std::size_t within = 0, checked = 0;
+  std::vector<double> errors;
+  for (std::size_t k = 0; k < rig.radars[0].scans.size(); ++k) {
+    std::vector<RigScan> scans;
+    for (std::size_t r = 0; r < 4; ++r) {
+      ASSERT_EQ(rig.radars[r].scans[k].timestamp, rig.radars[0].scans[k].timestamp);  // one instant
+      scans.push_back({&rig.radars[r].scans[k], rig.body_from_radar[r]});
+    }
+    const RigTwist twist = EstimateRigTwist(scans);
+    ASSERT_TRUE(twist.success) << k << ": " << twist.reason;
+    ASSERT_EQ(twist.rank, 6) << k;
+    for (std::size_t r = 0; r < 4; ++r) {
+      const SE3d& mounting = rig.body_from_radar[r];
+      // The radar's velocity as a linear map of the twist: J [v; w], J = R^T [I, -[t]x].
+      Eigen::Matrix<double, 3, 6> J;
+      J << mounting.rotation().Matrix().transpose(),
+          -mounting.rotation().Matrix().transpose() * SO3d::Hat(mounting.translation());
+      Vector6d x;
+      x << twist.velocity, twist.angular_velocity;
+      const Eigen::Vector3d error = J * x - rig.radars[r].sensor_velocity[k];
+      const Eigen::Matrix3d covariance = J * twist.covariance * J.transpose();
+      errors.push_back(error.norm());
+      within += error.dot(covariance.ldlt().solve(error)) < 14.16;  // chi-square, 3 dof, 99.73 %
+      ++checked;
+    }
+  }
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.03);  // m/s, median
+  EXPECT_GE(double(within), 0.97 * double(checked));
+}
+
+// Radars at their own rates and clocks: the files carry each radar's
+// stamps, the rig file its mounting and offset, and on the body's clock
+// every radar's scans span the drive from the same start.
+class SimulatedRigFiles : public testing::TempDirTest {};
+
+TEST_F(SimulatedRigFiles, WritesEachRadarOnItsClockAndTheRigFile) {
+  RigSimulationConfig config = FourCorners(20);
+  config.radars[1].second.rate_hz = 20.0;
+  config.radars[2].second.clock_offset = 0.021;
+  const SimulatedRig rig = SimulateRig(config);
+  EXPECT_EQ(rig.radars[0].scans.size(), 20u);
+  EXPECT_EQ(rig.radars[1].scans.size(), 40u);
+  EXPECT_NEAR(rig.radars[2].scans.front().timestamp - rig.radars[0].scans.front().timestamp, 0.021, 1e-6);
+  WriteSimulatedRig(Path("rig"), rig);
+  const Rig read = ReadRig(Path("rig/rig.yaml"));
+  ASSERT_EQ(read.radars.size(), 4u);
+  EXPECT_EQ(read.radars[2].name, "rear_left");
+  EXPECT_DOUBLE_EQ(read.radars[2].clock_offset, 0.021);
+  EXPECT_LT((read.radars[3].body_from_radar.translation() - Eigen::Vector3d(-0.9, -0.9, 0.5)).norm(), 1e-12);
+  std::vector<double> first(4, -1.0);
+  std::size_t scans = 0;
+  ForEachRigScan(read, [&](std::size_t radar, RadarScan& scan, const std::string&) {
+    if (first[radar] < 0.0) first[radar] = scan.timestamp;
+    ++scans;
+  });
+  EXPECT_EQ(scans, 20u + 40u + 20u + 20u);
+  for (std::size_t r = 1; r < 4; ++r) EXPECT_NEAR(first[r], first[0], 1e-6) << r;  // one start on the body's clock
+  const Trajectory body = ReadTum(Path("rig/gt_body_tum.txt"));
+  ASSERT_EQ(body.size(), 20u);
+  // The first radar's true pose is the body's times its mounting.
+  const SE3d radar = *rig.radars[0].ground_truth.Interpolate(rig.radars[0].scans[5].timestamp);
+  const SE3d composed = *body.Interpolate(rig.radars[0].scans[5].timestamp) * rig.body_from_radar[0];
+  EXPECT_LT((radar.translation() - composed.translation()).norm(), 1e-6);
+}
+
+TEST_F(SimulatedRigFiles, ItsConfigRefusesWhatIsTheRigsOwn) {
+  const auto error_of = [&](const std::string& text) {
+    const std::string path = WriteFile("rig.yaml", text);
+    try {
+      LoadRigSimulationConfig(path);
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of("radars:\n  - {name: a, loop_length: 50}\n").find("loop_length: radar 'a' sets a key of the rig"),
+            std::string::npos);
+  EXPECT_NE(error_of("radars:\n  - {mounting_x: 1}\n").find("radar 1 needs a name"), std::string::npos);
+  EXPECT_NE(error_of("radars:\n  - {name: a}\n  - {name: a}\n").find("two radars are named 'a'"), std::string::npos);
+  EXPECT_NE(error_of("world: {imu_rate_hz: 200}\nradars:\n  - {name: a}\n").find("without an IMU"), std::string::npos);
+  EXPECT_NE(error_of("radars: []\n").find("no radars"), std::string::npos);
+  EXPECT_NE(error_of("radars:\n  - {name: a, mounting_yaw_deg: 270}\n").find("mounting_yaw_deg"), std::string::npos);
+  EXPECT_EQ(error_of("world: {scans: 10}\nradars:\n  - {name: a, clock_offset: 0.01}\n"), "no error");
+  const RigSimulationConfig ok = LoadRigSimulationConfig(Path("rig.yaml"));
+  EXPECT_EQ(ok.world.scans, 10);
+  EXPECT_DOUBLE_EQ(ok.radars[0].second.clock_offset, 0.01);
+}
+
+}  // namespace
+}  // namespace radargauss
