@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The simulator's configuration file and outputs.
 #include "radargauss/simulator/simulator.hpp"
+
+#include "config_keys.hpp"
 #include "radargauss/simulator/imu_from_reference.hpp"
 
 #include <algorithm>
@@ -238,12 +240,8 @@ OptionValue ReadValue(const OptionSpec& option, const YAML::Node& node) {
 
 }  // namespace
 
-namespace {
-
-// The keys of the map `root` set on `config`; a key in `refused` is an error
-// saying `why`.
 void ApplySimulationKeys(const YAML::Node& root, const std::string& path, SimulationConfig& config,
-                         const std::vector<std::string>& refused = {}, const std::string& why = "") {
+                         const std::vector<std::string>& refused, const std::string& why) {
   if (!root.IsMap()) throw FileError(path, "expected a map of parameters");
   const OptionTable<SimulationConfig>& table = SimulationOptionTable();
   for (const auto& entry : root) {
@@ -289,74 +287,13 @@ void ApplySimulationKeys(const YAML::Node& root, const std::string& path, Simula
   }
 }
 
-}  // namespace
-
 SimulationConfig LoadSimulationConfig(const std::string& path) {
   SimulationConfig config;
   const YAML::Node root = ReadYamlDocument(path, "simulation config");
   if (root.IsNull()) return config;
-  ApplySimulationKeys(root, path, config);
+  ApplySimulationKeys(root, path, config, {}, "");
   ValidateSimulationConfig(config, path);
   return config;
-}
-
-const std::vector<std::string>& RigSharedSimulationKeys() {
-  static const std::vector<std::string> keys = {"world_seed",
-                                                "start_offset",
-                                                "scans",
-                                                "start_time",
-                                                "speed",
-                                                "loop_length",
-                                                "loop_width",
-                                                "corner_radius",
-                                                "sensor_height",
-                                                "attitude_wobble_deg",
-                                                "scene",
-                                                "traffic_min_speed",
-                                                "traffic_max_speed",
-                                                "poles",
-                                                "parked_cars",
-                                                "moving_cars",
-                                                "moving_car_speed",
-                                                "object_rcs_spread_db",
-                                                "materials",
-                                                "imu_rate_hz"};
-  return keys;
-}
-
-RigSimulationConfig LoadRigSimulationConfig(const std::string& path) {
-  const YAML::Node root = ReadYamlDocument(path, "rig simulation config");
-  if (!root.IsMap()) throw FileError(path, "a rig simulation config is a map of world: and radars:");
-  for (const auto& entry : root) {
-    const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
-    if (key != "world" && key != "radars") throw FileError(path, "unknown key '" + key + "' (world, radars)");
-  }
-  RigSimulationConfig rig;
-  if (root["world"]) ApplySimulationKeys(root["world"], path, rig.world);
-  if (rig.world.imu_rate_hz > 0.0) throw FileError(path, "imu_rate_hz: a rig is simulated without an IMU");
-  ValidateSimulationConfig(rig.world, path);
-  const YAML::Node radars = root["radars"];
-  if (!radars || !radars.IsSequence() || radars.size() == 0) throw FileError(path, "no radars: (a list of radars)");
-  if (radars.size() > 16) throw FileError(path, std::to_string(radars.size()) + " radars (at most 16)");
-  for (std::size_t i = 0; i < radars.size(); ++i) {
-    const YAML::Node radar = radars[i];
-    if (!radar.IsMap() || !radar["name"] || !radar["name"].IsScalar() || radar["name"].Scalar().empty()) {
-      throw FileError(path, "radar " + std::to_string(i + 1) + " needs a name");
-    }
-    const std::string name = radar["name"].Scalar();
-    for (const auto& [other, unused] : rig.radars) {
-      if (other == name) throw FileError(path, "two radars are named '" + name + "'");
-    }
-    YAML::Node keys = YAML::Clone(radar);
-    keys.remove("name");
-    SimulationConfig config = rig.world;
-    config.seed = rig.world.seed + std::uint32_t(i);
-    ApplySimulationKeys(keys, path, config, RigSharedSimulationKeys(),
-                        "radar '" + name + "' sets a key of the rig's drive and world (set it under world:)");
-    ValidateSimulationConfig(config, path + " (radar '" + name + "')");
-    rig.radars.emplace_back(name, config);
-  }
-  return rig;
 }
 
 std::string SimulationConfigToYaml(const SimulationConfig& config) {

@@ -1,16 +1,78 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // A simulated rig (docs/design/rig.md, "A simulated rig"): one simulation
-// per radar over the same drive and world, written as a rig file's folders.
+// per radar over the same drive and world, written as a rig file's folders;
+// its config file.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <system_error>
 
+#include "config_keys.hpp"
 #include "radargauss/core/error.hpp"
+#include "radargauss/io/yaml_file.hpp"
 #include "radargauss/io/rig.hpp"
 #include "radargauss/simulator/simulator.hpp"
 
 namespace radargauss {
+
+const std::vector<std::string>& RigSharedSimulationKeys() {
+  static const std::vector<std::string> keys = {"world_seed",
+                                                "start_offset",
+                                                "scans",
+                                                "start_time",
+                                                "speed",
+                                                "loop_length",
+                                                "loop_width",
+                                                "corner_radius",
+                                                "sensor_height",
+                                                "attitude_wobble_deg",
+                                                "scene",
+                                                "traffic_min_speed",
+                                                "traffic_max_speed",
+                                                "poles",
+                                                "parked_cars",
+                                                "moving_cars",
+                                                "moving_car_speed",
+                                                "object_rcs_spread_db",
+                                                "materials",
+                                                "imu_rate_hz"};
+  return keys;
+}
+
+RigSimulationConfig LoadRigSimulationConfig(const std::string& path) {
+  const YAML::Node root = ReadYamlDocument(path, "rig simulation config");
+  if (!root.IsMap()) throw FileError(path, "a rig simulation config is a map of world: and radars:");
+  for (const auto& entry : root) {
+    const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
+    if (key != "world" && key != "radars") throw FileError(path, "unknown key '" + key + "' (world, radars)");
+  }
+  RigSimulationConfig rig;
+  if (root["world"]) ApplySimulationKeys(root["world"], path, rig.world, {}, "");
+  if (rig.world.imu_rate_hz > 0.0) throw FileError(path, "imu_rate_hz: a rig is simulated without an IMU");
+  ValidateSimulationConfig(rig.world, path);
+  const YAML::Node radars = root["radars"];
+  if (!radars || !radars.IsSequence() || radars.size() == 0) throw FileError(path, "no radars: (a list of radars)");
+  if (radars.size() > 16) throw FileError(path, std::to_string(radars.size()) + " radars (at most 16)");
+  for (std::size_t i = 0; i < radars.size(); ++i) {
+    const YAML::Node radar = radars[i];
+    if (!radar.IsMap() || !radar["name"] || !radar["name"].IsScalar() || radar["name"].Scalar().empty()) {
+      throw FileError(path, "radar " + std::to_string(i + 1) + " needs a name");
+    }
+    const std::string name = radar["name"].Scalar();
+    for (const auto& [other, unused] : rig.radars) {
+      if (other == name) throw FileError(path, "two radars are named '" + name + "'");
+    }
+    YAML::Node keys = YAML::Clone(radar);
+    keys.remove("name");
+    SimulationConfig config = rig.world;
+    config.seed = rig.world.seed + std::uint32_t(i);
+    ApplySimulationKeys(keys, path, config, RigSharedSimulationKeys(),
+                        "radar '" + name + "' sets a key of the rig's drive and world (set it under world:)");
+    ValidateSimulationConfig(config, path + " (radar '" + name + "')");
+    rig.radars.emplace_back(name, config);
+  }
+  return rig;
+}
 
 namespace {
 
