@@ -381,6 +381,9 @@ def build_map(scans: Any, poses: Any = None, builder: str = 'kmeans', points_per
 def compose(a: Any, b: Any) -> numpy.ndarray:
     """The rigid transform a * b as [x y z qx qy qz qw]."""
 
+def estimate_rig_twist(scans: list[Scan], body_from_radar: Any, **kwargs) -> dict:
+    """The body's velocity and angular velocity (body frame) from the Doppler of several radars' scans taken together, each radar at its body_from_radar (4x4 or [x y z qx qy qz qw]). A dict: success, reason, velocity, angular_velocity, covariance (6x6 of [v; w]), observed (the projector onto the observed directions), rank, inlier (per radar, per point)."""
+
 def evaluate(estimate: tuple, reference: tuple, align: str = 'se3') -> dict:
     """ATE and RPE of `radargauss evaluate`: align se3, sim3, first or none."""
 
@@ -419,6 +422,9 @@ def read_map(path: str) -> GaussianMap:
 
 def read_pcd(path: str) -> Scan:
     """One PCD scan (ascii, binary or binary_compressed); the stamp from a <secs>.<nsecs>.pcd name."""
+
+def read_rig(path: str) -> list:
+    """The radars of a rig file, each a dict: name, sequence (a folder) or bag and topic, body_from_radar (4x4 T_body_radar), clock_offset (s: the radar's stamps minus the body's clock)."""
 
 def read_sequence(path: str = '', gt: str = '', extrinsic: str = 'auto', bag: str = '', topic: str = '', rcs_field: str = '', doppler_field: str = '', elevation_bias_deg: float = 0.0) -> Sequence:
     """Reads a sequence as `radargauss info` does: a Snail-Radar folder, a folder of .pcd or .bin scans (path), or a bag (bag, topic: a ROS1 .bag, a ROS 2 .db3 or .mcap, a rosbag2 folder); gt: a TUM file of reference poses, extrinsic T_gt_radar; elevation_bias_deg removed from every point."""

@@ -54,6 +54,7 @@ py::tuple TrajectoryToArrays(const Trajectory& trajectory);
 Trajectory TrajectoryFromArrays(const py::handle& stamps, const py::handle& poses, const std::string& name);
 
 void BindData(py::module_& m);
+void BindRig(py::module_& m);  // read_rig, estimate_rig_twist
 void BindMap(py::module_& m);
 void BindMatch(py::module_& m);
 void BindOdometry(py::module_& m);

@@ -21,6 +21,7 @@ PYBIND11_MODULE(_radargauss, m) {
   m.doc() = "radargauss: 4D radar Gaussian-RCS maps, scan matching and odometry";
   py::register_exception<radargauss::DataError>(m, "DataError", PyExc_ValueError);
   radargauss::python::BindData(m);
+  radargauss::python::BindRig(m);
   radargauss::python::BindMap(m);
   radargauss::python::BindMatch(m);
   radargauss::python::BindOdometry(m);

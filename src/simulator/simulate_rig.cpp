@@ -5,13 +5,16 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <system_error>
 
 #include "config_keys.hpp"
+#include "radargauss/core/atomic_file.hpp"
 #include "radargauss/core/error.hpp"
 #include "radargauss/io/yaml_file.hpp"
 #include "radargauss/io/rig.hpp"
 #include "radargauss/simulator/simulator.hpp"
+#include "scene.hpp"
 
 namespace radargauss {
 
@@ -102,8 +105,19 @@ SimulatedRig SimulateRig(const RigSimulationConfig& config) {
   // The body on the true clock, from the first radar's poses.
   const SimulatedSequence& first = rig.radars.front();
   const SE3d radar_from_body = rig.body_from_radar.front().Inverse();
-  for (const StampedPose& sample : first.ground_truth) {
+  const simulation::LoopPath path{config.world.loop_length, config.world.loop_width, config.world.corner_radius};
+  for (std::size_t k = 0; k < first.ground_truth.size(); ++k) {
+    const StampedPose& sample = first.ground_truth[k];
     rig.body.Append(sample.time - first.config.clock_offset, sample.pose * radar_from_body);
+    constexpr double kStep = 1e-4;  // s
+    const double since_start = double(k) / first.config.rate_hz;
+    SE3d before, after;
+    Eigen::Vector3d unused;
+    simulation::SensorState(first.config, path, since_start - kStep, before, unused);
+    simulation::SensorState(first.config, path, since_start + kStep, after, unused);
+    const SO3d rotation = (sample.pose * radar_from_body).rotation();
+    rig.body_velocity.push_back(rotation.Inverse() * (after.translation() - before.translation()) / (2.0 * kStep));
+    rig.body_angular_velocity.push_back((before.rotation().Inverse() * after.rotation()).Log() / (2.0 * kStep));
   }
   return rig;
 }
@@ -125,6 +139,16 @@ void WriteSimulatedRig(const std::string& dir, const SimulatedRig& simulated) {
   }
   WriteRig((fs::path(dir) / "rig.yaml").string(), rig);
   WriteTum((fs::path(dir) / "gt_body_tum.txt").string(), simulated.body);
+  WriteFileAtomically((fs::path(dir) / "twist_body.txt").string(), [&](std::ostream& out) {
+    out << "# t vx vy vz wx wy wz: the body's true velocity (m/s) and angular velocity (rad/s), body frame\n";
+    out << std::setprecision(12);
+    for (std::size_t k = 0; k < simulated.body.size(); ++k) {
+      const Eigen::Vector3d& v = simulated.body_velocity[k];
+      const Eigen::Vector3d& w = simulated.body_angular_velocity[k];
+      out << simulated.body[k].time << ' ' << v.x() << ' ' << v.y() << ' ' << v.z() << ' ' << w.x() << ' ' << w.y()
+          << ' ' << w.z() << '\n';
+    }
+  });
 }
 
 }  // namespace radargauss

@@ -205,6 +205,9 @@ struct SimulatedRig {
   std::vector<SimulatedSequence> radars;  // each on its own clock, its ground truth T_world_radar
   std::vector<SE3d> body_from_radar;      // T_body_radar of each
   Trajectory body;                        // T_world_body on the true clock, at the first radar's scans
+  // The body's true twist at the same times: velocity and angular velocity
+  // in the body frame (central differences of its pose over 1e-4 s).
+  std::vector<Eigen::Vector3d> body_velocity, body_angular_velocity;
 };
 // Each radar simulated over the world's drive: its scans number its rate
 // times the drive's duration (world.scans / world.rate_hz), its noise seed
@@ -212,7 +215,8 @@ struct SimulatedRig {
 // are one for all (world_seed, or world.seed when that is 0).
 SimulatedRig SimulateRig(const RigSimulationConfig& config);
 // <dir>/<name>/ per radar (WriteSimulatedSequence), <dir>/rig.yaml (io/rig.hpp:
-// the folders, mountings and clock offsets) and <dir>/gt_body_tum.txt.
+// the folders, mountings and clock offsets), <dir>/gt_body_tum.txt and
+// <dir>/twist_body.txt (lines "t vx vy vz wx wy wz", body frame).
 void WriteSimulatedRig(const std::string& dir, const SimulatedRig& rig);
 
 // "<secs>.<nsecs>" with nine decimals: the Snail-Radar file stem of a time,
