@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <stdexcept>
 
@@ -91,20 +92,39 @@ int DrawsFor(int size, const EgoVelocityOptions& options) {
   return std::max(1, int(std::ceil(std::log(1.0 - options.success_probability) / std::log(1.0 - clean))));
 }
 
-// The rows of largest support among seeded `size`-row draws of A z = y (the
-// first of largest support), in row order.
-std::vector<Eigen::Index> LargestConsensus(const Eigen::MatrixXd& A, const Eigen::VectorXd& y, int draws,
+// The rows of largest support among seeded `size`-row draws of A z = y
+// (the first of largest support), in row order. Each radar votes with the
+// share of its points a hypothesis explains, and a draw takes a radar at
+// random, then one of its points: a radar whose view a close car fills can
+// neither outvote the others nor fill the draws with the car.
+std::vector<Eigen::Index> LargestConsensus(const Eigen::MatrixXd& A, const Eigen::VectorXd& y,
+                                           const std::vector<std::size_t>& radar_of_row, int draws,
                                            const EgoVelocityOptions& options) {
   const Eigen::Index n = A.rows(), size = A.cols();
+  std::vector<std::vector<Eigen::Index>> rows_of;  // per radar with rows
+  std::vector<std::size_t> slot(*std::max_element(radar_of_row.begin(), radar_of_row.end()) + 1, SIZE_MAX);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    std::size_t& s = slot[radar_of_row[std::size_t(k)]];
+    if (s == SIZE_MAX) {
+      s = rows_of.size();
+      rows_of.emplace_back();
+    }
+    rows_of[s].push_back(k);
+  }
+  std::vector<double> vote(static_cast<std::size_t>(n));  // a row's vote: 1 / the points of its radar
+  for (const std::vector<Eigen::Index>& rows : rows_of) {
+    for (const Eigen::Index k : rows) vote[std::size_t(k)] = 1.0 / double(rows.size());
+  }
   std::mt19937 rng(options.seed);
-  std::uniform_int_distribution<Eigen::Index> pick(0, n - 1);
+  std::uniform_int_distribution<std::size_t> pick_radar(0, rows_of.size() - 1);
   std::vector<Eigen::Index> drawn(std::size_t(size), 0);
   Eigen::VectorXd best_z;
-  Eigen::Index best_support = 0;
+  double best_votes = 0.0;
   for (int draw = 0; draw < draws; ++draw) {
     for (std::size_t k = 0; k < drawn.size(); ++k) {
       do {
-        drawn[k] = pick(rng);
+        const std::vector<Eigen::Index>& rows = rows_of[pick_radar(rng)];
+        drawn[k] = rows[std::uniform_int_distribution<std::size_t>(0, rows.size() - 1)(rng)];
       } while (std::find(drawn.begin(), drawn.begin() + std::ptrdiff_t(k), drawn[k]) !=
                drawn.begin() + std::ptrdiff_t(k));
     }
@@ -117,14 +137,16 @@ std::vector<Eigen::Index> LargestConsensus(const Eigen::MatrixXd& A, const Eigen
     const Eigen::FullPivLU<Eigen::MatrixXd> lu(a);
     if (lu.rank() < size) continue;  // points whose directions leave the twist open
     const Eigen::VectorXd z = lu.solve(b);
-    const Eigen::Index support = ((y - A * z).array().abs() < options.inlier_threshold).count();
-    if (support > best_support) {
-      best_support = support;
+    const Eigen::ArrayXd residual = (y - A * z).array().abs();
+    double votes = 0.0;
+    for (Eigen::Index k = 0; k < n; ++k) votes += residual(k) < options.inlier_threshold ? vote[std::size_t(k)] : 0.0;
+    if (votes > best_votes) {
+      best_votes = votes;
       best_z = z;
     }
   }
   std::vector<Eigen::Index> best;
-  if (best_support == 0) return best;
+  if (best_votes == 0.0) return best;
   const Eigen::VectorXd residual = (y - A * best_z).cwiseAbs();
   for (Eigen::Index k = 0; k < n; ++k) {
     if (residual(k) < options.inlier_threshold) best.push_back(k);
@@ -164,7 +186,10 @@ RigTwist EstimateRigTwist(const std::vector<RigScan>& scans, const RigTwistOptio
   }
   const Eigen::MatrixXd A = rows.H * basis;  // the rows in the observed coordinates z, [v; w] = V_o z
   result.ransac_iterations = DrawsFor(result.rank, options.doppler);
-  const std::vector<Eigen::Index> consensus = LargestConsensus(A, rows.y, result.ransac_iterations, options.doppler);
+  std::vector<std::size_t> radar_of_row;
+  for (const auto& [radar, point] : rows.source) radar_of_row.push_back(radar);
+  const std::vector<Eigen::Index> consensus =
+      LargestConsensus(A, rows.y, radar_of_row, result.ransac_iterations, options.doppler);
   if (consensus.size() <= std::size_t(result.rank)) {
     result.reason = "no consensus: too few points agree on one twist";
     return result;

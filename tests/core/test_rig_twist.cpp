@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -115,6 +116,29 @@ TEST(RigTwist, ExactDopplerGivesThePlantedTwistAmongOutliers) {
       }
     }
   }
+}
+
+// A close car fills the rear-left radar's view (300 returns moving with it,
+// 30 static): each radar votes with the share of its points a twist
+// explains, so the car cannot outvote the four radars that see the world
+// (by points it would: 300 against 190).
+TEST(RigTwist, ACarFillingOneRadarsViewDoesNotOutvoteTheRig) {
+  std::mt19937 rng(29);
+  PlantedRig planted = Plant(FiveRadarRig(), kVelocity, kAngularVelocity, 40, 0, 0.0, rng);
+  const Eigen::Vector3d car_velocity(-8.0, 1.5, 0.0);  // the rig's twist as the car's returns show it
+  RadarScan& filled = planted.scans[3];
+  filled = PlantedRigScan(FiveRadarRig()[3], kVelocity, kAngularVelocity, 30, 0, 0.0, rng);
+  const RadarScan car = PlantedRigScan(FiveRadarRig()[3], car_velocity, Eigen::Vector3d::Zero(), 300, 0, 0.0, rng);
+  filled.points.insert(filled.points.end(), car.points.begin(), car.points.end());
+  const RigTwist twist = EstimateRigTwist(planted.rig);
+  ASSERT_TRUE(twist.success) << twist.reason;
+  // The world's twist, up to the few car returns whose Doppler happens to
+  // fall within the threshold of it (directions across the two motions).
+  EXPECT_LT((twist.velocity - kVelocity).norm(), 0.02);
+  EXPECT_LT((twist.angular_velocity - kAngularVelocity).norm(), 0.01);
+  const auto kept = std::count(twist.inlier[3].begin(), twist.inlier[3].end(), true);
+  EXPECT_GE(kept, 30);
+  EXPECT_LT(kept, 60);
 }
 
 // Over 200 draws of noise (0.05 m/s) with a fifth of the points moving,

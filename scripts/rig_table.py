@@ -1,0 +1,119 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""The rig's twist from Doppler alone (bench/RESULTS.md, "Radar rigs"): rigs
+of 1, 2, 4 and 6 radars simulated over one drive (`radargauss simulate
+--rig-config`), every radar at 10 Hz on one clock so that their scans are
+taken together, and at each instant the body's twist estimated from all
+their Doppler (`radargauss.estimate_rig_twist`) against the simulator's true
+twist (twist_body.txt).
+
+Per rig and world: the scans estimated, the rank (observed directions), the
+median of the error in the observed directions (|P e|, P the projector onto
+them) and the share of scans where it is under 0.1 (the others took a
+moving object for the world); over those, the velocity's RMSE (m/s, with
+all six observed), the yaw rate's (mrad/s, with five or six) and the roll
+and pitch rates' (with six), and the mean NEES over the observed directions
+against their count; and the time per estimate.
+
+    scripts/rig_table.py [--tool build/release/bin/radargauss] [--work /tmp/rig_table] [--scans 300]
+
+The module is found beside the tool (build/release/python).
+"""
+import argparse
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+FRONT = "  - {name: front, mounting_x: 3.7, mounting_z: 0.5}\n"
+REAR = "  - {name: rear, mounting_x: -1.0, mounting_z: 0.5, mounting_yaw_deg: 180}\n"
+CORNER = ("  - {{name: {name}, mounting_x: {x}, mounting_y: {y}, mounting_z: 0.5, mounting_yaw_deg: {yaw}, "
+          "azimuth_fov_deg: 75, max_range: 80, min_detections: 60, max_detections: 200}}\n")
+CORNERS = "".join(CORNER.format(name=n, x=x, y=y, yaw=yaw) for n, x, y, yaw in
+                  [("front_left", 3.4, 0.9, 45), ("front_right", 3.4, -0.9, -45),
+                   ("rear_left", -0.9, 0.9, 135), ("rear_right", -0.9, -0.9, -135)])
+RIGS = [("1: front", FRONT), ("2: front and rear (on the axis)", FRONT + REAR),
+        ("4: corners", CORNERS), ("6: front, corners, rear", FRONT + CORNERS + REAR)]
+WORLDS = [("demo", "configs/synthetic_world.yaml"), ("realistic faults", "configs/synthetic_realistic.yaml")]
+# The world's keys a rig takes from a single-radar config (a radar's own
+# mounting is the rig's, so the world's is left out).
+RADAR_KEYS = ("mounting_roll_deg", "mounting_pitch_deg", "mounting_yaw_deg", "imu_")
+
+
+def world_section(config, scans):
+    lines = []
+    for line in open(os.path.join(ROOT, config)):
+        line = line.split("#")[0].rstrip()
+        if not line or line.startswith(" ") or ":" not in line or line.startswith(RADAR_KEYS):
+            continue
+        if line.startswith(("scans:", "rate_hz:", "materials:")):
+            continue
+        lines.append("  " + line)
+    lines += [f"  scans: {scans}", "  rate_hz: 10"]
+    return "world:\n" + "\n".join(lines) + "\n"
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--tool", default=os.path.join(ROOT, "build/release/bin/radargauss"))
+    parser.add_argument("--work", default="/tmp/rig_table")
+    parser.add_argument("--scans", type=int, default=300)
+    args = parser.parse_args()
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(args.tool))), "python"))
+    import radargauss as rg
+
+    print("| world | rig | scans | rank | observed error median | under 0.1 | velocity RMSE m/s "
+          "| yaw rate RMSE mrad/s | roll / pitch rate RMSE mrad/s | mean NEES (dof) | ms per estimate |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for world, config in WORLDS:
+        for label, radars in RIGS:
+            out = os.path.join(args.work, f"{world.split()[0]}_{label.split(':')[0]}")
+            os.makedirs(args.work, exist_ok=True)
+            rig_config = out + ".yaml"
+            with open(rig_config, "w") as f:
+                f.write(world_section(config, args.scans) + "radars:\n" + radars)
+            result = subprocess.run([args.tool, "simulate", "--rig-config", rig_config, "--out", out, "--force"],
+                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            if result.returncode != 0:
+                sys.exit(f"rig_table: simulate {rig_config} failed: {result.stderr.strip()}")
+            rig = rg.read_rig(os.path.join(out, "rig.yaml"))
+            sequences = [rg.read_sequence(radar["sequence"]) for radar in rig]
+            mountings = [radar["body_from_radar"] for radar in rig]
+            truth = np.loadtxt(os.path.join(out, "twist_body.txt"), comments="#")
+            projected, velocity, yaw, tilt, nees, dof, ranks, elapsed = [], [], [], [], [], [], [], 0.0
+            for k in range(len(truth)):
+                start = time.perf_counter()
+                twist = rg.estimate_rig_twist([s.scans[k] for s in sequences], mountings)
+                elapsed += time.perf_counter() - start
+                if not twist["success"]:
+                    continue
+                x = np.concatenate([twist["velocity"].ravel(), twist["angular_velocity"].ravel()])
+                error = x - truth[k, 1:7]
+                observed = twist["observed"]
+                error = observed @ error  # an unobserved direction is not an error of the estimate
+                projected.append(error @ error)
+                velocity.append(np.sum(error[:3] ** 2))
+                yaw.append(error[5] ** 2)
+                tilt.append(error[3] ** 2 + error[4] ** 2)
+                nees.append(error @ np.linalg.pinv(twist["covariance"]) @ error)
+                dof.append(twist["rank"])
+                ranks.append(twist["rank"])
+            rank = int(np.median(ranks))
+            norms = np.sqrt(projected)
+            good = norms < 0.1
+
+            def rmse(values, scale=1.0, shown=True, parts=1):
+                values = np.asarray(values)[good]
+                return f"{scale * np.sqrt(np.mean(values) / parts):.4g}" if shown else "-"
+
+            print(f"| {world} | {label} | {len(ranks)} | {rank} | {np.median(norms):.4f} | "
+                  f"{100 * np.mean(good):.0f} % | {rmse(velocity, shown=rank == 6)} | {rmse(yaw, 1e3, rank >= 5)} | "
+                  f"{rmse(tilt, 1e3, rank == 6, 2)} | {np.mean(np.asarray(nees)[good]):.2f} ({np.mean(dof):.0f}) | "
+                  f"{1e3 * elapsed / len(truth):.2f} |")
+
+if __name__ == "__main__":
+    main()
