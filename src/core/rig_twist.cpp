@@ -154,6 +154,36 @@ std::vector<Eigen::Index> LargestConsensus(const Eigen::MatrixXd& A, const Eigen
   return best;
 }
 
+// Least squares on `inliers`, then on the points within the threshold of
+// that fit, until the set holds (at most five fits): a draw's few noisy
+// points pick a consensus biased towards themselves, which the refit sheds.
+// False when the inliers leave a direction open.
+bool RefitOnInliers(const Eigen::MatrixXd& A, const Eigen::VectorXd& y, double threshold,
+                    std::vector<Eigen::Index>& inliers, Eigen::VectorXd& z, Eigen::MatrixXd& normal_inverse) {
+  const Eigen::Index size = A.cols();
+  constexpr int kRefits = 5;
+  for (int refit = 0; refit < kRefits; ++refit) {
+    Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(size, size);
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(size);
+    for (const Eigen::Index k : inliers) {
+      normal += A.row(k).transpose() * A.row(k);
+      rhs += A.row(k).transpose() * y(k);
+    }
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(normal);
+    if (lu.rank() < size) return false;
+    z = lu.solve(rhs);
+    normal_inverse = lu.inverse();
+    std::vector<Eigen::Index> next;
+    const Eigen::VectorXd residual = (y - A * z).cwiseAbs();
+    for (Eigen::Index k = 0; k < A.rows(); ++k) {
+      if (residual(k) < threshold) next.push_back(k);
+    }
+    if (next == inliers || next.size() <= std::size_t(size)) break;
+    inliers = std::move(next);
+  }
+  return true;
+}
+
 }  // namespace
 
 RigTwist EstimateRigTwist(const std::vector<RigScan>& scans, const RigTwistOptions& options) {
@@ -194,34 +224,12 @@ RigTwist EstimateRigTwist(const std::vector<RigScan>& scans, const RigTwistOptio
     result.reason = "no consensus: too few points agree on one twist";
     return result;
   }
-  // Least squares on the consensus, then on the points within the threshold
-  // of that fit, until the set holds: a draw's few noisy points pick a
-  // consensus biased towards themselves, which the refit sheds.
   std::vector<Eigen::Index> inliers = consensus;
   Eigen::VectorXd z;
   Eigen::MatrixXd normal_inverse;
-  constexpr int kRefits = 5;
-  for (int refit = 0; refit < kRefits; ++refit) {
-    Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(result.rank, result.rank);
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(result.rank);
-    for (const Eigen::Index k : inliers) {
-      normal += A.row(k).transpose() * A.row(k);
-      rhs += A.row(k).transpose() * rows.y(k);
-    }
-    const Eigen::FullPivLU<Eigen::MatrixXd> lu(normal);
-    if (lu.rank() < result.rank) {
-      result.reason = "the consensus points leave the twist open";
-      return result;
-    }
-    z = lu.solve(rhs);
-    normal_inverse = lu.inverse();
-    std::vector<Eigen::Index> next;
-    const Eigen::VectorXd residual = (rows.y - A * z).cwiseAbs();
-    for (Eigen::Index k = 0; k < A.rows(); ++k) {
-      if (residual(k) < options.doppler.inlier_threshold) next.push_back(k);
-    }
-    if (next == inliers || next.size() <= std::size_t(result.rank)) break;
-    inliers = std::move(next);
+  if (!RefitOnInliers(A, rows.y, options.doppler.inlier_threshold, inliers, z, normal_inverse)) {
+    result.reason = "the consensus points leave the twist open";
+    return result;
   }
   double sse = 0.0;
   for (const Eigen::Index k : inliers) sse += std::pow(rows.y(k) - A.row(k).dot(z), 2);
