@@ -5,12 +5,20 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <utility>
 #include <string>
 #include <vector>
 
 #include "radargauss/core/error.hpp"
+#include "radargauss/io/mcap.hpp"
 #include "radargauss/io/pcd.hpp"
+#include "radargauss/io/ros2_messages.hpp"
+#include "radargauss/io/rosbag.hpp"
 #include "support/temp_dir.hpp"
 
 namespace radargauss {
@@ -127,6 +135,53 @@ TEST_F(RigFile, TheRadarsScansComeInOneTimeOrderOnTheBodysClock) {
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("radar 'gone'"), std::string::npos) << e.what();
   }
+}
+
+// A rig whose radars are two PointCloud2 topics of one MCAP file: the
+// scans come from their topics, in one order on the body's clock.
+TEST_F(RigFile, TheRadarsOfOneBagAreItsTopics) {
+  const std::string bag = Path("drive.mcap");
+  {
+    std::ofstream out(bag, std::ios::binary);
+    McapWriter writer(out);
+    const std::uint16_t schema = writer.AddSchema("sensor_msgs/msg/PointCloud2", "ros2msg", "");
+    const std::uint16_t front = writer.AddChannel("/front/points", schema);
+    const std::uint16_t rear = writer.AddChannel("/rear/points", schema);
+    for (int k = 0; k < 4; ++k) {
+      for (const auto& [channel, stamp] : {std::pair{front, 100.0 + 0.1 * k}, std::pair{rear, 100.04 + 0.1 * k}}) {
+        RadarScan scan;
+        scan.timestamp = stamp;
+        scan.has_doppler = true;
+        RadarPoint point;
+        point.position = Eigen::Vector3d(5.0, channel == front ? 1.0 : -1.0, 0.0);
+        scan.points.push_back(point);
+        const std::uint64_t log_time = std::uint64_t(std::llround(stamp * 1e9));
+        writer.Write(channel, log_time, log_time, EncodeRos2PointCloud2({stamp, "radar"}, EncodePointCloud2(scan)));
+      }
+    }
+    writer.Finish();
+  }
+  const std::string path = WriteFile("rig.yaml",
+                                     "bag: drive.mcap\n"
+                                     "radars:\n"
+                                     "  - {name: front, topic: /front/points, extrinsic: [3.7, 0, 0.5, 0, 0, 0, 1]}\n"
+                                     "  - {name: rear, topic: /rear/points, extrinsic: [-1, 0, 0.5, 0, 0, 1, 0], "
+                                     "clock_offset: 0.08}\n");
+  const Rig rig = ReadRig(path);
+  EXPECT_EQ(rig.radars[1].scans.bag, bag);
+  std::vector<std::size_t> radars;
+  std::vector<double> stamps;
+  ForEachRigScan(rig, [&](std::size_t radar, RadarScan& scan, const std::string& source) {
+    EXPECT_NE(source.find(radar == 0 ? ":/front/points#" : ":/rear/points#"), std::string::npos) << source;
+    EXPECT_EQ(scan.points.front().position.y(), radar == 0 ? 1.0 : -1.0);
+    radars.push_back(radar);
+    stamps.push_back(scan.timestamp);
+  });
+  // The rear radar's stamps run 0.08 s ahead of the body's clock: 100.04 is 99.96 on it.
+  EXPECT_EQ(radars, (std::vector<std::size_t>{1, 0, 1, 0, 1, 0, 1, 0}));
+  ASSERT_EQ(stamps.size(), 8u);
+  EXPECT_NEAR(stamps[0], 99.96, 1e-9);
+  EXPECT_TRUE(std::is_sorted(stamps.begin(), stamps.end()));
 }
 
 TEST_F(RigFile, EveryBadRigIsRefusedInOneLine) {
