@@ -3,6 +3,7 @@
 // (docs/design/odometry.md, "Odometry"), evaluated against a reference when one is given.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -11,7 +12,9 @@
 #include "radargauss/core/atomic_file.hpp"
 #include "radargauss/core/error.hpp"
 #include "radargauss/experiment/evaluation.hpp"
+#include "radargauss/io/rig.hpp"
 #include "radargauss/odometry/mounting.hpp"
+#include "radargauss/odometry/rig_odometry.hpp"
 #include "radargauss/core/progress.hpp"
 
 namespace radargauss::cli {
@@ -79,7 +82,55 @@ void PrintInertial(const InertialMotion& inertial) {
   }
 }
 
+// The body's odometry from a rig's radars (docs/design/rig.md, "Odometry on a rig").
+int RunRigOdometry(const OdometrySettings& s) {
+  const OdometryOptions& options = s.odometry;
+  ValidateOptions(options);
+  if (!s.sequence.sequence_dir.empty() || !s.sequence.bag.empty()) {
+    throw DataError("--rig names the radars' scans itself: drop --sequence and --bag");
+  }
+  if (!s.imu_file.empty() || !s.imu_topic.empty()) throw DataError("--rig: odometry on a rig takes no IMU yet");
+  if (!s.mcap.empty() || s.matcher != "gaussians") throw DataError("--rig: no --mcap, and no --matcher but gaussians");
+  const Rig rig = ReadRig(s.rig);
+  std::optional<Trajectory> reference;
+  if (!s.sequence.ground_truth.empty()) {
+    reference =
+        ReadRadarTrajectory(s.sequence.ground_truth, ResolveExtrinsic(s.sequence.extrinsic, s.sequence.ground_truth));
+  }
+  StagedFolder folder = RunFolder(s, {"odometry.tum", "body.tum", "levelled.tum", "map.rgm", "map.ply"});
+  std::vector<SE3d> mountings;
+  for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
+  RigOdometry odometry(mountings, options);
+  std::size_t scans = 0;
+  ForEachRigScan(rig, [&](std::size_t radar, RadarScan& scan, const std::string& source) {
+    try {
+      odometry.Register(radar, scan);
+    } catch (const DataError& e) {
+      throw DataError(source + ": " + e.what());
+    }
+    ++scans;
+  });
+  odometry.Finish();
+  const Trajectory body = odometry.trajectory();
+  std::optional<Evaluation> evaluation;
+  if (reference) evaluation = EvaluateTrajectory(body, *reference);
+  WriteOdometry(folder.path(), odometry.odometry());
+  WriteTum((std::filesystem::path(folder.path()) / "body.tum").string(), body);
+  const std::string table = evaluation ? WriteEvaluation(folder.path(), *evaluation) : std::string();
+  folder.Commit();
+  std::printf("rig: %zu radars, %zu scans at %zu instants of the body, %zu with their velocity measured\n",
+              rig.radars.size(), scans, odometry.instant_radars().size(), odometry.velocity_measured());
+  PrintSummary(Summarise(odometry.odometry()));
+  std::printf("%s", table.c_str());
+  std::printf("wrote %s (body.tum: T_world_body; odometry.tum, per_scan.csv and summary.json of the %s odometry%s%s)\n",
+              s.out.c_str(), rig.radars.size() == 1 ? "radar's" : "body's",
+              options.map.keep_evicted ? ", map.rgm, map.ply" : "",
+              evaluation ? ", evaluation.json, evaluation.md" : "");
+  return 0;
+}
+
 int RunOdometry(const OdometrySettings& s) {
+  if (!s.rig.empty()) return RunRigOdometry(s);
   const OdometryOptions& options = s.odometry;
   ValidateOptions(options);
   ImuRotation(s.imu_rotation);
@@ -128,6 +179,9 @@ Subcommand AddOdometry(CLI::App& parent) {
                      "Reference trajectory (TUM, or BAG:/topic[:child] of a ROS 2 bag), for the evaluation only");
   app->add_option("--out", s->out, "Output folder")->required();
   AddOdometryOptions(app, *s);
+  app->add_option("--rig", s->rig,
+                  "Rig file (docs/design/rig.md): the body's odometry from every radar's scans instead of --sequence "
+                  "(--gt: the body's reference)");
   return {app, [s] { return RunOdometry(*s); }};
 }
 

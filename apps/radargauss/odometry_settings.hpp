@@ -36,6 +36,7 @@ struct OdometrySettings {
   std::string matcher = "gaussians";  // or a PCL peer
   RadarInertialOptions inertial;      // the IMU's motion model (--imu-fusion) and the window's
   std::string mcap;                   // --mcap: the run for a viewer (run_mcap.hpp)
+  std::string rig;                    // --rig: a rig file's radars instead of one sequence
   const CLI::App* app = nullptr;      // the command's, to tell a flag given from its default
 };
 

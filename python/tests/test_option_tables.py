@@ -17,7 +17,7 @@ RUN_FLAGS = {"--help", "--sequence", "--gt", "--extrinsic", "--bag", "--topic", 
              "--doppler-field", "--doppler-sign", "--elevation-bias", "--out", "--first-scan", "--max-scans", "--mcap"}
 IMU_FLAGS = {"--imu", "--imu-extrinsic", "--imu-topic", "--imu-stamps", "--imu-rotation"}
 # command, the option tables its flags come from, its own flags.
-COMMANDS = [("odometry", ("odometry", "radar_inertial"), {"--matcher"} | IMU_FLAGS),
+COMMANDS = [("odometry", ("odometry", "radar_inertial"), {"--matcher", "--rig"} | IMU_FLAGS),
             ("slam", ("slam", "radar_inertial"), {"--no-map", "--map-tiles", "--false-loop-rate", "--false-loop-seed"} | IMU_FLAGS),
             ("relocalize", ("relocalization",), {"--map", "--w-rcs-from-map"})]
 

@@ -170,15 +170,22 @@ Eigen::Vector3d RadarOdometry::Displacement(const Prediction& p, const Eigen::Ve
 }
 
 RadarOdometry::Velocity RadarOdometry::MeasureVelocity(const RadarScan& scan,
-                                                       const std::optional<Prediction>& prediction) const {
+                                                       const std::optional<Prediction>& prediction,
+                                                       const std::optional<MeasuredVelocity>& measured) const {
   Velocity v;
   if (prediction) {
     v.value = prediction->velocity;
     v.covariance = prediction->velocity_covariance;
   }
   if (!scan.has_doppler) {
-    v.reason = "no Doppler field: velocity predicted, every point matched";
     for (std::size_t i = 0; i < scan.points.size(); ++i) v.static_points.push_back(i);
+    if (measured) {
+      v.measured = true;
+      v.value = measured->value;
+      v.covariance = measured->covariance;
+      return v;
+    }
+    v.reason = "no Doppler field: velocity predicted, every point matched";
     return v;
   }
   std::optional<VelocityGate> gate;
@@ -228,8 +235,12 @@ bool RadarOdometry::RunBeside(const RadarScan& scan) {
   return true;
 }
 
-const OdometryStep& RadarOdometry::Register(const RadarScan& input) {
+const OdometryStep& RadarOdometry::Register(const RadarScan& input) { return Register(input, std::nullopt); }
+
+const OdometryStep& RadarOdometry::Register(const RadarScan& input, const std::optional<MeasuredVelocity>& measured) {
   const auto start = std::chrono::steady_clock::now();
+  if (measured && input.has_doppler)
+    throw std::invalid_argument("a velocity measured apart is for scans without Doppler");
   if (RunBeside(input)) return steps_.back();
   CheckStamp(input);
   motion_->Advance(input.timestamp);
@@ -239,7 +250,7 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& input) {
   const RadarScan& scan = correct ? corrected : input;
   std::optional<Prediction> prediction;
   if (state_) prediction = Predict(scan.timestamp);
-  const Velocity velocity = MeasureVelocity(scan, prediction);
+  const Velocity velocity = MeasureVelocity(scan, prediction, measured);
   if (velocity.measured && !velocity.standstill) elevation_bias_.Observe(velocity.value);
   FinishMapUpdate();  // the map is read from here on
   PoseEstimate estimate = EstimatePose(scan, prediction, velocity);

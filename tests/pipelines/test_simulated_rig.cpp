@@ -12,7 +12,9 @@
 
 #include "radargauss/core/error.hpp"
 #include "radargauss/core/rig_twist.hpp"
+#include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/io/rig.hpp"
+#include "radargauss/odometry/rig_odometry.hpp"
 #include "radargauss/simulator/simulator.hpp"
 #include "support/temp_dir.hpp"
 
@@ -131,6 +133,53 @@ TEST_F(SimulatedRigFiles, WritesEachRadarOnItsClockAndTheRigFile) {
   const SE3d radar = *rig.radars[0].ground_truth.Interpolate(rig.radars[0].scans[5].timestamp);
   const SE3d composed = *body.Interpolate(rig.radars[0].scans[5].timestamp) * rig.body_from_radar[0];
   EXPECT_LT((radar.translation() - composed.translation()).norm(), 1e-6);
+}
+
+// A rig of one radar is the single-radar odometry bit for bit, its poses
+// moved to the body; a front radar with a corner radar beside it gives one
+// trajectory whose scans hold both radars' static points.
+TEST(RigOdometry, OneRadarIsTheSingleRadarOdometryAndTwoShareOneMap) {
+  RigSimulationConfig config;
+  config.world.scans = 80;
+  SimulationConfig front;
+  front.mounting_x = 3.7;
+  front.mounting_z = 0.5;
+  config.radars = {{"front", front}, {"front_left", Corner(3.4, 0.9, 45.0)}};
+  const SimulatedRig rig = SimulateRig(config);
+  OdometryOptions options;
+  RadarOdometry single(options);
+  RigOdometry alone({rig.body_from_radar[0]}, options);
+  for (const RadarScan& scan : rig.radars[0].scans) {
+    single.Register(scan);
+    alone.Register(0, scan);
+  }
+  alone.Finish();
+  const Trajectory body = alone.trajectory();
+  ASSERT_EQ(body.size(), single.steps().size());
+  const SE3d& mounting = rig.body_from_radar[0];
+  for (std::size_t k = 0; k < body.size(); ++k) {
+    const SE3d expected = mounting * single.steps()[k].pose * mounting.Inverse();
+    ASSERT_EQ(body[k].pose.translation(), expected.translation()) << k;
+  }
+  RigOdometry both(rig.body_from_radar, options);
+  std::size_t a = 0, b = 0;  // the next scan of each radar, merged by time
+  while (a < rig.radars[0].scans.size() || b < rig.radars[1].scans.size()) {
+    const bool first =
+        b == rig.radars[1].scans.size() ||
+        (a < rig.radars[0].scans.size() && rig.radars[0].scans[a].timestamp <= rig.radars[1].scans[b].timestamp);
+    if (first) {
+      both.Register(0, rig.radars[0].scans[a++]);
+    } else {
+      both.Register(1, rig.radars[1].scans[b++]);
+    }
+  }
+  both.Finish();
+  ASSERT_EQ(both.instant_radars().size(), 80u);  // both at 10 Hz on one clock: every instant holds two scans
+  EXPECT_EQ(both.instant_radars()[5], (std::vector<std::size_t>{0, 1}));
+  EXPECT_GT(both.odometry().steps()[40].points, single.steps()[40].static_points);
+  const Evaluation evaluation = EvaluateTrajectory(both.trajectory(), rig.body);
+  EXPECT_LT(evaluation.ate_translation.rmse, 0.5);
+  EXPECT_THROW(both.Register(2, rig.radars[0].scans[0]), DataError);
 }
 
 TEST_F(SimulatedRigFiles, ItsConfigRefusesWhatIsTheRigsOwn) {

@@ -224,6 +224,12 @@ printf 'radars:\n  - {name: front, sequence: seq10, extrinsic: [3.7, 0, 0.5, 0, 
   > "$work/rig_shared.yaml"
 expect_fail "a rig whose radars share a folder" "radar 'rear' reads the folder" -- "$tool" info --rig "$work/rig_shared.yaml"
 expect_fail "a rig and a sequence" "drop --sequence" -- "$tool" info --rig "$work/rig.yaml" --sequence "$work/seq10"
+expect_ok "odometry on a rig" "rig: 2 radars, 20 scans at 20 instants" -- \
+  "$tool" odometry --rig "$work/rig.yaml" --out "$work/rig_odometry"
+[[ -s "$work/rig_odometry/body.tum" ]] || { echo "FAIL: odometry --rig wrote no body.tum"; failed=1; }
+expect_fail "odometry on a rig with an IMU" "takes no IMU yet" -- \
+  "$tool" odometry --rig "$work/rig.yaml" --imu "$work/seq10/gt_radar_tum.txt" --out "$work/rig_imu"
+[[ ! -e "$work/rig_imu" ]] || { echo "FAIL: a refused rig run left $work/rig_imu"; failed=1; }
 expect_ok "slam writes the map as tiles" "map_tiles/" -- \
   "$tool" slam --sequence "$work/seq10" --submap-distance 2 --map-tiles 20 --out "$work/slam_tiles"
 [[ -s "$work/slam_tiles/map_tiles/tiles.json" ]] || { echo "FAIL: slam --map-tiles wrote no tiles.json"; failed=1; }

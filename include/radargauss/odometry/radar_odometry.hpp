@@ -142,6 +142,15 @@ class RadarOdometry {
   // map fields (active_gaussians, active_map_bytes, map_update_ms) are
   // completed when it finishes: steps(), map() or FinishMapUpdate().
   const OdometryStep& Register(const RadarScan& scan);
+  // The same for a scan without Doppler whose sensor velocity (m/s, the
+  // scan's frame) was measured apart, with its covariance: a rig's body
+  // velocity from its radars' Doppler (odometry/rig_odometry.hpp). Every
+  // point is matched, as without Doppler.
+  struct MeasuredVelocity {
+    Eigen::Vector3d value = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  };
+  const OdometryStep& Register(const RadarScan& scan, const std::optional<MeasuredVelocity>& velocity);
   // From the next scan on, matches against `map`, fixed (nothing is
   // inserted), with the motion model carried into the map's frame by
   // `map_from_odometry`: localisation in a given map (relocalisation's tracking).
@@ -220,7 +229,8 @@ class RadarOdometry {
   SE3d PredictedPose(const Prediction& prediction, const Eigen::Vector3d& velocity) const;
   // The translation since the last scan in its frame for a velocity of the new frame.
   static Eigen::Vector3d Displacement(const Prediction& prediction, const Eigen::Vector3d& velocity);
-  Velocity MeasureVelocity(const RadarScan& scan, const std::optional<Prediction>& prediction) const;
+  Velocity MeasureVelocity(const RadarScan& scan, const std::optional<Prediction>& prediction,
+                           const std::optional<MeasuredVelocity>& measured) const;
   PoseEstimate EstimatePose(const RadarScan& scan, const std::optional<Prediction>& prediction,
                             const Velocity& velocity);
   PoseEstimate Match(const RadarScan& scan, const Prediction& prediction, const Velocity& velocity,
