@@ -15,11 +15,18 @@ all six observed), the yaw rate's (mrad/s, with five or six) and the roll
 and pitch rates' (with six), and the mean NEES over the observed directions
 against their count; and the time per estimate.
 
+Table 2, odometry on a rig (`radargauss --threads 1 odometry --rig`):
+configs/rig_five_radars.yaml over its lap, rigs made of subsets of its
+radars against the body's reference, and each radar alone (today's
+odometry against its own reference): ATE, RPE and the run's wall time.
+
     scripts/rig_table.py [--tool build/release/bin/radargauss] [--work /tmp/rig_table] [--scans 300]
+                         [--tables 1,2]
 
 The module is found beside the tool (build/release/python).
 """
 import argparse
+import json
 import os
 import subprocess
 import sys
@@ -57,15 +64,68 @@ def world_section(config, scans):
     return "world:\n" + "\n".join(lines) + "\n"
 
 
+ODOMETRY_RIGS = [("front, front_left", ["front", "front_left"]),
+                 ("front, front_left, front_right", ["front", "front_left", "front_right"]),
+                 ("front_left, front_right", ["front_left", "front_right"]),
+                 ("four corners", ["front_left", "front_right", "rear_left", "rear_right"]),
+                 ("all five", ["front", "front_left", "front_right", "rear_left", "rear_right"])]
+
+
+def run_odometry(tool, flags, out):
+    """ATE m, RPE t %, horizontal % and the wall time (s) of one odometry run."""
+    start = time.perf_counter()
+    result = subprocess.run([tool, "--threads", "1", "odometry", "--out", out] + flags, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    wall = time.perf_counter() - start
+    if result.returncode != 0:
+        sys.exit(f"rig_table: odometry {' '.join(flags)} failed: {result.stderr.strip()}")
+    evaluation = json.load(open(os.path.join(out, "evaluation.json")))
+    return (evaluation["ate_translation_m"]["rmse"], evaluation["rpe"]["translation_percent"],
+            evaluation["rpe"]["horizontal_percent"], wall)
+
+
+def odometry_table(tool, work):
+    rig_dir = os.path.join(work, "five_radars")
+    result = subprocess.run([tool, "simulate", "--rig-config", os.path.join(ROOT, "configs/rig_five_radars.yaml"),
+                             "--out", rig_dir, "--force"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if result.returncode != 0:
+        sys.exit(f"rig_table: simulate the five-radar rig failed: {result.stderr.strip()}")
+    text = open(os.path.join(rig_dir, "rig.yaml")).read()
+    head, *radars = text.split("  - name:")
+    by_name = {r.split("\n")[0].strip().strip('"'): "  - name:" + r for r in radars}
+    print("| run | ATE m | RPE t % | horizontal % | wall s |")
+    print("|---|---|---|---|---|")
+    for name in by_name:
+        sequence = os.path.join(rig_dir, name)
+        row = run_odometry(tool, ["--sequence", sequence, "--gt", os.path.join(sequence, "gt_radar_tum.txt")],
+                           os.path.join(work, "alone_" + name))
+        print(f"| {name} alone | {row[0]:.3f} | {row[1]:.3f} | {row[2]:.3f} | {row[3]:.2f} |")
+    for label, names in [("rig of the front radar", ["front"])] + ODOMETRY_RIGS:
+        rig_file = os.path.join(rig_dir, "rig_" + "_".join(names) + ".yaml")
+        with open(rig_file, "w") as f:
+            f.write(head + "".join(by_name[n] for n in names))
+        row = run_odometry(tool, ["--rig", rig_file, "--gt", os.path.join(rig_dir, "gt_body_tum.txt")],
+                           os.path.join(work, "rig_" + "_".join(names)))
+        print(f"| {label} | {row[0]:.3f} | {row[1]:.3f} | {row[2]:.3f} | {row[3]:.2f} |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--tool", default=os.path.join(ROOT, "build/release/bin/radargauss"))
     parser.add_argument("--work", default="/tmp/rig_table")
     parser.add_argument("--scans", type=int, default=300)
+    parser.add_argument("--tables", default="1,2")
     args = parser.parse_args()
+    tables = args.tables.split(",")
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(args.tool))), "python"))
     import radargauss as rg
 
+    if "2" in tables:
+        odometry_table(args.tool, args.work)
+        if "1" in tables:
+            print()
+    if "1" not in tables:
+        return
     print("| world | rig | scans | rank | observed error median | under 0.1 | velocity RMSE m/s "
           "| yaw rate RMSE mrad/s | roll / pitch rate RMSE mrad/s | mean NEES (dof) | ms per estimate |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
