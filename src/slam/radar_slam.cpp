@@ -237,30 +237,24 @@ void RadarSlam::DescribeAndSearch(std::vector<RadarPoint> submap, std::vector<Ra
   graph_.last().describe_ms += MillisecondsSince(hold);
 }
 
-bool RadarSlam::Near(std::size_t keyframe, const std::vector<bool>& among) const {
+bool RadarSlam::SamePlace(std::size_t a, std::size_t b) const {
   if (options_.place_merge_distance <= 0.0) return false;
-  const std::vector<SE3d>& poses = graph_.graph().poses();
-  const double merge_angle = options_.place_merge_angle_deg * M_PI / 180.0;
+  const SE3d &pa = graph_.graph().poses()[a], &pb = graph_.graph().poses()[b];
+  return (pa.translation() - pb.translation()).norm() <= options_.place_merge_distance &&
+         (pa.rotation().Inverse() * pb.rotation()).Log().norm() <= options_.place_merge_angle_deg * M_PI / 180.0;
+}
+
+bool RadarSlam::Near(std::size_t keyframe, const std::vector<bool>& among) const {
   for (std::size_t k = 0; k < keyframe; ++k) {
-    if (among[k] && (poses[k].translation() - poses[keyframe].translation()).norm() <= options_.place_merge_distance &&
-        (poses[k].rotation().Inverse() * poses[keyframe].rotation()).Log().norm() <= merge_angle) {
-      return true;
-    }
+    if (among[k] && SamePlace(k, keyframe)) return true;
   }
   return false;
 }
 
 void RadarSlam::Represent(std::size_t keyframe) {
-  const std::vector<SE3d>& poses = graph_.graph().poses();
-  const double merge_angle = options_.place_merge_angle_deg * M_PI / 180.0;
   candidate_.push_back(true);
-  if (options_.place_merge_distance <= 0.0) return;
   for (std::size_t k = 0; k < keyframe; ++k) {
-    if (!candidate_[k] ||
-        (poses[k].translation() - poses[keyframe].translation()).norm() > options_.place_merge_distance ||
-        (poses[k].rotation().Inverse() * poses[keyframe].rotation()).Log().norm() > merge_angle) {
-      continue;
-    }
+    if (!candidate_[k] || !SamePlace(k, keyframe)) continue;
     candidate_[k] = false;  // the newest visit answers for the place
     if (!first_visit_[k]) std::vector<RadarPoint>().swap(graph_.keyframe(k).points);  // no place either: done
   }

@@ -109,8 +109,10 @@ class RadarSlam {
   // The back end's side: the closed keyframe's place, its loop search, the
   // accepted loop into the graph, and the study's false loop.
   void DescribeAndSearch(std::vector<RadarPoint> submap, std::vector<RadarScan> scans);
-  // Whether the keyframe lies within place_merge_distance and angle of one
-  // of `among` before it, at the graph's poses now.
+  // Whether keyframes a and b lie within place_merge_distance and angle of
+  // each other at the graph's poses now (never with the distance 0).
+  bool SamePlace(std::size_t a, std::size_t b) const;
+  // Whether the keyframe is the SamePlace of one of `among` before it.
   bool Near(std::size_t keyframe, const std::vector<bool>& among) const;
   // Without revisit_candidates: the closed keyframe becomes its place's
   // loop candidate, in place of the candidates within the merge distance.
