@@ -213,6 +213,13 @@ ScanStamp TimeOfScan(const SimulationConfig& config, int k) {
 
 }  // namespace
 
+SE3d RadarOnVehicle(const SimulationConfig& config) {
+  return SE3d(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, config.mounting_yaw_deg * kDeg)) *
+                  SO3d::Exp(Eigen::Vector3d(0.0, config.mounting_pitch_deg * kDeg, 0.0)) *
+                  SO3d::Exp(Eigen::Vector3d(config.mounting_roll_deg * kDeg, 0.0, 0.0)),
+              Eigen::Vector3d(config.mounting_x, config.mounting_y, config.mounting_z));
+}
+
 SimulatedSequence Simulate(const SimulationConfig& config) {
   ValidateSimulationConfig(config, "simulation config");
   SimulatedSequence sequence;
@@ -221,13 +228,10 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
   Draws draws(config.seed);
   std::mt19937 world_rng(config.world_seed);
   const Scene scene = BuildScene(config, path, config.world_seed == 0 ? draws.rng : world_rng);
-  const Eigen::Vector3d lever_arm(config.mounting_x, config.mounting_y, config.mounting_z);
+  const SE3d mounting = RadarOnVehicle(config);
+  const Eigen::Vector3d& lever_arm = mounting.translation();
   const bool mounted = config.mounting_roll_deg != 0.0 || config.mounting_pitch_deg != 0.0 ||
                        config.mounting_yaw_deg != 0.0 || !lever_arm.isZero(0.0);
-  const SE3d mounting(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, config.mounting_yaw_deg * kDeg)) *
-                          SO3d::Exp(Eigen::Vector3d(0.0, config.mounting_pitch_deg * kDeg, 0.0)) *
-                          SO3d::Exp(Eigen::Vector3d(config.mounting_roll_deg * kDeg, 0.0, 0.0)),
-                      lever_arm);
   ScanState state;
   state.stds = {float(config.range_noise), float(config.azimuth_noise_deg * kDeg),
                 float(config.elevation_noise_deg * kDeg), float(config.doppler_noise)};

@@ -77,19 +77,6 @@ RigSimulationConfig LoadRigSimulationConfig(const std::string& path) {
   return rig;
 }
 
-namespace {
-
-constexpr double kDegree = M_PI / 180.0;
-
-SE3d MountingOf(const SimulationConfig& config) {
-  return SE3d(SO3d::Exp(Eigen::Vector3d(0.0, 0.0, config.mounting_yaw_deg * kDegree)) *
-                  SO3d::Exp(Eigen::Vector3d(0.0, config.mounting_pitch_deg * kDegree, 0.0)) *
-                  SO3d::Exp(Eigen::Vector3d(config.mounting_roll_deg * kDegree, 0.0, 0.0)),
-              Eigen::Vector3d(config.mounting_x, config.mounting_y, config.mounting_z));
-}
-
-}  // namespace
-
 SimulatedRig SimulateRig(const RigSimulationConfig& config) {
   if (config.radars.empty()) throw DataError("a simulated rig needs a radar");
   const double duration = double(config.world.scans) / config.world.rate_hz;  // s
@@ -100,7 +87,7 @@ SimulatedRig SimulateRig(const RigSimulationConfig& config) {
     one.scans = std::max(1, int(std::floor(duration * one.rate_hz + 1e-9)));
     rig.names.push_back(name);
     rig.radars.push_back(Simulate(one));
-    rig.body_from_radar.push_back(MountingOf(one));
+    rig.body_from_radar.push_back(RadarOnVehicle(one));
   }
   // The body on the true clock, from the first radar's poses.
   const SimulatedSequence& first = rig.radars.front();

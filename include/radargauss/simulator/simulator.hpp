@@ -167,6 +167,9 @@ struct SimulatedSequence {
 };
 
 SimulatedSequence Simulate(const SimulationConfig& config);
+// The radar on the vehicle, T_vehicle_radar = Rz(yaw) Ry(pitch) Rx(roll) at
+// (mounting_x, mounting_y, mounting_z): its mounting keys.
+SE3d RadarOnVehicle(const SimulationConfig& config);
 
 // The IMU's samples over the drive, every 1 / imu_rate_hz from the first
 // scan's time to the last's (0 without an IMU); at most kMaxImuSamples.
