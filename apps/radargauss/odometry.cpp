@@ -118,8 +118,9 @@ int RunRigOdometry(const OdometrySettings& s) {
   WriteTum((std::filesystem::path(folder.path()) / "body.tum").string(), body);
   const std::string table = evaluation ? WriteEvaluation(folder.path(), *evaluation) : std::string();
   folder.Commit();
-  std::printf("rig: %zu radars, %zu scans at %zu instants of the body, %zu with their velocity measured\n",
-              rig.radars.size(), scans, odometry.instant_radars().size(), odometry.velocity_measured());
+  std::printf("rig: %zu radars, %zu scans in %zu frames, %zu with their velocity measured (%zu by the rig's twist)\n",
+              rig.radars.size(), scans, odometry.frame_radars().size(), odometry.velocity_measured(),
+              odometry.rig_velocity_measured());
   PrintSummary(Summarise(odometry.odometry()));
   std::printf("%s", table.c_str());
   std::printf("wrote %s (body.tum: T_world_body; odometry.tum, per_scan.csv and summary.json of the %s odometry%s%s)\n",

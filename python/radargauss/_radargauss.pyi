@@ -105,6 +105,9 @@ class OdometryOptions(MatchOptions, total=False):
     estimate_elevation_bias: bool  # False
     elevation_bias_window: int  # 100
     elevation_bias_min_speed: float  # 5.0
+    rig_max_frame_span: float  # 0.1
+    rig_velocity: bool  # True
+    rig_motion_compensation: bool  # True
 
 class PlaceSearchOptions(TypedDict, total=False):
     """what RadarSlam and Relocalizer share beyond RadarOdometry's"""

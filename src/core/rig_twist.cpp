@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <stdexcept>
 
@@ -99,7 +100,8 @@ int DrawsFor(int size, const EgoVelocityOptions& options) {
 // neither outvote the others nor fill the draws with the car.
 std::vector<Eigen::Index> LargestConsensus(const Eigen::MatrixXd& A, const Eigen::VectorXd& y,
                                            const std::vector<std::size_t>& radar_of_row, int draws,
-                                           const EgoVelocityOptions& options) {
+                                           const EgoVelocityOptions& options,
+                                           const std::function<bool(const Eigen::VectorXd&)>& admissible) {
   const Eigen::Index n = A.rows(), size = A.cols();
   std::vector<std::vector<Eigen::Index>> rows_of;  // per radar with rows
   std::vector<std::size_t> slot(*std::max_element(radar_of_row.begin(), radar_of_row.end()) + 1, SIZE_MAX);
@@ -137,6 +139,7 @@ std::vector<Eigen::Index> LargestConsensus(const Eigen::MatrixXd& A, const Eigen
     const Eigen::FullPivLU<Eigen::MatrixXd> lu(a);
     if (lu.rank() < size) continue;  // points whose directions leave the twist open
     const Eigen::VectorXd z = lu.solve(b);
+    if (!admissible(z)) continue;
     const Eigen::ArrayXd residual = (y - A * z).array().abs();
     double votes = 0.0;
     for (Eigen::Index k = 0; k < n; ++k) votes += residual(k) < options.inlier_threshold ? vote[std::size_t(k)] : 0.0;
@@ -218,8 +221,14 @@ RigTwist EstimateRigTwist(const std::vector<RigScan>& scans, const RigTwistOptio
   result.ransac_iterations = DrawsFor(result.rank, options.doppler);
   std::vector<std::size_t> radar_of_row;
   for (const auto& [radar, point] : rows.source) radar_of_row.push_back(radar);
+  // A hypothesis whose velocity or rotation rate leaves its gate does not count.
+  const auto admissible = [&](const Eigen::VectorXd& z) {
+    const Vector6d twist = basis * z;
+    return (!options.gate || options.gate->Admits(twist.head<3>())) &&
+           (!options.angular_gate || options.angular_gate->Admits(twist.tail<3>()));
+  };
   const std::vector<Eigen::Index> consensus =
-      LargestConsensus(A, rows.y, radar_of_row, result.ransac_iterations, options.doppler);
+      LargestConsensus(A, rows.y, radar_of_row, result.ransac_iterations, options.doppler, admissible);
   if (consensus.size() <= std::size_t(result.rank)) {
     result.reason = "no consensus: too few points agree on one twist";
     return result;
@@ -229,6 +238,10 @@ RigTwist EstimateRigTwist(const std::vector<RigScan>& scans, const RigTwistOptio
   Eigen::MatrixXd normal_inverse;
   if (!RefitOnInliers(A, rows.y, options.doppler.inlier_threshold, inliers, z, normal_inverse)) {
     result.reason = "the consensus points leave the twist open";
+    return result;
+  }
+  if (!admissible(z)) {
+    result.reason = "the twist left its gate";
     return result;
   }
   double sse = 0.0;

@@ -77,6 +77,8 @@ const OptionTable<OdometryOptions>& OdometryOptionTable() {
         t, LocalMapOptionTable(), +[](O & o) -> auto& { return o.map; }, "map");
     AppendNested(
         t, ElevationBiasOptionTable(), +[](O & o) -> auto& { return o.elevation_bias; }, "elevation_bias");
+    AppendNested(
+        t, RigOdometryOptionTable(), +[](O & o) -> auto& { return o.rig; }, "rig");
     return t;
   }();
   return table;

@@ -1,17 +1,54 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "radargauss/odometry/rig_odometry.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 
+#include <Eigen/Eigenvalues>
+
 #include "radargauss/core/doppler.hpp"
 #include "radargauss/core/error.hpp"
+#include "radargauss/core/options.hpp"
+#include "radargauss/core/rig_twist.hpp"
 
 namespace radargauss {
 
+namespace {
+
+// Without a prediction (the first frame), the rig's twist is gated around
+// the reference radar's own velocity (its sigmas, at least a floor); its
+// rotation rate always around the last one.
+constexpr double kReferenceGateSigmas = 3.0;
+constexpr double kMinReferenceGate = 0.05;  // m/s
+constexpr double kAngularGate = 0.5;        // rad/s
+
+}  // namespace
+
+const OptionTable<RigOdometryOptions>& RigOdometryOptionTable() {
+  using O = RigOdometryOptions;
+  static const OptionTable<O> table = {
+      RADARGAUSS_OPTION(O, "rig_max_frame_span", max_frame_span)
+          .Above(0.0)
+          .Unit("s")
+          .Help("a rig's frame: the longest its scans may span (it closes at the reference radar's scan)"),
+      RADARGAUSS_OPTION(O, "rig_velocity", rig_velocity)
+          .Help("a rig's velocity from every radar's Doppler (the rig's twist); off: the reference radar's"),
+      RADARGAUSS_OPTION(O, "rig_motion_compensation", motion_compensation)
+          .Help("a rig's scans moved from their stamps to their frame's by its velocity and rotation rate"),
+  };
+  return table;
+}
+
 RigOdometry::RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options)
-    : body_from_radar_(std::move(body_from_radar)), doppler_(options.ego_velocity), odometry_(options) {
+    : body_from_radar_(std::move(body_from_radar)),
+      doppler_(options.ego_velocity),
+      rig_options_(options.rig),
+      odometry_(options) {
   if (body_from_radar_.empty()) throw DataError("a rig's odometry needs a radar");
+  const SE3d reference_from_body = body_from_radar_.front().Inverse();
+  for (const SE3d& mounting : body_from_radar_) reference_from_radar_.push_back(reference_from_body * mounting);
 }
 
 void RigOdometry::Register(std::size_t radar, const RadarScan& scan) {
@@ -20,57 +57,163 @@ void RigOdometry::Register(std::size_t radar, const RadarScan& scan) {
   }
   if (body_from_radar_.size() == 1) {  // the single-radar odometry
     odometry_.Register(scan);
-    instant_radars_.push_back({radar});
+    frame_radars_.push_back({radar});
     return;
   }
-  if (!pending_.empty() && scan.timestamp < pending_.front().timestamp) {
+  if (last_stamp_ && !(scan.timestamp >= *last_stamp_)) {
     throw DataError("a rig's scans must come in time order: " + std::to_string(scan.timestamp) + " s after " +
-                    std::to_string(pending_.front().timestamp) + " s");
+                    std::to_string(*last_stamp_) + " s");
   }
-  if (!pending_.empty() && scan.timestamp > pending_.front().timestamp) RegisterPending();
   ValidateScan(scan, "scan at " + std::to_string(scan.timestamp) + " s");
+  // The frame closes after its reference scan's instant, or before a scan that would stretch it too far.
+  if (!pending_.empty() && ((closing_stamp_ && scan.timestamp > *closing_stamp_) ||
+                            scan.timestamp - pending_.front().timestamp > rig_options_.max_frame_span)) {
+    RegisterPending();
+  }
+  last_stamp_ = scan.timestamp;
   pending_.push_back(scan);
   pending_radars_.push_back(radar);
+  if (radar == 0) closing_stamp_ = scan.timestamp;
 }
 
 void RigOdometry::Finish() {
   if (!pending_.empty()) RegisterPending();
 }
 
+Eigen::Matrix<double, 6, 1> RigOdometry::LastTwist() const {
+  const std::size_t n = frame_stamps_.size();
+  if (n < 2) return Eigen::Matrix<double, 6, 1>::Zero();
+  const SE3d motion = odometry_.pose(n - 2).Inverse() * odometry_.pose(n - 1);
+  return motion.Log() / (frame_stamps_[n - 1] - frame_stamps_[n - 2]);
+}
+
+std::optional<VelocityGate> RigOdometry::Gate(double stamp) const {
+  // Around the last measured velocity, as the single-radar odometry's.
+  if (!last_measured_) return std::nullopt;
+  const OdometryOptions& o = odometry_.options();
+  const double dt = stamp - last_measured_->stamp;
+  const double spread =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(last_measured_->velocity.covariance).eigenvalues().maxCoeff();
+  return VelocityGate{
+      last_measured_->velocity.value,
+      std::max(o.min_gate, o.gate_sigmas * std::sqrt(std::max(spread, 0.0) + std::pow(o.acceleration_std * dt, 2)))};
+}
+
+RigOdometry::FrameVelocity RigOdometry::MeasureVelocity(const std::optional<VelocityGate>& gate) const {
+  FrameVelocity out;
+  out.twist = LastTwist();
+  out.static_points.resize(pending_.size());
+  std::vector<bool> decided(pending_.size(), false);
+  // Each radar's newest scan (a twist holds at one instant; older scans would bend it).
+  std::vector<std::size_t> newest;
+  for (std::size_t k = pending_.size(); k-- > 0;) {
+    bool seen = false;
+    for (const std::size_t j : newest) seen = seen || pending_radars_[j] == pending_radars_[k];
+    if (!seen) newest.push_back(k);
+  }
+  // The reference radar's own velocity, gated by the prediction.
+  std::optional<EgoVelocityResult> reference;
+  for (const std::size_t k : newest) {
+    if (pending_radars_[k] != 0 || !pending_[k].has_doppler) continue;
+    EgoVelocityResult own = EstimateEgoVelocity(pending_[k], doppler_, gate);
+    if (own.success) {
+      out.static_points[k] = own.inlier;
+      decided[k] = true;
+      out.measured = RadarOdometry::MeasuredVelocity{own.velocity, own.covariance};
+      out.twist.head<3>() = own.velocity;
+      reference = std::move(own);
+    }
+  }
+  if (rig_options_.rig_velocity && newest.size() > 1) {
+    // The rig's twist at the reference radar, gated by the prediction, and
+    // its rotation rate around the last one: a car that fills one radar's
+    // view cannot pull it to the car's velocity.
+    std::vector<RigScan> scans;
+    for (const std::size_t k : newest) scans.push_back({&pending_[k], reference_from_radar_[pending_radars_[k]]});
+    RigTwistOptions options;
+    options.doppler = doppler_;
+    options.gate = gate;
+    if (!gate && reference) {  // the first frame: around the reference radar's own velocity
+      const double spread =
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(reference->covariance).eigenvalues().maxCoeff();
+      options.gate = VelocityGate{reference->velocity,
+                                  std::max(kMinReferenceGate, kReferenceGateSigmas * std::sqrt(std::max(spread, 0.0)))};
+    }
+    options.angular_gate = VelocityGate{out.twist.tail<3>(), kAngularGate};
+    const RigTwist rig = EstimateRigTwist(scans, options);
+    if (!gate && reference && !rig.success) {  // the rig and the reference disagree: no velocity yet
+      out.measured.reset();
+      out.twist = LastTwist();
+    }
+    // It stands when it observes the reference radar's velocity in full.
+    if (rig.success && (rig.observed.topLeftCorner<3, 3>() - Eigen::Matrix3d::Identity()).norm() < 1e-6 &&
+        rig.observed.topRightCorner<3, 3>().norm() < 1e-6) {
+      out.measured = RadarOdometry::MeasuredVelocity{rig.velocity, rig.covariance.topLeftCorner<3, 3>()};
+      out.by_rig = true;
+      out.twist.head<3>() = rig.velocity;
+      for (std::size_t n = 0; n < newest.size(); ++n) {
+        out.static_points[newest[n]] = rig.inlier[n];
+        decided[newest[n]] = true;
+      }
+    }
+  }
+  for (std::size_t k = 0; k < pending_.size(); ++k) {
+    if (!decided[k]) out.static_points[k] = OwnStaticPoints(k, gate, out);
+  }
+  return out;
+}
+
+std::vector<bool> RigOdometry::OwnStaticPoints(std::size_t k, const std::optional<VelocityGate>& gate,
+                                               const FrameVelocity& frame) const {
+  // The radar's own Doppler filter, gated around the velocity the frame's twist gives it.
+  const RadarScan& scan = pending_[k];
+  std::vector<bool> keep(scan.points.size(), !scan.has_doppler);
+  if (!scan.has_doppler) return keep;
+  const SE3d& mounting = reference_from_radar_[pending_radars_[k]];
+  std::optional<VelocityGate> own_gate = gate;
+  if (gate) {
+    const Eigen::Vector3d v = frame.measured ? frame.twist.head<3>() : gate->predicted;
+    own_gate->predicted =
+        mounting.rotation().Inverse() * (v + Eigen::Vector3d(frame.twist.tail<3>()).cross(mounting.translation()));
+  }
+  const EgoVelocityResult own = EstimateEgoVelocity(scan, doppler_, own_gate);
+  if (own.success) keep = own.inlier;
+  return keep;
+}
+
 void RigOdometry::RegisterPending() {
-  // The odometry runs in the first radar's frame: every radar's static points
-  // are moved into it, and its own Doppler velocity, when it scanned at this
-  // instant, is the measured one (a velocity moved between radars would need
-  // the rotation rate times the lever arm, which feeds the rate's errors back).
-  const SE3d reference_from_body = body_from_radar_.front().Inverse();
-  std::optional<RadarOdometry::MeasuredVelocity> measured;
+  const double stamp = closing_stamp_.value_or(pending_.back().timestamp);
+  const FrameVelocity velocity = MeasureVelocity(Gate(stamp));
+  // Every radar's static points in the reference frame at the frame's stamp:
+  // T_ref(stamp)^-1 T_ref(t_k) = Exp(xi (t_k - stamp)) at a constant twist xi.
   RadarScan frame;
-  frame.timestamp = pending_.front().timestamp;
+  frame.timestamp = stamp;
   frame.has_rcs = true;
   for (std::size_t k = 0; k < pending_.size(); ++k) {
     const RadarScan& scan = pending_[k];
-    const std::size_t radar = pending_radars_[k];
-    std::vector<bool> keep(scan.points.size(), !scan.has_doppler);
-    if (scan.has_doppler) {
-      const EgoVelocityResult own = EstimateEgoVelocity(scan, doppler_);
-      if (own.success) keep = own.inlier;
-      if (own.success && radar == 0) measured = RadarOdometry::MeasuredVelocity{own.velocity, own.covariance};
+    SE3d to_frame = reference_from_radar_[pending_radars_[k]];
+    if (rig_options_.motion_compensation && scan.timestamp != stamp) {
+      to_frame = SE3d::Exp(velocity.twist * (scan.timestamp - stamp)) * to_frame;
     }
-    const SE3d to_reference = reference_from_body * body_from_radar_[radar];
     frame.has_rcs = frame.has_rcs && scan.has_rcs;
     for (std::size_t i = 0; i < scan.points.size(); ++i) {
-      if (!keep[i]) continue;
+      if (!velocity.static_points[k][i]) continue;
       RadarPoint point = scan.points[i];
-      point.position = to_reference * point.position;
+      point.position = to_frame * point.position;
       point.doppler = 0.0;
       frame.points.push_back(point);
     }
   }
-  velocity_measured_ += measured.has_value();
-  odometry_.Register(frame, measured);
-  instant_radars_.push_back(std::move(pending_radars_));
+  velocity_measured_ += velocity.measured.has_value();
+  rig_velocity_measured_ += velocity.by_rig;
+  if (velocity.measured) last_measured_ = MeasuredAt{stamp, *velocity.measured};
+  odometry_.Register(frame, velocity.measured);
+  last_frame_ = std::move(frame);
+  frame_stamps_.push_back(stamp);
+  frame_radars_.push_back(std::move(pending_radars_));
   pending_radars_.clear();
   pending_.clear();
+  closing_stamp_.reset();
 }
 
 Trajectory RigOdometry::trajectory() const {

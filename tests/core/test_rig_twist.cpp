@@ -141,6 +141,57 @@ TEST(RigTwist, ACarFillingOneRadarsViewDoesNotOutvoteTheRig) {
   EXPECT_LT(kept, 60);
 }
 
+// Two radars whose views a car's returns fill (the car's returns follow a
+// twist of their own) give the car's twist without a gate. The odometry's
+// gates bring back the world's: around the predicted velocity when the car's
+// velocity is off it, around the last rotation rate when only the rate is.
+TEST(RigTwist, TheGatesKeepACarThatFillsTheViewsOut) {
+  // The body's origin at the front radar, as the rig's odometry puts it: the
+  // velocity there is observed though the rotation about the radars' line is not.
+  const SE3d origin = FiveRadarRig()[0];
+  const std::vector<SE3d> mountings = {SE3d(), origin.Inverse() * FiveRadarRig()[1]};
+  const auto plant = [&](const Eigen::Vector3d& car_v, const Eigen::Vector3d& car_w, std::mt19937& rng) {
+    PlantedRig planted;
+    for (std::size_t r = 0; r < 2; ++r) {
+      RadarScan scan = PlantedRigScan(mountings[r], kVelocity, kAngularVelocity, r == 0 ? 60 : 15, 0, 0.0, rng);
+      const RadarScan car = PlantedRigScan(mountings[r], car_v, car_w, r == 0 ? 30 : 50, 0, 0.0, rng);
+      scan.points.insert(scan.points.end(), car.points.begin(), car.points.end());
+      planted.scans.push_back(scan);
+    }
+    for (std::size_t r = 0; r < 2; ++r) planted.rig.push_back({&planted.scans[r], mountings[r]});
+    return planted;
+  };
+  std::mt19937 rng(41);
+  const PlantedRig faster = plant(Eigen::Vector3d(20.0, -1.0, 0.0), kAngularVelocity, rng);
+  const PlantedRig turning = plant(kVelocity, Eigen::Vector3d(0.0, 0.0, 2.5), rng);
+  RigTwistOptions options;
+  options.doppler.outlier_probability = 0.7;  // draws enough to find the world among the car's returns
+  for (const PlantedRig* planted : {&faster, &turning}) {
+    const RigTwist ungated = EstimateRigTwist(planted->rig, options);
+    ASSERT_TRUE(ungated.success) << ungated.reason;
+    EXPECT_GT((ungated.velocity - kVelocity).norm() + (ungated.angular_velocity - kAngularVelocity).norm(), 1.0);
+  }
+  options.gate = VelocityGate{kVelocity + Eigen::Vector3d(0.3, -0.2, 0.0), 1.0};
+  options.angular_gate = VelocityGate{Eigen::Vector3d(0.0, 0.0, 0.3), 0.5};
+  for (const PlantedRig* planted : {&faster, &turning}) {
+    SCOPED_TRACE(planted == &faster ? "the faster car" : "the turning car");
+    const RigTwist gated = EstimateRigTwist(planted->rig, options);
+    ASSERT_TRUE(gated.success) << gated.reason;
+    // The world's twist, up to the few car returns whose Doppler falls within
+    // the threshold of it; rank 5: the rotation about the radars' line is unobserved.
+    EXPECT_LT((gated.velocity - kVelocity).norm(), 0.02);
+    EXPECT_LT((gated.observed *
+               (Vector6d() << gated.velocity - kVelocity, gated.angular_velocity - kAngularVelocity).finished())
+                  .norm(),
+              0.03);
+  }
+  // A gate that holds no twist the points agree on fails, saying so.
+  options.gate = VelocityGate{Eigen::Vector3d(-30.0, 0.0, 0.0), 0.5};
+  const RigTwist none = EstimateRigTwist(faster.rig, options);
+  EXPECT_FALSE(none.success);
+  EXPECT_FALSE(none.reason.empty());
+}
+
 // Over 200 draws of noise (0.05 m/s) with a fifth of the points moving,
 // the error's Mahalanobis distance under the stated covariance is
 // chi-square with 6 degrees of freedom: its mean near 6, 97 % or more

@@ -224,7 +224,7 @@ printf 'radars:\n  - {name: front, sequence: seq10, extrinsic: [3.7, 0, 0.5, 0, 
   > "$work/rig_shared.yaml"
 expect_fail "a rig whose radars share a folder" "radar 'rear' reads the folder" -- "$tool" info --rig "$work/rig_shared.yaml"
 expect_fail "a rig and a sequence" "drop --sequence" -- "$tool" info --rig "$work/rig.yaml" --sequence "$work/seq10"
-expect_ok "odometry on a rig" "rig: 2 radars, 20 scans at 20 instants" -- \
+expect_ok "odometry on a rig" "rig: 2 radars, 20 scans in 10 frames" -- \
   "$tool" odometry --rig "$work/rig.yaml" --out "$work/rig_odometry"
 [[ -s "$work/rig_odometry/body.tum" ]] || { echo "FAIL: odometry --rig wrote no body.tum"; failed=1; }
 expect_fail "odometry on a rig with an IMU" "takes no IMU yet" -- \

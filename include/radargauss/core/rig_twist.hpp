@@ -19,6 +19,7 @@
 //   if (twist.success) yaw_rate = twist.angular_velocity.z();
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,13 @@ struct RigTwistOptions {
   // A direction of the twist whose singular value of H, relative to the
   // largest, lies below this is unobserved.
   double min_relative_singular_value = 1e-4;
+  // A gate around a predicted velocity v (the body's frame and origin):
+  // hypotheses outside it do not count, and a twist outside it fails (the
+  // odometry's prediction, as for one radar; none: no gate). Where the rig
+  // leaves a rotation unobserved, put the origin at a radar, where v is.
+  std::optional<VelocityGate> gate;
+  // The same for the angular velocity w (rad/s, body frame).
+  std::optional<VelocityGate> angular_gate;
 };
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;

@@ -41,6 +41,20 @@ inline EgoVelocityOptions OdometryEgoVelocityOptions() {
   return options;
 }
 
+// How a rig's scans become the odometry's frames (odometry/rig_odometry.hpp,
+// docs/design/rig.md, "Odometry on a rig"); unused with one radar.
+struct RigOdometryOptions {
+  // s: the longest a frame's scans may span on the body's clock; a frame
+  // closes early when the reference radar drops a scan.
+  double max_frame_span = 0.1;
+  // The frame's velocity from every radar's Doppler (the rig's twist at the
+  // reference radar); false: from the reference radar's alone.
+  bool rig_velocity = true;
+  // Each scan's points moved from its stamp to the frame's at the frame's velocity and the last rotation rate.
+  bool motion_compensation = true;
+};
+const OptionTable<RigOdometryOptions>& RigOdometryOptionTable();
+
 struct OdometryOptions {
   EgoVelocityOptions ego_velocity = OdometryEgoVelocityOptions();
   // The gate on Doppler hypotheses around the predicted velocity:
@@ -79,6 +93,7 @@ struct OdometryOptions {
   // The elevation bias estimated from the Doppler velocity and removed
   // (odometry/elevation_bias.hpp), beyond what the sequence's reading removed.
   ElevationBiasOptions elevation_bias;
+  RigOdometryOptions rig;
 };
 
 // R_vehicle_radar = Rz(yaw) Ry(pitch) Rx(roll) (z up, a positive pitch looks

@@ -1,15 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Odometry of a rig of radars (docs/design/rig.md, "Odometry on a rig"): one
 // trajectory of the body, T_world_body, from every radar's scans matched
-// into one map. The scans of one instant on the body's clock (ties) are
-// registered together, the scans of other instants each on their own, so
-// no radar waits for another:
+// into one map. The odometry runs in the first radar's frame (the
+// reference) and registers frames:
 //
-// - the odometry runs in the first radar's frame (the reference radar);
-// - every radar's static points (its own Doppler filter) are moved into it
-//   through the mountings and matched as one scan;
-// - the reference radar's Doppler velocity, at the instants it scans, is the
-//   measured velocity; at the others the motion model predicts it.
+// - a frame closes at each scan of the reference radar (with the scans of
+//   its instant), or when its scans would span more than max_frame_span;
+// - the frame's velocity and static points come from every radar's Doppler
+//   at once (the rig's twist, core/rig_twist.hpp, at the reference radar);
+// - each scan's static points are moved through its mounting into the
+//   reference frame and, by that twist, from their own stamp to the frame's.
 //
 // A rig of one radar is the single-radar odometry, bit for bit, its poses
 // moved to the body through the mounting.
@@ -23,6 +23,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "radargauss/core/trajectory.hpp"
@@ -35,35 +36,69 @@ class RigOdometry {
  public:
   // `body_from_radar`: T_body_radar of each radar. The odometry's Doppler
   // filter (options.ego_velocity) serves every radar; the map and the match
-  // are the body's.
+  // are the body's; options.rig says how scans become frames. Throws
+  // DataError for no radar, std::invalid_argument for a bad option.
   RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options = {});
 
   // `scan` of radar `radar`, its timestamp on the body's clock (not before
   // the last scan's). Throws DataError for an unknown radar or a stamp that
   // goes back.
   void Register(std::size_t radar, const RadarScan& scan);
-  // Registers the scans of the last instant.
+  // Registers the last frame.
   void Finish();
 
-  // T_world_body at each registered instant.
+  // T_world_body at each frame.
   Trajectory trajectory() const;
   // The odometry the instants went through, in the first radar's frame
   // (with one radar, that radar's own).
   const RadarOdometry& odometry() const { return odometry_; }
-  // Each instant's radars, and the instants whose velocity the Doppler measured.
-  const std::vector<std::vector<std::size_t>>& instant_radars() const { return instant_radars_; }
+  // Each frame's radars (one entry per scan), the frames whose velocity the
+  // Doppler measured, and those measured by the rig's twist.
+  const std::vector<std::vector<std::size_t>>& frame_radars() const { return frame_radars_; }
   std::size_t velocity_measured() const { return velocity_measured_; }
+  std::size_t rig_velocity_measured() const { return rig_velocity_measured_; }
+  // The last frame registered: every radar's static points in the reference
+  // radar's frame at the frame's stamp, without Doppler (empty with one radar).
+  const RadarScan& last_frame() const { return last_frame_; }
 
  private:
+  // A frame's velocity: measured (by the rig's twist or the reference
+  // radar), each scan's static points, and the twist [v; w] that moves the
+  // scans to the frame's stamp (w: the last rotation rate).
+  struct FrameVelocity {
+    std::optional<RadarOdometry::MeasuredVelocity> measured;
+    bool by_rig = false;
+    std::vector<std::vector<bool>> static_points;
+    Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();
+  };
   void RegisterPending();
+  std::optional<VelocityGate> Gate(double stamp) const;
+  FrameVelocity MeasureVelocity(const std::optional<VelocityGate>& gate) const;
+  // Scan k's static points by its radar's own Doppler filter.
+  std::vector<bool> OwnStaticPoints(std::size_t k, const std::optional<VelocityGate>& gate,
+                                    const FrameVelocity& frame) const;
+  // The reference radar's twist [v; w] (its frame) over the last two frames; zero before.
+  Eigen::Matrix<double, 6, 1> LastTwist() const;
 
   std::vector<SE3d> body_from_radar_;
+  std::vector<SE3d> reference_from_radar_;
   EgoVelocityOptions doppler_;
+  RigOdometryOptions rig_options_;  // options.rig
   RadarOdometry odometry_;
-  std::vector<RadarScan> pending_;  // the instant's scans, not yet registered
+  std::vector<RadarScan> pending_;  // the frame's scans, not yet registered
   std::vector<std::size_t> pending_radars_;
-  std::vector<std::vector<std::size_t>> instant_radars_;
+  std::optional<double> closing_stamp_;  // the reference radar's scan in the frame
+  std::optional<double> last_stamp_;     // of the last scan registered or pending
+  std::vector<std::vector<std::size_t>> frame_radars_;
+  std::vector<double> frame_stamps_;
+  RadarScan last_frame_;
+  struct MeasuredAt {
+    double stamp = 0.0;
+    RadarOdometry::MeasuredVelocity velocity;
+  };
+  std::optional<MeasuredAt> last_measured_;  // the gate's centre
   std::size_t velocity_measured_ = 0;
+  std::size_t rig_velocity_measured_ = 0;
 };
 
 }  // namespace radargauss
