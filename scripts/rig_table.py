@@ -15,10 +15,13 @@ all six observed), the yaw rate's (mrad/s, with five or six) and the roll
 and pitch rates' (with six), and the mean NEES over the observed directions
 against their count; and the time per estimate.
 
-Table 2, odometry on a rig (`radargauss --threads 1 odometry --rig`):
-configs/rig_five_radars.yaml over its lap, rigs made of subsets of its
-radars against the body's reference, and each radar alone (today's
-odometry against its own reference): ATE, RPE and the run's wall time.
+Table 2, odometry on a rig (`radargauss --threads 1 odometry --rig`): the
+radars of configs/rig_five_radars.yaml and a rear radar over the demo
+world, the realistic faults and the two-lap route; rigs of 1, 2, 4, 5 and
+6 of them against the body's reference, and each radar alone (today's
+odometry against its own reference): ATE, RPE (and its ratio to the rig's
+best radar alone), the median time per scan (a rig: per frame, against
+its radars' medians as many as a frame holds) and the run's wall time.
 
     scripts/rig_table.py [--tool build/release/bin/radargauss] [--work /tmp/rig_table] [--scans 300]
                          [--tables 1,2]
@@ -28,6 +31,7 @@ The module is found beside the tool (build/release/python).
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import time
@@ -64,15 +68,51 @@ def world_section(config, scans):
     return "world:\n" + "\n".join(lines) + "\n"
 
 
-ODOMETRY_RIGS = [("front, front_left", ["front", "front_left"]),
-                 ("front, front_left, front_right", ["front", "front_left", "front_right"]),
-                 ("front_left, front_right", ["front_left", "front_right"]),
-                 ("four corners", ["front_left", "front_right", "rear_left", "rear_right"]),
-                 ("all five", ["front", "front_left", "front_right", "rear_left", "rear_right"])]
+# Table 2: the five radars of configs/rig_five_radars.yaml and a rear radar
+# at 10 Hz; rigs of 1, 2, 4, 5 and 6 of them. Each world's keys (but the
+# radar's own: its mounting) overlay the rig config's world.
+REAR_RADAR = "  - {name: rear, mounting_x: -1.0, mounting_z: 0.6, mounting_yaw_deg: 180, clock_offset: 0.004}\n"
+ODOMETRY_RIGS = [("1: front", ["front"]),
+                 ("2: front, front_left", ["front", "front_left"]),
+                 ("4: corners", ["front_left", "front_right", "rear_left", "rear_right"]),
+                 ("5: front, corners", ["front", "front_left", "front_right", "rear_left", "rear_right"]),
+                 ("6: front, corners, rear", ["front", "front_left", "front_right", "rear_left", "rear_right", "rear"])]
+ODOMETRY_WORLDS = [("demo", None, None), ("realistic faults", "configs/synthetic_realistic.yaml", None),
+                   ("two-lap route", "configs/synthetic_two_laps.yaml", 6000)]
+
+
+def world_keys(config):
+    """The world's keys of a single-radar config (no radar's own), as 'key: value' lines."""
+    keys = {}
+    for line in open(os.path.join(ROOT, config)):
+        line = line.split("#")[0].rstrip()
+        if line and not line.startswith(" ") and ":" in line and not line.startswith(RADAR_KEYS):
+            key, value = line.split(":", 1)
+            keys[key.strip()] = value.strip()
+    return keys
+
+
+def odometry_rig_config(world_config, scans):
+    """configs/rig_five_radars.yaml with the rear radar, its world overlaid by `world_config`'s keys."""
+    text = open(os.path.join(ROOT, "configs/rig_five_radars.yaml")).read()
+    world, radars = text.split("radars:", 1)
+    keys = {}
+    for line in world.splitlines():
+        line = line.split("#")[0].rstrip()
+        if line.startswith("  ") and ":" in line:
+            key, value = line.strip().split(":", 1)
+            keys[key] = value.strip()
+    if world_config:
+        keys.update({k: v for k, v in world_keys(world_config).items() if k not in ("rate_hz", "materials")})
+    if scans:
+        keys["scans"] = str(scans)
+    return ("world:\n" + "".join(f"  {k}: {v}\n" for k, v in keys.items()) + "radars:" + radars.rstrip() + "\n" +
+            REAR_RADAR)
 
 
 def run_odometry(tool, flags, out):
-    """ATE m, RPE t %, horizontal % and the wall time (s) of one odometry run."""
+    """ATE m, RPE t %, horizontal %, the median step (ms; a rig's frame), the steps (a rig's frames) and
+    the wall time (s) of one odometry run."""
     start = time.perf_counter()
     result = subprocess.run([tool, "--threads", "1", "odometry", "--out", out] + flags, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
@@ -80,33 +120,51 @@ def run_odometry(tool, flags, out):
     if result.returncode != 0:
         sys.exit(f"rig_table: odometry {' '.join(flags)} failed: {result.stderr.strip()}")
     evaluation = json.load(open(os.path.join(out, "evaluation.json")))
+    frames = re.search(r"; ([0-9.]+) ms per frame", result.stdout)
+    steps = np.genfromtxt(os.path.join(out, "per_scan.csv"), delimiter=",", names=True, usecols=("time_ms",))
+    median = float(frames.group(1)) if frames else float(np.median(steps["time_ms"]))
     return (evaluation["ate_translation_m"]["rmse"], evaluation["rpe"]["translation_percent"],
-            evaluation["rpe"]["horizontal_percent"], wall)
+            evaluation["rpe"]["horizontal_percent"], median, len(steps), wall)
 
 
 def odometry_table(tool, work):
-    rig_dir = os.path.join(work, "five_radars")
-    result = subprocess.run([tool, "simulate", "--rig-config", os.path.join(ROOT, "configs/rig_five_radars.yaml"),
-                             "--out", rig_dir, "--force"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if result.returncode != 0:
-        sys.exit(f"rig_table: simulate the five-radar rig failed: {result.stderr.strip()}")
-    text = open(os.path.join(rig_dir, "rig.yaml")).read()
-    head, *radars = text.split("  - name:")
-    by_name = {r.split("\n")[0].strip().strip('"'): "  - name:" + r for r in radars}
-    print("| run | ATE m | RPE t % | horizontal % | wall s |")
-    print("|---|---|---|---|---|")
-    for name in by_name:
-        sequence = os.path.join(rig_dir, name)
-        row = run_odometry(tool, ["--sequence", sequence, "--gt", os.path.join(sequence, "gt_radar_tum.txt")],
-                           os.path.join(work, "alone_" + name))
-        print(f"| {name} alone | {row[0]:.3f} | {row[1]:.3f} | {row[2]:.3f} | {row[3]:.2f} |")
-    for label, names in [("rig of the front radar", ["front"])] + ODOMETRY_RIGS:
-        rig_file = os.path.join(rig_dir, "rig_" + "_".join(names) + ".yaml")
-        with open(rig_file, "w") as f:
-            f.write(head + "".join(by_name[n] for n in names))
-        row = run_odometry(tool, ["--rig", rig_file, "--gt", os.path.join(rig_dir, "gt_body_tum.txt")],
-                           os.path.join(work, "rig_" + "_".join(names)))
-        print(f"| {label} | {row[0]:.3f} | {row[1]:.3f} | {row[2]:.3f} | {row[3]:.2f} |")
+    print("| world | run | ATE m | RPE t % | horizontal % | median ms per scan or frame | wall s |")
+    print("|---|---|---|---|---|---|---|")
+    for world, config, scans in ODOMETRY_WORLDS:
+        rig_dir = os.path.join(work, "rig_" + world.split()[0].replace("-", "_"))
+        rig_config = rig_dir + ".yaml"
+        os.makedirs(work, exist_ok=True)
+        with open(rig_config, "w") as f:
+            f.write(odometry_rig_config(config, scans))
+        result = subprocess.run([tool, "simulate", "--rig-config", rig_config, "--out", rig_dir, "--force"],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        if result.returncode != 0:
+            sys.exit(f"rig_table: simulate {rig_config} failed: {result.stderr.strip()}")
+        text = open(os.path.join(rig_dir, "rig.yaml")).read()
+        head, *radars = text.split("  - name:")
+        by_name = {r.split("\n")[0].strip().strip('"'): "  - name:" + r for r in radars}
+        alone = {}
+        for name in by_name:
+            sequence = os.path.join(rig_dir, name)
+            alone[name] = run_odometry(tool, ["--sequence", sequence, "--gt",
+                                              os.path.join(sequence, "gt_radar_tum.txt")],
+                                       os.path.join(work, "alone_" + name))
+            row = alone[name]
+            print(f"| {world} | {name} alone | {row[0]:.3f} | {row[1]:.3f} | {row[2]:.3f} | {row[3]:.2f} | "
+                  f"{row[5]:.2f} |")
+        for label, names in ODOMETRY_RIGS:
+            rig_file = os.path.join(rig_dir, "rig_" + "_".join(names) + ".yaml")
+            with open(rig_file, "w") as f:
+                f.write(head + "".join(by_name[n] for n in names))
+            row = run_odometry(tool, ["--rig", rig_file, "--gt", os.path.join(rig_dir, "gt_body_tum.txt")],
+                               os.path.join(work, "rig_" + "_".join(names)))
+            best = min(alone[n][1] for n in names)
+            wall_alone = sum(alone[n][5] for n in names)
+            # Its radars' median scans, as many as a frame holds of each.
+            per_frame_alone = sum(alone[n][3] * alone[n][4] / row[4] for n in names)
+            print(f"| {world} | rig {label} | {row[0]:.3f} | {row[1]:.3f} ({row[1] / best:.2f}x its best radar) | "
+                  f"{row[2]:.3f} | {row[3]:.2f} (its radars' {per_frame_alone:.2f}) | "
+                  f"{row[5]:.2f} ({row[5] / wall_alone:.2f}x its radars') |")
 
 
 def main():

@@ -11,6 +11,7 @@
 #include "odometry_settings.hpp"
 #include "radargauss/core/atomic_file.hpp"
 #include "radargauss/core/error.hpp"
+#include "radargauss/core/stats.hpp"
 #include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/io/rig.hpp"
 #include "radargauss/odometry/mounting.hpp"
@@ -118,9 +119,15 @@ int RunRigOdometry(const OdometrySettings& s) {
   WriteTum((std::filesystem::path(folder.path()) / "body.tum").string(), body);
   const std::string table = evaluation ? WriteEvaluation(folder.path(), *evaluation) : std::string();
   folder.Commit();
-  std::printf("rig: %zu radars, %zu scans in %zu frames, %zu with their velocity measured (%zu by the rig's twist)\n",
+  std::printf("rig: %zu radars, %zu scans in %zu frames, %zu with their velocity measured (%zu by the rig's twist)",
               rig.radars.size(), scans, odometry.frame_radars().size(), odometry.velocity_measured(),
               odometry.rig_velocity_measured());
+  if (!odometry.frame_times_ms().empty()) {
+    std::vector<double> times = odometry.frame_times_ms();
+    std::sort(times.begin(), times.end());
+    std::printf("; %.2f ms per frame (median, p90 %.2f)", MedianOfSorted(times), PercentileOfSorted(times, 0.9));
+  }
+  std::printf("\n");
   PrintSummary(Summarise(odometry.odometry()));
   std::printf("%s", table.c_str());
   std::printf("wrote %s (body.tum: T_world_body; odometry.tum, per_scan.csv and summary.json of the %s odometry%s%s)\n",

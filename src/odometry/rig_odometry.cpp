@@ -2,6 +2,7 @@
 #include "radargauss/odometry/rig_odometry.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -182,6 +183,7 @@ std::vector<bool> RigOdometry::OwnStaticPoints(std::size_t k, const std::optiona
 }
 
 void RigOdometry::RegisterPending() {
+  const auto start = std::chrono::steady_clock::now();
   const double stamp = closing_stamp_.value_or(pending_.back().timestamp);
   const FrameVelocity velocity = MeasureVelocity(Gate(stamp));
   // Every radar's static points in the reference frame at the frame's stamp:
@@ -209,6 +211,7 @@ void RigOdometry::RegisterPending() {
   if (velocity.measured) last_measured_ = MeasuredAt{stamp, *velocity.measured};
   odometry_.Register(frame, velocity.measured);
   last_frame_ = std::move(frame);
+  frame_times_ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   frame_stamps_.push_back(stamp);
   frame_radars_.push_back(std::move(pending_radars_));
   pending_radars_.clear();

@@ -11,6 +11,7 @@
 #include "radargauss/residuals/radar_inertial_residuals.hpp"
 #include "radargauss/residuals/rcs_residual.hpp"
 #include "radargauss/residuals/relative_pose_residual.hpp"
+#include "radargauss/residuals/rig_doppler_residual.hpp"
 #include "radargauss/residuals/rotation_residual.hpp"
 #include "radargauss/residuals/velocity_residual.hpp"
 
@@ -52,6 +53,11 @@ ceres::CostFunction* RcsCoefficientResidual::Create(const RcsTerm& term, const E
 ceres::CostFunction* RelativePoseResidual::Create(const SE3d& measured,
                                                   const Eigen::Matrix<double, 6, 6>& sqrt_information) {
   return new AutoDiff(new RelativePoseResidual(measured, sqrt_information));
+}
+
+ceres::CostFunction* RigDopplerResidual::Create(const Eigen::Vector3d& direction, double doppler,
+                                                const ReferenceMotion& motion, double sqrt_information) {
+  return new AutoDiff(new RigDopplerResidual(direction, doppler, motion, sqrt_information));
 }
 
 ceres::CostFunction* RotationResidual::Create(const SO3d& predicted, const Eigen::Matrix3d& sqrt_information) {

@@ -60,6 +60,8 @@ class RigOdometry {
   // The last frame registered: every radar's static points in the reference
   // radar's frame at the frame's stamp, without Doppler (empty with one radar).
   const RadarScan& last_frame() const { return last_frame_; }
+  // Each frame's time (ms): its twist, its points moved and its odometry step (empty with one radar).
+  const std::vector<double>& frame_times_ms() const { return frame_times_ms_; }
 
  private:
   // A frame's velocity: measured (by the rig's twist or the reference
@@ -92,6 +94,7 @@ class RigOdometry {
   std::vector<std::vector<std::size_t>> frame_radars_;
   std::vector<double> frame_stamps_;
   RadarScan last_frame_;
+  std::vector<double> frame_times_ms_;
   struct MeasuredAt {
     double stamp = 0.0;
     RadarOdometry::MeasuredVelocity velocity;
