@@ -34,6 +34,7 @@ Subcommand AddRefine(CLI::App& parent);
 Subcommand AddOdometry(CLI::App& parent);
 Subcommand AddSlam(CLI::App& parent);
 Subcommand AddRelocalize(CLI::App& parent);
+Subcommand AddCalibrate(CLI::App& parent);
 
 // The flags every subcommand that reads a sequence shares; the trajectory
 // that gives the scans their poses is `poses_flag` (refine: --poses).

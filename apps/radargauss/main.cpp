@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
   const std::vector<Subcommand> subcommands = {
       AddInfo(app),       AddSimulate(app), AddSimulateImu(app), AddBuildMap(app), AddMapInfo(app),
       AddLocalize(app),   AddEvaluate(app), AddRefine(app),      AddOdometry(app), AddSlam(app),
-      AddRelocalize(app), AddMerge(app),    AddConvert(app),     AddExport(app)};
+      AddRelocalize(app), AddMerge(app),    AddConvert(app),     AddExport(app),   AddCalibrate(app)};
   std::vector<std::string> names;
   for (const Subcommand& command : subcommands) names.push_back(command.app->get_name());
   int threads = 0;

@@ -60,6 +60,12 @@ ceres::CostFunction* RigDopplerResidual::Create(const Eigen::Vector3d& direction
   return new AutoDiff(new RigDopplerResidual(direction, doppler, motion, sqrt_information));
 }
 
+ceres::CostFunction* RigPointResidual::Create(const Eigen::Vector3d& point, const Eigen::Vector3d& mean,
+                                              const Eigen::Matrix3d& sqrt_information_t,
+                                              const ReferenceMotion& motion) {
+  return new AutoDiff(new RigPointResidual(point, mean, sqrt_information_t, motion));
+}
+
 ceres::CostFunction* RotationResidual::Create(const SO3d& predicted, const Eigen::Matrix3d& sqrt_information) {
   return new AutoDiff(new RotationResidual(predicted, sqrt_information));
 }

@@ -16,6 +16,7 @@
 #include "radargauss/core/rig_twist.hpp"
 #include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/io/rig.hpp"
+#include "radargauss/odometry/rig_calibration.hpp"
 #include "radargauss/odometry/rig_odometry.hpp"
 #include "radargauss/simulator/simulator.hpp"
 #include "support/temp_dir.hpp"
@@ -267,6 +268,62 @@ TEST(RigOdometry, AnOlderScanIsMovedToTheFramesStamp) {
     if (move) EXPECT_LT(worst, 1e-9);
     if (!move) EXPECT_NEAR(worst, 0.5, 1e-9);
   }
+}
+
+// A front radar and a front corner radar over 20 s. Given the truth, the
+// calibration against the front radar stays within 0.3 deg, 3 cm and 6 ms
+// of it (it is biased: the reference's odometry lags the true rotation
+// rate). Given 2 deg, 5 cm and 20 ms off, it brings the corner within
+// 0.5 deg, 3 cm and 10 ms. The goals of 0.2 deg, 3 cm and 2 ms are not
+// reached (bench/RESULTS.md, "Radar rigs").
+TEST(RigCalibration, StaysAtTheTruthAndBringsAGivenOffCornerRadarCloser) {
+  RigSimulationConfig config;
+  config.world.scans = 200;
+  SimulationConfig front;
+  front.mounting_x = 3.7;
+  front.mounting_z = 0.5;
+  SimulationConfig corner = Corner(3.4, 0.9, 45.0);
+  corner.rate_hz = 20.0;
+  corner.clock_offset = 0.012;
+  config.radars = {{"front", front}, {"front_left", corner}};
+  const SimulatedRig simulated = SimulateRig(config);
+  Rig truth;
+  for (std::size_t r = 0; r < 2; ++r) {
+    RigRadar radar;
+    radar.name = config.radars[r].first;
+    radar.body_from_radar = simulated.body_from_radar[r];
+    radar.clock_offset = config.radars[r].second.clock_offset;
+    truth.radars.push_back(radar);
+  }
+  const std::vector<std::vector<RadarScan>> scans = {simulated.radars[0].scans, simulated.radars[1].scans};
+  const auto errors = [&](const Rig& calibrated) {
+    const RigRadar& radar = calibrated.radars[1];
+    return Eigen::Vector3d(
+        (truth.radars[1].body_from_radar.rotation().Inverse() * radar.body_from_radar.rotation()).Log().norm() * 180.0 /
+            M_PI,
+        (radar.body_from_radar.translation() - truth.radars[1].body_from_radar.translation()).norm(),
+        std::abs(radar.clock_offset - truth.radars[1].clock_offset));
+  };
+  const RigCalibration at_truth = CalibrateRig(truth, scans);
+  EXPECT_LT(errors(at_truth.rig).x(), 0.3);
+  EXPECT_LT(errors(at_truth.rig).y(), 0.03);
+  EXPECT_LT(errors(at_truth.rig).z(), 0.006);
+  Rig given = truth;
+  given.radars[1].body_from_radar =
+      SE3d(truth.radars[1].body_from_radar.rotation() *
+               SO3d::Exp(Eigen::Vector3d(1.0, -1.0, 1.0).normalized() * (2.0 * M_PI / 180.0)),
+           truth.radars[1].body_from_radar.translation() + 0.05 * Eigen::Vector3d(-1.0, 1.0, 1.0).normalized());
+  given.radars[1].clock_offset += 0.020;
+  const RigCalibration calibration = CalibrateRig(given, scans);
+  ASSERT_EQ(calibration.radars.size(), 2u);
+  EXPECT_LT(errors(calibration.rig).x(), 0.5);
+  EXPECT_LT(errors(calibration.rig).y(), 0.03);
+  EXPECT_LT(errors(calibration.rig).z(), 0.01);
+  EXPECT_TRUE(calibration.radars[1].rotation_std.allFinite());
+  EXPECT_GT(calibration.radars[1].map_points, 1000u);
+  // The reference stays as given; the scans must be the rig's.
+  EXPECT_EQ(calibration.rig.radars[0].body_from_radar.translation(), given.radars[0].body_from_radar.translation());
+  EXPECT_THROW(CalibrateRig(given, {scans[0]}), DataError);
 }
 
 TEST_F(SimulatedRigFiles, ItsConfigRefusesWhatIsTheRigsOwn) {

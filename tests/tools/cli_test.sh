@@ -230,6 +230,18 @@ expect_ok "odometry on a rig" "rig: 2 radars, 20 scans in 10 frames" -- \
 expect_fail "odometry on a rig with an IMU" "takes no IMU yet" -- \
   "$tool" odometry --rig "$work/rig.yaml" --imu "$work/seq10/gt_radar_tum.txt" --out "$work/rig_imu"
 [[ ! -e "$work/rig_imu" ]] || { echo "FAIL: a refused rig run left $work/rig_imu"; failed=1; }
+expect_ok "calibrate a rig" "wrote .*calibrated" -- \
+  "$tool" calibrate --rig "$work/rig.yaml" --compare "$work/rig.yaml" --out "$work/calibrated"
+[[ -s "$work/calibrated/rig.yaml" && -s "$work/calibrated/calibration.json" ]] || {
+  echo "FAIL: calibrate wrote no rig.yaml or calibration.json"; failed=1; }
+expect_ok "the calibrated rig is a rig" "rig: .*2 radars" -- "$tool" info --rig "$work/calibrated/rig.yaml"
+printf 'radars:\n  - {name: front, sequence: seq10, extrinsic: [0, 0, 0, 0, 0, 0, 1]}\n' > "$work/rig_one.yaml"
+expect_fail "calibrate a rig of one radar" "needs a reference radar and another" -- \
+  "$tool" calibrate --rig "$work/rig_one.yaml" --out "$work/calibrated_one"
+expect_fail "calibrate against a rig of other radars" "--compare: 1 radars, the rig has 2" -- \
+  "$tool" calibrate --rig "$work/rig.yaml" --compare "$work/rig_one.yaml" --out "$work/calibrated_other"
+[[ ! -e "$work/calibrated_one" && ! -e "$work/calibrated_other" ]] || {
+  echo "FAIL: a refused calibration left its folder"; failed=1; }
 expect_ok "slam writes the map as tiles" "map_tiles/" -- \
   "$tool" slam --sequence "$work/seq10" --submap-distance 2 --map-tiles 20 --out "$work/slam_tiles"
 [[ -s "$work/slam_tiles/map_tiles/tiles.json" ]] || { echo "FAIL: slam --map-tiles wrote no tiles.json"; failed=1; }

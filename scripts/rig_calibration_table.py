@@ -1,0 +1,124 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""The calibration of a rig (bench/RESULTS.md, "Radar rigs"; docs/design/rig.md,
+"Calibration of a rig"): the radars of scripts/rig_table.py's table 2 (the
+five of configs/rig_five_radars.yaml and a rear radar) simulated over a
+world, their mountings given 2 deg (about a random axis) and 5 cm (in a
+random direction) off, and their clocks 20 ms off (either sign), then
+`radargauss calibrate --compare` against the simulator's rig.yaml.
+
+Per world and radar: the error after calibration of the rotation (deg),
+the translation (m) and the clock offset (ms), beside the stated standard
+deviations; the last row per world counts the errors within 3 sigma
+(per axis: rotation and translation as their norms against the norm of
+the stds). Draws of the offsets: --draws (seeds 1..N).
+
+    scripts/rig_calibration_table.py [--tool build/release/bin/radargauss] [--work /tmp/rig_calibration]
+                                     [--worlds demo,realistic] [--draws 1]
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from rig_table import ODOMETRY_WORLDS, odometry_rig_config  # noqa: E402
+
+
+def rotation(axis_angle):
+    angle = np.linalg.norm(axis_angle)
+    if angle == 0.0:
+        return np.eye(3)
+    k = axis_angle / angle
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+def quaternion(R):
+    w = np.sqrt(max(0.0, 1.0 + np.trace(R))) / 2.0
+    x = np.copysign(np.sqrt(max(0.0, 1.0 + R[0, 0] - R[1, 1] - R[2, 2])) / 2.0, R[2, 1] - R[1, 2])
+    y = np.copysign(np.sqrt(max(0.0, 1.0 - R[0, 0] + R[1, 1] - R[2, 2])) / 2.0, R[0, 2] - R[2, 0])
+    z = np.copysign(np.sqrt(max(0.0, 1.0 - R[0, 0] - R[1, 1] + R[2, 2])) / 2.0, R[1, 0] - R[0, 1])
+    return np.array([x, y, z, w])
+
+
+def matrix(q):
+    x, y, z, w = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def perturbed_rig(text, rng):
+    """The rig file's text with every radar but the first moved 2 deg / 5 cm and its clock 20 ms."""
+    out, index = [], -1
+    for line in text.splitlines():
+        stripped = line.strip()
+        if stripped.startswith("- name:"):
+            index += 1
+        if index >= 1 and stripped.startswith("extrinsic:"):
+            values = np.array(json.loads(stripped.split(":", 1)[1]))
+            axis = rng.normal(size=3)
+            direction = rng.normal(size=3)
+            R = matrix(values[3:]) @ rotation(np.radians(2.0) * axis / np.linalg.norm(axis))
+            t = values[:3] + 0.05 * direction / np.linalg.norm(direction)
+            line = line.split("extrinsic:")[0] + "extrinsic: " + json.dumps([float(v) for v in np.concatenate([t, quaternion(R)])])
+        if index >= 1 and stripped.startswith("clock_offset:"):
+            offset = float(stripped.split(":", 1)[1]) + (0.02 if rng.uniform() < 0.5 else -0.02)
+            line = line.split("clock_offset:")[0] + f"clock_offset: {offset}"
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    parser.add_argument("--tool", default=os.path.join(root, "build/release/bin/radargauss"))
+    parser.add_argument("--work", default="/tmp/rig_calibration")
+    parser.add_argument("--worlds", default="demo,realistic")
+    parser.add_argument("--draws", type=int, default=1)
+    parser.add_argument("--flags", default="", help="further flags of radargauss calibrate")
+    args = parser.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    print("| world | radar | rotation error deg (std) | translation error m (std) | clock error ms (std) |")
+    print("|---|---|---|---|---|")
+    for world, config, scans in ODOMETRY_WORLDS:
+        if world.split()[0].replace("-", "_") not in args.worlds.split(","):
+            continue
+        rig_dir = os.path.join(args.work, world.split()[0].replace("-", "_"))
+        if not os.path.exists(os.path.join(rig_dir, "rig.yaml")):
+            with open(rig_dir + ".yaml", "w") as f:
+                f.write(odometry_rig_config(config, scans))
+            subprocess.run([args.tool, "simulate", "--rig-config", rig_dir + ".yaml", "--out", rig_dir], check=True,
+                           stdout=subprocess.DEVNULL)
+        within, count = np.zeros(3), 0
+        for draw in range(1, args.draws + 1):
+            rng = np.random.default_rng(draw)
+            given = os.path.join(rig_dir, f"rig_off_{draw}.yaml")
+            with open(given, "w") as f:
+                f.write(perturbed_rig(open(os.path.join(rig_dir, "rig.yaml")).read(), rng))
+            out = os.path.join(args.work, f"calibrated_{world.split()[0]}_{draw}")
+            subprocess.run(["rm", "-rf", out], check=True)
+            result = subprocess.run([args.tool, "calibrate", "--rig", given, "--compare",
+                                     os.path.join(rig_dir, "rig.yaml"), "--out", out] + args.flags.split(),
+                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            if result.returncode != 0:
+                sys.exit(f"rig_calibration_table: calibrate failed: {result.stderr.strip()}")
+            for radar in json.load(open(os.path.join(out, "calibration.json")))["radars"]:
+                e = radar["error"]
+                sr = np.linalg.norm([s if s is not None else np.inf for s in radar["rotation_std_deg"]])
+                st = np.linalg.norm([s if s is not None else np.inf for s in radar["translation_std_m"]])
+                sc = radar["clock_offset_std_ms"] if radar["clock_offset_std_ms"] is not None else np.inf
+                within += [e["rotation_deg"] <= 3 * sr, e["translation_m"] <= 3 * st, abs(e["clock_ms"]) <= 3 * sc]
+                count += 1
+                print(f"| {world} | {radar['name']} | {e['rotation_deg']:.3f} ({sr:.3f}) | "
+                      f"{e['translation_m']:.4f} ({st:.4f}) | {e['clock_ms']:.2f} ({sc:.2f}) |")
+        print(f"| {world} | within 3 sigma | {within[0]:.0f} of {count} | {within[1]:.0f} of {count} | "
+              f"{within[2]:.0f} of {count} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,358 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "radargauss/odometry/rig_calibration.hpp"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <utility>
+
+#include <Eigen/Eigenvalues>
+
+#include "radargauss/core/doppler.hpp"
+#include "radargauss/core/error.hpp"
+#include "radargauss/lie/manifold.hpp"
+#include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/residuals/rig_doppler_residual.hpp"
+
+namespace radargauss {
+
+const OptionTable<RigCalibrationOptions>& RigCalibrationOptionTable() {
+  using O = RigCalibrationOptions;
+  static const OptionTable<O> table = [] {
+    OptionTable<O> t = {
+        RADARGAUSS_OPTION(O, "estimate_rotation", estimate_rotation).Sensor().Help("estimate each radar's rotation"),
+        RADARGAUSS_OPTION(O, "estimate_translation", estimate_translation)
+            .Sensor()
+            .Help("estimate each radar's translation"),
+        RADARGAUSS_OPTION(O, "estimate_clock_offset", estimate_clock_offset)
+            .Sensor()
+            .Help("estimate each radar's clock offset"),
+        RADARGAUSS_OPTION(O, "doppler_std", doppler_std).Above(0.0).Unit("m/s").Help("a Doppler residual's sigma"),
+        RADARGAUSS_OPTION(O, "map_weight", map_weight)
+            .AtLeast(0.0)
+            .Help("weight of the points against the reference's map (0: the Doppler alone)"),
+        RADARGAUSS_OPTION(O, "points_per_scan", points_per_scan).In(1, 10000).Help("static points used per scan"),
+        RADARGAUSS_OPTION(O, "rounds", rounds).In(1, 100).Help("re-associations and re-readings of the motion"),
+        RADARGAUSS_OPTION(O, "loss_scale", loss_scale).Above(0.0).Help("Huber loss scale (sigmas)"),
+        RADARGAUSS_OPTION(O, "map_max_age", map_max_age)
+            .Above(0.0)
+            .Unit("s")
+            .Help("a point meets only the Gaussians the reference saw within this time of its scan"),
+        RADARGAUSS_OPTION(O, "association_gate", association_gate)
+            .Above(0.0)
+            .Help("Mahalanobis distance of a point to its Gaussian"),
+        RADARGAUSS_OPTION(O, "min_relative_eigenvalue", min_relative_eigenvalue)
+            .In(0.0, 1.0)
+            .Help("information directions below this share of the largest are unobserved"),
+    };
+    return t;
+  }();
+  return table;
+}
+
+void ValidateOptions(const RigCalibrationOptions& options) {
+  CheckOptions(RigCalibrationOptionTable(), options);
+  ValidateOptions(options.reference);
+  ValidateOptions(options.map);
+}
+
+namespace {
+
+// The reference radar's motion between its odometry's scans: the velocity
+// linear between scans, the angular velocity of each interval linear between
+// the intervals' midpoints, the pose at a constant twist over its interval.
+class ReferenceTrack {
+ public:
+  explicit ReferenceTrack(const std::vector<OdometryStep>& steps) {
+    for (const OdometryStep& step : steps) {
+      stamps_.push_back(step.stamp);
+      poses_.push_back(step.pose);
+      velocities_.push_back(step.velocity);
+    }
+    for (std::size_t k = 0; k + 1 < stamps_.size(); ++k) {
+      const double dt = stamps_[k + 1] - stamps_[k];
+      twists_.push_back((poses_[k].Inverse() * poses_[k + 1]).Log() / dt);
+      midpoints_.push_back(0.5 * (stamps_[k] + stamps_[k + 1]));
+    }
+  }
+
+  bool Covers(double t) const { return midpoints_.size() >= 2 && t >= midpoints_.front() && t < midpoints_.back(); }
+
+  ReferenceMotion Motion(double t) const {
+    ReferenceMotion motion;
+    const std::size_t k = Interval(stamps_, t);
+    const double dt = stamps_[k + 1] - stamps_[k], s = (t - stamps_[k]) / dt;
+    motion.velocity = (1.0 - s) * velocities_[k] + s * velocities_[k + 1];
+    motion.acceleration = (velocities_[k + 1] - velocities_[k]) / dt;
+    const std::size_t j = Interval(midpoints_, t);
+    const double dm = midpoints_[j + 1] - midpoints_[j], r = (t - midpoints_[j]) / dm;
+    const Eigen::Vector3d w0 = twists_[j].tail<3>(), w1 = twists_[j + 1].tail<3>();
+    motion.angular_velocity = (1.0 - r) * w0 + r * w1;
+    motion.angular_acceleration = (w1 - w0) / dm;
+    return motion;
+  }
+
+  SE3d Pose(double t) const {
+    const std::size_t k = Interval(stamps_, t);
+    return poses_[k] * SE3d::Exp(twists_[k] * (t - stamps_[k]));
+  }
+
+ private:
+  // The k with times[k] <= t < times[k + 1], clamped to the intervals.
+  static std::size_t Interval(const std::vector<double>& times, double t) {
+    const auto upper = std::upper_bound(times.begin(), times.end(), t);
+    const std::size_t k = std::size_t(std::max<std::ptrdiff_t>(1, upper - times.begin())) - 1;
+    return std::min(k, times.size() - 2);
+  }
+
+  std::vector<double> stamps_, midpoints_;
+  std::vector<SE3d> poses_;
+  std::vector<Eigen::Vector3d> velocities_;
+  std::vector<Eigen::Matrix<double, 6, 1>> twists_;
+};
+
+// A radar's static points used: the Doppler filter's inliers, gated around
+// the velocity the reference's motion gives the radar at its given
+// extrinsic, at most `count` spread over the scan.
+std::vector<std::size_t> UsedPoints(const RadarScan& scan, const ReferenceMotion& motion, const SE3d& extrinsic,
+                                    const RigCalibrationOptions& options) {
+  std::vector<std::size_t> used;
+  if (!scan.has_doppler) return used;
+  const Eigen::Vector3d expected =
+      extrinsic.rotation().Inverse() * (motion.velocity + motion.angular_velocity.cross(extrinsic.translation()));
+  const VelocityGate gate{expected, std::max(options.reference.min_gate, 0.1 * expected.norm())};
+  const EgoVelocityResult ego = EstimateEgoVelocity(scan, options.reference.ego_velocity, gate);
+  if (!ego.success) return used;
+  std::vector<std::size_t> inliers;
+  for (std::size_t i = 0; i < ego.inlier.size(); ++i) {
+    if (ego.inlier[i]) inliers.push_back(i);
+  }
+  const std::size_t stride =
+      std::max<std::size_t>(1, (inliers.size() + options.points_per_scan - 1) / options.points_per_scan);
+  for (std::size_t k = 0; k < inliers.size(); k += stride) used.push_back(inliers[k]);
+  return used;
+}
+
+// The reference radar's map, with when the reference saw each Gaussian:
+// its odometry drifts, and a point matched to what the reference saw long
+// before carries that drift into the extrinsic.
+struct ReferenceMap {
+  GaussianIndex index;
+  std::vector<double> first_seen, last_seen;  // s, the body's clock
+};
+
+ReferenceMap BuildReferenceMap(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
+                               const MapOptions& options) {
+  const MapGeometry geometry = BuildMapGeometry(scans, poses, options);
+  ReferenceMap map{GaussianIndex(geometry.map.gaussians),
+                   std::vector<double>(geometry.map.gaussians.size(), std::numeric_limits<double>::infinity()),
+                   std::vector<double>(geometry.map.gaussians.size(), -std::numeric_limits<double>::infinity())};
+  for (std::size_t i = 0; i < geometry.association.size(); ++i) {
+    if (geometry.association[i] < 0) continue;
+    const std::size_t g = std::size_t(geometry.association[i]);
+    const double stamp = scans[geometry.cloud.scan[i]].timestamp;
+    map.first_seen[g] = std::min(map.first_seen[g], stamp);
+    map.last_seen[g] = std::max(map.last_seen[g], stamp);
+  }
+  return map;
+}
+
+struct RadarBlocks {
+  Eigen::Vector4d rotation;  // x y z w of R_ref_radar
+  Eigen::Vector3d translation;
+  double clock_change = 0.0;  // s: the offset's change in this round
+};
+
+// The standard deviations of the 7 tangent directions (rotation, translation,
+// clock) at the problem's solution, clustered by scan: C = H^+ B H^+ with
+// H = J^T J and B the sum over scans of g g^T, g = J_s^T r_s. A scan's
+// residuals share its reference motion's errors, so they are not counted as
+// independent. Infinite along the directions H leaves unobserved.
+Eigen::Matrix<double, 7, 1> TangentStd(ceres::Problem& problem, RadarBlocks& blocks,
+                                       const std::vector<ceres::ResidualBlockId>& residuals,
+                                       const std::vector<std::size_t>& scan_of, double min_relative) {
+  using Matrix7d = Eigen::Matrix<double, 7, 7>;
+  using Vector7d = Eigen::Matrix<double, 7, 1>;
+  Vector7d std = Vector7d::Constant(std::numeric_limits<double>::infinity());
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = {blocks.rotation.data(), blocks.translation.data(), &blocks.clock_change};
+  evaluate.residual_blocks = residuals;
+  std::vector<double> values;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(evaluate, nullptr, &values, nullptr, &crs);
+  if (crs.num_cols != 7) return std;
+  Matrix7d information = Matrix7d::Zero(), spread = Matrix7d::Zero();
+  Vector7d gradient = Vector7d::Zero();
+  int row = 0;
+  for (std::size_t b = 0; b < residuals.size(); ++b) {
+    const int size = problem.GetCostFunctionForResidualBlock(residuals[b])->num_residuals();
+    for (int k = 0; k < size; ++k, ++row) {
+      Vector7d j = Vector7d::Zero();
+      for (int e = crs.rows[std::size_t(row)]; e < crs.rows[std::size_t(row) + 1]; ++e) {
+        j(crs.cols[std::size_t(e)]) = crs.values[std::size_t(e)];
+      }
+      information += j * j.transpose();
+      gradient += j * values[std::size_t(row)];
+    }
+    if (b + 1 == residuals.size() || scan_of[b + 1] != scan_of[b]) {  // the scan's residuals end here
+      spread += gradient * gradient.transpose();
+      gradient.setZero();
+    }
+  }
+  const Eigen::SelfAdjointEigenSolver<Matrix7d> eigen(information);
+  const double largest = eigen.eigenvalues().maxCoeff();
+  Matrix7d inverse = Matrix7d::Zero();
+  Vector7d open = Vector7d::Zero();  // each coordinate's weight in the unobserved directions
+  for (int k = 0; k < 7; ++k) {
+    const Vector7d direction = eigen.eigenvectors().col(k);
+    if (largest > 0.0 && eigen.eigenvalues()(k) > min_relative * largest) {
+      inverse += direction * direction.transpose() / eigen.eigenvalues()(k);
+    } else {
+      open += direction.cwiseAbs2();
+    }
+  }
+  const Matrix7d covariance = inverse * spread * inverse;
+  for (int k = 0; k < 7; ++k) {
+    if (open(k) < 1e-6) std(k) = std::sqrt(covariance(k, k));
+  }
+  return std;
+}
+
+// One radar's extrinsic and clock offset, refined in rounds.
+RadarCalibration CalibrateRadar(const RigRadar& radar, const SE3d& reference_from_radar,
+                                const std::vector<RadarScan>& scans, const ReferenceTrack& track,
+                                const ReferenceMap& map, const RigCalibrationOptions& options) {
+  RadarCalibration out;
+  out.name = radar.name;
+  RadarBlocks blocks{reference_from_radar.rotation().quaternion().coeffs(), reference_from_radar.translation()};
+  double clock_offset = radar.clock_offset;
+  std::vector<std::vector<std::size_t>> used(scans.size());
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    const double t = scans[s].timestamp - clock_offset;
+    if (!track.Covers(t)) continue;
+    used[s] = UsedPoints(scans[s], track.Motion(t), reference_from_radar, options);
+    ++out.scans;
+  }
+  if (out.scans == 0) throw DataError("radar '" + radar.name + "': no scan within the reference radar's drive");
+  SO3Manifold so3;
+  Eigen::Matrix<double, 7, 1> std;
+  for (int round = 0; round < options.rounds; ++round) {
+    // Coarse to fine: the rotation from the Doppler first (its strongest
+    // signal), then the translation with the map, then the clock.
+    const bool with_map = round >= 1 || options.rounds == 1;
+    const bool with_clock = round >= 2 || options.rounds <= 2;
+    ceres::Problem::Options problem_options;
+    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    problem.AddParameterBlock(blocks.rotation.data(), 4, &so3);
+    problem.AddParameterBlock(blocks.translation.data(), 3);
+    problem.AddParameterBlock(&blocks.clock_change, 1);
+    const SE3d extrinsic(SO3d::FromXyzw(blocks.rotation.data()), blocks.translation);
+    out.doppler_points = out.map_points = 0;
+    std::vector<ceres::ResidualBlockId> residuals;
+    std::vector<std::size_t> scan_of;
+    for (std::size_t s = 0; s < scans.size(); ++s) {
+      const double t = scans[s].timestamp - clock_offset;
+      if (used[s].empty() || !track.Covers(t)) continue;
+      const ReferenceMotion motion = track.Motion(t);
+      const SE3d world_from_reference = track.Pose(t);
+      const SE3d reference_from_world = world_from_reference.Inverse();
+      for (const std::size_t i : used[s]) {
+        const RadarPoint& point = scans[s].points[i];
+        residuals.push_back(problem.AddResidualBlock(
+            new RigDopplerCostFunction(point.position, point.doppler, motion, 1.0 / options.doppler_std),
+            new ceres::HuberLoss(options.loss_scale), blocks.rotation.data(), blocks.translation.data(),
+            &blocks.clock_change));
+        scan_of.push_back(s);
+        ++out.doppler_points;
+        if (options.map_weight <= 0.0 || !with_map) continue;
+        const int g = map.index.Associate(world_from_reference * (extrinsic * point.position),
+                                          options.association_gate * options.association_gate);
+        if (g < 0 || t < map.first_seen[std::size_t(g)] - options.map_max_age ||
+            t > map.last_seen[std::size_t(g)] + options.map_max_age) {
+          continue;
+        }
+        // The Gaussian in the reference's frame at the scan's time: mean T^-1 mu, sqrt information L^T R.
+        residuals.push_back(problem.AddResidualBlock(
+            new RigPointCostFunction(
+                point.position, reference_from_world * map.index.Mean(std::size_t(g)),
+                map.index.SqrtInformationT(std::size_t(g)) * world_from_reference.rotation().Matrix(), motion),
+            new ceres::ScaledLoss(new ceres::HuberLoss(options.loss_scale), options.map_weight, ceres::TAKE_OWNERSHIP),
+            blocks.rotation.data(), blocks.translation.data(), &blocks.clock_change));
+        scan_of.push_back(s);
+        ++out.map_points;
+      }
+    }
+    if (!options.estimate_rotation) problem.SetParameterBlockConstant(blocks.rotation.data());
+    if (!options.estimate_translation || !with_map) problem.SetParameterBlockConstant(blocks.translation.data());
+    if (!options.estimate_clock_offset || !with_clock) problem.SetParameterBlockConstant(&blocks.clock_change);
+    ceres::Solver::Options solver;
+    solver.linear_solver_type = ceres::DENSE_QR;
+    solver.max_num_iterations = 50;
+    solver.num_threads = 1;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver, &problem, &summary);
+    std = TangentStd(problem, blocks, residuals, scan_of, options.min_relative_eigenvalue);
+    out.rms_doppler = options.doppler_std * std::sqrt(2.0 * summary.final_cost /
+                                                      std::max<std::size_t>(1, out.doppler_points + out.map_points));
+    clock_offset += blocks.clock_change;
+    blocks.clock_change = 0.0;
+  }
+  out.body_from_radar = SE3d(SO3d::FromXyzw(blocks.rotation.data()), blocks.translation);  // T_ref_radar for now
+  out.clock_offset = clock_offset;
+  out.rotation_std = std.head<3>();
+  out.translation_std = std.segment<3>(3);
+  out.clock_offset_std = std(6);
+  if (!options.estimate_rotation) out.rotation_std.setZero();
+  if (!options.estimate_translation) out.translation_std.setZero();
+  if (!options.estimate_clock_offset) out.clock_offset_std = 0.0;
+  return out;
+}
+
+}  // namespace
+
+RigCalibration CalibrateRig(const Rig& rig, const std::vector<std::vector<RadarScan>>& scans,
+                            const RigCalibrationOptions& options) {
+  ValidateOptions(options);
+  if (scans.size() != rig.radars.size()) {
+    throw DataError("a rig of " + std::to_string(rig.radars.size()) + " radars with the scans of " +
+                    std::to_string(scans.size()));
+  }
+  if (scans.front().size() < 3) throw DataError("radar '" + rig.radars.front().name + "': fewer than 3 scans");
+  // The reference radar's odometry on the body's clock, and its map.
+  std::vector<RadarScan> reference_scans = scans.front();
+  for (RadarScan& scan : reference_scans) scan.timestamp -= rig.radars.front().clock_offset;
+  RadarOdometry odometry(options.reference);
+  for (const RadarScan& scan : reference_scans) odometry.Register(scan);
+  const ReferenceTrack track(odometry.steps());
+  std::vector<SE3d> poses;
+  for (const OdometryStep& step : odometry.steps()) poses.push_back(step.pose);
+  const ReferenceMap map = BuildReferenceMap(reference_scans, poses, options.map);
+
+  RigCalibration result;
+  result.rig = rig;
+  result.reference = odometry.trajectory();
+  const SE3d& body_from_reference = rig.radars.front().body_from_radar;
+  RadarCalibration reference;
+  reference.name = rig.radars.front().name;
+  reference.body_from_radar = body_from_reference;
+  reference.clock_offset = rig.radars.front().clock_offset;
+  reference.scans = scans.front().size();
+  result.radars.push_back(reference);
+  for (std::size_t r = 1; r < rig.radars.size(); ++r) {
+    const RigRadar& radar = rig.radars[r];
+    RadarCalibration calibration =
+        CalibrateRadar(radar, body_from_reference.Inverse() * radar.body_from_radar, scans[r], track, map, options);
+    calibration.body_from_radar = body_from_reference * calibration.body_from_radar;
+    result.rig.radars[r].body_from_radar = calibration.body_from_radar;
+    result.rig.radars[r].clock_offset = calibration.clock_offset;
+    result.radars.push_back(std::move(calibration));
+  }
+  return result;
+}
+
+}  // namespace radargauss
