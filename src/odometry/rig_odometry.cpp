@@ -211,7 +211,8 @@ void RigOdometry::RegisterPending() {
   if (velocity.measured) last_measured_ = MeasuredAt{stamp, *velocity.measured};
   odometry_.Register(frame, velocity.measured);
   last_frame_ = std::move(frame);
-  frame_times_ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  frame_times_ms_.push_back(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   frame_stamps_.push_back(stamp);
   frame_radars_.push_back(std::move(pending_radars_));
   pending_radars_.clear();
