@@ -53,6 +53,44 @@ Difference Between(const RigRadar& a, const RigRadar& b) {
           1e3 * (a.clock_offset - b.clock_offset)};
 }
 
+// One radar's row of the printed table and its entry of calibration.json:
+// the calibration, how far it moved from `given`, and its error against `truth`.
+nlohmann::json ReportRadar(const RadarCalibration& c, const RigRadar& calibrated, const RigRadar& given,
+                           const RigRadar* truth) {
+  const Difference moved = Between(calibrated, given);
+  const Eigen::Vector3d& t = c.body_from_radar.translation();
+  const Eigen::Quaterniond& q = c.body_from_radar.rotation().quaternion();
+  nlohmann::json entry = {
+      {"name", c.name},
+      {"translation", {t.x(), t.y(), t.z()}},
+      {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}},
+      {"clock_offset", c.clock_offset},
+      {"rotation_std_deg", Stds(c.rotation_std, kDeg)},
+      {"translation_std_m", Stds(c.translation_std, 1.0)},
+      {"clock_offset_std_ms", Std(c.clock_offset_std, 1e3)},
+      {"scans", c.scans},
+      {"doppler_points", c.doppler_points},
+      {"map_points", c.map_points},
+      {"moved",
+       {{"rotation_deg", moved.rotation_deg}, {"translation_m", moved.translation}, {"clock_ms", moved.clock_ms}}}};
+  const auto text = [](const Eigen::Vector3d& v, double scale) {
+    char out[96];
+    std::snprintf(out, sizeof(out), "%.3g %.3g %.3g", v.x() * scale, v.y() * scale, v.z() * scale);
+    return std::string(out);
+  };
+  std::printf("| %s | %zu | %zu / %zu | %.3f | %.4f | %.2f | %s | %s | %.3g |", c.name.c_str(), c.scans,
+              c.doppler_points, c.map_points, moved.rotation_deg, moved.translation, moved.clock_ms,
+              text(c.rotation_std, kDeg).c_str(), text(c.translation_std, 1.0).c_str(), 1e3 * c.clock_offset_std);
+  if (truth) {
+    const Difference error = Between(calibrated, *truth);
+    entry["error"] = {
+        {"rotation_deg", error.rotation_deg}, {"translation_m", error.translation}, {"clock_ms", error.clock_ms}};
+    std::printf(" %.3f | %.4f | %.2f |", error.rotation_deg, error.translation, error.clock_ms);
+  }
+  std::printf("\n");
+  return entry;
+}
+
 int RunCalibrate(const CalibrateSettings& s) {
   ValidateOptions(s.calibration);
   const Rig rig = ReadRig(s.rig);
@@ -89,41 +127,8 @@ int RunCalibrate(const CalibrateSettings& s) {
       truth ? " error deg | error m | clock error ms |" : "");
   std::printf("|---|---|---|---|---|---|---|---|---|%s\n", truth ? "---|---|---|" : "");
   for (std::size_t r = 1; r < result.radars.size(); ++r) {
-    const RadarCalibration& c = result.radars[r];
-    const Difference moved = Between(result.rig.radars[r], rig.radars[r]);
-    nlohmann::json entry = {
-        {"name", c.name},
-        {"translation",
-         {c.body_from_radar.translation().x(), c.body_from_radar.translation().y(),
-          c.body_from_radar.translation().z()}},
-        {"rotation_xyzw",
-         {c.body_from_radar.rotation().quaternion().x(), c.body_from_radar.rotation().quaternion().y(),
-          c.body_from_radar.rotation().quaternion().z(), c.body_from_radar.rotation().quaternion().w()}},
-        {"clock_offset", c.clock_offset},
-        {"rotation_std_deg", Stds(c.rotation_std, kDeg)},
-        {"translation_std_m", Stds(c.translation_std, 1.0)},
-        {"clock_offset_std_ms", Std(c.clock_offset_std, 1e3)},
-        {"scans", c.scans},
-        {"doppler_points", c.doppler_points},
-        {"map_points", c.map_points},
-        {"moved",
-         {{"rotation_deg", moved.rotation_deg}, {"translation_m", moved.translation}, {"clock_ms", moved.clock_ms}}}};
-    const auto text = [](const Eigen::Vector3d& v, double scale) {
-      char out[96];
-      std::snprintf(out, sizeof(out), "%.3g %.3g %.3g", v.x() * scale, v.y() * scale, v.z() * scale);
-      return std::string(out);
-    };
-    std::printf("| %s | %zu | %zu / %zu | %.3f | %.4f | %.2f | %s | %s | %.3g |", c.name.c_str(), c.scans,
-                c.doppler_points, c.map_points, moved.rotation_deg, moved.translation, moved.clock_ms,
-                text(c.rotation_std, kDeg).c_str(), text(c.translation_std, 1.0).c_str(), 1e3 * c.clock_offset_std);
-    if (truth) {
-      const Difference error = Between(result.rig.radars[r], truth->radars[r]);
-      entry["error"] = {
-          {"rotation_deg", error.rotation_deg}, {"translation_m", error.translation}, {"clock_ms", error.clock_ms}};
-      std::printf(" %.3f | %.4f | %.2f |", error.rotation_deg, error.translation, error.clock_ms);
-    }
-    std::printf("\n");
-    report.push_back(entry);
+    report.push_back(
+        ReportRadar(result.radars[r], result.rig.radars[r], rig.radars[r], truth ? &truth->radars[r] : nullptr));
   }
   {
     std::ofstream out(fs::path(folder.path()) / "calibration.json");

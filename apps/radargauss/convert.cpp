@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss convert: a sequence (PCD or KITTI folder, the Snail-Radar
-// layout, a bag of any kind) with its IMU and reference to a ROS 2 bag.
+// layout, a bag of any kind) with its IMU and reference to a ROS 2 bag; or
+// a rig's radars to one bag, a topic each, with the rig file that reads it.
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -9,6 +11,7 @@
 #include "option_flags.hpp"
 #include "radargauss/core/error.hpp"
 #include "radargauss/io/imu.hpp"
+#include "radargauss/io/rig.hpp"
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/io/bag_writer.hpp"
 
@@ -18,6 +21,7 @@ namespace {
 
 struct ConvertSettings {
   SequenceOptions sequence;
+  std::string rig, rig_out;
   std::string imu, imu_topic, imu_stamps = "header";
   std::string out;
   std::string format;  // mcap, db3; empty: from --out's extension
@@ -37,6 +41,42 @@ BagFormat FormatOf(const ConvertSettings& s) {
   throw DataError("--out " + s.out + ": say --format mcap or db3 (or end the name in .mcap or .db3)");
 }
 
+// A rig's radars to one bag, radar `name`'s scans on /name/points (stamps
+// on its own clock), and beside it the rig file naming that bag and topics.
+int RunRigConvert(const ConvertSettings& s, BagFormat format) {
+  namespace fs = std::filesystem;
+  if (!s.sequence.sequence_dir.empty() || !s.sequence.bag.empty() || !s.sequence.ground_truth.empty()) {
+    throw DataError("--rig names the radars' scans itself: drop --sequence, --bag and --gt");
+  }
+  if (!s.imu.empty() || !s.imu_topic.empty()) throw DataError("--rig: a rig's bag takes no IMU yet");
+  const Rig rig = ReadRig(s.rig);
+  std::string rig_out = s.rig_out;
+  if (rig_out.empty()) rig_out = (fs::path(s.out).parent_path() / fs::path(s.out).stem()).string() + ".rig.yaml";
+  std::vector<std::vector<RadarScan>> scans;
+  std::vector<RigBagRadar> radars;
+  Rig written = rig;
+  for (std::size_t r = 0; r < rig.radars.size(); ++r) {
+    try {
+      scans.push_back(LoadSequence(rig.radars[r].scans).scans);
+    } catch (const DataError& e) {
+      throw DataError("radar '" + rig.radars[r].name + "': " + e.what());
+    }
+    written.radars[r].scans = SequenceOptions();
+    written.radars[r].scans.bag = fs::relative(fs::absolute(s.out), fs::absolute(rig_out).parent_path()).string();
+    written.radars[r].scans.topic = "/" + rig.radars[r].name + "/points";
+  }
+  for (std::size_t r = 0; r < rig.radars.size(); ++r) {
+    radars.push_back({written.radars[r].scans.topic, rig.radars[r].name, &scans[r]});
+  }
+  WriteRigBag(s.out, format, radars, s.bag.mcap);
+  WriteRig(rig_out, written);
+  std::size_t count = 0;
+  for (const auto& radar_scans : scans) count += radar_scans.size();
+  std::printf("wrote %s: %zu scans of %zu radars on /<radar>/points; %s reads it\n", s.out.c_str(), count,
+              rig.radars.size(), rig_out.c_str());
+  return 0;
+}
+
 int RunConvert(ConvertSettings s) {
   const BagFormat format = FormatOf(s);
   if (!s.imu.empty() && !s.imu_topic.empty()) throw DataError("--imu and --imu-topic: give one");
@@ -45,6 +85,8 @@ int RunConvert(ConvertSettings s) {
                            : s.compression == "none" ? McapCompression::kNone
                                                      : McapCompression::kZstd;
   s.bag.mcap.chunked = !s.unchunked;
+  if (!s.rig.empty()) return RunRigConvert(s, format);
+  if (!s.rig_out.empty()) throw DataError("--rig-out needs --rig");
   // The topics written, checked before anything is read.
   CheckBagTopics(
       {{"--scan-topic", s.bag.scan_topic}, {"--imu-topic-out", s.bag.imu_topic}, {"--pose-topic", s.bag.pose_topic}});
@@ -89,6 +131,10 @@ Subcommand AddConvert(CLI::App& parent) {
   auto s = std::make_shared<ConvertSettings>();
   CLI::App* app = parent.add_subcommand("convert", "Write a sequence (scans, IMU, reference) as a ROS 2 bag");
   AddSequenceOptions(app, s->sequence);
+  app->add_option("--rig", s->rig,
+                  "Rig file (docs/design/rig.md): every radar's scans to one bag, /<radar>/points each, instead of "
+                  "--sequence");
+  app->add_option("--rig-out", s->rig_out, "With --rig: the rig file that reads the bag (default: --out as .rig.yaml)");
   app->add_option("--imu", s->imu, "IMU file of lines 'stamp wx wy wz ax ay az' to include");
   app->add_option("--imu-topic", s->imu_topic, "sensor_msgs/Imu topic of --bag to include");
   app->add_option("--imu-stamps", s->imu_stamps, "Stamp the IMU by its header or by the bag's record time")

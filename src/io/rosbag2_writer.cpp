@@ -2,12 +2,14 @@
 // Writing ROS 2 bags (.mcap, .db3): Ros2BagWriter over one writer per format, and WriteRos2Bag.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <tuple>
 
 #include "radargauss/core/atomic_file.hpp"
 #include "radargauss/core/error.hpp"
@@ -218,6 +220,35 @@ void WriteRos2Bag(const std::string& path, BagFormat format, const std::vector<R
     if (pose) writer.Write(pose_topic, at, EncodeRos2PoseStamped({scan.timestamp, options.world_frame}, *pose));
   }
   write_imu_until(std::numeric_limits<double>::infinity());
+  writer.Finish();
+}
+
+void WriteRigBag(const std::string& path, BagFormat format, const std::vector<RigBagRadar>& radars,
+                 const McapWriterOptions& mcap) {
+  std::vector<std::pair<std::string, std::string>> topics;
+  for (const RigBagRadar& radar : radars) topics.emplace_back("radar '" + radar.frame + "'s topic", radar.topic);
+  CheckBagTopics(topics);
+  // Every scan by its stamp, checked before the bag is begun.
+  std::vector<std::tuple<double, std::size_t, std::size_t>> order;  // stamp, radar, scan
+  for (std::size_t r = 0; r < radars.size(); ++r) {
+    for (std::size_t k = 0; k < radars[r].scans->size(); ++k) {
+      const double stamp = (*radars[r].scans)[k].timestamp;
+      if (!FitsRosTime(stamp)) {
+        throw DataError("radar '" + radars[r].frame + "', scan " + std::to_string(k) + ": stamp " +
+                        std::to_string(stamp) + " s does not fit ROS's time (0 to 2^31 s since 1970)");
+      }
+      order.emplace_back(stamp, r, k);
+    }
+  }
+  std::stable_sort(order.begin(), order.end());
+  Ros2BagWriter writer(path, format, mcap);
+  std::vector<int> ids;
+  for (const RigBagRadar& radar : radars) ids.push_back(writer.AddTopic(radar.topic, "sensor_msgs/msg/PointCloud2"));
+  for (const auto& [stamp, r, k] : order) {
+    const RadarScan& scan = (*radars[r].scans)[k];
+    writer.Write(ids[r], StampNanoseconds(stamp),
+                 EncodeRos2PointCloud2({stamp, radars[r].frame}, EncodePointCloud2(scan)));
+  }
   writer.Finish();
 }
 

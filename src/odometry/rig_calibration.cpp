@@ -222,6 +222,51 @@ Eigen::Matrix<double, 7, 1> TangentStd(ceres::Problem& problem, RadarBlocks& blo
   return std;
 }
 
+// A round's residuals: their ids and scans (for the clustered deviations)
+// and how many of each kind.
+struct RoundResiduals {
+  std::vector<ceres::ResidualBlockId> ids;
+  std::vector<std::size_t> scan_of;
+  std::size_t doppler = 0, map = 0;
+};
+
+// Scan s's used points into `problem`: each one's Doppler and, with the map,
+// its position against the Gaussian it meets.
+void AddScanResiduals(const RadarScan& scan, std::size_t s, const std::vector<std::size_t>& used, double t,
+                      const ReferenceTrack& track, const ReferenceMap& map, bool with_map,
+                      const RigCalibrationOptions& options, RadarBlocks& blocks, ceres::Problem& problem,
+                      RoundResiduals& out) {
+  const SE3d extrinsic(SO3d::FromXyzw(blocks.rotation.data()), blocks.translation);
+  const ReferenceMotion motion = track.Motion(t);
+  const SE3d world_from_reference = track.Pose(t);
+  const SE3d reference_from_world = world_from_reference.Inverse();
+  for (const std::size_t i : used) {
+    const RadarPoint& point = scan.points[i];
+    out.ids.push_back(problem.AddResidualBlock(
+        new RigDopplerCostFunction(point.position, point.doppler, motion, 1.0 / options.doppler_std),
+        new ceres::HuberLoss(options.loss_scale), blocks.rotation.data(), blocks.translation.data(),
+        &blocks.clock_change));
+    out.scan_of.push_back(s);
+    ++out.doppler;
+    if (options.map_weight <= 0.0 || !with_map) continue;
+    const int g = map.index.Associate(world_from_reference * (extrinsic * point.position),
+                                      options.association_gate * options.association_gate);
+    if (g < 0 || t < map.first_seen[std::size_t(g)] - options.map_max_age ||
+        t > map.last_seen[std::size_t(g)] + options.map_max_age) {
+      continue;
+    }
+    // The Gaussian in the reference's frame at the scan's time: mean T^-1 mu, sqrt information L^T R.
+    out.ids.push_back(problem.AddResidualBlock(
+        new RigPointCostFunction(point.position, reference_from_world * map.index.Mean(std::size_t(g)),
+                                 map.index.SqrtInformationT(std::size_t(g)) * world_from_reference.rotation().Matrix(),
+                                 motion),
+        new ceres::ScaledLoss(new ceres::HuberLoss(options.loss_scale), options.map_weight, ceres::TAKE_OWNERSHIP),
+        blocks.rotation.data(), blocks.translation.data(), &blocks.clock_change));
+    out.scan_of.push_back(s);
+    ++out.map;
+  }
+}
+
 // One radar's extrinsic and clock offset, refined in rounds.
 RadarCalibration CalibrateRadar(const RigRadar& radar, const SE3d& reference_from_radar,
                                 const std::vector<RadarScan>& scans, const ReferenceTrack& track,
@@ -239,7 +284,7 @@ RadarCalibration CalibrateRadar(const RigRadar& radar, const SE3d& reference_fro
   }
   if (out.scans == 0) throw DataError("radar '" + radar.name + "': no scan within the reference radar's drive");
   SO3Manifold so3;
-  Eigen::Matrix<double, 7, 1> std;
+  Eigen::Matrix<double, 7, 1> std = Eigen::Matrix<double, 7, 1>::Zero();
   for (int round = 0; round < options.rounds; ++round) {
     // Coarse to fine: the rotation from the Doppler first (its strongest
     // signal), then the translation with the map, then the clock.
@@ -251,42 +296,14 @@ RadarCalibration CalibrateRadar(const RigRadar& radar, const SE3d& reference_fro
     problem.AddParameterBlock(blocks.rotation.data(), 4, &so3);
     problem.AddParameterBlock(blocks.translation.data(), 3);
     problem.AddParameterBlock(&blocks.clock_change, 1);
-    const SE3d extrinsic(SO3d::FromXyzw(blocks.rotation.data()), blocks.translation);
-    out.doppler_points = out.map_points = 0;
-    std::vector<ceres::ResidualBlockId> residuals;
-    std::vector<std::size_t> scan_of;
+    RoundResiduals residuals;
     for (std::size_t s = 0; s < scans.size(); ++s) {
       const double t = scans[s].timestamp - clock_offset;
       if (used[s].empty() || !track.Covers(t)) continue;
-      const ReferenceMotion motion = track.Motion(t);
-      const SE3d world_from_reference = track.Pose(t);
-      const SE3d reference_from_world = world_from_reference.Inverse();
-      for (const std::size_t i : used[s]) {
-        const RadarPoint& point = scans[s].points[i];
-        residuals.push_back(problem.AddResidualBlock(
-            new RigDopplerCostFunction(point.position, point.doppler, motion, 1.0 / options.doppler_std),
-            new ceres::HuberLoss(options.loss_scale), blocks.rotation.data(), blocks.translation.data(),
-            &blocks.clock_change));
-        scan_of.push_back(s);
-        ++out.doppler_points;
-        if (options.map_weight <= 0.0 || !with_map) continue;
-        const int g = map.index.Associate(world_from_reference * (extrinsic * point.position),
-                                          options.association_gate * options.association_gate);
-        if (g < 0 || t < map.first_seen[std::size_t(g)] - options.map_max_age ||
-            t > map.last_seen[std::size_t(g)] + options.map_max_age) {
-          continue;
-        }
-        // The Gaussian in the reference's frame at the scan's time: mean T^-1 mu, sqrt information L^T R.
-        residuals.push_back(problem.AddResidualBlock(
-            new RigPointCostFunction(
-                point.position, reference_from_world * map.index.Mean(std::size_t(g)),
-                map.index.SqrtInformationT(std::size_t(g)) * world_from_reference.rotation().Matrix(), motion),
-            new ceres::ScaledLoss(new ceres::HuberLoss(options.loss_scale), options.map_weight, ceres::TAKE_OWNERSHIP),
-            blocks.rotation.data(), blocks.translation.data(), &blocks.clock_change));
-        scan_of.push_back(s);
-        ++out.map_points;
-      }
+      AddScanResiduals(scans[s], s, used[s], t, track, map, with_map, options, blocks, problem, residuals);
     }
+    out.doppler_points = residuals.doppler;
+    out.map_points = residuals.map;
     if (!options.estimate_rotation) problem.SetParameterBlockConstant(blocks.rotation.data());
     if (!options.estimate_translation || !with_map) problem.SetParameterBlockConstant(blocks.translation.data());
     if (!options.estimate_clock_offset || !with_clock) problem.SetParameterBlockConstant(&blocks.clock_change);
@@ -296,20 +313,15 @@ RadarCalibration CalibrateRadar(const RigRadar& radar, const SE3d& reference_fro
     solver.num_threads = 1;
     ceres::Solver::Summary summary;
     ceres::Solve(solver, &problem, &summary);
-    std = TangentStd(problem, blocks, residuals, scan_of, options.min_relative_eigenvalue);
-    out.rms_doppler = options.doppler_std * std::sqrt(2.0 * summary.final_cost /
-                                                      std::max<std::size_t>(1, out.doppler_points + out.map_points));
+    std = TangentStd(problem, blocks, residuals.ids, residuals.scan_of, options.min_relative_eigenvalue);
     clock_offset += blocks.clock_change;
     blocks.clock_change = 0.0;
   }
   out.body_from_radar = SE3d(SO3d::FromXyzw(blocks.rotation.data()), blocks.translation);  // T_ref_radar for now
   out.clock_offset = clock_offset;
-  out.rotation_std = std.head<3>();
-  out.translation_std = std.segment<3>(3);
-  out.clock_offset_std = std(6);
-  if (!options.estimate_rotation) out.rotation_std.setZero();
-  if (!options.estimate_translation) out.translation_std.setZero();
-  if (!options.estimate_clock_offset) out.clock_offset_std = 0.0;
+  out.rotation_std = options.estimate_rotation ? Eigen::Vector3d(std.head<3>()) : Eigen::Vector3d::Zero();
+  out.translation_std = options.estimate_translation ? Eigen::Vector3d(std.segment<3>(3)) : Eigen::Vector3d::Zero();
+  out.clock_offset_std = options.estimate_clock_offset ? std(6) : 0.0;
   return out;
 }
 

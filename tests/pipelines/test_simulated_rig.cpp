@@ -265,8 +265,7 @@ TEST(RigOdometry, AnOlderScanIsMovedToTheFramesStamp) {
       worst = std::max(worst, (frame.points[i].position - front_at_stamp.Inverse() * world[i]).norm());
       EXPECT_LT((frame.points[world.size() + i].position - front_at_stamp.Inverse() * world[i]).norm(), 1e-9);
     }
-    if (move) EXPECT_LT(worst, 1e-9);
-    if (!move) EXPECT_NEAR(worst, 0.5, 1e-9);
+    EXPECT_NEAR(worst, move ? 0.0 : 0.5, 1e-9);
   }
 }
 

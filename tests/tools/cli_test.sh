@@ -230,6 +230,15 @@ expect_ok "odometry on a rig" "rig: 2 radars, 20 scans in 10 frames" -- \
 expect_fail "odometry on a rig with an IMU" "takes no IMU yet" -- \
   "$tool" odometry --rig "$work/rig.yaml" --imu "$work/seq10/gt_radar_tum.txt" --out "$work/rig_imu"
 [[ ! -e "$work/rig_imu" ]] || { echo "FAIL: a refused rig run left $work/rig_imu"; failed=1; }
+expect_ok "a rig to one bag" "20 scans of 2 radars" -- "$tool" convert --rig "$work/rig.yaml" --out "$work/rig_bag.mcap"
+expect_ok "the bag's rig file" "rear: 10 scans (rosbag)" -- "$tool" info --rig "$work/rig_bag.rig.yaml"
+expect_ok "odometry on the bag's rig" "rig: 2 radars" -- \
+  "$tool" odometry --rig "$work/rig_bag.rig.yaml" --out "$work/rig_bag_odometry"
+cmp -s "$work/rig_odometry/body.tum" "$work/rig_bag_odometry/body.tum" || {
+  echo "FAIL: odometry on the rig's bag differs from odometry on its folders"; failed=1; }
+expect_fail "a rig and a sequence to convert" "drop --sequence" -- \
+  "$tool" convert --rig "$work/rig.yaml" --sequence "$work/seq10" --out "$work/rig_seq.mcap"
+[[ ! -e "$work/rig_seq.mcap" ]] || { echo "FAIL: a refused rig conversion left its bag"; failed=1; }
 expect_ok "calibrate a rig" "wrote .*calibrated" -- \
   "$tool" calibrate --rig "$work/rig.yaml" --compare "$work/rig.yaml" --out "$work/calibrated"
 [[ -s "$work/calibrated/rig.yaml" && -s "$work/calibrated/calibration.json" ]] || {

@@ -52,6 +52,19 @@ struct BagExportOptions {
 void WriteRos2Bag(const std::string& path, BagFormat format, const std::vector<RadarScan>& scans,
                   const std::vector<ImuSample>& imu, const Trajectory* reference, const BagExportOptions& options = {});
 
+// A rig's radars as one ROS 2 bag (`radargauss convert --rig`): each
+// radar's scans as sensor_msgs/msg/PointCloud2 on its topic, with its frame
+// id, stamped on its own clock; all radars' messages in one order of their
+// stamps (a tie: the radar listed first). Throws DataError, before anything
+// is written, as WriteRos2Bag does.
+struct RigBagRadar {
+  std::string topic;
+  std::string frame;
+  const std::vector<RadarScan>* scans = nullptr;
+};
+void WriteRigBag(const std::string& path, BagFormat format, const std::vector<RigBagRadar>& radars,
+                 const McapWriterOptions& mcap = {});
+
 // Empty when `name` is a topic name ROS accepts: '/' then parts of letters,
 // digits and '_' that do not start with a digit, separated by single '/';
 // otherwise why not.

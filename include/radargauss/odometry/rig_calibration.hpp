@@ -67,7 +67,6 @@ struct RadarCalibration {
   std::size_t scans = 0;           // scans within the reference's drive
   std::size_t doppler_points = 0;  // residuals of the last round
   std::size_t map_points = 0;
-  double rms_doppler = 0.0;  // m/s, over the last round's inliers of the loss
 };
 
 struct RigCalibration {
