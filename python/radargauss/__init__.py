@@ -15,15 +15,16 @@ and relocalization_options read them back).
 Every function's help() lists its arguments; docs/python.md tells the rest.
 """
 from ._radargauss import (DataError, GaussianMap, MatchResult, RadarInertialOdometry, RadarOdometry, RadarSlam,
-                          Relocalizer, Scan, Sequence, build_map, compose, estimate_rig_twist,
+                          Relocalizer, Scan, Sequence, build_map, calibrate_rig, compose, estimate_rig_twist,
                           evaluate, initial_errors, match, match_options, odometry_options, option_fields,
                           pose_matrices, pose_matrix, read_bag_poses, read_bag_topics, read_imu, read_map, read_pcd,
-                          read_rig, read_sequence, read_tum, relocalization_options, set_threads, simulate, slam_options,
-                          write_map, write_run_mcap, write_tum)
+                          read_rig, read_sequence, read_tum, relocalization_options, rig_odometry, set_threads,
+                          simulate, slam_options, write_map, write_run_mcap, write_tum)
 from .sweep import Task, plan, run_task, sweep
 
-__all__ = ["DataError", "GaussianMap", "MatchResult", "RadarInertialOdometry", "RadarOdometry", "RadarSlam", "Relocalizer", "Scan", "Sequence", "build_map", "compose",
+__all__ = ["DataError", "GaussianMap", "MatchResult", "RadarInertialOdometry", "RadarOdometry", "RadarSlam", "Relocalizer", "Scan", "Sequence", "build_map", "calibrate_rig", "compose",
            "estimate_rig_twist", "evaluate", "initial_errors", "match", "match_options", "odometry_options", "option_fields",
            "pose_matrices", "pose_matrix", "read_bag_poses", "read_bag_topics", "read_imu", "read_map", "read_pcd",
-           "read_rig", "read_sequence", "read_tum", "relocalization_options", "set_threads", "simulate", "slam_options",
+           "read_rig", "read_sequence", "read_tum", "relocalization_options", "rig_odometry", "set_threads", "simulate",
+           "slam_options",
            "write_map", "write_run_mcap", "write_tum", "Task", "plan", "run_task", "sweep"]

@@ -381,6 +381,9 @@ class Sequence:
 def build_map(scans: Any, poses: Any = None, builder: str = 'kmeans', points_per_gaussian: float = 4.0, min_std: float = 0.05, incidence: str = 'offset', max_degree: int = 3, doppler_filter: bool = True) -> GaussianMap:
     """The map of `radargauss build-map`: from a Sequence with poses, or from a list of Scans and their poses T_world_radar (4x4 or [x y z qx qy qz qw]). builder: kmeans or voxel; incidence: offset, view or none."""
 
+def calibrate_rig(path: str, **kwargs) -> dict:
+    """Each radar's extrinsic and clock offset of a rig file against its first radar, over its drive (docs/design/rig.md, "Calibration of a rig"). A dict: rig (the radars as read_rig gives them, calibrated) and radars (per radar: name, body_from_radar, clock_offset, rotation_std (rad), translation_std (m), clock_offset_std (s), inf where unobserved; scans, doppler_points, map_points)."""
+
 def compose(a: Any, b: Any) -> numpy.ndarray:
     """The rigid transform a * b as [x y z qx qy qz qw]."""
 
@@ -437,6 +440,9 @@ def read_tum(path: str) -> tuple:
 
 def relocalization_options(**options: Unpack[RelocalizationOptions]) -> dict:
     """Every option of Relocalizer, the given keywords set (checked), as a dict."""
+
+def rig_odometry(path: str, **kwargs) -> dict:
+    """The body's odometry from a rig file's radars (docs/design/rig.md, "Odometry on a rig"). A dict: trajectory ((stamps (N,), poses (N, 7)) of T_world_body), frame_radars (each frame's radars), velocity_measured, rig_velocity_measured (frames)."""
 
 def set_threads(threads: int) -> None:
     """Worker threads of the parallel stages (0: all cores), as the tool's --threads."""

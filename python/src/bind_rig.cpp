@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Radar rigs in Python (docs/design/rig.md): the rig file and the rig's
-// twist from its radars' Doppler.
+// Radar rigs in Python (docs/design/rig.md): the rig file, the rig's twist
+// from its radars' Doppler, odometry on a rig and its calibration.
 #include <pybind11/stl.h>
 
 #include <string>
@@ -9,8 +9,11 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "option_fields.hpp"
+#include "radargauss/core/error.hpp"
 #include "radargauss/core/rig_twist.hpp"
 #include "radargauss/io/rig.hpp"
+#include "radargauss/odometry/rig_calibration.hpp"
+#include "radargauss/odometry/rig_odometry.hpp"
 
 namespace radargauss::python {
 
@@ -42,9 +45,96 @@ py::dict TwistToDict(const RigTwist& twist) {
   return d;
 }
 
+py::dict CalibrationToDict(const RigCalibration& calibration) {
+  py::list rig, radars;
+  for (const RigRadar& radar : calibration.rig.radars) rig.append(RadarToDict(radar));
+  for (const RadarCalibration& c : calibration.radars) {
+    py::dict d;
+    d["name"] = c.name;
+    d["body_from_radar"] = PoseToMatrix(c.body_from_radar);
+    d["clock_offset"] = c.clock_offset;
+    d["rotation_std"] = MatrixToArray<3, 1>(c.rotation_std);
+    d["translation_std"] = MatrixToArray<3, 1>(c.translation_std);
+    d["clock_offset_std"] = c.clock_offset_std;
+    d["scans"] = c.scans;
+    d["doppler_points"] = c.doppler_points;
+    d["map_points"] = c.map_points;
+    radars.append(d);
+  }
+  py::dict out;
+  out["rig"] = rig;
+  out["radars"] = radars;
+  return out;
+}
+
+// The radars' scans of a rig file, each radar's as read (stamps on its clock).
+std::vector<std::vector<RadarScan>> RigScans(const Rig& rig) {
+  std::vector<std::vector<RadarScan>> scans;
+  for (const RigRadar& radar : rig.radars) {
+    try {
+      scans.push_back(LoadSequence(radar.scans).scans);
+    } catch (const DataError& e) {
+      throw DataError("radar '" + radar.name + "': " + e.what());
+    }
+  }
+  return scans;
+}
+
+void BindRigRuns(py::module_& m) {
+  m.def(
+      "rig_odometry",
+      [](const std::string& path, const py::kwargs& kwargs) {
+        const OdometryOptions options = OptionsFrom(OdometryOptionTable(), kwargs);
+        ValidateOptions(options);  // std::invalid_argument: ValueError
+        const Rig rig = ReadRig(path);
+        std::vector<SE3d> mountings;
+        for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
+        RigOdometry odometry(mountings, options);
+        {
+          py::gil_scoped_release release;
+          ForEachRigScan(
+              rig, [&](std::size_t radar, RadarScan& scan, const std::string&) { odometry.Register(radar, scan); });
+          odometry.Finish();
+        }
+        py::dict out;
+        out["trajectory"] = TrajectoryToArrays(odometry.trajectory());
+        out["frame_radars"] = py::cast(odometry.frame_radars());
+        out["velocity_measured"] = odometry.velocity_measured();
+        out["rig_velocity_measured"] = odometry.rig_velocity_measured();
+        return out;
+      },
+      py::arg("path"),
+      "The body's odometry from a rig file's radars (docs/design/rig.md, \"Odometry on a rig\"). A dict: "
+      "trajectory ((stamps (N,), poses (N, 7)) of T_world_body), frame_radars (each frame's radars), "
+      "velocity_measured, rig_velocity_measured (frames).\n\nKeywords: RadarOdometry's (odometry_options)");
+  m.def(
+      "calibrate_rig",
+      [](const std::string& path, const py::kwargs& kwargs) {
+        RigCalibrationOptions options = OptionsFrom(RigCalibrationOptionTable(), kwargs);
+        ValidateOptions(options);
+        const Rig rig = ReadRig(path);
+        const std::vector<std::vector<RadarScan>> scans = RigScans(rig);
+        RigCalibration calibration;
+        {
+          py::gil_scoped_release release;
+          calibration = CalibrateRig(rig, scans, options);
+        }
+        return CalibrationToDict(calibration);
+      },
+      py::arg("path"),
+      ("Each radar's extrinsic and clock offset of a rig file against its first radar, over its drive "
+       "(docs/design/rig.md, \"Calibration of a rig\"). A dict: rig (the radars as read_rig gives them, "
+       "calibrated) and radars (per radar: name, body_from_radar, clock_offset, rotation_std (rad), "
+       "translation_std (m), clock_offset_std (s), inf where unobserved; scans, doppler_points, map_points)."
+       "\n\nKeywords:\n" +
+       ParametersDoc(RigCalibrationOptionTable()))
+          .c_str());
+}
+
 }  // namespace
 
 void BindRig(py::module_& m) {
+  BindRigRuns(m);
   m.def(
       "read_rig",
       [](const std::string& path) {
