@@ -23,8 +23,12 @@ odometry against its own reference): ATE, RPE (and its ratio to the rig's
 best radar alone), the median time per scan (a rig: per frame, against
 its radars' medians as many as a frame holds) and the run's wall time.
 
+Table 3, SLAM on a rig (`radargauss slam --rig --no-map`): table 2's rigs
+over the two-lap route, against the body's reference: ATE, RPE, loops,
+the odometry's ATE and the wall time (two threads).
+
     scripts/rig_table.py [--tool build/release/bin/radargauss] [--work /tmp/rig_table] [--scans 300]
-                         [--tables 1,2]
+                         [--tables 1,2,3]
 
 The module is found beside the tool (build/release/python).
 """
@@ -167,12 +171,47 @@ def odometry_table(tool, work):
                   f"{row[5]:.2f} ({row[5] / wall_alone:.2f}x its radars') |")
 
 
+def slam_table(tool, work):
+    """SLAM on the two-lap route's rigs (table 2's radars), against the front radar's SLAM."""
+    world, config, scans = ODOMETRY_WORLDS[2]
+    rig_dir = os.path.join(work, "rig_two_lap")
+    if not os.path.exists(os.path.join(rig_dir, "rig.yaml")):
+        os.makedirs(work, exist_ok=True)
+        with open(rig_dir + ".yaml", "w") as f:
+            f.write(odometry_rig_config(config, scans))
+        subprocess.run([tool, "simulate", "--rig-config", rig_dir + ".yaml", "--out", rig_dir, "--force"], check=True,
+                       stdout=subprocess.DEVNULL)
+    text = open(os.path.join(rig_dir, "rig.yaml")).read()
+    head, *radars = text.split("  - name:")
+    by_name = {r.split("\n")[0].strip().strip('"'): "  - name:" + r for r in radars}
+    print("| rig | ATE m | RPE t % | horizontal % | loops | odometry ATE m | wall s |")
+    print("|---|---|---|---|---|---|---|")
+    for label, names in ODOMETRY_RIGS:
+        rig_file = os.path.join(rig_dir, "rig_" + "_".join(names) + ".yaml")
+        with open(rig_file, "w") as f:
+            f.write(head + "".join(by_name[n] for n in names))
+        out = os.path.join(work, "slam_" + "_".join(names))
+        subprocess.run(["rm", "-rf", out], check=True)
+        start = time.perf_counter()
+        result = subprocess.run([tool, "slam", "--rig", rig_file, "--gt", os.path.join(rig_dir, "gt_body_tum.txt"),
+                                 "--no-map", "--out", out], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        wall = time.perf_counter() - start
+        if result.returncode != 0:
+            sys.exit(f"rig_table: slam --rig {rig_file} failed: {result.stderr.strip()}")
+        evaluation = json.load(open(os.path.join(out, "evaluation.json")))
+        odometry = json.load(open(os.path.join(out, "odometry", "evaluation.json")))
+        loops = re.search(r"([0-9]+) loops", result.stdout).group(1)
+        print(f"| {label} | {evaluation['ate_translation_m']['rmse']:.3f} | "
+              f"{evaluation['rpe']['translation_percent']:.3f} | {evaluation['rpe']['horizontal_percent']:.3f} | "
+              f"{loops} | {odometry['ate_translation_m']['rmse']:.3f} | {wall:.1f} |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--tool", default=os.path.join(ROOT, "build/release/bin/radargauss"))
     parser.add_argument("--work", default="/tmp/rig_table")
     parser.add_argument("--scans", type=int, default=300)
-    parser.add_argument("--tables", default="1,2")
+    parser.add_argument("--tables", default="1,2,3")
     args = parser.parse_args()
     tables = args.tables.split(",")
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(args.tool))), "python"))
@@ -180,8 +219,10 @@ def main():
 
     if "2" in tables:
         odometry_table(args.tool, args.work)
-        if "1" in tables:
-            print()
+        print()
+    if "3" in tables:
+        slam_table(args.tool, args.work)
+        print()
     if "1" not in tables:
         return
     print("| world | rig | scans | rank | observed error median | under 0.1 | velocity RMSE m/s "

@@ -18,7 +18,8 @@ RUN_FLAGS = {"--help", "--sequence", "--gt", "--extrinsic", "--bag", "--topic", 
 IMU_FLAGS = {"--imu", "--imu-extrinsic", "--imu-topic", "--imu-stamps", "--imu-rotation"}
 # command, the option tables its flags come from, its own flags.
 COMMANDS = [("odometry", ("odometry", "radar_inertial"), {"--matcher", "--rig"} | IMU_FLAGS),
-            ("slam", ("slam", "radar_inertial"), {"--no-map", "--map-tiles", "--false-loop-rate", "--false-loop-seed"} | IMU_FLAGS),
+            ("slam", ("slam", "radar_inertial"), {"--no-map", "--map-tiles", "--false-loop-rate", "--false-loop-seed", "--rig"}
+             | IMU_FLAGS),
             ("relocalize", ("relocalization",), {"--map", "--w-rcs-from-map"})]
 
 pytestmark = pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool")

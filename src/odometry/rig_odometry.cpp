@@ -42,25 +42,22 @@ const OptionTable<RigOdometryOptions>& RigOdometryOptionTable() {
   return table;
 }
 
-RigOdometry::RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options)
+RigFrames::RigFrames(std::vector<SE3d> body_from_radar, const OdometryOptions& options)
     : body_from_radar_(std::move(body_from_radar)),
       doppler_(options.ego_velocity),
-      rig_options_(options.rig),
-      odometry_(options) {
+      gate_(options),
+      rig_options_(options.rig) {
   if (body_from_radar_.empty()) throw DataError("a rig's odometry needs a radar");
+  CheckOptions(RigOdometryOptionTable(), rig_options_);
   const SE3d reference_from_body = body_from_radar_.front().Inverse();
   for (const SE3d& mounting : body_from_radar_) reference_from_radar_.push_back(reference_from_body * mounting);
 }
 
-void RigOdometry::Register(std::size_t radar, const RadarScan& scan) {
+std::optional<RigFrame> RigFrames::Add(std::size_t radar, const RadarScan& scan) {
   if (radar >= body_from_radar_.size()) {
     throw DataError("radar " + std::to_string(radar) + " of a rig of " + std::to_string(body_from_radar_.size()));
   }
-  if (body_from_radar_.size() == 1) {  // the single-radar odometry
-    odometry_.Register(scan);
-    frame_radars_.push_back({radar});
-    return;
-  }
+  std::optional<RigFrame> closed;
   if (last_stamp_ && !(scan.timestamp >= *last_stamp_)) {
     throw DataError("a rig's scans must come in time order: " + std::to_string(scan.timestamp) + " s after " +
                     std::to_string(*last_stamp_) + " s");
@@ -69,29 +66,36 @@ void RigOdometry::Register(std::size_t radar, const RadarScan& scan) {
   // The frame closes after its reference scan's instant, or before a scan that would stretch it too far.
   if (!pending_.empty() && ((closing_stamp_ && scan.timestamp > *closing_stamp_) ||
                             scan.timestamp - pending_.front().timestamp > rig_options_.max_frame_span)) {
-    RegisterPending();
+    closed = Close();
   }
   last_stamp_ = scan.timestamp;
   pending_.push_back(scan);
   pending_radars_.push_back(radar);
   if (radar == 0) closing_stamp_ = scan.timestamp;
+  return closed;
 }
 
-void RigOdometry::Finish() {
-  if (!pending_.empty()) RegisterPending();
+std::optional<RigFrame> RigFrames::Finish() {
+  if (pending_.empty()) return std::nullopt;
+  return Close();
 }
 
-Eigen::Matrix<double, 6, 1> RigOdometry::LastTwist() const {
-  const std::size_t n = frame_stamps_.size();
-  if (n < 2) return Eigen::Matrix<double, 6, 1>::Zero();
-  const SE3d motion = odometry_.pose(n - 2).Inverse() * odometry_.pose(n - 1);
-  return motion.Log() / (frame_stamps_[n - 1] - frame_stamps_[n - 2]);
+void RigFrames::Registered(double stamp, const SE3d& pose) {
+  registered_.emplace_back(stamp, pose);
+  if (registered_.size() > 2) registered_.erase(registered_.begin());
 }
 
-std::optional<VelocityGate> RigOdometry::Gate(double stamp) const {
+Eigen::Matrix<double, 6, 1> RigFrames::LastTwist() const {
+  if (registered_.size() < 2) return Eigen::Matrix<double, 6, 1>::Zero();
+  const auto& [before, from] = registered_.front();
+  const auto& [after, to] = registered_.back();
+  return (from.Inverse() * to).Log() / (after - before);
+}
+
+std::optional<VelocityGate> RigFrames::Gate(double stamp) const {
   // Around the last measured velocity, as the single-radar odometry's.
   if (!last_measured_) return std::nullopt;
-  const OdometryOptions& o = odometry_.options();
+  const GateOptions& o = gate_;
   const double dt = stamp - last_measured_->stamp;
   const double spread =
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(last_measured_->velocity.covariance).eigenvalues().maxCoeff();
@@ -100,7 +104,7 @@ std::optional<VelocityGate> RigOdometry::Gate(double stamp) const {
       std::max(o.min_gate, o.gate_sigmas * std::sqrt(std::max(spread, 0.0) + std::pow(o.acceleration_std * dt, 2)))};
 }
 
-RigOdometry::FrameVelocity RigOdometry::MeasureVelocity(const std::optional<VelocityGate>& gate) const {
+RigFrames::FrameVelocity RigFrames::MeasureVelocity(const std::optional<VelocityGate>& gate) const {
   FrameVelocity out;
   out.twist = LastTwist();
   out.static_points.resize(pending_.size());
@@ -164,8 +168,8 @@ RigOdometry::FrameVelocity RigOdometry::MeasureVelocity(const std::optional<Velo
   return out;
 }
 
-std::vector<bool> RigOdometry::OwnStaticPoints(std::size_t k, const std::optional<VelocityGate>& gate,
-                                               const FrameVelocity& frame) const {
+std::vector<bool> RigFrames::OwnStaticPoints(std::size_t k, const std::optional<VelocityGate>& gate,
+                                             const FrameVelocity& frame) const {
   // The radar's own Doppler filter, gated around the velocity the frame's twist gives it.
   const RadarScan& scan = pending_[k];
   std::vector<bool> keep(scan.points.size(), !scan.has_doppler);
@@ -182,7 +186,7 @@ std::vector<bool> RigOdometry::OwnStaticPoints(std::size_t k, const std::optiona
   return keep;
 }
 
-void RigOdometry::RegisterPending() {
+RigFrame RigFrames::Close() {
   const auto start = std::chrono::steady_clock::now();
   const double stamp = closing_stamp_.value_or(pending_.back().timestamp);
   const FrameVelocity velocity = MeasureVelocity(Gate(stamp));
@@ -206,28 +210,55 @@ void RigOdometry::RegisterPending() {
       frame.points.push_back(point);
     }
   }
-  velocity_measured_ += velocity.measured.has_value();
-  rig_velocity_measured_ += velocity.by_rig;
   if (velocity.measured) last_measured_ = MeasuredAt{stamp, *velocity.measured};
-  odometry_.Register(frame, velocity.measured);
-  last_frame_ = std::move(frame);
-  frame_times_ms_.push_back(
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  frame_stamps_.push_back(stamp);
-  frame_radars_.push_back(std::move(pending_radars_));
+  RigFrame out{std::move(frame), velocity.measured, velocity.by_rig, std::move(pending_radars_),
+               std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()};
   pending_radars_.clear();
   pending_.clear();
   closing_stamp_.reset();
+  return out;
+}
+
+RigOdometry::RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options)
+    : frames_(std::move(body_from_radar), options), odometry_(options) {}
+
+void RigOdometry::Register(std::size_t radar, const RadarScan& scan) {
+  if (frames_.radars() == 1) {  // the single-radar odometry
+    if (radar != 0) throw DataError("radar " + std::to_string(radar) + " of a rig of 1");
+    odometry_.Register(scan);
+    frame_radars_.push_back({radar});
+    return;
+  }
+  if (std::optional<RigFrame> frame = frames_.Add(radar, scan)) RegisterFrame(std::move(*frame));
+}
+
+void RigOdometry::Finish() {
+  if (frames_.radars() == 1) return;
+  if (std::optional<RigFrame> frame = frames_.Finish()) RegisterFrame(std::move(*frame));
+}
+
+void RigOdometry::RegisterFrame(RigFrame frame) {
+  const auto start = std::chrono::steady_clock::now();
+  odometry_.Register(frame.scan, frame.velocity);
+  frames_.Registered(frame.scan.timestamp, odometry_.pose(odometry_.scans() - 1));
+  velocity_measured_ += frame.velocity.has_value();
+  rig_velocity_measured_ += frame.velocity_by_rig;
+  frame_radars_.push_back(std::move(frame.radars));
+  frame_times_ms_.push_back(
+      frame.build_ms + std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  last_frame_ = std::move(frame.scan);
+}
+
+Trajectory BodyTrajectory(const Trajectory& reference, const SE3d& body_from_reference) {
+  Trajectory body;
+  for (const StampedPose& sample : reference) {
+    body.Append(sample.time, body_from_reference * sample.pose * body_from_reference.Inverse());
+  }
+  return body;
 }
 
 Trajectory RigOdometry::trajectory() const {
-  // The first radar's poses in its first frame, as the body's in the body's first frame.
-  const SE3d& mounting = body_from_radar_.front();
-  Trajectory body;
-  for (const StampedPose& sample : odometry_.trajectory()) {
-    body.Append(sample.time, mounting * sample.pose * mounting.Inverse());
-  }
-  return body;
+  return BodyTrajectory(odometry_.trajectory(), frames_.body_from_reference());
 }
 
 }  // namespace radargauss

@@ -118,10 +118,13 @@ RadarSlam::RadarSlam(const SlamOptions& options, const FalseLoopStudy& study, st
 
 RadarSlam::~RadarSlam() = default;
 
-const OdometryStep& RadarSlam::Register(const RadarScan& scan) {
+const OdometryStep& RadarSlam::Register(const RadarScan& scan) { return Register(scan, std::nullopt); }
+
+const OdometryStep& RadarSlam::Register(const RadarScan& scan,
+                                        const std::optional<RadarOdometry::MeasuredVelocity>& velocity) {
   const auto start = std::chrono::steady_clock::now();
   const std::size_t index = odometry_.scans();  // not steps(): it would wait for the map update behind the last
-  const OdometryStep& step = odometry_.Register(scan);
+  const OdometryStep& step = odometry_.Register(scan, velocity);
   ScanTime time;
   time.front_end_ms = MillisecondsSince(start);
   const auto back_end = std::chrono::steady_clock::now();

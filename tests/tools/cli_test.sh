@@ -239,6 +239,16 @@ cmp -s "$work/rig_odometry/body.tum" "$work/rig_bag_odometry/body.tum" || {
 expect_fail "a rig and a sequence to convert" "drop --sequence" -- \
   "$tool" convert --rig "$work/rig.yaml" --sequence "$work/seq10" --out "$work/rig_seq.mcap"
 [[ ! -e "$work/rig_seq.mcap" ]] || { echo "FAIL: a refused rig conversion left its bag"; failed=1; }
+expect_ok "slam on a rig" "rig: 2 radars, 20 scans in 10 frames" -- \
+  "$tool" slam --rig "$work/rig.yaml" --submap-distance 2 --out "$work/rig_slam"
+[[ -s "$work/rig_slam/body.tum" && -s "$work/rig_slam/map.rgm" ]] || { echo "FAIL: slam --rig wrote no body.tum or map"; failed=1; }
+printf 'radars:\n  - {name: front, sequence: seq10, extrinsic: [0, 0, 0, 0, 0, 0, 1]}\n' > "$work/rig_front.yaml"
+"$tool" slam --rig "$work/rig_front.yaml" --submap-distance 2 --out "$work/rig_slam_one" >/dev/null
+"$tool" slam --sequence "$work/seq10" --submap-distance 2 --out "$work/slam_one" >/dev/null
+cmp -s "$work/rig_slam_one/slam.tum" "$work/slam_one/slam.tum" || {
+  echo "FAIL: slam on a rig of one radar differs from slam on its sequence"; failed=1; }
+expect_fail "slam on a rig with an IMU" "takes no IMU yet" -- \
+  "$tool" slam --rig "$work/rig.yaml" --imu "$work/seq10/gt_radar_tum.txt" --out "$work/rig_slam_imu"
 expect_ok "calibrate a rig" "wrote .*calibrated" -- \
   "$tool" calibrate --rig "$work/rig.yaml" --compare "$work/rig.yaml" --out "$work/calibrated"
 [[ -s "$work/calibrated/rig.yaml" && -s "$work/calibrated/calibration.json" ]] || {

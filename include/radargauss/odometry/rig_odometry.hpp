@@ -24,6 +24,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "radargauss/core/trajectory.hpp"
@@ -32,12 +33,91 @@
 
 namespace radargauss {
 
+// One frame of a rig: every radar's static points in the reference radar's
+// frame at the frame's stamp (without Doppler), and its velocity when measured.
+struct RigFrame {
+  RadarScan scan;
+  std::optional<RadarOdometry::MeasuredVelocity> velocity;
+  bool velocity_by_rig = false;     // the rig's twist measured it (else the reference radar)
+  std::vector<std::size_t> radars;  // the radar of each scan in the frame
+  double build_ms = 0.0;            // its twist and its points moved
+};
+
+// A rig's scans made into frames, for any front end that registers them
+// (RigOdometry, RadarSlam): give each scan in the body's time order, register
+// each frame returned, and tell the frames where it was registered.
+class RigFrames {
+ public:
+  // Throws DataError for no radar, std::invalid_argument for a bad options.rig.
+  RigFrames(std::vector<SE3d> body_from_radar, const OdometryOptions& options);
+
+  // `scan` of radar `radar`, its timestamp on the body's clock (not before
+  // the last scan's); the frame it closed, if any. Throws DataError for an
+  // unknown radar, a stamp that goes back or a scan ValidateScan refuses.
+  std::optional<RigFrame> Add(std::size_t radar, const RadarScan& scan);
+  // The last frame, if scans are left.
+  std::optional<RigFrame> Finish();
+  // The pose T_world_ref a frame was registered at: the rotation rate that
+  // moves the next frames' scans comes from the last two.
+  void Registered(double stamp, const SE3d& pose);
+
+  std::size_t radars() const { return body_from_radar_.size(); }
+  const SE3d& body_from_reference() const { return body_from_radar_.front(); }
+  const std::vector<SE3d>& reference_from_radar() const { return reference_from_radar_; }
+
+ private:
+  // A frame's velocity: measured (by the rig's twist or the reference
+  // radar), each scan's static points, and the twist [v; w] that moves the
+  // scans to the frame's stamp (w: the last rotation rate).
+  struct FrameVelocity {
+    std::optional<RadarOdometry::MeasuredVelocity> measured;
+    bool by_rig = false;
+    std::vector<std::vector<bool>> static_points;
+    Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();
+  };
+  // The odometry's Doppler gate (OdometryOptions).
+  struct GateOptions {
+    explicit GateOptions(const OdometryOptions& o)
+        : gate_sigmas(o.gate_sigmas), acceleration_std(o.acceleration_std), min_gate(o.min_gate) {}
+    double gate_sigmas, acceleration_std, min_gate;
+  };
+  RigFrame Close();
+  std::optional<VelocityGate> Gate(double stamp) const;
+  FrameVelocity MeasureVelocity(const std::optional<VelocityGate>& gate) const;
+  // Scan k's static points by its radar's own Doppler filter.
+  std::vector<bool> OwnStaticPoints(std::size_t k, const std::optional<VelocityGate>& gate,
+                                    const FrameVelocity& frame) const;
+  // The reference radar's twist [v; w] (its frame) between the last two frames registered; zero before.
+  Eigen::Matrix<double, 6, 1> LastTwist() const;
+
+  std::vector<SE3d> body_from_radar_;
+  std::vector<SE3d> reference_from_radar_;
+  EgoVelocityOptions doppler_;
+  GateOptions gate_;
+  RigOdometryOptions rig_options_;  // options.rig
+  std::vector<RadarScan> pending_;  // the frame's scans, not yet closed
+  std::vector<std::size_t> pending_radars_;
+  std::optional<double> closing_stamp_;              // the reference radar's scan in the frame
+  std::optional<double> last_stamp_;                 // of the last scan added
+  std::vector<std::pair<double, SE3d>> registered_;  // the last two frames' stamps and poses
+  struct MeasuredAt {
+    double stamp = 0.0;
+    RadarOdometry::MeasuredVelocity velocity;
+  };
+  std::optional<MeasuredAt> last_measured_;  // the gate's centre
+};
+
+// The body's trajectory from the reference radar's, T_world_ref in its
+// first frame: T_world_body = M T M^-1 (M = T_body_ref), so that the body
+// starts where the reference does.
+Trajectory BodyTrajectory(const Trajectory& reference, const SE3d& body_from_reference);
+
 class RigOdometry {
  public:
   // `body_from_radar`: T_body_radar of each radar. The odometry's Doppler
   // filter (options.ego_velocity) serves every radar; the map and the match
-  // are the body's; options.rig says how scans become frames. Throws
-  // DataError for no radar, std::invalid_argument for a bad option.
+  // are the body's; options.rig says how scans become frames (RigFrames).
+  // Throws DataError for no radar, std::invalid_argument for a bad option.
   RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options = {});
 
   // `scan` of radar `radar`, its timestamp on the body's clock (not before
@@ -49,7 +129,7 @@ class RigOdometry {
 
   // T_world_body at each frame.
   Trajectory trajectory() const;
-  // The odometry the instants went through, in the first radar's frame
+  // The odometry the frames went through, in the first radar's frame
   // (with one radar, that radar's own).
   const RadarOdometry& odometry() const { return odometry_; }
   // Each frame's radars (one entry per scan), the frames whose velocity the
@@ -64,42 +144,13 @@ class RigOdometry {
   const std::vector<double>& frame_times_ms() const { return frame_times_ms_; }
 
  private:
-  // A frame's velocity: measured (by the rig's twist or the reference
-  // radar), each scan's static points, and the twist [v; w] that moves the
-  // scans to the frame's stamp (w: the last rotation rate).
-  struct FrameVelocity {
-    std::optional<RadarOdometry::MeasuredVelocity> measured;
-    bool by_rig = false;
-    std::vector<std::vector<bool>> static_points;
-    Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();
-  };
-  void RegisterPending();
-  std::optional<VelocityGate> Gate(double stamp) const;
-  FrameVelocity MeasureVelocity(const std::optional<VelocityGate>& gate) const;
-  // Scan k's static points by its radar's own Doppler filter.
-  std::vector<bool> OwnStaticPoints(std::size_t k, const std::optional<VelocityGate>& gate,
-                                    const FrameVelocity& frame) const;
-  // The reference radar's twist [v; w] (its frame) over the last two frames; zero before.
-  Eigen::Matrix<double, 6, 1> LastTwist() const;
+  void RegisterFrame(RigFrame frame);
 
-  std::vector<SE3d> body_from_radar_;
-  std::vector<SE3d> reference_from_radar_;
-  EgoVelocityOptions doppler_;
-  RigOdometryOptions rig_options_;  // options.rig
+  RigFrames frames_;
   RadarOdometry odometry_;
-  std::vector<RadarScan> pending_;  // the frame's scans, not yet registered
-  std::vector<std::size_t> pending_radars_;
-  std::optional<double> closing_stamp_;  // the reference radar's scan in the frame
-  std::optional<double> last_stamp_;     // of the last scan registered or pending
   std::vector<std::vector<std::size_t>> frame_radars_;
-  std::vector<double> frame_stamps_;
   RadarScan last_frame_;
   std::vector<double> frame_times_ms_;
-  struct MeasuredAt {
-    double stamp = 0.0;
-    RadarOdometry::MeasuredVelocity velocity;
-  };
-  std::optional<MeasuredAt> last_measured_;  // the gate's centre
   std::size_t velocity_measured_ = 0;
   std::size_t rig_velocity_measured_ = 0;
 };

@@ -64,6 +64,9 @@ class RadarSlam {
 
   // As RadarOdometry::Register; a keyframe that closes is described and searched.
   const OdometryStep& Register(const RadarScan& scan);
+  // The same for a scan without Doppler whose velocity was measured apart
+  // (a rig's frame, odometry/rig_odometry.hpp).
+  const OdometryStep& Register(const RadarScan& scan, const std::optional<RadarOdometry::MeasuredVelocity>& velocity);
   // Closes the last keyframe (described and searched) and waits for the back end.
   void Finish();
   // Whether the back end runs on its own thread (asynchronous_back_end and
