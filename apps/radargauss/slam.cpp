@@ -192,7 +192,8 @@ int RunSlam(const SlamSettings& settings) {
 
 Subcommand AddSlam(CLI::App& parent) {
   auto s = std::make_shared<SlamSettings>();
-  CLI::App* app = parent.add_subcommand("slam", "Radar SLAM: odometry, loop closure, one map of the place (of a rig: --rig)");
+  CLI::App* app =
+      parent.add_subcommand("slam", "Radar SLAM: odometry, loop closure, one map of the place (of a rig: --rig)");
   AddSequenceOptions(app, s->odometry.sequence, "--gt",
                      "Reference trajectory (TUM, or BAG:/topic[:child] of a ROS 2 bag), for the evaluation only");
   app->add_option("--out", s->odometry.out, "Output folder")->required();
