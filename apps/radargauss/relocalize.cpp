@@ -18,6 +18,8 @@
 #include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/map/map_file.hpp"
 #include "radargauss/map/map_tiles.hpp"
+#include "radargauss/io/rig.hpp"
+#include "radargauss/odometry/rig_odometry.hpp"
 #include "radargauss/core/progress.hpp"
 #include "radargauss/residuals/rcs_likelihood.hpp"
 #include "radargauss/slam/relocalization.hpp"
@@ -61,6 +63,41 @@ void WriteCandidates(std::ostream& out, const Relocalizer& relocalizer) {
   }
 }
 
+// A rig's frames (RigFrames) into the relocaliser, on the body's clock; the
+// number of scans read.
+std::size_t RelocalizeRig(const Rig& rig, const RelocalizationOptions& options, Relocalizer& relocalizer) {
+  std::vector<SE3d> mountings;
+  for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
+  RigFrames frames(mountings, options.odometry);
+  const RadarOdometry* odometry = nullptr;
+  bool fixed = false;
+  const auto register_frame = [&](const RigFrame& frame) {
+    relocalizer.Register(frame.scan, frame.velocity);
+    // A fix or a restart moves the odometry's poses: the rate between frames starts again.
+    if (&relocalizer.odometry() != odometry || relocalizer.fixed() != fixed) frames.ForgetMotion();
+    odometry = &relocalizer.odometry();
+    fixed = relocalizer.fixed();
+    frames.Registered(frame.scan.timestamp, odometry->pose(odometry->scans() - 1));
+  };
+  std::size_t scans = 0;
+  ForEachRigScan(rig, [&](std::size_t radar, RadarScan& scan, const std::string& source) {
+    try {
+      if (rig.radars.size() == 1) {
+        relocalizer.Register(scan);
+      } else if (const std::optional<RigFrame> frame = frames.Add(radar, scan)) {
+        register_frame(*frame);
+      }
+    } catch (const DataError& e) {
+      throw DataError(source + ": " + e.what());
+    }
+    ++scans;
+  });
+  if (rig.radars.size() > 1) {
+    if (const std::optional<RigFrame> frame = frames.Finish()) register_frame(*frame);
+  }
+  return scans;
+}
+
 int RunRelocalize(const RelocalizeSettings& s) {
   RelocalizationOptions options = s.relocalization;
   ValidateOptions(options);
@@ -74,48 +111,73 @@ int RunRelocalize(const RelocalizeSettings& s) {
     throw FileError(s.map, "the map has no places to relocalise against (build it with radargauss slam)");
   }
   if (map.gaussians.empty()) throw FileError(s.map, "the map has no Gaussians to match against");
-  RunInputs inputs = LoadRunInputs(s.odometry, matching.w_rcs);
+  const bool on_rig = !s.odometry.rig.empty();
+  if (on_rig && (!s.odometry.sequence.sequence_dir.empty() || !s.odometry.sequence.bag.empty())) {
+    throw DataError("--rig names the radars' scans itself: drop --sequence and --bag");
+  }
+  if (on_rig && !s.odometry.mcap.empty()) throw DataError("--rig: no --mcap");
+  const std::optional<Rig> rig = on_rig ? std::optional<Rig>(ReadRig(s.odometry.rig)) : std::nullopt;
+  RunInputs inputs;
+  if (!on_rig) {
+    inputs = LoadRunInputs(s.odometry, matching.w_rcs);
+  } else if (!s.odometry.sequence.ground_truth.empty()) {
+    inputs.reference =
+        ReadRadarTrajectory(s.odometry.sequence.ground_truth,
+                            ResolveExtrinsic(s.odometry.sequence.extrinsic, s.odometry.sequence.ground_truth));
+  }
   const Sequence& sequence = inputs.sequence;
   const std::optional<Trajectory>& reference = inputs.reference;
-  StagedFolder folder = RunFolder(s.odometry, {"relocalization.tum"});
+  StagedFolder folder = RunFolder(s.odometry, {"relocalization.tum", "body.tum"});
   Relocalizer relocalizer(std::move(map), options);
-  RegisterScans(sequence, "relocalize", [&](const RadarScan& scan) { relocalizer.Register(scan); });
+  std::size_t scans = sequence.scans.size();
+  if (rig) {
+    scans = RelocalizeRig(*rig, options, relocalizer);
+  } else {
+    RegisterScans(sequence, "relocalize", [&](const RadarScan& scan) { relocalizer.Register(scan); });
+  }
   Trajectory located;
   std::size_t matched = 0;
   for (const RelocalizationStep& step : relocalizer.steps()) {
     if (step.fixed) located.Append(step.stamp, step.pose);
     matched += step.matched;
   }
+  // On a rig: the body's poses beside the reference radar's, and the evaluation of the body's.
+  const Trajectory evaluated = rig ? BodyTrajectory(located, rig->radars.front().body_from_radar) : located;
   const std::filesystem::path out(folder.path());
   WriteTum((out / "relocalization.tum").string(), located);
+  if (rig) WriteTum((out / "body.tum").string(), evaluated);
   WriteFileAtomically((out / "per_scan.csv").string(), [&](std::ostream& o) { WritePerScan(o, relocalizer); });
   WriteFileAtomically((out / "candidates.csv").string(), [&](std::ostream& o) { WriteCandidates(o, relocalizer); });
   const std::optional<std::size_t> fix = relocalizer.first_fix();
   nlohmann::json summary = {
-      {"scans", sequence.scans.size()},
+      {"scans", relocalizer.steps().size()},
       {"fixed_scans", located.size()},
       {"matched_scans", matched},
       {"submaps_compared", relocalizer.candidates().empty() ? 0 : relocalizer.candidates().back().submap + 1}};
   summary["first_fix_scan"] = fix ? nlohmann::json(*fix) : nlohmann::json(nullptr);
+  const double first_stamp = relocalizer.steps().empty() ? 0.0 : relocalizer.steps().front().stamp;
   summary["time_to_first_fix_s"] =
-      fix ? nlohmann::json(sequence.scans[*fix].timestamp - sequence.scans.front().timestamp) : nlohmann::json(nullptr);
+      fix ? nlohmann::json(relocalizer.steps()[*fix].stamp - first_stamp) : nlohmann::json(nullptr);
   WriteFileAtomically((out / "summary.json").string(), [&](std::ostream& o) { o << summary.dump(2) << "\n"; });
   std::string table;
-  if (reference && located.size() >= 3) table = WriteEvaluation(out.string(), EvaluateTrajectory(located, *reference));
+  if (reference && located.size() >= 3)
+    table = WriteEvaluation(out.string(), EvaluateTrajectory(evaluated, *reference));
   folder.Commit();
   if (!s.odometry.mcap.empty()) WriteRunForViewer(s.odometry.out, sequence.scans, reference, s.odometry.mcap);
   if (fix) {
-    std::printf("relocalize: first fix at scan %zu (%.1f s in); %zu of %zu scans located, %zu matched to the map\n",
-                *fix, sequence.scans[*fix].timestamp - sequence.scans.front().timestamp, located.size(),
-                sequence.scans.size(), matched);
+    std::printf("relocalize: first fix at %s %zu (%.1f s in); %zu of %zu %s located, %zu matched to the map\n",
+                rig ? "frame" : "scan", *fix, relocalizer.steps()[*fix].stamp - first_stamp, located.size(),
+                relocalizer.steps().size(), rig ? "frames" : "scans", matched);
   } else {
     std::printf("relocalize: no fix: none of the %zu candidates of %d submaps verified; no pose reported\n",
                 relocalizer.candidates().size(),
                 relocalizer.candidates().empty() ? 0 : relocalizer.candidates().back().submap + 1);
   }
   std::printf("%s", table.c_str());
-  std::printf("wrote %s (relocalization.tum, per_scan.csv, candidates.csv, summary.json%s)\n", s.odometry.out.c_str(),
-              table.empty() ? "" : ", evaluation.json, evaluation.md");
+  if (rig)
+    std::printf("rig: %zu radars, %zu scans in %zu frames\n", rig->radars.size(), scans, relocalizer.steps().size());
+  std::printf("wrote %s (relocalization.tum%s, per_scan.csv, candidates.csv, summary.json%s)\n", s.odometry.out.c_str(),
+              rig ? ", body.tum" : "", table.empty() ? "" : ", evaluation.json, evaluation.md");
   return 0;
 }
 
@@ -123,7 +185,8 @@ int RunRelocalize(const RelocalizeSettings& s) {
 
 Subcommand AddRelocalize(CLI::App& parent) {
   auto s = std::make_shared<RelocalizeSettings>();
-  CLI::App* app = parent.add_subcommand("relocalize", "Locate a sequence in a SLAM map without an initial pose");
+  CLI::App* app =
+      parent.add_subcommand("relocalize", "Locate a sequence (or a rig: --rig) in a SLAM map without an initial pose");
   app->add_option("--map", s->map, "Map of radargauss slam (.rgm with places, or its folder of map tiles)")->required();
   AddSequenceOptions(app, s->odometry.sequence, "--gt",
                      "Reference trajectory (TUM, map frame), for the evaluation only");
@@ -134,6 +197,10 @@ Subcommand AddRelocalize(CLI::App& parent) {
       ->excludes(app->get_option("--w-rcs"))
       ->group(HelpGroup(OptionGroup::kTuning));
   AddRunOptions(app, s->odometry);
+  app->add_option("--rig", s->odometry.rig,
+                  "Rig file (docs/design/rig.md): relocalise the body from every radar's scans instead of --sequence, "
+                  "in a map of slam --rig (--gt: the body's reference)")
+      ->group(HelpGroup(OptionGroup::kTuning));  // --help-all; the command's description names it
   return {app, [s] { return RunRelocalize(*s); }};
 }
 

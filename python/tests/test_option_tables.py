@@ -20,7 +20,7 @@ IMU_FLAGS = {"--imu", "--imu-extrinsic", "--imu-topic", "--imu-stamps", "--imu-r
 COMMANDS = [("odometry", ("odometry", "radar_inertial"), {"--matcher", "--rig"} | IMU_FLAGS),
             ("slam", ("slam", "radar_inertial"), {"--no-map", "--map-tiles", "--false-loop-rate", "--false-loop-seed", "--rig"}
              | IMU_FLAGS),
-            ("relocalize", ("relocalization",), {"--map", "--w-rcs-from-map"})]
+            ("relocalize", ("relocalization",), {"--map", "--w-rcs-from-map", "--rig"})]
 
 pytestmark = pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool")
 

@@ -84,10 +84,13 @@ void Relocalizer::Restart() {
   unmatched_ = 0;
 }
 
-const RelocalizationStep& Relocalizer::Register(const RadarScan& scan) {
+const RelocalizationStep& Relocalizer::Register(const RadarScan& scan) { return Register(scan, std::nullopt); }
+
+const RelocalizationStep& Relocalizer::Register(const RadarScan& scan,
+                                                const std::optional<RadarOdometry::MeasuredVelocity>& velocity) {
   const std::size_t index = steps_.size();
   const std::size_t local = odometry_->steps().size();  // since the last restart
-  const OdometryStep& odometry = odometry_->Register(scan);
+  const OdometryStep& odometry = odometry_->Register(scan, velocity);
   RelocalizationStep step;
   step.stamp = odometry.stamp;
   if (fix_) {

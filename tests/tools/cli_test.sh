@@ -249,6 +249,15 @@ cmp -s "$work/rig_slam_one/slam.tum" "$work/slam_one/slam.tum" || {
   echo "FAIL: slam on a rig of one radar differs from slam on its sequence"; failed=1; }
 expect_fail "slam on a rig with an IMU" "takes no IMU yet" -- \
   "$tool" slam --rig "$work/rig.yaml" --imu "$work/seq10/gt_radar_tum.txt" --out "$work/rig_slam_imu"
+expect_ok "relocalize a rig in its slam map" "rig: 2 radars, 20 scans in 10 frames" -- \
+  "$tool" relocalize --rig "$work/rig.yaml" --map "$work/rig_slam/map.rgm" --submap-distance 2 --out "$work/rig_reloc"
+[[ -e "$work/rig_reloc/body.tum" ]] || { echo "FAIL: relocalize --rig wrote no body.tum"; failed=1; }
+"$tool" relocalize --rig "$work/rig_front.yaml" --map "$work/slam_one/map.rgm" --submap-distance 2 \
+  --out "$work/rig_reloc_one" >/dev/null
+"$tool" relocalize --sequence "$work/seq10" --map "$work/slam_one/map.rgm" --submap-distance 2 \
+  --out "$work/reloc_one" >/dev/null
+[[ -s "$work/reloc_one/relocalization.tum" ]] && cmp -s "$work/rig_reloc_one/relocalization.tum" "$work/reloc_one/relocalization.tum" || {
+  echo "FAIL: relocalize on a rig of one radar differs from relocalize on its sequence"; failed=1; }
 expect_ok "calibrate a rig" "wrote .*calibrated" -- \
   "$tool" calibrate --rig "$work/rig.yaml" --compare "$work/rig.yaml" --out "$work/calibrated"
 [[ -s "$work/calibrated/rig.yaml" && -s "$work/calibrated/calibration.json" ]] || {

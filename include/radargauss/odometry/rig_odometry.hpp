@@ -60,6 +60,9 @@ class RigFrames {
   // The pose T_world_ref a frame was registered at: the rotation rate that
   // moves the next frames' scans comes from the last two.
   void Registered(double stamp, const SE3d& pose);
+  // The front end's poses jumped (a relocalisation's fix, a restart): the
+  // rotation rate waits for two frames registered after it.
+  void ForgetMotion() { registered_.clear(); }
 
   std::size_t radars() const { return body_from_radar_.size(); }
   const SE3d& body_from_reference() const { return body_from_radar_.front(); }

@@ -82,6 +82,10 @@ class Relocalizer {
   Relocalizer(GaussianMap map, const RelocalizationOptions& options = {});
 
   const RelocalizationStep& Register(const RadarScan& scan);
+  // The same for a scan without Doppler whose velocity was measured apart
+  // (a rig's frame, odometry/rig_odometry.hpp).
+  const RelocalizationStep& Register(const RadarScan& scan,
+                                     const std::optional<RadarOdometry::MeasuredVelocity>& velocity);
 
   bool fixed() const { return fix_.has_value(); }
   // The index of the scan at which the first fix was made.
