@@ -98,6 +98,20 @@ std::size_t RelocalizeRig(const Rig& rig, const RelocalizationOptions& options, 
   return scans;
 }
 
+nlohmann::json Summary(const Relocalizer& relocalizer, std::size_t located, std::size_t matched) {
+  const std::optional<std::size_t> fix = relocalizer.first_fix();
+  const std::vector<RelocalizationStep>& steps = relocalizer.steps();
+  nlohmann::json summary = {
+      {"scans", steps.size()},
+      {"fixed_scans", located},
+      {"matched_scans", matched},
+      {"submaps_compared", relocalizer.candidates().empty() ? 0 : relocalizer.candidates().back().submap + 1}};
+  summary["first_fix_scan"] = fix ? nlohmann::json(*fix) : nlohmann::json(nullptr);
+  summary["time_to_first_fix_s"] =
+      fix ? nlohmann::json(steps[*fix].stamp - steps.front().stamp) : nlohmann::json(nullptr);
+  return summary;
+}
+
 int RunRelocalize(const RelocalizeSettings& s) {
   RelocalizationOptions options = s.relocalization;
   ValidateOptions(options);
@@ -149,16 +163,9 @@ int RunRelocalize(const RelocalizeSettings& s) {
   WriteFileAtomically((out / "per_scan.csv").string(), [&](std::ostream& o) { WritePerScan(o, relocalizer); });
   WriteFileAtomically((out / "candidates.csv").string(), [&](std::ostream& o) { WriteCandidates(o, relocalizer); });
   const std::optional<std::size_t> fix = relocalizer.first_fix();
-  nlohmann::json summary = {
-      {"scans", relocalizer.steps().size()},
-      {"fixed_scans", located.size()},
-      {"matched_scans", matched},
-      {"submaps_compared", relocalizer.candidates().empty() ? 0 : relocalizer.candidates().back().submap + 1}};
-  summary["first_fix_scan"] = fix ? nlohmann::json(*fix) : nlohmann::json(nullptr);
   const double first_stamp = relocalizer.steps().empty() ? 0.0 : relocalizer.steps().front().stamp;
-  summary["time_to_first_fix_s"] =
-      fix ? nlohmann::json(relocalizer.steps()[*fix].stamp - first_stamp) : nlohmann::json(nullptr);
-  WriteFileAtomically((out / "summary.json").string(), [&](std::ostream& o) { o << summary.dump(2) << "\n"; });
+  WriteFileAtomically((out / "summary.json").string(),
+                      [&](std::ostream& o) { o << Summary(relocalizer, located.size(), matched).dump(2) << "\n"; });
   std::string table;
   if (reference && located.size() >= 3)
     table = WriteEvaluation(out.string(), EvaluateTrajectory(evaluated, *reference));
