@@ -156,11 +156,13 @@ def odometry_table(tool, work):
             row = alone[name]
             print(f"| {world} | {name} alone | {row[0]:.3f} | {row[1]:.3f} | {row[2]:.3f} | {row[3]:.2f} | "
                   f"{row[5]:.2f} |")
-        for label, names in ODOMETRY_RIGS:
+        every_rate = [(label + ", every rate", names, ["--rig-rotation-rate", "all"])
+                      for label, names in ODOMETRY_RIGS if label.startswith("4")]
+        for label, names, flags in [(label, names, []) for label, names in ODOMETRY_RIGS] + every_rate:
             rig_file = os.path.join(rig_dir, "rig_" + "_".join(names) + ".yaml")
             with open(rig_file, "w") as f:
                 f.write(head + "".join(by_name[n] for n in names))
-            row = run_odometry(tool, ["--rig", rig_file, "--gt", os.path.join(rig_dir, "gt_body_tum.txt")],
+            row = run_odometry(tool, ["--rig", rig_file, "--gt", os.path.join(rig_dir, "gt_body_tum.txt")] + flags,
                                os.path.join(work, "rig_" + "_".join(names)))
             best = min(alone[n][1] for n in names)
             wall_alone = sum(alone[n][5] for n in names)

@@ -107,6 +107,7 @@ class OdometryOptions(MatchOptions, total=False):
     elevation_bias_min_speed: float  # 5.0
     rig_max_frame_span: float  # 0.1
     rig_velocity: bool  # True
+    rig_rotation_rate: str  # 'yaw'
     rig_motion_compensation: bool  # True
 
 class PlaceSearchOptions(TypedDict, total=False):

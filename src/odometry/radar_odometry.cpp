@@ -16,6 +16,10 @@
 
 namespace radargauss {
 
+// rad/s: the least std of a measured yaw rate in the rotation term (a rig's
+// rates are measured at the interval's ends, its increment is trapezoidal).
+constexpr double kMeasuredRateFloor = 0.005;
+
 const OptionTable<OdometryOptions>& OdometryOptionTable() {
   using O = OdometryOptions;
   static const OptionTable<O> table = [] {
@@ -137,6 +141,23 @@ SO3d VehicleFromRadar(const Eigen::Vector3d& roll_pitch_yaw_deg) {
          SO3d::Exp(Eigen::Vector3d(angles.x(), 0.0, 0.0));
 }
 
+void RadarOdometry::PredictFromRates(const MeasuredRate& before, const MeasuredRate& now, Prediction& p) const {
+  // The rates measured at both ends of the interval, trapezoidal: the turn
+  // about the vehicle's vertical, roll and pitch held as without them; with
+  // `all`, every rate (a rig's roll and pitch rates come from elevations).
+  const Eigen::Vector3d rate = 0.5 * (before.value + now.value);
+  const Eigen::Matrix3d covariance = 0.25 * (before.covariance + now.covariance);
+  if (now.all) {
+    p.increment = SO3d::Exp(rate * p.dt);
+    p.increment_std = covariance.diagonal().cwiseSqrt() * p.dt;
+  } else {
+    const Eigen::Vector3d up = vehicle_from_radar_.Inverse() * Eigen::Vector3d::UnitZ();
+    p.increment = SO3d::Exp(up * (rate.dot(up) * p.dt));
+    p.yaw_std = std::sqrt(up.dot(covariance * up)) * p.dt;
+  }
+  p.gyro = true;
+}
+
 RadarOdometry::Prediction RadarOdometry::Predict(double stamp) const {
   const MotionState& last = *state_;
   Prediction p;
@@ -252,6 +273,8 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& input, const std::o
   const RadarScan& scan = correct ? corrected : input;
   std::optional<Prediction> prediction;
   if (state_) prediction = Predict(scan.timestamp);
+  if (prediction && measured && measured->rate && state_->rate)
+    PredictFromRates(*state_->rate, *measured->rate, *prediction);
   const Velocity velocity = MeasureVelocity(scan, prediction, measured);
   if (velocity.measured && !velocity.standstill) elevation_bias_.Observe(velocity.value);
   FinishMapUpdate();  // the map is read from here on
@@ -276,6 +299,7 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& input, const std::o
   next.velocity_covariance = step.velocity_covariance;
   next.measured = velocity.measured ? std::make_optional(std::make_pair(step.stamp, step.velocity_covariance))
                                     : (state_ ? state_->measured : std::nullopt);
+  if (measured) next.rate = measured->rate;
   state_ = next;
   steps_.push_back(step);
   // Counted outside the step's time: the map changes on keyframes only.
@@ -344,7 +368,10 @@ ScanPriors RadarOdometry::PriorsOf(const Prediction& prediction, const Velocity&
   if (options_.rotation_weight > 0.0) {
     RotationPrior prior;
     prior.predicted = state_->pose.rotation() * prediction.increment;
-    const Eigen::Vector3d sigma = options_.rotation_rate_std_deg * (M_PI / 180.0 * prediction.dt);
+    Eigen::Vector3d sigma = options_.rotation_rate_std_deg * (M_PI / 180.0 * prediction.dt);
+    // A measured yaw increment's own std where it is tighter.
+    if (prediction.yaw_std)
+      sigma.z() = std::min(sigma.z(), std::max(*prediction.yaw_std, kMeasuredRateFloor * prediction.dt));
     // About the vehicle's axes: the residual Log(R_pred^T R) turned into them.
     prior.sqrt_information = sigma.cwiseInverse().asDiagonal() * vehicle_from_radar_.Matrix();
     prior.weight = options_.rotation_weight;

@@ -36,6 +36,10 @@ const OptionTable<RigOdometryOptions>& RigOdometryOptionTable() {
           .Help("a rig's frame: the longest its scans may span (it closes at the reference radar's scan)"),
       RADARGAUSS_OPTION(O, "rig_velocity", rig_velocity)
           .Help("a rig's velocity from every radar's Doppler (the rig's twist); off: the reference radar's"),
+      RADARGAUSS_OPTION(O, "rig_rotation_rate", rotation_rate)
+          .Choices({"yaw", "all", "off"})
+          .Help("a rig's rotation rates as the rotation term's prediction: yaw; all (roll and pitch too: an elevation "
+                "bias tilts them); off"),
       RADARGAUSS_OPTION(O, "rig_motion_compensation", motion_compensation)
           .Help("a rig's scans moved from their stamps to their frame's by its velocity and rotation rate"),
   };
@@ -154,6 +158,10 @@ RigFrames::FrameVelocity RigFrames::MeasureVelocity(const std::optional<Velocity
     if (rig.success && (rig.observed.topLeftCorner<3, 3>() - Eigen::Matrix3d::Identity()).norm() < 1e-6 &&
         rig.observed.topRightCorner<3, 3>().norm() < 1e-6) {
       out.measured = RadarOdometry::MeasuredVelocity{rig.velocity, rig.covariance.topLeftCorner<3, 3>()};
+      if (rig_options_.rotation_rate != "off" && rig.rank == 6) {
+        out.measured->rate = RadarOdometry::MeasuredRate{rig.angular_velocity, rig.covariance.bottomRightCorner<3, 3>(),
+                                                         rig_options_.rotation_rate == "all"};
+      }
       out.by_rig = true;
       out.twist.head<3>() = rig.velocity;
       for (std::size_t n = 0; n < newest.size(); ++n) {

@@ -50,6 +50,11 @@ struct RigOdometryOptions {
   // The frame's velocity from every radar's Doppler (the rig's twist at the
   // reference radar); false: from the reference radar's alone.
   bool rig_velocity = true;
+  // The rig's rotation rates (its twist, where it observes all three) as the
+  // rotation term's prediction, with the twist's covariance: "yaw" about the
+  // vertical; "all" roll and pitch too (they come from the points'
+  // elevations, which a radar's elevation bias tilts); "off".
+  std::string rotation_rate = "yaw";
   // Each scan's points moved from its stamp to the frame's at the frame's velocity and the last rotation rate.
   bool motion_compensation = true;
 };
@@ -161,9 +166,18 @@ class RadarOdometry {
   // scan's frame) was measured apart, with its covariance: a rig's body
   // velocity from its radars' Doppler (odometry/rig_odometry.hpp). Every
   // point is matched, as without Doppler.
+  // The rotation rate measured with it (rad/s, the scan's frame) and its
+  // covariance: with the last scan's, the rotation term's prediction (its
+  // yaw about the vehicle's vertical; with `all`, roll and pitch too).
+  struct MeasuredRate {
+    Eigen::Vector3d value = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    bool all = false;
+  };
   struct MeasuredVelocity {
     Eigen::Vector3d value = Eigen::Vector3d::Zero();
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    std::optional<MeasuredRate> rate;
   };
   const OdometryStep& Register(const RadarScan& scan, const std::optional<MeasuredVelocity>& velocity);
   // From the next scan on, matches against `map`, fixed (nothing is
@@ -210,6 +224,7 @@ class RadarOdometry {
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();
     std::optional<std::pair<double, Eigen::Matrix3d>> measured;  // stamp, velocity covariance
+    std::optional<MeasuredRate> rate;                            // measured apart with the velocity
   };
   // The motion model's guess for the next scan.
   struct Prediction {
@@ -218,6 +233,10 @@ class RadarOdometry {
     Eigen::Matrix3d velocity_covariance;
     double dt = 0.0;
     bool gyro = false;  // the increment comes from the motion model
+    // The increment's std (rad) when measured rates gave it: about the
+    // vehicle's vertical, or about the radar's axes with every rate.
+    std::optional<double> yaw_std;
+    std::optional<Eigen::Vector3d> increment_std;
   };
   // The scan's ego velocity: measured (gated by the prediction), or the prediction's.
   struct Velocity {
@@ -241,6 +260,8 @@ class RadarOdometry {
   // on this scan and the radar alone's run has become this one.
   bool RunBeside(const RadarScan& scan);
   Prediction Predict(double stamp) const;
+  // The increment (and its std) from the rates measured at the last scan and this one.
+  void PredictFromRates(const MeasuredRate& before, const MeasuredRate& now, Prediction& p) const;
   SE3d PredictedPose(const Prediction& prediction, const Eigen::Vector3d& velocity) const;
   // The translation since the last scan in its frame for a velocity of the new frame.
   static Eigen::Vector3d Displacement(const Prediction& prediction, const Eigen::Vector3d& velocity);
