@@ -104,15 +104,7 @@ int RunCalibrate(const CalibrateSettings& s) {
   }
   if (rig.radars.size() < 2) throw DataError("--rig: calibration needs a reference radar and another");
   StagedFolder folder(s.out);
-  std::vector<std::vector<RadarScan>> scans;
-  for (const RigRadar& radar : rig.radars) {
-    try {
-      scans.push_back(LoadSequence(radar.scans).scans);
-    } catch (const DataError& e) {
-      throw DataError("radar '" + radar.name + "': " + e.what());
-    }
-  }
-  const RigCalibration result = CalibrateRig(rig, scans, s.calibration);
+  const RigCalibration result = CalibrateRig(rig, LoadRigScans(rig), s.calibration);
   // The calibrated rig beside the results, its scans' paths absolute.
   Rig calibrated = result.rig;
   for (RigRadar& radar : calibrated.radars) {

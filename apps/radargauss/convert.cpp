@@ -52,15 +52,10 @@ int RunRigConvert(const ConvertSettings& s, BagFormat format) {
   const Rig rig = ReadRig(s.rig);
   std::string rig_out = s.rig_out;
   if (rig_out.empty()) rig_out = (fs::path(s.out).parent_path() / fs::path(s.out).stem()).string() + ".rig.yaml";
-  std::vector<std::vector<RadarScan>> scans;
+  const std::vector<std::vector<RadarScan>> scans = LoadRigScans(rig);
   std::vector<RigBagRadar> radars;
   Rig written = rig;
   for (std::size_t r = 0; r < rig.radars.size(); ++r) {
-    try {
-      scans.push_back(LoadSequence(rig.radars[r].scans).scans);
-    } catch (const DataError& e) {
-      throw DataError("radar '" + rig.radars[r].name + "': " + e.what());
-    }
     written.radars[r].scans = SequenceOptions();
     written.radars[r].scans.bag = fs::relative(fs::absolute(s.out), fs::absolute(rig_out).parent_path()).string();
     written.radars[r].scans.topic = "/" + rig.radars[r].name + "/points";

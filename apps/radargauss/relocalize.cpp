@@ -63,39 +63,18 @@ void WriteCandidates(std::ostream& out, const Relocalizer& relocalizer) {
   }
 }
 
-// A rig's frames (RigFrames) into the relocaliser, on the body's clock; the
-// number of scans read.
+// A rig's frames into the relocaliser, on the body's clock; the scans read.
 std::size_t RelocalizeRig(const Rig& rig, const RelocalizationOptions& options, Relocalizer& relocalizer) {
-  std::vector<SE3d> mountings;
-  for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
-  RigFrames frames(mountings, options.odometry);
   const RadarOdometry* odometry = nullptr;
   bool fixed = false;
-  const auto register_frame = [&](const RigFrame& frame) {
+  return RegisterRigFrames(rig, options.odometry, [&](const RigFrame& frame) {
     relocalizer.Register(frame.scan, frame.velocity);
-    // A fix or a restart moves the odometry's poses: the rate between frames starts again.
-    if (&relocalizer.odometry() != odometry || relocalizer.fixed() != fixed) frames.ForgetMotion();
+    // A fix or a restart moves the odometry's poses.
+    const bool jumped = &relocalizer.odometry() != odometry || relocalizer.fixed() != fixed;
     odometry = &relocalizer.odometry();
     fixed = relocalizer.fixed();
-    frames.Registered(frame.scan.timestamp, odometry->pose(odometry->scans() - 1));
-  };
-  std::size_t scans = 0;
-  ForEachRigScan(rig, [&](std::size_t radar, RadarScan& scan, const std::string& source) {
-    try {
-      if (rig.radars.size() == 1) {
-        relocalizer.Register(scan);
-      } else if (const std::optional<RigFrame> frame = frames.Add(radar, scan)) {
-        register_frame(*frame);
-      }
-    } catch (const DataError& e) {
-      throw DataError(source + ": " + e.what());
-    }
-    ++scans;
+    return RegisteredFrame{odometry->pose(odometry->scans() - 1), jumped};
   });
-  if (rig.radars.size() > 1) {
-    if (const std::optional<RigFrame> frame = frames.Finish()) register_frame(*frame);
-  }
-  return scans;
 }
 
 nlohmann::json Summary(const Relocalizer& relocalizer, std::size_t located, std::size_t matched) {

@@ -84,42 +84,24 @@ int RunRigSlam(const SlamSettings& s) {
                                     ResolveExtrinsic(s.odometry.sequence.extrinsic, s.odometry.sequence.ground_truth));
   }
   StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "body.tum", "odometry", "map.rgm", "map.ply", "map_tiles"});
-  std::vector<SE3d> mountings;
-  for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
+  const SE3d& body_from_reference = rig.radars.front().body_from_radar;
   RadarSlam slam(options, s.study);
-  RigFrames frames(mountings, options.odometry);
-  const auto register_frame = [&](const RigFrame& frame) {
+  const std::size_t scans = RegisterRigFrames(rig, options.odometry, [&](const RigFrame& frame) {
     slam.Register(frame.scan, frame.velocity);
-    frames.Registered(frame.scan.timestamp, slam.odometry().pose(slam.odometry().scans() - 1));
-  };
-  std::size_t scans = 0;
-  ForEachRigScan(rig, [&](std::size_t radar, RadarScan& scan, const std::string& source) {
-    try {
-      if (rig.radars.size() == 1) {
-        slam.Register(scan);
-      } else if (const std::optional<RigFrame> frame = frames.Add(radar, scan)) {
-        register_frame(*frame);
-      }
-    } catch (const DataError& e) {
-      throw DataError(source + ": " + e.what());
-    }
-    ++scans;
+    return RegisteredFrame{slam.odometry().pose(slam.odometry().scans() - 1)};
   });
-  if (rig.radars.size() > 1) {
-    if (const std::optional<RigFrame> frame = frames.Finish()) register_frame(*frame);
-  }
   slam.Finish();
   const GaussianMap map = s.no_map ? GaussianMap() : PlaceMapOf(slam, s.odometry.rig);
   const std::string out = folder.path();
   WriteOdometry((std::filesystem::path(out) / "odometry").string(), slam.odometry());
   WriteSlam(out, slam);
-  const Trajectory body = BodyTrajectory(slam.trajectory(), mountings.front());
+  const Trajectory body = BodyTrajectory(slam.trajectory(), body_from_reference);
   WriteTum((std::filesystem::path(out) / "body.tum").string(), body);
   if (!s.no_map) WriteMaps(out, map, s.map_tiles);
   std::string tables;
   if (reference) {
     WriteEvaluation((std::filesystem::path(out) / "odometry").string(),
-                    EvaluateTrajectory(BodyTrajectory(slam.odometry().trajectory(), mountings.front()), *reference));
+                    EvaluateTrajectory(BodyTrajectory(slam.odometry().trajectory(), body_from_reference), *reference));
     tables = WriteEvaluation(out, EvaluateTrajectory(body, *reference));
   }
   folder.Commit();

@@ -67,19 +67,6 @@ py::dict CalibrationToDict(const RigCalibration& calibration) {
   return out;
 }
 
-// The radars' scans of a rig file, each radar's as read (stamps on its clock).
-std::vector<std::vector<RadarScan>> RigScans(const Rig& rig) {
-  std::vector<std::vector<RadarScan>> scans;
-  for (const RigRadar& radar : rig.radars) {
-    try {
-      scans.push_back(LoadSequence(radar.scans).scans);
-    } catch (const DataError& e) {
-      throw DataError("radar '" + radar.name + "': " + e.what());
-    }
-  }
-  return scans;
-}
-
 void BindRigRuns(py::module_& m) {
   m.def(
       "rig_odometry",
@@ -113,7 +100,7 @@ void BindRigRuns(py::module_& m) {
         RigCalibrationOptions options = OptionsFrom(RigCalibrationOptionTable(), kwargs);
         ValidateOptions(options);
         const Rig rig = ReadRig(path);
-        const std::vector<std::vector<RadarScan>> scans = RigScans(rig);
+        const std::vector<std::vector<RadarScan>> scans = LoadRigScans(rig);
         RigCalibration calibration;
         {
           py::gil_scoped_release release;

@@ -4,10 +4,11 @@
 #include "radargauss/core/error.hpp"
 #include "radargauss/io/rig.hpp"
 
+#include <utility>
+
 namespace radargauss {
 
-void ForEachRigScan(const Rig& rig,
-                    const std::function<void(std::size_t radar, RadarScan& scan, const std::string& source)>& visit) {
+std::vector<Sequence> LoadRigSequences(const Rig& rig) {
   std::vector<Sequence> sequences;
   for (const RigRadar& radar : rig.radars) {
     try {
@@ -15,7 +16,21 @@ void ForEachRigScan(const Rig& rig,
     } catch (const DataError& e) {
       throw DataError("radar '" + radar.name + "': " + e.what());
     }
-    for (RadarScan& scan : sequences.back().scans) scan.timestamp -= radar.clock_offset;
+  }
+  return sequences;
+}
+
+std::vector<std::vector<RadarScan>> LoadRigScans(const Rig& rig) {
+  std::vector<std::vector<RadarScan>> scans;
+  for (Sequence& sequence : LoadRigSequences(rig)) scans.push_back(std::move(sequence.scans));
+  return scans;
+}
+
+void ForEachRigScan(const Rig& rig,
+                    const std::function<void(std::size_t radar, RadarScan& scan, const std::string& source)>& visit) {
+  std::vector<Sequence> sequences = LoadRigSequences(rig);
+  for (std::size_t r = 0; r < sequences.size(); ++r) {
+    for (RadarScan& scan : sequences[r].scans) scan.timestamp -= rig.radars[r].clock_offset;
   }
   std::vector<std::size_t> next(sequences.size(), 0);
   while (true) {

@@ -257,6 +257,35 @@ void RigOdometry::RegisterFrame(RigFrame frame) {
   last_frame_ = std::move(frame.scan);
 }
 
+std::size_t RegisterRigFrames(const Rig& rig, const OdometryOptions& options,
+                              const std::function<RegisteredFrame(const RigFrame&)>& front_end) {
+  std::vector<SE3d> mountings;
+  for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
+  RigFrames frames(mountings, options);
+  const auto give = [&](const RigFrame& frame) {
+    const RegisteredFrame registered = front_end(frame);
+    if (registered.jumped) frames.ForgetMotion();
+    frames.Registered(frame.scan.timestamp, registered.pose);
+  };
+  std::size_t scans = 0;
+  ForEachRigScan(rig, [&](std::size_t radar, RadarScan& scan, const std::string& source) {
+    try {
+      if (rig.radars.size() == 1) {
+        give(RigFrame{scan, std::nullopt, false, {radar}, 0.0});
+      } else if (const std::optional<RigFrame> frame = frames.Add(radar, scan)) {
+        give(*frame);
+      }
+    } catch (const DataError& e) {
+      throw DataError(source + ": " + e.what());
+    }
+    ++scans;
+  });
+  if (rig.radars.size() > 1) {
+    if (const std::optional<RigFrame> frame = frames.Finish()) give(*frame);
+  }
+  return scans;
+}
+
 Trajectory BodyTrajectory(const Trajectory& reference, const SE3d& body_from_reference) {
   Trajectory body;
   for (const StampedPose& sample : reference) {

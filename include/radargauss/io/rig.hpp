@@ -55,6 +55,11 @@ Rig ReadRig(const std::string& path);
 // as given), whole or not at all.
 void WriteRig(const std::string& path, const Rig& rig);
 
+// Each radar's sequence, and each radar's scans, as read (stamps on the
+// radar's own clock). Throws DataError as LoadSequence does, naming the radar.
+std::vector<Sequence> LoadRigSequences(const Rig& rig);
+std::vector<std::vector<RadarScan>> LoadRigScans(const Rig& rig);
+
 // Every radar's scans in one time order on the body's clock (each scan's
 // timestamp minus its radar's clock offset; a tie goes to the radar
 // listed first): `visit(radar, scan, source)`. The radars' scans are read

@@ -23,11 +23,13 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <utility>
 #include <vector>
 
 #include "radargauss/core/trajectory.hpp"
+#include "radargauss/io/rig.hpp"
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 
@@ -109,6 +111,20 @@ class RigFrames {
   };
   std::optional<MeasuredAt> last_measured_;  // the gate's centre
 };
+
+// What a front end tells of a frame it registered: the pose T_world_ref it
+// gave it, and whether its poses jumped before it (a relocalisation's fix,
+// a restart).
+struct RegisteredFrame {
+  SE3d pose;
+  bool jumped = false;
+};
+// Every scan of `rig` (ForEachRigScan) made into frames that `front_end`
+// registers (RadarSlam, Relocalizer): a rig of one radar gives each scan
+// as it is, as its own frame without a velocity. Returns the scans read;
+// throws DataError as ForEachRigScan and RigFrames do, naming the scan's source.
+std::size_t RegisterRigFrames(const Rig& rig, const OdometryOptions& options,
+                              const std::function<RegisteredFrame(const RigFrame&)>& front_end);
 
 // The body's trajectory from the reference radar's, T_world_ref in its
 // first frame: T_world_body = M T M^-1 (M = T_body_ref), so that the body
