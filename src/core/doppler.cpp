@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include "radargauss/core/voxel_grid.hpp"
@@ -49,6 +50,12 @@ const OptionTable<EgoVelocityOptions>& EgoVelocityOptionTable() {
           .Help("support counted in voxels of this edge (0: points)"),
   };
   return table;
+}
+
+double VelocityGateWidth(const Eigen::Matrix3d& covariance, double dt, double gate_sigmas, double acceleration_std,
+                         double min_gate) {
+  const double spread = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues().maxCoeff();
+  return std::max(min_gate, gate_sigmas * std::sqrt(std::max(spread, 0.0) + std::pow(acceleration_std * dt, 2)));
 }
 
 int RansacIterations(double outlier_probability, double success_probability) {

@@ -21,11 +21,13 @@ Eigen::Matrix<double, 1, 6> RigDopplerJacobian(const Eigen::Vector3d& position, 
   return row;
 }
 
+Eigen::Vector3d RigRadarVelocity(const SE3d& body_from_radar, const Eigen::Vector3d& v, const Eigen::Vector3d& w) {
+  return body_from_radar.rotation().Inverse() * (v + w.cross(body_from_radar.translation()));
+}
+
 double RigDoppler(const Eigen::Vector3d& position, const SE3d& body_from_radar, const Eigen::Vector3d& v,
                   const Eigen::Vector3d& w) {
-  const Eigen::Vector3d radar_velocity =
-      body_from_radar.rotation().Inverse() * (v + w.cross(body_from_radar.translation()));
-  return -position.normalized().dot(radar_velocity);
+  return -position.normalized().dot(RigRadarVelocity(body_from_radar, v, w));
 }
 
 Eigen::Matrix3Xd UnobservedRotations(const std::vector<SE3d>& body_from_radars) {

@@ -215,11 +215,8 @@ RadarOdometry::Velocity RadarOdometry::MeasureVelocity(const RadarScan& scan,
   if (prediction && state_->measured) {
     const auto& [measured_stamp, measured_covariance] = *state_->measured;
     const double dt = scan.timestamp - measured_stamp;
-    const double spread = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(measured_covariance).eigenvalues().maxCoeff();
-    gate = VelocityGate{
-        prediction->velocity,
-        std::max(options_.min_gate, options_.gate_sigmas * std::sqrt(std::max(spread, 0.0) +
-                                                                     std::pow(options_.acceleration_std * dt, 2)))};
+    gate = VelocityGate{prediction->velocity, VelocityGateWidth(measured_covariance, dt, options_.gate_sigmas,
+                                                                options_.acceleration_std, options_.min_gate)};
   }
   const EgoVelocityResult ego = EstimateEgoVelocity(scan, options_.ego_velocity, gate);
   for (std::size_t i = 0; i < ego.inlier.size(); ++i) {

@@ -14,6 +14,7 @@
 
 #include "radargauss/core/doppler.hpp"
 #include "radargauss/core/error.hpp"
+#include "radargauss/core/rig_twist.hpp"
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/residuals/rig_doppler_residual.hpp"
@@ -122,8 +123,7 @@ std::vector<std::size_t> UsedPoints(const RadarScan& scan, const ReferenceMotion
                                     const RigCalibrationOptions& options) {
   std::vector<std::size_t> used;
   if (!scan.has_doppler) return used;
-  const Eigen::Vector3d expected =
-      extrinsic.rotation().Inverse() * (motion.velocity + motion.angular_velocity.cross(extrinsic.translation()));
+  const Eigen::Vector3d expected = RigRadarVelocity(extrinsic, motion.velocity, motion.angular_velocity);
   const VelocityGate gate{expected, std::max(options.reference.min_gate, 0.1 * expected.norm())};
   const EgoVelocityResult ego = EstimateEgoVelocity(scan, options.reference.ego_velocity, gate);
   if (!ego.success) return used;

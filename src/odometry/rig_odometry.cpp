@@ -101,11 +101,8 @@ std::optional<VelocityGate> RigFrames::Gate(double stamp) const {
   if (!last_measured_) return std::nullopt;
   const GateOptions& o = gate_;
   const double dt = stamp - last_measured_->stamp;
-  const double spread =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(last_measured_->velocity.covariance).eigenvalues().maxCoeff();
-  return VelocityGate{
-      last_measured_->velocity.value,
-      std::max(o.min_gate, o.gate_sigmas * std::sqrt(std::max(spread, 0.0) + std::pow(o.acceleration_std * dt, 2)))};
+  return VelocityGate{last_measured_->velocity.value, VelocityGateWidth(last_measured_->velocity.covariance, dt,
+                                                                        o.gate_sigmas, o.acceleration_std, o.min_gate)};
 }
 
 RigFrames::FrameVelocity RigFrames::MeasureVelocity(const std::optional<VelocityGate>& gate) const {
@@ -186,8 +183,7 @@ std::vector<bool> RigFrames::OwnStaticPoints(std::size_t k, const std::optional<
   std::optional<VelocityGate> own_gate = gate;
   if (gate) {
     const Eigen::Vector3d v = frame.measured ? frame.twist.head<3>() : gate->predicted;
-    own_gate->predicted =
-        mounting.rotation().Inverse() * (v + Eigen::Vector3d(frame.twist.tail<3>()).cross(mounting.translation()));
+    own_gate->predicted = RigRadarVelocity(mounting, v, frame.twist.tail<3>());
   }
   const EgoVelocityResult own = EstimateEgoVelocity(scan, doppler_, own_gate);
   if (own.success) keep = own.inlier;

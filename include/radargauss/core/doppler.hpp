@@ -59,6 +59,10 @@ struct VelocityGate {
   double gate = 1.0;                                    // m/s
   bool Admits(const Eigen::Vector3d& velocity) const { return (velocity - predicted).norm() <= gate; }
 };
+// The gate's width around a velocity measured `dt` ago with covariance S:
+// gate_sigmas sqrt(lambda_max(S) + (acceleration_std dt)^2), at least min_gate.
+double VelocityGateWidth(const Eigen::Matrix3d& covariance, double dt, double gate_sigmas, double acceleration_std,
+                         double min_gate);
 
 EgoVelocityResult EstimateEgoVelocity(const RadarScan& scan, const EgoVelocityOptions& options = {},
                                       const std::optional<VelocityGate>& gate = std::nullopt);

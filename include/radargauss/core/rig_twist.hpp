@@ -70,6 +70,9 @@ struct RigTwist {
   int ransac_iterations = 0;
 };
 
+// The velocity (m/s, its own frame) of the radar at `body_from_radar` when
+// the body moves with v and w (body frame): R^T (v + w x t).
+Eigen::Vector3d RigRadarVelocity(const SE3d& body_from_radar, const Eigen::Vector3d& v, const Eigen::Vector3d& w);
 // The Doppler (m/s, positive receding) that a static point at `position`
 // (radar frame) shows to the radar at `body_from_radar` when the body moves
 // with velocity v and angular velocity w (body frame).
