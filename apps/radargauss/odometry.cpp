@@ -90,9 +90,9 @@ int RunRigOdometry(const OdometrySettings& s) {
   if (!s.sequence.sequence_dir.empty() || !s.sequence.bag.empty()) {
     throw DataError("--rig names the radars' scans itself: drop --sequence and --bag");
   }
-  if (!s.imu_file.empty() || !s.imu_topic.empty()) throw DataError("--rig: odometry on a rig takes no IMU yet");
   if (!s.mcap.empty() || s.matcher != "gaussians") throw DataError("--rig: no --mcap, and no --matcher but gaussians");
   const Rig rig = ReadRig(s.rig);
+  const ImuInput imu = RigImuOf(s, rig);  // before the run: a bad IMU leaves nothing behind
   std::optional<Trajectory> reference;
   if (!s.sequence.ground_truth.empty()) {
     reference =
@@ -101,7 +101,11 @@ int RunRigOdometry(const OdometrySettings& s) {
   StagedFolder folder = RunFolder(s, {"odometry.tum", "body.tum", "levelled.tum", "map.rgm", "map.ply"});
   std::vector<SE3d> mountings;
   for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
-  RigOdometry odometry(mountings, options);
+  // The window runs in the reference radar's frame: T_ref_imu = T_body_ref^-1 T_body_imu.
+  std::unique_ptr<MotionModel> motion =
+      MakeMotionModel(imu.inertial, mountings.front().Inverse() * imu.radar_from_imu, imu.samples);
+  PrintScreening(motion->screening());
+  RigOdometry odometry(mountings, options, std::move(motion));
   std::size_t scans = 0;
   ForEachRigScan(rig, [&](std::size_t radar, RadarScan& scan, const std::string& source) {
     try {
@@ -129,11 +133,14 @@ int RunRigOdometry(const OdometrySettings& s) {
   }
   std::printf("\n");
   PrintSummary(Summarise(odometry.odometry()));
+  const InertialMotion* inertial = InertialMotionOf(odometry.odometry());
+  if (inertial) PrintInertial(*inertial);
   std::printf("%s", table.c_str());
-  std::printf("wrote %s (body.tum: T_world_body; odometry.tum, per_scan.csv and summary.json of the %s odometry%s%s)\n",
-              s.out.c_str(), rig.radars.size() == 1 ? "radar's" : "body's",
-              options.map.keep_evicted ? ", map.rgm, map.ply" : "",
-              evaluation ? ", evaluation.json, evaluation.md" : "");
+  std::printf(
+      "wrote %s (body.tum: T_world_body; odometry.tum, per_scan.csv and summary.json of the %s odometry%s%s%s)\n",
+      s.out.c_str(), rig.radars.size() == 1 ? "radar's" : "body's",
+      options.map.keep_evicted ? ", map.rgm, map.ply" : "", inertial ? ", inertial.csv" : "",
+      evaluation ? ", evaluation.json, evaluation.md" : "");
   return 0;
 }
 

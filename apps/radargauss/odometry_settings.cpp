@@ -95,6 +95,24 @@ ImuInput ImuOf(const OdometrySettings& s) {
   return input;
 }
 
+// A rig's IMU (docs/design/rig.md, "An IMU on a rig"): --imu FILE, or
+// --imu-topic of the bag that holds the rig's radars; its --imu-extrinsic
+// (or --imu-rotation) is T_body_imu, its clock offset the IMU's stamps
+// minus the body's clock.
+ImuInput RigImuOf(const OdometrySettings& s, const Rig& rig) {
+  OdometrySettings on_rig = s;
+  if (!s.imu_topic.empty()) {
+    const std::string& bag = rig.radars.front().scans.bag;
+    const bool one_bag = std::all_of(rig.radars.begin(), rig.radars.end(),
+                                     [&](const RigRadar& radar) { return radar.scans.bag == bag; });
+    if (bag.empty() || !one_bag) {
+      throw DataError("--imu-topic on a rig needs the radars in one bag (bag: in the rig file); else --imu FILE");
+    }
+    on_rig.sequence.bag = bag;
+  }
+  return ImuOf(on_rig);
+}
+
 // IMU samples that cover none of the scans' time span are a clock mismatch, not data.
 void CheckOverlap(const std::vector<ImuSample>& gyro, const Sequence& sequence, const std::string& hint) {
   const double first = sequence.scans.front().timestamp, last = sequence.scans.back().timestamp;
@@ -144,18 +162,20 @@ ListedElsewhere OdometryListedElsewhere() {
 
 void AddImuOptions(CLI::App* app, OdometrySettings& s) {
   CLI::Option* imu_topic =
-      app->add_option("--imu-topic", s.imu_topic, "sensor_msgs/Imu topic of --bag: the IMU (--imu-fusion)");
+      app->add_option("--imu-topic", s.imu_topic,
+                      "sensor_msgs/Imu topic of --bag (with --rig, of the rig's bag): the IMU (--imu-fusion)");
   app->add_option("--imu", s.imu_file,
                   "IMU file of lines 'stamp wx wy wz ax ay az' (s, rad/s, m/s^2; the IMU's frame)");
   app->add_option("--imu-extrinsic", s.imu_extrinsic,
-                  "T_radar_imu: a file 'x y z qx qy qz qw' (the IMU's frame in the radar's)");
+                  "T_radar_imu (with --rig, T_body_imu): a file 'x y z qx qy qz qw' (the IMU's frame in the radar's)");
   // The IMU's settings without its topic would be read by nothing: refused.
   app->add_option("--imu-stamps", s.imu_stamps, "Stamp the IMU by its header or by the bag's record time")
       ->check(CLI::IsMember({"header", "record"}))
       ->needs(imu_topic)
       ->capture_default_str()
       ->group(HelpGroup(OptionGroup::kTuning));  // a bag's IMU details: --help-all
-  app->add_option("--imu-rotation", s.imu_rotation, "q_radar_imu as x y z w (rotates gyro rates into the radar frame)")
+  app->add_option("--imu-rotation", s.imu_rotation,
+                  "q_radar_imu (with --rig, q_body_imu) as x y z w (rotates gyro rates into the radar frame)")
       ->expected(4)
       ->needs(imu_topic)
       ->capture_default_str()

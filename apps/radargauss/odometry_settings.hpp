@@ -15,6 +15,7 @@
 #include "option_flags.hpp"
 #include "radargauss/core/atomic_file.hpp"
 #include "radargauss/core/error.hpp"
+#include "radargauss/io/rig.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/core/progress.hpp"
@@ -57,6 +58,11 @@ struct ImuInput {
   RadarInertialOptions inertial;
 };
 ImuInput ImuOf(const OdometrySettings& s);
+// A rig's IMU: --imu FILE, or --imu-topic of the bag that holds the rig's
+// radars; its --imu-extrinsic (or --imu-rotation) is T_body_imu, and the
+// window's clock offset the IMU's stamps minus the body's clock
+// (docs/design/rig.md, "An IMU on a rig").
+ImuInput RigImuOf(const OdometrySettings& s, const Rig& rig);
 // IMU samples that cover none of the scans' time span are a clock mismatch
 // (`hint`: what to try, appended to the message).
 void CheckOverlap(const std::vector<ImuSample>& imu, const Sequence& sequence, const std::string& hint);

@@ -45,8 +45,9 @@ int RunSimulateRig(const SimulateSettings& s) {
   const SimulatedRig rig = SimulateRig(config);
   WriteSimulatedRig(folder.path(), rig);
   folder.Commit();
-  std::printf("simulated a rig of %zu radars over %.1f s into %s (rig.yaml, gt_body_tum.txt)\n", rig.radars.size(),
-              double(config.world.scans) / config.world.rate_hz, s.out.c_str());
+  std::printf("simulated a rig of %zu radars over %.1f s into %s (rig.yaml, gt_body_tum.txt%s)\n", rig.radars.size(),
+              double(config.world.scans) / config.world.rate_hz, s.out.c_str(),
+              rig.imu.empty() ? "" : "; the body's IMU: imu.txt, imu_extrinsic.txt with T_body_imu");
   for (std::size_t r = 0; r < rig.radars.size(); ++r) {
     std::size_t detections = 0;
     for (const RadarScan& scan : rig.radars[r].scans) detections += scan.points.size();

@@ -72,12 +72,10 @@ int RunRigSlam(const SlamSettings& s) {
   if (!s.odometry.sequence.sequence_dir.empty() || !s.odometry.sequence.bag.empty()) {
     throw DataError("--rig names the radars' scans itself: drop --sequence and --bag");
   }
-  if (!s.odometry.imu_file.empty() || !s.odometry.imu_topic.empty()) {
-    throw DataError("--rig: SLAM on a rig takes no IMU yet");
-  }
   if (!s.odometry.mcap.empty()) throw DataError("--rig: no --mcap");
   if (s.map_tiles > 0.0 && s.no_map) throw DataError("--map-tiles writes the map: drop --no-map");
   const Rig rig = ReadRig(s.odometry.rig);
+  const ImuInput imu = RigImuOf(s.odometry, rig);  // before the run: a bad IMU leaves nothing behind
   std::optional<Trajectory> reference;
   if (!s.odometry.sequence.ground_truth.empty()) {
     reference = ReadRadarTrajectory(s.odometry.sequence.ground_truth,
@@ -85,7 +83,9 @@ int RunRigSlam(const SlamSettings& s) {
   }
   StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "body.tum", "odometry", "map.rgm", "map.ply", "map_tiles"});
   const SE3d& body_from_reference = rig.radars.front().body_from_radar;
-  RadarSlam slam(options, s.study);
+  // The window runs in the reference radar's frame: T_ref_imu = T_body_ref^-1 T_body_imu.
+  RadarSlam slam(options, s.study,
+                 MakeMotionModel(imu.inertial, body_from_reference.Inverse() * imu.radar_from_imu, imu.samples));
   const std::size_t scans = RegisterRigFrames(rig, options.odometry, [&](const RigFrame& frame) {
     slam.Register(frame.scan, frame.velocity);
     return RegisteredFrame{slam.odometry().pose(slam.odometry().scans() - 1)};

@@ -442,8 +442,8 @@ def read_tum(path: str) -> tuple:
 def relocalization_options(**options: Unpack[RelocalizationOptions]) -> dict:
     """Every option of Relocalizer, the given keywords set (checked), as a dict."""
 
-def rig_odometry(path: str, **kwargs) -> dict:
-    """The body's odometry from a rig file's radars (docs/design/rig.md, "Odometry on a rig"). A dict: trajectory ((stamps (N,), poses (N, 7)) of T_world_body), frame_radars (each frame's radars), velocity_measured, rig_velocity_measured (frames)."""
+def rig_odometry(path: str, imu: Any = None, body_from_imu: Any = None, **kwargs) -> dict:
+    """The body's odometry from a rig file's radars (docs/design/rig.md, "Odometry on a rig"), with an IMU on the body when given ("An IMU on a rig"). A dict: trajectory ((stamps (N,), poses (N, 7)) of T_world_body), frame_radars (each frame's radars), velocity_measured, rig_velocity_measured (frames); with the IMU's window, inertial_state (the newest state, in the first radar's frame; None before the window started)."""
 
 def set_threads(threads: int) -> None:
     """Worker threads of the parallel stages (0: all cores), as the tool's --threads."""

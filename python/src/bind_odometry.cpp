@@ -59,6 +59,8 @@ const char* OdometryDoc() {
   return doc.c_str();
 }
 
+}  // namespace
+
 OdometryOptions OdometryOptionsFrom(const py::kwargs& kwargs) {
   const OdometryOptions options = OptionsFrom(OdometryOptionTable(), kwargs);
   ValidateOptions(options);  // std::invalid_argument: ValueError
@@ -102,6 +104,8 @@ std::pair<OdometryOptions, RadarInertialOptions> InertialOptionsFrom(const py::k
   CheckOptions(RadarInertialOptionTable(), options);
   return {OdometryOptionsFrom(odometry), options};
 }
+
+namespace {
 
 const char* InertialDoc() {
   static const std::string doc =

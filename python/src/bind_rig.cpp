@@ -70,13 +70,22 @@ py::dict CalibrationToDict(const RigCalibration& calibration) {
 void BindRigRuns(py::module_& m) {
   m.def(
       "rig_odometry",
-      [](const std::string& path, const py::kwargs& kwargs) {
-        const OdometryOptions options = OptionsFrom(OdometryOptionTable(), kwargs);
-        ValidateOptions(options);  // std::invalid_argument: ValueError
+      [](const std::string& path, const py::object& imu, const py::object& body_from_imu, const py::kwargs& kwargs) {
+        const auto [options, inertial] = InertialOptionsFrom(kwargs);
+        if (imu.is_none() && !body_from_imu.is_none()) throw py::value_error("body_from_imu needs imu");
         const Rig rig = ReadRig(path);
         std::vector<SE3d> mountings;
         for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
-        RigOdometry odometry(mountings, options);
+        std::unique_ptr<MotionModel> motion;
+        if (!imu.is_none()) {
+          std::vector<ImuSample> samples = ImuFromArray(imu);
+          if (samples.empty()) throw DataError("the IMU has no sample");
+          const SE3d body_from_imu_pose =
+              body_from_imu.is_none() ? SE3d() : PoseFromPython(body_from_imu, "body_from_imu");
+          // The window in the reference radar's frame: T_ref_imu = T_body_ref^-1 T_body_imu.
+          motion = MakeMotionModel(inertial, mountings.front().Inverse() * body_from_imu_pose, std::move(samples));
+        }
+        RigOdometry odometry(mountings, options, std::move(motion));
         {
           py::gil_scoped_release release;
           ForEachRigScan(
@@ -88,12 +97,19 @@ void BindRigRuns(py::module_& m) {
         out["frame_radars"] = py::cast(odometry.frame_radars());
         out["velocity_measured"] = odometry.velocity_measured();
         out["rig_velocity_measured"] = odometry.rig_velocity_measured();
+        if (const InertialMotion* window = InertialMotionOf(odometry.odometry())) {
+          out["inertial_state"] = window->states().empty() ? py::none() : StateToDict(window->states().back());
+        }
         return out;
       },
-      py::arg("path"),
-      "The body's odometry from a rig file's radars (docs/design/rig.md, \"Odometry on a rig\"). A dict: "
-      "trajectory ((stamps (N,), poses (N, 7)) of T_world_body), frame_radars (each frame's radars), "
-      "velocity_measured, rig_velocity_measured (frames).\n\nKeywords: RadarOdometry's (odometry_options)");
+      py::arg("path"), py::arg("imu") = py::none(), py::arg("body_from_imu") = py::none(),
+      "The body's odometry from a rig file's radars (docs/design/rig.md, \"Odometry on a rig\"), with an IMU "
+      "on the body when given (\"An IMU on a rig\"). A dict: trajectory ((stamps (N,), poses (N, 7)) of "
+      "T_world_body), frame_radars (each frame's radars), velocity_measured, rig_velocity_measured (frames); "
+      "with the IMU's window, inertial_state (the newest state, in the first radar's frame; None before the "
+      "window started).\n\nimu: array (N, 7) [stamp wx wy wz ax ay az] on the body's clock (s, rad/s, m/s^2, "
+      "the IMU's frame); body_from_imu: (4, 4) or [x y z qx qy qz qw], T_body_imu, default identity.\n\n"
+      "Keywords: RadarOdometry's (odometry_options) and RadarInertialOdometry's (option_fields('radar_inertial'))");
   m.def(
       "calibrate_rig",
       [](const std::string& path, const py::kwargs& kwargs) {

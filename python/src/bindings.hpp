@@ -4,12 +4,17 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <utility>
+#include <vector>
 
 #include "convert.hpp"
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/map/matching_map.hpp"
 #include "radargauss/core/trajectory.hpp"
+#include "radargauss/io/imu.hpp"
+#include "radargauss/odometry/radar_inertial.hpp"
+#include "radargauss/odometry/radar_odometry.hpp"
 
 namespace radargauss::python {
 
@@ -52,6 +57,14 @@ class Locked {
 // (stamps (N,), poses (N, 7)) and back; poses may also be (N, 4, 4).
 py::tuple TrajectoryToArrays(const Trajectory& trajectory);
 Trajectory TrajectoryFromArrays(const py::handle& stamps, const py::handle& poses, const std::string& name);
+
+// The odometry's keywords (ValueError for a bad one); an (N, 7) IMU array
+// [stamp wx wy wz ax ay az]; an inertial state as a dict (None before the
+// window started); keywords split between the odometry's table and the window's.
+OdometryOptions OdometryOptionsFrom(const py::kwargs& kwargs);
+std::vector<ImuSample> ImuFromArray(const py::handle& value);
+py::object StateToDict(const std::optional<InertialState>& state);
+std::pair<OdometryOptions, RadarInertialOptions> InertialOptionsFrom(const py::kwargs& kwargs);
 
 void BindData(py::module_& m);
 void BindRig(py::module_& m);  // read_rig, estimate_rig_twist

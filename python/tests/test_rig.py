@@ -50,6 +50,33 @@ CLI = os.environ.get("RADARGAUSS_CLI")
 
 
 @pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool (it simulates the rig)")
+def test_odometry_of_a_simulated_rig_with_an_imu(tmp_path):
+    # One IMU on the body, off the axle: rig_odometry with the IMU's samples
+    # and T_body_imu gives the command line's --imu --imu-extrinsic run.
+    (tmp_path / "rig_config.yaml").write_text(
+        "world: {scans: 40, imu_rate_hz: 200, imu_x: 1.0, imu_yaw_deg: 90}\nradars:\n"
+        "  - {name: front, mounting_x: 3.7, mounting_z: 0.5}\n"
+        "  - {name: rear, mounting_x: -1.0, mounting_z: 0.6, mounting_yaw_deg: 180, clock_offset: 0.01}\n")
+    subprocess.run([CLI, "simulate", "--rig-config", str(tmp_path / "rig_config.yaml"), "--out",
+                    str(tmp_path / "rig")], check=True, stdout=subprocess.DEVNULL)
+    rig_file = str(tmp_path / "rig" / "rig.yaml")
+    imu = np.loadtxt(tmp_path / "rig" / "imu.txt")
+    body_from_imu = np.loadtxt(tmp_path / "rig" / "imu_extrinsic.txt")
+    assert np.allclose(body_from_imu[:3], [1.0, 0.0, 0.0]) and np.isclose(abs(body_from_imu[5]), np.sqrt(0.5))
+    run = rg.rig_odometry(rig_file, imu=imu, body_from_imu=body_from_imu)
+    subprocess.run([CLI, "odometry", "--rig", rig_file, "--imu", str(tmp_path / "rig" / "imu.txt"), "--imu-extrinsic",
+                    str(tmp_path / "rig" / "imu_extrinsic.txt"), "--out", str(tmp_path / "odometry")], check=True,
+                   stdout=subprocess.DEVNULL)
+    stamps, poses = run["trajectory"]
+    written = np.loadtxt(tmp_path / "odometry" / "body.tum")
+    assert np.allclose(stamps, written[:, 0]) and np.allclose(poses, written[:, 1:], atol=1e-6)
+    assert run["inertial_state"] is not None and run["inertial_state"]["gyro_bias"].size == 3
+    assert "inertial_state" not in rg.rig_odometry(rig_file)
+    with pytest.raises(ValueError, match="body_from_imu needs imu"):
+        rg.rig_odometry(rig_file, body_from_imu=body_from_imu)
+
+
+@pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool (it simulates the rig)")
 def test_odometry_and_calibration_of_a_simulated_rig(tmp_path):
     # A front radar and a front corner at twice its rate on its own clock:
     # the body's odometry equals the command line's, and the calibration

@@ -237,13 +237,13 @@ RadarOdometry::Velocity RadarOdometry::MeasureVelocity(const RadarScan& scan,
 }
 
 // Kiss-icp's shape: each stage returns a value, the step is assembled at the end.
-bool RadarOdometry::RunBeside(const RadarScan& scan) {
+bool RadarOdometry::RunBeside(const RadarScan& scan, const std::optional<MeasuredVelocity>& measured) {
   if (!motion_->OnProbation() || fixed_map_) {
     radar_alone_.reset();
     return false;
   }
   if (!radar_alone_) radar_alone_ = std::make_unique<RadarOdometry>(options_, nullptr, factory_);
-  const OdometryStep& alone = radar_alone_->Register(scan);
+  const OdometryStep& alone = radar_alone_->Register(scan, measured);
   if (motion_->Check(alone.stamp, alone.pose, alone.matched)) return false;
   // The model failed: the radar alone's run goes on as this one, the model kept for its record.
   radar_alone_->FinishMapUpdate();
@@ -261,7 +261,7 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& input, const std::o
   const auto start = std::chrono::steady_clock::now();
   if (measured && input.has_doppler)
     throw std::invalid_argument("a velocity measured apart is for scans without Doppler");
-  if (RunBeside(input)) return steps_.back();
+  if (RunBeside(input, measured)) return steps_.back();
   CheckStamp(input);
   motion_->Advance(input.timestamp);
   if (const std::optional<double> bias = motion_->ElevationBias()) elevation_bias_.Hold(*bias);
@@ -270,7 +270,7 @@ const OdometryStep& RadarOdometry::Register(const RadarScan& input, const std::o
   const RadarScan& scan = correct ? corrected : input;
   std::optional<Prediction> prediction;
   if (state_) prediction = Predict(scan.timestamp);
-  if (prediction && measured && measured->rate && state_->rate)
+  if (prediction && !prediction->gyro && measured && measured->rate && state_->rate)  // a gyro's rates come first
     PredictFromRates(*state_->rate, *measured->rate, *prediction);
   const Velocity velocity = MeasureVelocity(scan, prediction, measured);
   if (velocity.measured && !velocity.standstill) elevation_bias_.Observe(velocity.value);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -53,6 +54,10 @@ RigFrames::RigFrames(std::vector<SE3d> body_from_radar, const OdometryOptions& o
       rig_options_(options.rig) {
   if (body_from_radar_.empty()) throw DataError("a rig's odometry needs a radar");
   CheckOptions(RigOdometryOptionTable(), rig_options_);
+  if (options.elevation_bias.estimate && body_from_radar_.size() > 1) {
+    throw std::invalid_argument(
+        "estimate_elevation_bias: a rig's frames mix its radars' elevations (one radar's bias only)");
+  }
   const SE3d reference_from_body = body_from_radar_.front().Inverse();
   for (const SE3d& mounting : body_from_radar_) reference_from_radar_.push_back(reference_from_body * mounting);
 }
@@ -223,8 +228,9 @@ RigFrame RigFrames::Close() {
   return out;
 }
 
-RigOdometry::RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options)
-    : frames_(std::move(body_from_radar), options), odometry_(options) {}
+RigOdometry::RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options,
+                         std::unique_ptr<MotionModel> motion)
+    : frames_(std::move(body_from_radar), options), odometry_(options, std::move(motion)) {}
 
 void RigOdometry::Register(std::size_t radar, const RadarScan& scan) {
   if (frames_.radars() == 1) {  // the single-radar odometry

@@ -86,7 +86,8 @@ SimulatedImu SimulateImuAlong(const std::function<SE3d(double)>& world_from_imu,
   return imu;
 }
 
-void WriteImuFiles(const std::string& dir, const SimulatedImu& imu, const SE3d& radar_from_imu) {
+void WriteImuFiles(const std::string& dir, const SimulatedImu& imu, const SE3d& radar_from_imu,
+                   const std::string& host) {
   namespace fs = std::filesystem;
   WriteFileAtomically((fs::path(dir) / "imu.txt").string(), [&](std::ostream& out) {
     out << "# stamp wx wy wz ax ay az (s, rad/s, m/s^2; the IMU's frame)\n";
@@ -104,7 +105,7 @@ void WriteImuFiles(const std::string& dir, const SimulatedImu& imu, const SE3d& 
     char line[256];
     std::snprintf(line, sizeof(line), "%.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", t.x(), t.y(), t.z(), q.x(), q.y(),
                   q.z(), q.w());
-    out << "# x y z qx qy qz qw: T_radar_imu\n" << line;
+    out << "# x y z qx qy qz qw: T_" << host << "_imu\n" << line;
   });
   WriteFileAtomically((fs::path(dir) / "imu_biases.txt").string(), [&](std::ostream& out) {
     out << "# stamp bgx bgy bgz bax bay baz: the true biases (rad/s, m/s^2), for evaluation only\n";

@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include "radargauss/lie/se3.hpp"
+#include "radargauss/simulator/imu_from_reference.hpp"
 #include "radargauss/simulator/simulator.hpp"
 
 namespace radargauss::simulation {
@@ -122,6 +123,10 @@ double EgoArc(const SimulationConfig& config, double time);
 // Sensor pose and world velocity at `time`.
 void SensorState(const SimulationConfig& config, const LoopPath& path, double time, SE3d& pose,
                  Eigen::Vector3d& velocity_world);
+
+// The IMU on the vehicle (ImuOnVehicle) along the drive: `count` samples from
+// config.start_time on the true clock (SimulateImuAlong's model and draws).
+SimulatedImu VehicleImu(const SimulationConfig& config, std::size_t count);
 
 // The nearest surface along a ray within max_range: the ground, the scene's
 // static boxes, the moving boxes and the poles (hit.material null: none).

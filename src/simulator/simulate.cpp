@@ -179,24 +179,6 @@ struct ScanStamp {
   double since_start = 0.0;
 };
 
-// The IMU's samples over the drive (docs/design/simulator.md, "The synthetic
-// world"): the model of SimulateImuAlong on the vehicle's path.
-void SimulateImu(const SimulationConfig& config, const simulation::LoopPath& path, const SE3d& vehicle_from_radar,
-                 SimulatedSequence& sequence) {
-  const SE3d vehicle_from_imu = ImuOnVehicle(config);
-  sequence.radar_from_imu = vehicle_from_radar.Inverse() * vehicle_from_imu;
-  SimulatedImu imu = SimulateImuAlong(
-      [&](double t) {
-        SE3d pose;
-        Eigen::Vector3d velocity;
-        SensorState(config, path, t, pose, velocity);
-        return pose * vehicle_from_imu;
-      },
-      ImuSampleCount(config), config);
-  sequence.imu = std::move(imu.samples);
-  sequence.imu_bias = std::move(imu.bias);
-}
-
 // On the radar's clock: the true time plus its clock offset.
 ScanStamp TimeOfScan(const SimulationConfig& config, int k) {
   const double start = config.start_time + config.clock_offset;
@@ -218,6 +200,21 @@ SE3d RadarOnVehicle(const SimulationConfig& config) {
                   SO3d::Exp(Eigen::Vector3d(0.0, config.mounting_pitch_deg * kDeg, 0.0)) *
                   SO3d::Exp(Eigen::Vector3d(config.mounting_roll_deg * kDeg, 0.0, 0.0)),
               Eigen::Vector3d(config.mounting_x, config.mounting_y, config.mounting_z));
+}
+
+// The IMU on the vehicle along the drive (docs/design/simulator.md, "The
+// synthetic world"): the model of SimulateImuAlong on the vehicle's path.
+SimulatedImu simulation::VehicleImu(const SimulationConfig& config, std::size_t count) {
+  const LoopPath path{config.loop_length, config.loop_width, config.corner_radius};
+  const SE3d vehicle_from_imu = ImuOnVehicle(config);
+  return SimulateImuAlong(
+      [&](double t) {
+        SE3d pose;
+        Eigen::Vector3d velocity;
+        SensorState(config, path, t, pose, velocity);
+        return pose * vehicle_from_imu;
+      },
+      count, config);
 }
 
 SimulatedSequence Simulate(const SimulationConfig& config) {
@@ -279,7 +276,12 @@ SimulatedSequence Simulate(const SimulationConfig& config) {
   for (std::size_t k = 0; k < sequence.scans.size(); ++k) {
     ValidateScan(sequence.scans[k], "simulation config (scan " + std::to_string(k) + ")");
   }
-  if (config.imu_rate_hz > 0.0) SimulateImu(config, path, mounting, sequence);
+  if (config.imu_rate_hz > 0.0) {
+    SimulatedImu imu = simulation::VehicleImu(config, ImuSampleCount(config));
+    sequence.imu = std::move(imu.samples);
+    sequence.imu_bias = std::move(imu.bias);
+    sequence.radar_from_imu = mounting.Inverse() * ImuOnVehicle(config);
+  }
   return sequence;
 }
 

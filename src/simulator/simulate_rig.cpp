@@ -13,32 +13,39 @@
 #include "radargauss/core/error.hpp"
 #include "radargauss/io/yaml_file.hpp"
 #include "radargauss/io/rig.hpp"
+#include "radargauss/simulator/imu_from_reference.hpp"
 #include "radargauss/simulator/simulator.hpp"
 #include "scene.hpp"
 
 namespace radargauss {
 
+// The drive's and world's keys, and the IMU's (one on the body).
 const std::vector<std::string>& RigSharedSimulationKeys() {
-  static const std::vector<std::string> keys = {"world_seed",
-                                                "start_offset",
-                                                "scans",
-                                                "start_time",
-                                                "speed",
-                                                "loop_length",
-                                                "loop_width",
-                                                "corner_radius",
-                                                "sensor_height",
-                                                "attitude_wobble_deg",
-                                                "scene",
-                                                "traffic_min_speed",
-                                                "traffic_max_speed",
-                                                "poles",
-                                                "parked_cars",
-                                                "moving_cars",
-                                                "moving_car_speed",
-                                                "object_rcs_spread_db",
-                                                "materials",
-                                                "imu_rate_hz"};
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> shared = {"world_seed",
+                                       "start_offset",
+                                       "scans",
+                                       "start_time",
+                                       "speed",
+                                       "loop_length",
+                                       "loop_width",
+                                       "corner_radius",
+                                       "sensor_height",
+                                       "attitude_wobble_deg",
+                                       "scene",
+                                       "traffic_min_speed",
+                                       "traffic_max_speed",
+                                       "poles",
+                                       "parked_cars",
+                                       "moving_cars",
+                                       "moving_car_speed",
+                                       "object_rcs_spread_db",
+                                       "materials"};
+    for (const auto& row : SimulationOptionTable()) {
+      if (row.name.rfind("imu_", 0) == 0) shared.push_back(row.name);
+    }
+    return shared;
+  }();
   return keys;
 }
 
@@ -51,7 +58,6 @@ RigSimulationConfig LoadRigSimulationConfig(const std::string& path) {
   }
   RigSimulationConfig rig;
   if (root["world"]) ApplySimulationKeys(root["world"], path, rig.world, {}, "");
-  if (rig.world.imu_rate_hz > 0.0) throw FileError(path, "imu_rate_hz: a rig is simulated without an IMU");
   ValidateSimulationConfig(rig.world, path);
   const YAML::Node radars = root["radars"];
   if (!radars || !radars.IsSequence() || radars.size() == 0) throw FileError(path, "no radars: (a list of radars)");
@@ -83,6 +89,7 @@ SimulatedRig SimulateRig(const RigSimulationConfig& config) {
   SimulatedRig rig;
   for (const auto& [name, radar] : config.radars) {
     SimulationConfig one = radar;
+    one.imu_rate_hz = 0.0;  // the body's IMU is simulated once, below
     one.world_seed = config.world.world_seed != 0 ? config.world.world_seed : config.world.seed;
     one.scans = std::max(1, int(std::floor(duration * one.rate_hz + 1e-9)));
     rig.names.push_back(name);
@@ -106,6 +113,14 @@ SimulatedRig SimulateRig(const RigSimulationConfig& config) {
     rig.body_velocity.push_back(rotation.Inverse() * (after.translation() - before.translation()) / (2.0 * kStep));
     rig.body_angular_velocity.push_back((before.rotation().Inverse() * after.rotation()).Log() / (2.0 * kStep));
   }
+  if (config.world.imu_rate_hz > 0.0) {  // over the whole drive, its draws seeded after the radars'
+    SimulationConfig world = config.world;
+    world.seed = config.world.seed + std::uint32_t(config.radars.size());
+    SimulatedImu imu = simulation::VehicleImu(world, std::size_t(std::floor(duration * world.imu_rate_hz + 1e-9)) + 1);
+    rig.imu = std::move(imu.samples);
+    rig.imu_bias = std::move(imu.bias);
+    rig.body_from_imu = ImuOnVehicle(world);
+  }
   return rig;
 }
 
@@ -126,6 +141,7 @@ void WriteSimulatedRig(const std::string& dir, const SimulatedRig& simulated) {
   }
   WriteRig((fs::path(dir) / "rig.yaml").string(), rig);
   WriteTum((fs::path(dir) / "gt_body_tum.txt").string(), simulated.body);
+  if (!simulated.imu.empty()) WriteImuFiles(dir, {simulated.imu, simulated.imu_bias}, simulated.body_from_imu, "body");
   WriteFileAtomically((fs::path(dir) / "twist_body.txt").string(), [&](std::ostream& out) {
     out << "# t vx vy vz wx wy wz: the body's true velocity (m/s) and angular velocity (rad/s), body frame\n";
     out << std::setprecision(12);

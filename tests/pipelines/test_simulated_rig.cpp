@@ -17,6 +17,7 @@
 #include "radargauss/core/rig_twist.hpp"
 #include "radargauss/experiment/evaluation.hpp"
 #include "radargauss/io/rig.hpp"
+#include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/rig_calibration.hpp"
 #include "radargauss/odometry/rig_odometry.hpp"
 #include "radargauss/simulator/simulator.hpp"
@@ -245,6 +246,35 @@ TEST(RigOdometry, TheRigsRotationRateCutsTheDrift) {
   EXPECT_LT(with_rate, 0.67 * without) << with_rate << " against " << without;
 }
 
+// One IMU on the body, turned and off the axle, its window in the front
+// radar's frame (T_ref_imu = T_body_ref^-1 T_body_imu): the gravity and the
+// gyro take the drift the radars leave (the vertical above all), and the
+// window finds the gyro's true bias to a quarter of its size in 10 s (a
+// wrong extrinsic would turn it).
+TEST(RigOdometry, AnImuOnTheBodyCutsTheDriftAndFindsItsGyroBias) {
+  RigSimulationConfig config = FrontAndFastCorner(100);
+  config.world.imu_rate_hz = 200.0;
+  config.world.imu_yaw_deg = 90.0;
+  config.world.imu_x = 1.2;
+  config.world.imu_z = 0.3;
+  const SimulatedRig rig = SimulateRig(config);
+  ASSERT_FALSE(rig.imu.empty());
+  const auto drift = [&](RigOdometry& odometry) {
+    RegisterOnTheBodysClock(odometry, rig, config);
+    return EvaluateTrajectory(odometry.trajectory(), rig.body).rpe_mean.translation;
+  };
+  RigOdometry radars(rig.body_from_radar);
+  RigOdometry inertial(rig.body_from_radar, {},
+                       MakeMotionModel({}, rig.body_from_radar.front().Inverse() * rig.body_from_imu, rig.imu));
+  const double without = drift(radars), with_imu = drift(inertial);
+  EXPECT_LT(with_imu, 0.5 * without) << with_imu << " against " << without;
+  const InertialMotion* window = InertialMotionOf(inertial.odometry());
+  ASSERT_TRUE(window && !window->states().empty() && window->states().back());
+  const Eigen::Vector3d error = window->states().back()->bias.gyro - rig.imu_bias.back().gyro;
+  EXPECT_LT(error.norm(), 0.25 * rig.imu_bias.back().gyro.norm())
+      << error.transpose() << " (true " << rig.imu_bias.back().gyro.transpose() << ")";
+}
+
 // Planted by hand: the body drives straight at 10 m/s past static points; a
 // corner radar scans 50 ms before the front radar. The frame's points are
 // where the world's points lie in the front radar's frame at its stamp, to
@@ -354,7 +384,8 @@ TEST_F(SimulatedRigFiles, ItsConfigRefusesWhatIsTheRigsOwn) {
             std::string::npos);
   EXPECT_NE(error_of("radars:\n  - {mounting_x: 1}\n").find("radar 1 needs a name"), std::string::npos);
   EXPECT_NE(error_of("radars:\n  - {name: a}\n  - {name: a}\n").find("two radars are named 'a'"), std::string::npos);
-  EXPECT_NE(error_of("world: {imu_rate_hz: 200}\nradars:\n  - {name: a}\n").find("without an IMU"), std::string::npos);
+  EXPECT_NE(error_of("radars:\n  - {name: a, imu_x: 1}\n").find("imu_x: radar 'a' sets a key of the rig"),
+            std::string::npos);
   EXPECT_NE(error_of("radars: []\n").find("no radars"), std::string::npos);
   EXPECT_NE(error_of("radars:\n  - {name: a, mounting_yaw_deg: 270}\n").find("mounting_yaw_deg"), std::string::npos);
   EXPECT_EQ(error_of("world: {scans: 10}\nradars:\n  - {name: a, clock_offset: 0.01}\n"), "no error");

@@ -227,8 +227,8 @@ expect_fail "a rig and a sequence" "drop --sequence" -- "$tool" info --rig "$wor
 expect_ok "odometry on a rig" "rig: 2 radars, 20 scans in 10 frames" -- \
   "$tool" odometry --rig "$work/rig.yaml" --out "$work/rig_odometry"
 [[ -s "$work/rig_odometry/body.tum" ]] || { echo "FAIL: odometry --rig wrote no body.tum"; failed=1; }
-expect_fail "odometry on a rig with an IMU" "takes no IMU yet" -- \
-  "$tool" odometry --rig "$work/rig.yaml" --imu "$work/seq10/gt_radar_tum.txt" --out "$work/rig_imu"
+expect_fail "odometry on a rig of folders with an IMU topic" "needs the radars in one bag" -- \
+  "$tool" odometry --rig "$work/rig.yaml" --imu-topic /imu --out "$work/rig_imu"
 [[ ! -e "$work/rig_imu" ]] || { echo "FAIL: a refused rig run left $work/rig_imu"; failed=1; }
 expect_ok "a rig to one bag" "20 scans of 2 radars" -- "$tool" convert --rig "$work/rig.yaml" --out "$work/rig_bag.mcap"
 expect_ok "the bag's rig file" "rear: 10 scans (rosbag)" -- "$tool" info --rig "$work/rig_bag.rig.yaml"
@@ -247,8 +247,9 @@ printf 'radars:\n  - {name: front, sequence: seq10, extrinsic: [0, 0, 0, 0, 0, 0
 "$tool" slam --sequence "$work/seq10" --submap-distance 2 --out "$work/slam_one" >/dev/null
 cmp -s "$work/rig_slam_one/slam.tum" "$work/slam_one/slam.tum" || {
   echo "FAIL: slam on a rig of one radar differs from slam on its sequence"; failed=1; }
-expect_fail "slam on a rig with an IMU" "takes no IMU yet" -- \
+expect_fail "slam on a rig with an IMU file that is not one" "$work/seq10/gt_radar_tum.txt" -- \
   "$tool" slam --rig "$work/rig.yaml" --imu "$work/seq10/gt_radar_tum.txt" --out "$work/rig_slam_imu"
+[[ ! -e "$work/rig_slam_imu" ]] || { echo "FAIL: a refused rig run left $work/rig_slam_imu"; failed=1; }
 expect_ok "relocalize a rig in its slam map" "rig: 2 radars, 20 scans in 10 frames" -- \
   "$tool" relocalize --rig "$work/rig.yaml" --map "$work/rig_slam/map.rgm" --submap-distance 2 --out "$work/rig_reloc"
 [[ -e "$work/rig_reloc/body.tum" ]] || { echo "FAIL: relocalize --rig wrote no body.tum"; failed=1; }
@@ -343,6 +344,18 @@ for threads in 2 8; do
     cmp -s "$work/inertial_1/$file" "$work/inertial_$threads/$file" ||
       { echo "FAIL: radar-inertial $file differs between 1 and $threads threads"; failed=1; }
   done
+done
+# A rig of one radar with the IMU on the body: the IMU's T_body_imu = T_body_radar T_radar_imu
+# (here exact in floating point) gives the single radar's radar-inertial run, bit for bit.
+printf 'radars:\n  - {name: front, sequence: seq_imu, extrinsic: [1.5, 0.25, 0.5, 0, 0, 0, 1]}\n' > "$work/rig_imu_one.yaml"
+printf '1.5 0.25 0.5 0 0 0 1\n' > "$work/body_from_imu.txt"
+grep -q '^0 0 0 0 0 0 1$' "$work/seq_imu/imu_extrinsic.txt" || { echo "FAIL: the simulated T_radar_imu is not the identity"; failed=1; }
+expect_ok "radar-inertial odometry on a rig of one radar" "inertial.csv" -- \
+  "$tool" odometry --rig "$work/rig_imu_one.yaml" --imu "$work/seq_imu/imu.txt" \
+  --imu-extrinsic "$work/body_from_imu.txt" --out "$work/rig_inertial_one"
+for file in odometry.tum inertial.csv; do
+  cmp -s "$work/inertial_1/$file" "$work/rig_inertial_one/$file" ||
+    { echo "FAIL: radar-inertial $file on a rig of one radar differs from the radar's own"; failed=1; }
 done
 # Calibrating: each estimated parameter per scan in inertial.csv, its last row summary.json's value.
 expect_ok "radar-inertial odometry, calibrating" "inertial.csv" -- \

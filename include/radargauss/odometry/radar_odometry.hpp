@@ -168,7 +168,8 @@ class RadarOdometry {
   // point is matched, as without Doppler.
   // The rotation rate measured with it (rad/s, the scan's frame) and its
   // covariance: with the last scan's, the rotation term's prediction (its
-  // yaw about the vehicle's vertical; with `all`, roll and pitch too).
+  // yaw about the vehicle's vertical; with `all`, roll and pitch too),
+  // unless the motion model's gyro gives the rotation.
   struct MeasuredRate {
     Eigen::Vector3d value = Eigen::Vector3d::Zero();
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
@@ -258,7 +259,7 @@ class RadarOdometry {
   void CheckStamp(const RadarScan& scan) const;
   // The radar alone beside a model on probation; true when the model failed
   // on this scan and the radar alone's run has become this one.
-  bool RunBeside(const RadarScan& scan);
+  bool RunBeside(const RadarScan& scan, const std::optional<MeasuredVelocity>& measured);
   Prediction Predict(double stamp) const;
   // The increment (and its std) from the rates measured at the last scan and this one.
   void PredictFromRates(const MeasuredRate& before, const MeasuredRate& now, Prediction& p) const;

@@ -24,6 +24,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -50,7 +51,8 @@ struct RigFrame {
 // each frame returned, and tell the frames where it was registered.
 class RigFrames {
  public:
-  // Throws DataError for no radar, std::invalid_argument for a bad options.rig.
+  // Throws DataError for no radar, std::invalid_argument for a bad options.rig
+  // or an elevation bias to estimate over several radars.
   RigFrames(std::vector<SE3d> body_from_radar, const OdometryOptions& options);
 
   // `scan` of radar `radar`, its timestamp on the body's clock (not before
@@ -136,8 +138,13 @@ class RigOdometry {
   // `body_from_radar`: T_body_radar of each radar. The odometry's Doppler
   // filter (options.ego_velocity) serves every radar; the map and the match
   // are the body's; options.rig says how scans become frames (RigFrames).
+  // `motion`: the motion model of the reference radar's odometry (null:
+  // constant velocity); an IMU's (MakeMotionModel) takes T_ref_imu =
+  // T_body_ref^-1 T_body_imu and stamps on the body's clock (one window
+  // over the rig: docs/design/rig.md, "An IMU on a rig").
   // Throws DataError for no radar, std::invalid_argument for a bad option.
-  RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options = {});
+  RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options = {},
+              std::unique_ptr<MotionModel> motion = nullptr);
 
   // `scan` of radar `radar`, its timestamp on the body's clock (not before
   // the last scan's). Throws DataError for an unknown radar or a stamp that

@@ -32,9 +32,11 @@ SimulatedImu SimulateImuAlong(const std::function<SE3d(double)>& world_from_imu,
 // config's imu_roll/pitch/yaw_deg and imu_x/y/z: T_vehicle_imu.
 SE3d ImuOnVehicle(const SimulationConfig& config);
 
-// imu.txt, imu_extrinsic.txt (T_radar_imu) and the true imu_biases.txt in
-// `dir` (io/imu.hpp's formats), each written whole or not at all.
-void WriteImuFiles(const std::string& dir, const SimulatedImu& imu, const SE3d& radar_from_imu);
+// imu.txt, imu_extrinsic.txt (T_radar_imu; a rig's T_body_imu, `host`
+// "body") and the true imu_biases.txt in `dir` (io/imu.hpp's formats), each
+// written whole or not at all.
+void WriteImuFiles(const std::string& dir, const SimulatedImu& imu, const SE3d& radar_from_imu,
+                   const std::string& host = "radar");
 
 // A smooth motion through a reference: uniform cubic B-splines fitted by
 // least squares to its positions and to its roll, pitch and (unwrapped) yaw

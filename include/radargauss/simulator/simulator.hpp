@@ -211,15 +211,23 @@ struct SimulatedRig {
   // The body's true twist at the same times: velocity and angular velocity
   // in the body frame (central differences of its pose over 1e-4 s).
   std::vector<Eigen::Vector3d> body_velocity, body_angular_velocity;
+  // The body's IMU (the world's imu_* keys; empty at imu_rate_hz 0): its
+  // samples on its clock, its true biases and T_body_imu.
+  std::vector<ImuSample> imu;
+  std::vector<ImuBias> imu_bias;
+  SE3d body_from_imu;
 };
 // Each radar simulated over the world's drive: its scans number its rate
 // times the drive's duration (world.scans / world.rate_hz), its noise seed
 // is world.seed plus its index unless it sets one, and the world's objects
-// are one for all (world_seed, or world.seed when that is 0).
+// are one for all (world_seed, or world.seed when that is 0). With the
+// world's imu_rate_hz, one IMU on the body over the whole drive, its draws
+// seeded by world.seed plus the number of radars.
 SimulatedRig SimulateRig(const RigSimulationConfig& config);
 // <dir>/<name>/ per radar (WriteSimulatedSequence), <dir>/rig.yaml (io/rig.hpp:
 // the folders, mountings and clock offsets), <dir>/gt_body_tum.txt and
-// <dir>/twist_body.txt (lines "t vx vy vz wx wy wz", body frame).
+// <dir>/twist_body.txt (lines "t vx vy vz wx wy wz", body frame); with an
+// IMU, <dir>/imu.txt, imu_extrinsic.txt (T_body_imu) and imu_biases.txt.
 void WriteSimulatedRig(const std::string& dir, const SimulatedRig& rig);
 
 // "<secs>.<nsecs>" with nine decimals: the Snail-Radar file stem of a time,
