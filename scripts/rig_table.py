@@ -27,8 +27,11 @@ Table 3, SLAM on a rig (`radargauss slam --rig --no-map`): table 2's rigs
 over the two-lap route, against the body's reference: ATE, RPE, loops,
 the odometry's ATE and the wall time (two threads).
 
+Table 4, an IMU on a rig (`odometry --rig --imu`): table 2's worlds with one
+IMU on the body; the rigs of 1, 4, 5 and 6 radars with and without it.
+
     scripts/rig_table.py [--tool build/release/bin/radargauss] [--work /tmp/rig_table] [--scans 300]
-                         [--tables 1,2,3]
+                         [--tables 1,2,3,4]
 
 The module is found beside the tool (build/release/python).
 """
@@ -211,6 +214,44 @@ def slam_table(tool, work):
               f"{loops} | {odometry['ate_translation_m']['rmse']:.3f} | {wall:.1f} |")
 
 
+# Table 4: table 2's worlds with one IMU on the body (200 Hz, 0.3 m above
+# the vehicle's origin, turned 90 deg; the simulator's default noise and
+# biases). Not ahead of the origin: there the simulated path's yaw-rate
+# steps make impulses (docs/design/simulator.md, "The synthetic world").
+IMU_WORLD_KEYS = "  imu_rate_hz: 200\n  imu_z: 0.3\n  imu_yaw_deg: 90\n"
+IMU_RIGS = [rig for rig in ODOMETRY_RIGS if rig[0][0] in "1456"]
+
+
+def imu_table(tool, work):
+    """Each rig of table 2 with and without the body's IMU (one window over the rig)."""
+    print("| world | rig | ATE m | RPE t % | horizontal % | with the IMU: ATE m | RPE t % | horizontal % | "
+          "median ms per frame |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for world, config, scans in ODOMETRY_WORLDS:
+        rig_dir = os.path.join(work, "imu_rig_" + world.split()[0].replace("-", "_"))
+        os.makedirs(work, exist_ok=True)
+        with open(rig_dir + ".yaml", "w") as f:
+            f.write(odometry_rig_config(config, scans).replace("world:\n", "world:\n" + IMU_WORLD_KEYS, 1))
+        result = subprocess.run([tool, "simulate", "--rig-config", rig_dir + ".yaml", "--out", rig_dir, "--force"],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        if result.returncode != 0:
+            sys.exit(f"rig_table: simulate {rig_dir}.yaml failed: {result.stderr.strip()}")
+        text = open(os.path.join(rig_dir, "rig.yaml")).read()
+        head, *radars = text.split("  - name:")
+        by_name = {r.split("\n")[0].strip().strip('"'): "  - name:" + r for r in radars}
+        imu = ["--imu", os.path.join(rig_dir, "imu.txt"), "--imu-extrinsic", os.path.join(rig_dir, "imu_extrinsic.txt")]
+        for label, names in IMU_RIGS:
+            rig_file = os.path.join(rig_dir, "rig_" + "_".join(names) + ".yaml")
+            with open(rig_file, "w") as f:
+                f.write(head + "".join(by_name[n] for n in names))
+            flags = ["--rig", rig_file, "--gt", os.path.join(rig_dir, "gt_body_tum.txt")]
+            alone = run_odometry(tool, flags, os.path.join(work, "imu_without_" + "_".join(names)))
+            fused = run_odometry(tool, flags + imu, os.path.join(work, "imu_with_" + "_".join(names)))
+            print(f"| {world} | {label} | {alone[0]:.3f} | {alone[1]:.3f} | {alone[2]:.3f} | {fused[0]:.3f} | "
+                  f"{fused[1]:.3f} ({fused[1] / alone[1]:.2f}x) | {fused[2]:.3f} | {fused[3]:.2f} "
+                  f"(without {alone[3]:.2f}) |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--tool", default=os.path.join(ROOT, "build/release/bin/radargauss"))
@@ -227,6 +268,9 @@ def main():
         print()
     if "3" in tables:
         slam_table(args.tool, args.work)
+        print()
+    if "4" in tables:
+        imu_table(args.tool, args.work)
         print()
     if "1" not in tables:
         return

@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // radargauss export: a results folder as an MCAP file a robotics viewer opens.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 
 #include "commands.hpp"
 #include "radargauss/core/error.hpp"
+#include "radargauss/io/rig.hpp"
 #include "radargauss/io/ros2_messages.hpp"
 #include "radargauss/experiment/run_mcap.hpp"
 
@@ -52,9 +54,71 @@ struct ExportSettings {
   std::string run;
   std::string mcap;
   SequenceOptions sequence;  // the scans and (--gt) the reference, both optional
+  std::string rig;           // --rig: the scans of a rig's radars instead of --sequence
 };
 
+// A rig's scans as its run's frames (docs/design/rig.md, "The rig file"): each
+// scan, on the body's clock, joins the first pose at or after its stamp
+// (the frame that registered it), its points moved through its mounting
+// and by the run's motion between: T_map_ref(t_f)^-1 T_map_ref(t_k) T_ref_radar
+// (the run's poses are the reference radar's). Scans outside the run's span
+// take their frame's pose.
+std::vector<RadarScan> RigFramesOfRun(const Rig& rig, const RunForViewer& run) {
+  Trajectory trajectory;
+  for (std::size_t k = 0; k < run.stamps.size(); ++k) trajectory.Append(run.stamps[k], run.poses[k]);
+  std::vector<RadarScan> frames(run.stamps.size());
+  for (std::size_t k = 0; k < frames.size(); ++k) frames[k].timestamp = run.stamps[k];
+  if (frames.empty()) return frames;
+  std::vector<bool> doppler(frames.size(), true), rcs(frames.size(), true);
+  const SE3d reference_from_body = rig.radars.front().body_from_radar.Inverse();
+  const std::vector<std::vector<RadarScan>> scans = LoadRigScans(rig);
+  for (std::size_t r = 0; r < rig.radars.size(); ++r) {
+    const SE3d reference_from_radar = reference_from_body * rig.radars[r].body_from_radar;
+    for (const RadarScan& scan : scans[r]) {
+      const double stamp = scan.timestamp - rig.radars[r].clock_offset;
+      const auto at = std::lower_bound(run.stamps.begin(), run.stamps.end(), stamp - 1e-6);
+      if (at == run.stamps.end()) continue;  // after the run's last frame
+      const std::size_t f = std::size_t(at - run.stamps.begin());
+      const std::optional<SE3d> then = trajectory.Interpolate(stamp);
+      const SE3d frame_from_radar = (then ? run.poses[f].Inverse() * *then : SE3d()) * reference_from_radar;
+      for (RadarPoint point : scan.points) {
+        point.position = frame_from_radar * point.position;
+        frames[f].points.push_back(point);
+      }
+      doppler[f] = doppler[f] && scan.has_doppler;
+      rcs[f] = rcs[f] && scan.has_rcs;
+    }
+  }
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    frames[k].has_doppler = doppler[k];
+    frames[k].has_rcs = rcs[k];
+  }
+  return frames;
+}
+
+// --rig: the rig's frames beside the run's poses, and the body's --gt as the reference radar's.
+int RunRigExport(const ExportSettings& s) {
+  if (!s.sequence.sequence_dir.empty() || !s.sequence.bag.empty()) {
+    throw DataError("--rig names the radars' scans itself: drop --sequence and --bag");
+  }
+  const Rig rig = ReadRig(s.rig);
+  const std::vector<RadarScan> frames = RigFramesOfRun(rig, ReadRunFolder(s.run));
+  std::optional<Trajectory> reference;
+  if (!s.sequence.ground_truth.empty()) {
+    const SE3d& body_from_reference = rig.radars.front().body_from_radar;
+    reference.emplace();
+    for (const StampedPose& p : ReadTum(s.sequence.ground_truth)) {
+      reference->Append(p.time, p.pose * body_from_reference);
+    }
+  }
+  WriteRunForViewer(s.run, frames, reference, s.mcap);
+  std::printf("wrote %s (the frames of %zu radars in the reference radar's frame)\n", s.mcap.c_str(),
+              rig.radars.size());
+  return 0;
+}
+
 int RunExport(const ExportSettings& s) {
+  if (!s.rig.empty()) return RunRigExport(s);
   std::vector<RadarScan> scans;
   if (!s.sequence.sequence_dir.empty() || !s.sequence.bag.empty()) {
     SequenceOptions scans_only = s.sequence;
@@ -79,7 +143,11 @@ Subcommand AddExport(CLI::App& parent) {
       "export", "Write a results folder (odometry, slam, relocalize) as an MCAP file a robotics viewer opens");
   app->add_option("run", s->run, "The results folder")->required();
   app->add_option("--mcap", s->mcap, "The MCAP file to write")->required();
-  AddSequenceOptions(app, s->sequence, "--gt", "Reference trajectory (TUM), shown aligned at the first pose");
+  AddSequenceOptions(app, s->sequence, "--gt",
+                     "Reference trajectory (TUM; with --rig, the body's), shown aligned at the first pose");
+  app->add_option("--rig", s->rig,
+                  "Rig file (docs/design/rig.md) of the run (odometry, slam or relocalize --rig): every radar's "
+                  "scans as the run's frames instead of --sequence");
   return {app, [s] { return RunExport(*s); }};
 }
 

@@ -77,6 +77,38 @@ def test_odometry_of_a_simulated_rig_with_an_imu(tmp_path):
 
 
 @pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool (it simulates the rig)")
+def test_export_of_a_rig_puts_each_radars_scan_where_its_true_pose_does(tmp_path):
+    # A run whose poses are the front radar's true ones: export --rig places
+    # every point of the rear radar (on its own clock, 20 Hz) where the rear
+    # radar's own true pose at its stamp puts it, to the interpolation's error.
+    (tmp_path / "rig_config.yaml").write_text(
+        "world: {scans: 12}\nradars:\n  - {name: front, mounting_x: 3.7, mounting_z: 0.5}\n"
+        "  - {name: rear, mounting_x: -1.0, mounting_z: 0.6, mounting_yaw_deg: 180, rate_hz: 20, "
+        "clock_offset: 0.013}\n")
+    subprocess.run([CLI, "simulate", "--rig-config", str(tmp_path / "rig_config.yaml"), "--out",
+                    str(tmp_path / "rig")], check=True, stdout=subprocess.DEVNULL)
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "odometry.tum").write_text((tmp_path / "rig" / "front" / "gt_radar_tum.txt").read_text())
+    subprocess.run([CLI, "export", str(tmp_path / "run"), "--rig", str(tmp_path / "rig" / "rig.yaml"), "--mcap",
+                    str(tmp_path / "run.mcap")], check=True, stdout=subprocess.DEVNULL)
+    frames = rg.read_sequence(bag=str(tmp_path / "run.mcap"), topic="/radar/registered").scans
+    radars = [rg.read_sequence(path=str(tmp_path / "rig" / name), gt=str(tmp_path / "rig" / name / "gt_radar_tum.txt"))
+              for name in ("front", "rear")]
+    frame_stamps = np.array([frame.stamp for frame in frames])
+    expected = [[] for _ in frames]
+    for sequence, offset in zip(radars, (0.0, 0.013)):
+        for scan, pose in zip(sequence.scans, sequence.poses_matrix):
+            f = np.searchsorted(frame_stamps, scan.stamp - offset - 1e-6)
+            if f < len(frames):
+                expected[f].append(scan.points @ pose[:3, :3].T + pose[:3, 3])
+    assert len(frames) == 12 and sum(len(e) for e in expected) == 12 + 23
+    for frame, parts in zip(frames, expected):
+        error = np.linalg.norm(frame.points - np.vstack(parts), axis=1)
+        assert error.max() < 0.02, error.max()
+    assert len(frames[1]) == len(radars[0].scans[1]) + sum(len(radars[1].scans[k]) for k in (1, 2))
+
+
+@pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool (it simulates the rig)")
 def test_odometry_and_calibration_of_a_simulated_rig(tmp_path):
     # A front radar and a front corner at twice its rate on its own clock:
     # the body's odometry equals the command line's, and the calibration

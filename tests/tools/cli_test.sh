@@ -227,6 +227,11 @@ expect_fail "a rig and a sequence" "drop --sequence" -- "$tool" info --rig "$wor
 expect_ok "odometry on a rig" "rig: 2 radars, 20 scans in 10 frames" -- \
   "$tool" odometry --rig "$work/rig.yaml" --out "$work/rig_odometry"
 [[ -s "$work/rig_odometry/body.tum" ]] || { echo "FAIL: odometry --rig wrote no body.tum"; failed=1; }
+expect_ok "export a rig's run" "the frames of 2 radars" -- \
+  "$tool" export "$work/rig_odometry" --rig "$work/rig.yaml" --mcap "$work/rig_odometry.mcap"
+expect_fail "export a rig's run with a sequence" "drop --sequence" -- \
+  "$tool" export "$work/rig_odometry" --rig "$work/rig.yaml" --sequence "$work/seq10" --mcap "$work/rig_seq_run.mcap"
+[[ ! -e "$work/rig_seq_run.mcap" ]] || { echo "FAIL: a refused rig export left its file"; failed=1; }
 expect_fail "odometry on a rig of folders with an IMU topic" "needs the radars in one bag" -- \
   "$tool" odometry --rig "$work/rig.yaml" --imu-topic /imu --out "$work/rig_imu"
 [[ ! -e "$work/rig_imu" ]] || { echo "FAIL: a refused rig run left $work/rig_imu"; failed=1; }
