@@ -362,6 +362,16 @@ for file in odometry.tum inertial.csv; do
   cmp -s "$work/inertial_1/$file" "$work/rig_inertial_one/$file" ||
     { echo "FAIL: radar-inertial $file on a rig of one radar differs from the radar's own"; failed=1; }
 done
+"$tool" slam --sequence "$work/seq_imu" --imu "$work/seq_imu/imu.txt" --imu-extrinsic "$work/seq_imu/imu_extrinsic.txt" \
+  --submap-distance 2 --out "$work/slam_inertial" >/dev/null
+expect_ok "radar-inertial slam on a rig of one radar" "rig: 1 radars" -- \
+  "$tool" slam --rig "$work/rig_imu_one.yaml" --imu "$work/seq_imu/imu.txt" --imu-extrinsic "$work/body_from_imu.txt" \
+  --submap-distance 2 --out "$work/rig_slam_inertial"
+cmp -s "$work/slam_inertial/slam.tum" "$work/rig_slam_inertial/slam.tum" ||
+  { echo "FAIL: radar-inertial slam on a rig of one radar differs from the radar's own"; failed=1; }
+"$tool" slam --rig "$work/rig_imu_one.yaml" --submap-distance 2 --out "$work/rig_slam_radar" >/dev/null
+! cmp -s "$work/rig_slam_radar/slam.tum" "$work/rig_slam_inertial/slam.tum" ||
+  { echo "FAIL: slam on a rig with its IMU equals slam without it"; failed=1; }
 # Calibrating: each estimated parameter per scan in inertial.csv, its last row summary.json's value.
 expect_ok "radar-inertial odometry, calibrating" "inertial.csv" -- \
   "$tool" odometry --sequence "$work/seq_imu" --imu "$work/seq_imu/imu.txt" \
