@@ -13,8 +13,12 @@ deviations; the last row per world counts the errors within 3 sigma
 (per axis: rotation and translation as their norms against the norm of
 the stds). Draws of the offsets: --draws (seeds 1..N).
 
+With --imu, the same radars (the same scans) with scripts/rig_table.py's
+table-4 IMU on the body, given to calibrate --imu: the reference's
+odometry with its window and its rates from the gyro.
+
     scripts/rig_calibration_table.py [--tool build/release/bin/radargauss] [--work /tmp/rig_calibration]
-                                     [--worlds demo,realistic] [--draws 1]
+                                     [--worlds demo,realistic] [--draws 1] [--imu]
 """
 import argparse
 import json
@@ -25,7 +29,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from rig_table import ODOMETRY_WORLDS, odometry_rig_config  # noqa: E402
+from rig_table import IMU_WORLD_KEYS, ODOMETRY_WORLDS, odometry_rig_config  # noqa: E402
 
 
 def rotation(axis_angle):
@@ -81,6 +85,8 @@ def main():
     parser.add_argument("--worlds", default="demo,realistic")
     parser.add_argument("--draws", type=int, default=1)
     parser.add_argument("--flags", default="", help="further flags of radargauss calibrate")
+    parser.add_argument("--imu", action="store_true",
+                        help="the same radars with table 4's IMU on the body (calibrate --imu): the same scans")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
     print("| world | radar | rotation error deg (std) | translation error m (std) | clock error ms (std) |")
@@ -88,10 +94,11 @@ def main():
     for world, config, scans in ODOMETRY_WORLDS:
         if world.split()[0].replace("-", "_") not in args.worlds.split(","):
             continue
-        rig_dir = os.path.join(args.work, world.split()[0].replace("-", "_"))
+        rig_dir = os.path.join(args.work, world.split()[0].replace("-", "_") + ("_imu" if args.imu else ""))
         if not os.path.exists(os.path.join(rig_dir, "rig.yaml")):
             with open(rig_dir + ".yaml", "w") as f:
-                f.write(odometry_rig_config(config, scans))
+                text = odometry_rig_config(config, scans)
+                f.write(text.replace("world:\n", "world:\n" + IMU_WORLD_KEYS, 1) if args.imu else text)
             subprocess.run([args.tool, "simulate", "--rig-config", rig_dir + ".yaml", "--out", rig_dir], check=True,
                            stdout=subprocess.DEVNULL)
         within, count = np.zeros(3), 0
@@ -100,10 +107,12 @@ def main():
             given = os.path.join(rig_dir, f"rig_off_{draw}.yaml")
             with open(given, "w") as f:
                 f.write(perturbed_rig(open(os.path.join(rig_dir, "rig.yaml")).read(), rng))
-            out = os.path.join(args.work, f"calibrated_{world.split()[0]}_{draw}")
+            out = os.path.join(args.work, f"calibrated_{os.path.basename(rig_dir)}_{draw}")
             subprocess.run(["rm", "-rf", out], check=True)
             result = subprocess.run([args.tool, "calibrate", "--rig", given, "--compare",
-                                     os.path.join(rig_dir, "rig.yaml"), "--out", out] + args.flags.split(),
+                                     os.path.join(rig_dir, "rig.yaml"), "--out", out] + args.flags.split() +
+                                    (["--imu", os.path.join(rig_dir, "imu.txt"), "--imu-extrinsic",
+                                      os.path.join(rig_dir, "imu_extrinsic.txt")] if args.imu else []),
                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
             if result.returncode != 0:
                 sys.exit(f"rig_calibration_table: calibrate failed: {result.stderr.strip()}")

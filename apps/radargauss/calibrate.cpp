@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -15,7 +16,9 @@
 #include "option_flags.hpp"
 #include "radargauss/core/atomic_file.hpp"
 #include "radargauss/core/error.hpp"
+#include "radargauss/io/imu.hpp"
 #include "radargauss/io/rig.hpp"
+#include "radargauss/io/sequence.hpp"
 #include "radargauss/odometry/rig_calibration.hpp"
 
 namespace radargauss::cli {
@@ -29,7 +32,26 @@ struct CalibrateSettings {
   std::string compare;
   std::string out;
   RigCalibrationOptions calibration;
+  std::string imu;            // --imu: an IMU on the body
+  std::string imu_extrinsic;  // T_body_imu
+  RadarInertialOptions inertial;
 };
+
+// The IMU on the body (docs/design/rig.md, "Calibration of a rig"), when given.
+std::optional<RigImu> ImuOf(const CalibrateSettings& s) {
+  if (s.imu.empty()) {
+    if (!s.imu_extrinsic.empty()) throw DataError("--imu-extrinsic needs --imu");
+    return std::nullopt;
+  }
+  CheckOptions(RadarInertialOptionTable(), s.inertial);
+  if (s.inertial.fusion != "window") throw DataError("--imu-fusion: the calibration takes the IMU's window");
+  RigImu imu;
+  imu.samples = ReadImuFile(s.imu);
+  if (imu.samples.empty()) throw DataError(s.imu + ": no IMU sample");
+  if (!s.imu_extrinsic.empty()) imu.body_from_imu = ReadStatedExtrinsicFile(s.imu_extrinsic).pose;
+  imu.inertial = s.inertial;
+  return imu;
+}
 
 constexpr double kDeg = 180.0 / M_PI;
 
@@ -103,8 +125,14 @@ int RunCalibrate(const CalibrateSettings& s) {
     }
   }
   if (rig.radars.size() < 2) throw DataError("--rig: calibration needs a reference radar and another");
+  const std::optional<RigImu> imu = ImuOf(s);  // before the folder: a bad IMU leaves nothing behind
   StagedFolder folder(s.out);
-  const RigCalibration result = CalibrateRig(rig, LoadRigScans(rig), s.calibration);
+  const RigCalibration result = CalibrateRig(rig, LoadRigScans(rig), s.calibration, imu);
+  if (imu && !result.gyro) {
+    std::fprintf(stderr,
+                 "radargauss: warning: the IMU's window never ran (or dropped the IMU): the reference's "
+                 "rates come from its poses\n");
+  }
   // The calibrated rig beside the results, its scans' paths absolute.
   Rig calibrated = result.rig;
   for (RigRadar& radar : calibrated.radars) {
@@ -124,7 +152,8 @@ int RunCalibrate(const CalibrateSettings& s) {
   }
   {
     std::ofstream out(fs::path(folder.path()) / "calibration.json");
-    out << nlohmann::json{{"reference", rig.radars.front().name}, {"radars", report}}.dump(2) << "\n";
+    out << nlohmann::json{{"reference", rig.radars.front().name}, {"gyro", result.gyro}, {"radars", report}}.dump(2)
+        << "\n";
     if (!out) throw FileError(s.out + "/calibration.json", "cannot be written");
   }
   folder.Commit();
@@ -142,6 +171,13 @@ Subcommand AddCalibrate(CLI::App& parent) {
   app->add_option("--out", s->out, "Output folder (rig.yaml: the calibrated rig; calibration.json)")->required();
   app->add_option("--compare", s->compare, "Rig file with the true mountings and clocks (a simulated rig's rig.yaml)");
   AddTableOptions(app, RigCalibrationOptionTable(), s->calibration);
+  app->add_option("--imu", s->imu,
+                  "IMU file on the body (lines 'stamp wx wy wz ax ay az'): the reference's odometry with its window "
+                  "and its rates from the gyro");
+  app->add_option("--imu-extrinsic", s->imu_extrinsic, "T_body_imu: a file 'x y z qx qy qz qw' (default: identity)");
+  // The window at its defaults: its table's flags would meet the calibration's (estimate_clock_offset).
+  app->add_option("--imu-clock-offset", s->inertial.window.clock_offset, "The IMU's stamps minus the body's clock (s)")
+      ->capture_default_str();
   return {app, [s] { return RunCalibrate(*s); }};
 }
 

@@ -382,8 +382,8 @@ class Sequence:
 def build_map(scans: Any, poses: Any = None, builder: str = 'kmeans', points_per_gaussian: float = 4.0, min_std: float = 0.05, incidence: str = 'offset', max_degree: int = 3, doppler_filter: bool = True) -> GaussianMap:
     """The map of `radargauss build-map`: from a Sequence with poses, or from a list of Scans and their poses T_world_radar (4x4 or [x y z qx qy qz qw]). builder: kmeans or voxel; incidence: offset, view or none."""
 
-def calibrate_rig(path: str, **kwargs) -> dict:
-    """Each radar's extrinsic and clock offset of a rig file against its first radar, over its drive (docs/design/rig.md, "Calibration of a rig"). A dict: rig (the radars as read_rig gives them, calibrated) and radars (per radar: name, body_from_radar, clock_offset, rotation_std (rad), translation_std (m), clock_offset_std (s), inf where unobserved; scans, doppler_points, map_points)."""
+def calibrate_rig(path: str, imu: Any = None, body_from_imu: Any = None, **kwargs) -> dict:
+    """Each radar's extrinsic and clock offset of a rig file against its first radar, over its drive (docs/design/rig.md, "Calibration of a rig"). A dict: rig (the radars as read_rig gives them, calibrated) and radars (per radar: name, body_from_radar, clock_offset, rotation_std (rad), translation_std (m), clock_offset_std (s), inf where unobserved; scans, doppler_points, map_points); gyro: whether the reference's rates came from the IMU. imu: (N, 7) [stamp wx wy wz ax ay az] on the body's clock, body_from_imu: T_body_imu (default identity): the reference's odometry with the IMU's window and its rates from the gyro."""
 
 def compose(a: Any, b: Any) -> numpy.ndarray:
     """The rigid transform a * b as [x y z qx qy qz qw]."""

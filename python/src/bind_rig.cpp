@@ -3,6 +3,7 @@
 // from its radars' Doppler, odometry on a rig and its calibration.
 #include <pybind11/stl.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -112,23 +113,35 @@ void BindRigRuns(py::module_& m) {
       "Keywords: RadarOdometry's (odometry_options) and RadarInertialOdometry's (option_fields('radar_inertial'))");
   m.def(
       "calibrate_rig",
-      [](const std::string& path, const py::kwargs& kwargs) {
+      [](const std::string& path, const py::object& imu, const py::object& body_from_imu, const py::kwargs& kwargs) {
         RigCalibrationOptions options = OptionsFrom(RigCalibrationOptionTable(), kwargs);
         ValidateOptions(options);
+        if (imu.is_none() && !body_from_imu.is_none()) throw py::value_error("body_from_imu needs imu");
+        std::optional<RigImu> rig_imu;
+        if (!imu.is_none()) {
+          rig_imu = RigImu{
+              ImuFromArray(imu), body_from_imu.is_none() ? SE3d() : PoseFromPython(body_from_imu, "body_from_imu"), {}};
+          if (rig_imu->samples.empty()) throw DataError("the IMU has no sample");
+        }
         const Rig rig = ReadRig(path);
         const std::vector<std::vector<RadarScan>> scans = LoadRigScans(rig);
         RigCalibration calibration;
         {
           py::gil_scoped_release release;
-          calibration = CalibrateRig(rig, scans, options);
+          calibration = CalibrateRig(rig, scans, options, rig_imu);
         }
-        return CalibrationToDict(calibration);
+        py::dict out = CalibrationToDict(calibration);
+        out["gyro"] = calibration.gyro;
+        return out;
       },
-      py::arg("path"),
+      py::arg("path"), py::arg("imu") = py::none(), py::arg("body_from_imu") = py::none(),
       ("Each radar's extrinsic and clock offset of a rig file against its first radar, over its drive "
        "(docs/design/rig.md, \"Calibration of a rig\"). A dict: rig (the radars as read_rig gives them, "
        "calibrated) and radars (per radar: name, body_from_radar, clock_offset, rotation_std (rad), "
-       "translation_std (m), clock_offset_std (s), inf where unobserved; scans, doppler_points, map_points)."
+       "translation_std (m), clock_offset_std (s), inf where unobserved; scans, doppler_points, map_points); "
+       "gyro: whether the reference's rates came from the IMU. imu: (N, 7) [stamp wx wy wz ax ay az] on the body's "
+       "clock, body_from_imu: T_body_imu (default identity): the reference's odometry with the IMU's window and its "
+       "rates from the gyro."
        "\n\nKeywords:\n" +
        ParametersDoc(RigCalibrationOptionTable()))
           .c_str());

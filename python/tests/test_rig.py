@@ -72,6 +72,8 @@ def test_odometry_of_a_simulated_rig_with_an_imu(tmp_path):
     assert np.allclose(stamps, written[:, 0]) and np.allclose(poses, written[:, 1:], atol=1e-6)
     assert run["inertial_state"] is not None and run["inertial_state"]["gyro_bias"].size == 3
     assert "inertial_state" not in rg.rig_odometry(rig_file)
+    calibration = rg.calibrate_rig(rig_file, imu=imu, body_from_imu=body_from_imu, rounds=2)
+    assert calibration["gyro"] and not rg.calibrate_rig(rig_file, rounds=2)["gyro"]
     with pytest.raises(ValueError, match="body_from_imu needs imu"):
         rg.rig_odometry(rig_file, body_from_imu=body_from_imu)
 

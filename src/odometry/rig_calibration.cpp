@@ -17,6 +17,7 @@
 #include "radargauss/core/rig_twist.hpp"
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/residuals/rig_doppler_residual.hpp"
 
 namespace radargauss {
@@ -83,6 +84,11 @@ class ReferenceTrack {
 
   bool Covers(double t) const { return midpoints_.size() >= 2 && t >= midpoints_.front() && t < midpoints_.back(); }
 
+  // The angular velocity from a gyro's rates (the reference's frame, the
+  // body's clock, bias removed) where they cover t: their mean within
+  // kGyroSpan of t, without the lag of rates differenced from the poses.
+  void UseGyro(std::vector<GyroSample> rates) { gyro_ = std::move(rates); }
+
   ReferenceMotion Motion(double t) const {
     ReferenceMotion motion;
     const std::size_t k = Interval(stamps_, t);
@@ -94,6 +100,7 @@ class ReferenceTrack {
     const Eigen::Vector3d w0 = twists_[j].tail<3>(), w1 = twists_[j + 1].tail<3>();
     motion.angular_velocity = (1.0 - r) * w0 + r * w1;
     motion.angular_acceleration = (w1 - w0) / dm;
+    if (const std::optional<Eigen::Vector3d> rate = GyroRate(t)) motion.angular_velocity = *rate;
     return motion;
   }
 
@@ -110,11 +117,47 @@ class ReferenceTrack {
     return std::min(k, times.size() - 2);
   }
 
+  static constexpr double kGyroSpan = 0.01;  // s
+  std::optional<Eigen::Vector3d> GyroRate(double t) const {
+    if (gyro_.empty() || t < gyro_.front().stamp || t > gyro_.back().stamp) return std::nullopt;
+    const auto by_stamp = [](const GyroSample& a, double b) { return a.stamp < b; };
+    auto it = std::lower_bound(gyro_.begin(), gyro_.end(), t - kGyroSpan, by_stamp);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (; it != gyro_.end() && it->stamp <= t + kGyroSpan; ++it, ++count) sum += it->rate;
+    if (count == 0) return std::nullopt;
+    return Eigen::Vector3d(sum / double(count));
+  }
+
   std::vector<double> stamps_, midpoints_;
+  std::vector<GyroSample> gyro_;
   std::vector<SE3d> poses_;
   std::vector<Eigen::Vector3d> velocities_;
   std::vector<Eigen::Matrix<double, 6, 1>> twists_;
 };
+
+// The gyro's rates in the reference radar's frame on the body's clock, each
+// at its interval's middle (a sample holds the mean rate to the next), less
+// the window's gyro bias at the nearest state; none where the window never
+// started or dropped the IMU.
+std::vector<GyroSample> GyroRatesOf(const InertialMotion& inertial, std::vector<ImuSample> imu) {
+  std::vector<std::pair<double, Eigen::Vector3d>> biases;
+  for (const std::optional<InertialState>& state : inertial.states()) {
+    if (state) biases.emplace_back(state->stamp, state->bias.gyro);
+  }
+  if (inertial.imu_fault() || biases.empty()) return {};
+  ScreenImuSamples(imu, inertial.options().window.noise);
+  const SO3d reference_from_imu = inertial.window().radar_from_imu().rotation();
+  const double offset = inertial.window().clock_offset();  // the IMU's stamps minus the body's clock
+  std::vector<GyroSample> rates;
+  std::size_t b = 0;
+  for (std::size_t i = 0; i + 1 < imu.size(); ++i) {
+    const double t = 0.5 * (imu[i].stamp + imu[i + 1].stamp) - offset;
+    while (b + 1 < biases.size() && std::abs(biases[b + 1].first - t) <= std::abs(biases[b].first - t)) ++b;
+    rates.push_back({t, reference_from_imu * (imu[i].angular_velocity - biases[b].second)});
+  }
+  return rates;
+}
 
 // A radar's static points used: the Doppler filter's inliers, gated around
 // the velocity the reference's motion gives the radar at its given
@@ -328,7 +371,7 @@ RadarCalibration CalibrateRadar(const RigRadar& radar, const SE3d& reference_fro
 }  // namespace
 
 RigCalibration CalibrateRig(const Rig& rig, const std::vector<std::vector<RadarScan>>& scans,
-                            const RigCalibrationOptions& options) {
+                            const RigCalibrationOptions& options, const std::optional<RigImu>& imu) {
   ValidateOptions(options);
   if (scans.size() != rig.radars.size()) {
     throw DataError("a rig of " + std::to_string(rig.radars.size()) + " radars with the scans of " +
@@ -338,9 +381,18 @@ RigCalibration CalibrateRig(const Rig& rig, const std::vector<std::vector<RadarS
   // The reference radar's odometry on the body's clock, and its map.
   std::vector<RadarScan> reference_scans = scans.front();
   for (RadarScan& scan : reference_scans) scan.timestamp -= rig.radars.front().clock_offset;
-  RadarOdometry odometry(options.reference);
+  const SE3d& body_from_reference = rig.radars.front().body_from_radar;
+  // With the IMU, the reference's odometry runs with its window (in the
+  // reference radar's frame, as a rig's odometry does).
+  RadarOdometry odometry(
+      options.reference,
+      imu ? MakeMotionModel(imu->inertial, body_from_reference.Inverse() * imu->body_from_imu, imu->samples) : nullptr);
   for (const RadarScan& scan : reference_scans) odometry.Register(scan);
-  const ReferenceTrack track(odometry.steps());
+  ReferenceTrack track(odometry.steps());
+  std::vector<GyroSample> gyro;
+  if (const InertialMotion* inertial = imu ? InertialMotionOf(odometry) : nullptr) {
+    gyro = GyroRatesOf(*inertial, imu->samples);
+  }
   std::vector<SE3d> poses;
   for (const OdometryStep& step : odometry.steps()) poses.push_back(step.pose);
   const ReferenceMap map = BuildReferenceMap(reference_scans, poses, options.map);
@@ -348,7 +400,8 @@ RigCalibration CalibrateRig(const Rig& rig, const std::vector<std::vector<RadarS
   RigCalibration result;
   result.rig = rig;
   result.reference = odometry.trajectory();
-  const SE3d& body_from_reference = rig.radars.front().body_from_radar;
+  result.gyro = !gyro.empty();
+  track.UseGyro(std::move(gyro));
   RadarCalibration reference;
   reference.name = rig.radars.front().name;
   reference.body_from_radar = body_from_reference;

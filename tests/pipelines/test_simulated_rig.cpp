@@ -369,6 +369,35 @@ TEST(RigCalibration, StaysAtTheTruthAndBringsAGivenOffCornerRadarCloser) {
   EXPECT_THROW(CalibrateRig(given, {scans[0]}), DataError);
 }
 
+// With an IMU on the body, the reference's odometry runs with its window
+// and its angular velocity comes from the gyro: from the truth the corner
+// radar stays within the bounds of the calibration without it. An IMU that
+// covers none of the drive is refused.
+TEST(RigCalibration, WithAnImuTheRatesComeFromTheGyroWhereItsWindowRan) {
+  RigSimulationConfig config = FrontAndFastCorner(200);
+  config.world.imu_rate_hz = 200.0;
+  const SimulatedRig simulated = SimulateRig(config);
+  Rig truth;
+  for (std::size_t r = 0; r < 2; ++r) {
+    RigRadar radar;
+    radar.name = config.radars[r].first;
+    radar.body_from_radar = simulated.body_from_radar[r];
+    radar.clock_offset = config.radars[r].second.clock_offset;
+    truth.radars.push_back(radar);
+  }
+  const std::vector<std::vector<RadarScan>> scans = {simulated.radars[0].scans, simulated.radars[1].scans};
+  const RigCalibration calibration = CalibrateRig(truth, scans, {}, RigImu{simulated.imu, simulated.body_from_imu, {}});
+  EXPECT_TRUE(calibration.gyro);
+  const RigRadar& corner = calibration.rig.radars[1];
+  EXPECT_LT((truth.radars[1].body_from_radar.rotation().Inverse() * corner.body_from_radar.rotation()).Log().norm(),
+            0.3 * M_PI / 180.0);
+  EXPECT_LT((corner.body_from_radar.translation() - truth.radars[1].body_from_radar.translation()).norm(), 0.03);
+  EXPECT_LT(std::abs(corner.clock_offset - truth.radars[1].clock_offset), 0.006);
+  std::vector<ImuSample> early(simulated.imu.begin(), simulated.imu.begin() + 100);
+  for (ImuSample& sample : early) sample.stamp -= 100.0;  // before the first scan
+  EXPECT_THROW(CalibrateRig(truth, scans, {}, RigImu{early, simulated.body_from_imu, {}}), DataError);
+}
+
 TEST_F(SimulatedRigFiles, ItsConfigRefusesWhatIsTheRigsOwn) {
   const auto error_of = [&](const std::string& text) {
     const std::string path = WriteFile("rig.yaml", text);

@@ -269,6 +269,12 @@ expect_ok "calibrate a rig" "wrote .*calibrated" -- \
 [[ -s "$work/calibrated/rig.yaml" && -s "$work/calibrated/calibration.json" ]] || {
   echo "FAIL: calibrate wrote no rig.yaml or calibration.json"; failed=1; }
 expect_ok "the calibrated rig is a rig" "rig: .*2 radars" -- "$tool" info --rig "$work/calibrated/rig.yaml"
+expect_fail "calibrate with an IMU extrinsic but no IMU" "needs --imu" -- \
+  "$tool" calibrate --rig "$work/rig.yaml" --imu-extrinsic "$work/body_from_imu.txt" --out "$work/calibrated_no_imu"
+expect_fail "calibrate with an IMU file that is not one" "gt_radar_tum.txt" -- \
+  "$tool" calibrate --rig "$work/rig.yaml" --imu "$work/seq10/gt_radar_tum.txt" --out "$work/calibrated_bad_imu"
+[[ ! -e "$work/calibrated_no_imu" && ! -e "$work/calibrated_bad_imu" ]] || {
+  echo "FAIL: a refused calibration with an IMU left its folder"; failed=1; }
 printf 'radars:\n  - {name: front, sequence: seq10, extrinsic: [0, 0, 0, 0, 0, 0, 1]}\n' > "$work/rig_one.yaml"
 expect_fail "calibrate a rig of one radar" "needs a reference radar and another" -- \
   "$tool" calibrate --rig "$work/rig_one.yaml" --out "$work/calibrated_one"

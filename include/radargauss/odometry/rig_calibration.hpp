@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,9 +29,11 @@
 #include "radargauss/core/options.hpp"
 #include "radargauss/core/trajectory.hpp"
 #include "radargauss/core/types.hpp"
+#include "radargauss/io/imu.hpp"
 #include "radargauss/io/rig.hpp"
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/map/pipeline.hpp"
+#include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 
 namespace radargauss {
@@ -73,13 +76,26 @@ struct RigCalibration {
   Rig rig;                               // the given rig, its mountings and clocks calibrated
   std::vector<RadarCalibration> radars;  // in the rig's order; the reference first, as given
   Trajectory reference;                  // the reference radar's odometry, T_world_ref on the body's clock
+  bool gyro = false;                     // the reference's angular velocity came from the IMU's gyro
+};
+
+// An IMU on the body for the calibration: its samples (its frame, its
+// clock), T_body_imu and the window's options (its clock offset: the IMU's
+// stamps minus the body's clock).
+struct RigImu {
+  std::vector<ImuSample> samples;
+  SE3d body_from_imu;
+  RadarInertialOptions inertial;
 };
 
 // `scans[r]`: radar r's scans, stamps on its own clock (as its files hold
 // them). Throws DataError for a count of scan lists other than the rig's
 // radars, a reference radar without scans or a radar whose scans fall
-// outside the reference's drive.
+// outside the reference's drive. With `imu`, the reference's odometry runs
+// with the IMU's window, and the reference's angular velocity comes from the
+// gyro (less the window's bias) instead of its poses' differences, whose
+// rate lags the turn (docs/design/rig.md, "Calibration of a rig").
 RigCalibration CalibrateRig(const Rig& rig, const std::vector<std::vector<RadarScan>>& scans,
-                            const RigCalibrationOptions& options = {});
+                            const RigCalibrationOptions& options = {}, const std::optional<RigImu>& imu = std::nullopt);
 
 }  // namespace radargauss
