@@ -110,6 +110,7 @@ int RunRelocalize(const RelocalizeSettings& s) {
   }
   if (on_rig && !s.odometry.mcap.empty()) throw DataError("--rig: no --mcap");
   const std::optional<Rig> rig = on_rig ? std::optional<Rig>(ReadRig(s.odometry.rig)) : std::nullopt;
+  if (rig) options.odometry = ReferenceRadarOptions(options.odometry, rig->radars.front().body_from_radar);
   RunInputs inputs;
   if (!on_rig) {
     inputs = LoadRunInputs(s.odometry, matching.w_rcs);

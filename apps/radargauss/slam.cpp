@@ -68,7 +68,7 @@ void WriteMaps(const std::string& out, const GaussianMap& map, double tiles) {
 // (RigFrames) into one SLAM in the reference radar's frame; body.tum beside
 // slam.tum, evaluated against --gt as the body's reference.
 int RunRigSlam(const SlamSettings& s) {
-  const SlamOptions& options = s.slam;
+  SlamOptions options = s.slam;
   if (!s.odometry.sequence.sequence_dir.empty() || !s.odometry.sequence.bag.empty()) {
     throw DataError("--rig names the radars' scans itself: drop --sequence and --bag");
   }
@@ -83,6 +83,7 @@ int RunRigSlam(const SlamSettings& s) {
   }
   StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "body.tum", "odometry", "map.rgm", "map.ply", "map_tiles"});
   const SE3d& body_from_reference = rig.radars.front().body_from_radar;
+  options.odometry = ReferenceRadarOptions(options.odometry, body_from_reference);
   // The window runs in the reference radar's frame: T_ref_imu = T_body_ref^-1 T_body_imu.
   RadarSlam slam(options, s.study,
                  MakeMotionModel(imu.inertial, body_from_reference.Inverse() * imu.radar_from_imu, imu.samples));

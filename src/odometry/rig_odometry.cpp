@@ -228,9 +228,22 @@ RigFrame RigFrames::Close() {
   return out;
 }
 
+OdometryOptions ReferenceRadarOptions(OdometryOptions options, const SE3d& body_from_reference) {
+  if (!options.mounting_deg.isZero(0.0)) {
+    throw std::invalid_argument("mounting: a rig's mountings are in its rig file");
+  }
+  // R = Rz(yaw) Ry(pitch) Rx(roll), as VehicleFromRadar composes it; the
+  // yaw leaves the vehicle's vertical in the radar's frame as it is.
+  const Eigen::Matrix3d R = body_from_reference.rotation().Matrix();
+  options.mounting_deg =
+      Eigen::Vector3d(std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)), 0.0) * (180.0 / M_PI);
+  return options;
+}
+
 RigOdometry::RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options,
                          std::unique_ptr<MotionModel> motion)
-    : frames_(std::move(body_from_radar), options), odometry_(options, std::move(motion)) {}
+    : frames_(std::move(body_from_radar), options),
+      odometry_(ReferenceRadarOptions(options, frames_.body_from_reference()), std::move(motion)) {}
 
 void RigOdometry::Register(std::size_t radar, const RadarScan& scan) {
   if (frames_.radars() == 1) {  // the single-radar odometry

@@ -235,6 +235,21 @@ expect_fail "export a rig's run with a sequence" "drop --sequence" -- \
 expect_fail "odometry on a rig of folders with an IMU topic" "needs the radars in one bag" -- \
   "$tool" odometry --rig "$work/rig.yaml" --imu-topic /imu --out "$work/rig_imu"
 [[ ! -e "$work/rig_imu" ]] || { echo "FAIL: a refused rig run left $work/rig_imu"; failed=1; }
+# The reference radar's mounting is its roll and pitch on the body: a rig of
+# one radar pitched 10 deg is that radar's odometry with --mounting 0 10 0.
+printf 'radars:\n  - {name: front, sequence: seq10, extrinsic: [0, 0, 0, 0, 0.0871557427476582, 0, 0.9961946980917455]}\n' \
+  > "$work/rig_pitched.yaml"
+"$tool" odometry --rig "$work/rig_pitched.yaml" --out "$work/rig_pitched" >/dev/null
+"$tool" odometry --sequence "$work/seq10" --mounting 0 10 0 --out "$work/sequence_pitched" >/dev/null
+python3 - "$work/rig_pitched/odometry.tum" "$work/sequence_pitched/odometry.tum" <<'PY' || failed=1
+import sys
+a = [[float(v) for v in line.split()] for line in open(sys.argv[1]) if not line.startswith("#")]
+b = [[float(v) for v in line.split()] for line in open(sys.argv[2]) if not line.startswith("#")]
+if len(a) != len(b) or any(abs(x - y) > 1e-6 for ra, rb in zip(a, b) for x, y in zip(ra, rb)):
+    sys.exit("FAIL: odometry on a pitched rig of one radar differs from the radar's with --mounting")
+PY
+expect_fail "a rig and --mounting" "in its rig file" -- \
+  "$tool" odometry --rig "$work/rig.yaml" --mounting 0 1 0 --out "$work/rig_mounting"
 expect_ok "a rig to one bag" "20 scans of 2 radars" -- "$tool" convert --rig "$work/rig.yaml" --out "$work/rig_bag.mcap"
 expect_ok "the bag's rig file" "rear: 10 scans (rosbag)" -- "$tool" info --rig "$work/rig_bag.rig.yaml"
 expect_ok "odometry on the bag's rig" "rig: 2 radars" -- \

@@ -128,6 +128,13 @@ struct RegisteredFrame {
 std::size_t RegisterRigFrames(const Rig& rig, const OdometryOptions& options,
                               const std::function<RegisteredFrame(const RigFrame&)>& front_end);
 
+// The odometry's options for a rig's reference radar: its mounting (the
+// vehicle's vertical for the rotation term and the yaw rate's axis) is the
+// roll and pitch of T_body_ref (its yaw leaves the vertical as it is). Throws
+// std::invalid_argument for a `mounting` given apart: a rig's mountings are
+// in its file.
+OdometryOptions ReferenceRadarOptions(OdometryOptions options, const SE3d& body_from_reference);
+
 // The body's trajectory from the reference radar's, T_world_ref in its
 // first frame: T_world_body = M T M^-1 (M = T_body_ref), so that the body
 // starts where the reference does.
@@ -138,6 +145,7 @@ class RigOdometry {
   // `body_from_radar`: T_body_radar of each radar. The odometry's Doppler
   // filter (options.ego_velocity) serves every radar; the map and the match
   // are the body's; options.rig says how scans become frames (RigFrames).
+  // The reference radar's odometry takes ReferenceRadarOptions.
   // `motion`: the motion model of the reference radar's odometry (null:
   // constant velocity); an IMU's (MakeMotionModel) takes T_ref_imu =
   // T_body_ref^-1 T_body_imu and stamps on the body's clock (one window
