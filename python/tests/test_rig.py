@@ -49,20 +49,25 @@ def test_rig_twist_from_planted_doppler_and_the_rig_file(tmp_path):
 CLI = os.environ.get("RADARGAUSS_CLI")
 
 
-@pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool (it simulates the rig)")
-def test_odometry_of_a_simulated_rig_with_an_imu(tmp_path):
-    # One IMU on the body, off the axle: rig_odometry with the IMU's samples
-    # and T_body_imu gives the command line's --imu --imu-extrinsic run.
-    (tmp_path / "rig_config.yaml").write_text(
-        "world: {scans: 40, imu_rate_hz: 200, imu_x: 1.0, imu_yaw_deg: 90}\nradars:\n"
-        "  - {name: front, mounting_x: 3.7, mounting_z: 0.5}\n"
-        "  - {name: rear, mounting_x: -1.0, mounting_z: 0.6, mounting_yaw_deg: 180, clock_offset: 0.01}\n")
+def simulate_rig(tmp_path, config):
+    """`radargauss simulate --rig-config` of the config's text into tmp_path/rig."""
+    (tmp_path / "rig_config.yaml").write_text(config)
     subprocess.run([CLI, "simulate", "--rig-config", str(tmp_path / "rig_config.yaml"), "--out",
                     str(tmp_path / "rig")], check=True, stdout=subprocess.DEVNULL)
+
+
+@pytest.mark.skipif(not CLI, reason="RADARGAUSS_CLI names no command-line tool (it simulates the rig)")
+def test_odometry_of_a_simulated_rig_with_an_imu(tmp_path):
+    # One IMU on the body, above its origin and turned: rig_odometry with the IMU's samples
+    # and T_body_imu gives the command line's --imu --imu-extrinsic run.
+    simulate_rig(tmp_path,
+        "world: {scans: 40, imu_rate_hz: 200, imu_z: 0.3, imu_yaw_deg: 90}\nradars:\n"
+        "  - {name: front, mounting_x: 3.7, mounting_z: 0.5}\n"
+        "  - {name: rear, mounting_x: -1.0, mounting_z: 0.6, mounting_yaw_deg: 180, clock_offset: 0.01}\n")
     rig_file = str(tmp_path / "rig" / "rig.yaml")
     imu = np.loadtxt(tmp_path / "rig" / "imu.txt")
     body_from_imu = np.loadtxt(tmp_path / "rig" / "imu_extrinsic.txt")
-    assert np.allclose(body_from_imu[:3], [1.0, 0.0, 0.0]) and np.isclose(abs(body_from_imu[5]), np.sqrt(0.5))
+    assert np.allclose(body_from_imu[:3], [0.0, 0.0, 0.3]) and np.isclose(abs(body_from_imu[5]), np.sqrt(0.5))
     run = rg.rig_odometry(rig_file, imu=imu, body_from_imu=body_from_imu)
     subprocess.run([CLI, "odometry", "--rig", rig_file, "--imu", str(tmp_path / "rig" / "imu.txt"), "--imu-extrinsic",
                     str(tmp_path / "rig" / "imu_extrinsic.txt"), "--out", str(tmp_path / "odometry")], check=True,
@@ -83,12 +88,10 @@ def test_export_of_a_rig_puts_each_radars_scan_where_its_true_pose_does(tmp_path
     # A run whose poses are the front radar's true ones: export --rig places
     # every point of the rear radar (on its own clock, 20 Hz) where the rear
     # radar's own true pose at its stamp puts it, to the interpolation's error.
-    (tmp_path / "rig_config.yaml").write_text(
+    simulate_rig(tmp_path,
         "world: {scans: 12}\nradars:\n  - {name: front, mounting_x: 3.7, mounting_z: 0.5}\n"
         "  - {name: rear, mounting_x: -1.0, mounting_z: 0.6, mounting_yaw_deg: 180, rate_hz: 20, "
         "clock_offset: 0.013}\n")
-    subprocess.run([CLI, "simulate", "--rig-config", str(tmp_path / "rig_config.yaml"), "--out",
-                    str(tmp_path / "rig")], check=True, stdout=subprocess.DEVNULL)
     (tmp_path / "run").mkdir()
     (tmp_path / "run" / "odometry.tum").write_text((tmp_path / "rig" / "front" / "gt_radar_tum.txt").read_text())
     subprocess.run([CLI, "export", str(tmp_path / "run"), "--rig", str(tmp_path / "rig" / "rig.yaml"), "--mcap",
@@ -116,13 +119,11 @@ def test_odometry_and_calibration_of_a_simulated_rig(tmp_path):
     # the body's odometry equals the command line's, and the calibration
     # from the truth stays near it (0.3 deg, 3 cm, 6 ms: the test of the C++
     # calibration, RigCalibration.*).
-    (tmp_path / "rig_config.yaml").write_text(
+    simulate_rig(tmp_path,
         "world: {scans: 120}\nradars:\n  - {name: front, mounting_x: 3.7, mounting_z: 0.5}\n"
         "  - {name: front_left, mounting_x: 3.4, mounting_y: 0.9, mounting_z: 0.5, mounting_yaw_deg: 45, "
         "azimuth_fov_deg: 75, max_range: 80, min_detections: 80, max_detections: 200, rate_hz: 20, "
         "clock_offset: 0.012}\n")
-    subprocess.run([CLI, "simulate", "--rig-config", str(tmp_path / "rig_config.yaml"), "--out",
-                    str(tmp_path / "rig")], check=True, stdout=subprocess.DEVNULL)
     rig_file = str(tmp_path / "rig" / "rig.yaml")
     run = rg.rig_odometry(rig_file)
     subprocess.run([CLI, "odometry", "--rig", rig_file, "--out", str(tmp_path / "odometry")], check=True,
