@@ -117,6 +117,20 @@ def odometry_rig_config(world_config, scans):
             REAR_RADAR)
 
 
+def simulate_rig(tool, rig_dir, config_text):
+    """`radargauss simulate --rig-config` of the text into rig_dir: the rig file's head and each radar's entry
+    by name (to write rig files of some of its radars)."""
+    os.makedirs(os.path.dirname(rig_dir), exist_ok=True)
+    with open(rig_dir + ".yaml", "w") as f:
+        f.write(config_text)
+    result = subprocess.run([tool, "simulate", "--rig-config", rig_dir + ".yaml", "--out", rig_dir, "--force"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if result.returncode != 0:
+        sys.exit(f"rig_table: simulate {rig_dir}.yaml failed: {result.stderr.strip()}")
+    head, *radars = open(os.path.join(rig_dir, "rig.yaml")).read().split("  - name:")
+    return head, {r.split("\n")[0].strip().strip('"'): "  - name:" + r for r in radars}
+
+
 def run_odometry(tool, flags, out):
     """ATE m, RPE t %, horizontal %, the median step (ms; a rig's frame), the steps (a rig's frames) and
     the wall time (s) of one odometry run."""
@@ -139,17 +153,7 @@ def odometry_table(tool, work):
     print("|---|---|---|---|---|---|---|")
     for world, config, scans in ODOMETRY_WORLDS:
         rig_dir = os.path.join(work, "rig_" + world.split()[0].replace("-", "_"))
-        rig_config = rig_dir + ".yaml"
-        os.makedirs(work, exist_ok=True)
-        with open(rig_config, "w") as f:
-            f.write(odometry_rig_config(config, scans))
-        result = subprocess.run([tool, "simulate", "--rig-config", rig_config, "--out", rig_dir, "--force"],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        if result.returncode != 0:
-            sys.exit(f"rig_table: simulate {rig_config} failed: {result.stderr.strip()}")
-        text = open(os.path.join(rig_dir, "rig.yaml")).read()
-        head, *radars = text.split("  - name:")
-        by_name = {r.split("\n")[0].strip().strip('"'): "  - name:" + r for r in radars}
+        head, by_name = simulate_rig(tool, rig_dir, odometry_rig_config(config, scans))
         alone = {}
         for name in by_name:
             sequence = os.path.join(rig_dir, name)
@@ -229,16 +233,8 @@ def imu_table(tool, work):
     print("|---|---|---|---|---|---|---|---|---|")
     for world, config, scans in ODOMETRY_WORLDS:
         rig_dir = os.path.join(work, "imu_rig_" + world.split()[0].replace("-", "_"))
-        os.makedirs(work, exist_ok=True)
-        with open(rig_dir + ".yaml", "w") as f:
-            f.write(odometry_rig_config(config, scans).replace("world:\n", "world:\n" + IMU_WORLD_KEYS, 1))
-        result = subprocess.run([tool, "simulate", "--rig-config", rig_dir + ".yaml", "--out", rig_dir, "--force"],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        if result.returncode != 0:
-            sys.exit(f"rig_table: simulate {rig_dir}.yaml failed: {result.stderr.strip()}")
-        text = open(os.path.join(rig_dir, "rig.yaml")).read()
-        head, *radars = text.split("  - name:")
-        by_name = {r.split("\n")[0].strip().strip('"'): "  - name:" + r for r in radars}
+        head, by_name = simulate_rig(
+            tool, rig_dir, odometry_rig_config(config, scans).replace("world:\n", "world:\n" + IMU_WORLD_KEYS, 1))
         imu = ["--imu", os.path.join(rig_dir, "imu.txt"), "--imu-extrinsic", os.path.join(rig_dir, "imu_extrinsic.txt")]
         for label, names in IMU_RIGS:
             rig_file = os.path.join(rig_dir, "rig_" + "_".join(names) + ".yaml")
