@@ -130,7 +130,7 @@ RigFrames::FrameVelocity RigFrames::MeasureVelocity(const std::optional<Velocity
     if (own.success) {
       out.static_points[k] = own.inlier;
       decided[k] = true;
-      out.measured = RadarOdometry::MeasuredVelocity{own.velocity, own.covariance};
+      out.measured = RadarOdometry::MeasuredVelocity{own.velocity, own.covariance, std::nullopt};
       out.twist.head<3>() = own.velocity;
       reference = std::move(own);
     }
@@ -159,7 +159,7 @@ RigFrames::FrameVelocity RigFrames::MeasureVelocity(const std::optional<Velocity
     // It stands when it observes the reference radar's velocity in full.
     if (rig.success && (rig.observed.topLeftCorner<3, 3>() - Eigen::Matrix3d::Identity()).norm() < 1e-6 &&
         rig.observed.topRightCorner<3, 3>().norm() < 1e-6) {
-      out.measured = RadarOdometry::MeasuredVelocity{rig.velocity, rig.covariance.topLeftCorner<3, 3>()};
+      out.measured = RadarOdometry::MeasuredVelocity{rig.velocity, rig.covariance.topLeftCorner<3, 3>(), std::nullopt};
       if (rig_options_.rotation_rate != "off" && rig.rank == 6) {
         out.measured->rate = RadarOdometry::MeasuredRate{rig.angular_velocity, rig.covariance.bottomRightCorner<3, 3>(),
                                                          rig_options_.rotation_rate == "all"};
