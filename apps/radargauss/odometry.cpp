@@ -101,9 +101,8 @@ int RunRigOdometry(const OdometrySettings& s) {
   StagedFolder folder = RunFolder(s, {"odometry.tum", "body.tum", "levelled.tum", "map.rgm", "map.ply"});
   std::vector<SE3d> mountings;
   for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
-  // The window runs in the reference radar's frame: T_ref_imu = T_body_ref^-1 T_body_imu.
   std::unique_ptr<MotionModel> motion =
-      MakeMotionModel(imu.inertial, mountings.front().Inverse() * imu.radar_from_imu, imu.samples);
+      MakeRigMotionModel(imu.inertial, mountings.front(), imu.radar_from_imu, imu.samples);
   PrintScreening(motion->screening());
   RigOdometry odometry(mountings, options, std::move(motion));
   std::size_t scans = 0;

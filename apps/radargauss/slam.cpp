@@ -84,9 +84,8 @@ int RunRigSlam(const SlamSettings& s) {
   StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "body.tum", "odometry", "map.rgm", "map.ply", "map_tiles"});
   const SE3d& body_from_reference = rig.radars.front().body_from_radar;
   options.odometry = ReferenceRadarOptions(options.odometry, body_from_reference);
-  // The window runs in the reference radar's frame: T_ref_imu = T_body_ref^-1 T_body_imu.
   RadarSlam slam(options, s.study,
-                 MakeMotionModel(imu.inertial, body_from_reference.Inverse() * imu.radar_from_imu, imu.samples));
+                 MakeRigMotionModel(imu.inertial, body_from_reference, imu.radar_from_imu, imu.samples));
   const std::size_t scans = RegisterRigFrames(rig, options.odometry, [&](const RigFrame& frame) {
     slam.Register(frame.scan, frame.velocity);
     return RegisteredFrame{slam.odometry().pose(slam.odometry().scans() - 1)};

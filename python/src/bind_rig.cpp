@@ -83,8 +83,7 @@ void BindRigRuns(py::module_& m) {
           if (samples.empty()) throw DataError("the IMU has no sample");
           const SE3d body_from_imu_pose =
               body_from_imu.is_none() ? SE3d() : PoseFromPython(body_from_imu, "body_from_imu");
-          // The window in the reference radar's frame: T_ref_imu = T_body_ref^-1 T_body_imu.
-          motion = MakeMotionModel(inertial, mountings.front().Inverse() * body_from_imu_pose, std::move(samples));
+          motion = MakeRigMotionModel(inertial, mountings.front(), body_from_imu_pose, std::move(samples));
         }
         RigOdometry odometry(mountings, options, std::move(motion));
         {

@@ -18,6 +18,7 @@
 #include "radargauss/lie/manifold.hpp"
 #include "radargauss/map/gaussian_map.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
+#include "radargauss/odometry/rig_odometry.hpp"
 #include "radargauss/residuals/rig_doppler_residual.hpp"
 
 namespace radargauss {
@@ -386,7 +387,7 @@ RigCalibration CalibrateRig(const Rig& rig, const std::vector<std::vector<RadarS
   // reference radar's frame, as a rig's odometry does).
   RadarOdometry odometry(
       options.reference,
-      imu ? MakeMotionModel(imu->inertial, body_from_reference.Inverse() * imu->body_from_imu, imu->samples) : nullptr);
+      imu ? MakeRigMotionModel(imu->inertial, body_from_reference, imu->body_from_imu, imu->samples) : nullptr);
   for (const RadarScan& scan : reference_scans) odometry.Register(scan);
   ReferenceTrack track(odometry.steps());
   std::vector<GyroSample> gyro;

@@ -240,6 +240,11 @@ OdometryOptions ReferenceRadarOptions(OdometryOptions options, const SE3d& body_
   return options;
 }
 
+std::unique_ptr<MotionModel> MakeRigMotionModel(const RadarInertialOptions& options, const SE3d& body_from_reference,
+                                                const SE3d& body_from_imu, std::vector<ImuSample> imu) {
+  return MakeMotionModel(options, body_from_reference.Inverse() * body_from_imu, std::move(imu));
+}
+
 RigOdometry::RigOdometry(std::vector<SE3d> body_from_radar, const OdometryOptions& options,
                          std::unique_ptr<MotionModel> motion)
     : frames_(std::move(body_from_radar), options),

@@ -32,6 +32,7 @@
 #include "radargauss/core/trajectory.hpp"
 #include "radargauss/io/rig.hpp"
 #include "radargauss/lie/se3.hpp"
+#include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 
 namespace radargauss {
@@ -134,6 +135,12 @@ std::size_t RegisterRigFrames(const Rig& rig, const OdometryOptions& options,
 // std::invalid_argument for a `mounting` given apart: a rig's mountings are
 // in its file.
 OdometryOptions ReferenceRadarOptions(OdometryOptions options, const SE3d& body_from_reference);
+
+// The motion model of a rig's IMU (MakeMotionModel) for the reference radar's
+// odometry: in its frame, T_ref_imu = T_body_ref^-1 T_body_imu
+// (docs/design/rig.md, "An IMU on a rig"); constant velocity without samples.
+std::unique_ptr<MotionModel> MakeRigMotionModel(const RadarInertialOptions& options, const SE3d& body_from_reference,
+                                                const SE3d& body_from_imu, std::vector<ImuSample> imu);
 
 // The body's trajectory from the reference radar's, T_world_ref in its
 // first frame: T_world_body = M T M^-1 (M = T_body_ref), so that the body
