@@ -68,22 +68,31 @@ py::dict CalibrationToDict(const RigCalibration& calibration) {
   return out;
 }
 
+// The keywords imu ((N, 7) samples) and body_from_imu (T_body_imu, default
+// identity) as a rig's IMU, the window at its defaults; none without imu.
+std::optional<RigImu> RigImuFrom(const py::object& imu, const py::object& body_from_imu) {
+  if (imu.is_none()) {
+    if (!body_from_imu.is_none()) throw py::value_error("body_from_imu needs imu");
+    return std::nullopt;
+  }
+  RigImu rig_imu{
+      ImuFromArray(imu), body_from_imu.is_none() ? SE3d() : PoseFromPython(body_from_imu, "body_from_imu"), {}};
+  if (rig_imu.samples.empty()) throw DataError("the IMU has no sample");
+  return rig_imu;
+}
+
 void BindRigRuns(py::module_& m) {
   m.def(
       "rig_odometry",
       [](const std::string& path, const py::object& imu, const py::object& body_from_imu, const py::kwargs& kwargs) {
         const auto [options, inertial] = InertialOptionsFrom(kwargs);
-        if (imu.is_none() && !body_from_imu.is_none()) throw py::value_error("body_from_imu needs imu");
+        std::optional<RigImu> rig_imu = RigImuFrom(imu, body_from_imu);
         const Rig rig = ReadRig(path);
         std::vector<SE3d> mountings;
         for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
         std::unique_ptr<MotionModel> motion;
-        if (!imu.is_none()) {
-          std::vector<ImuSample> samples = ImuFromArray(imu);
-          if (samples.empty()) throw DataError("the IMU has no sample");
-          const SE3d body_from_imu_pose =
-              body_from_imu.is_none() ? SE3d() : PoseFromPython(body_from_imu, "body_from_imu");
-          motion = MakeRigMotionModel(inertial, mountings.front(), body_from_imu_pose, std::move(samples));
+        if (rig_imu) {
+          motion = MakeRigMotionModel(inertial, mountings.front(), rig_imu->body_from_imu, std::move(rig_imu->samples));
         }
         RigOdometry odometry(mountings, options, std::move(motion));
         {
@@ -115,13 +124,7 @@ void BindRigRuns(py::module_& m) {
       [](const std::string& path, const py::object& imu, const py::object& body_from_imu, const py::kwargs& kwargs) {
         RigCalibrationOptions options = OptionsFrom(RigCalibrationOptionTable(), kwargs);
         ValidateOptions(options);
-        if (imu.is_none() && !body_from_imu.is_none()) throw py::value_error("body_from_imu needs imu");
-        std::optional<RigImu> rig_imu;
-        if (!imu.is_none()) {
-          rig_imu = RigImu{
-              ImuFromArray(imu), body_from_imu.is_none() ? SE3d() : PoseFromPython(body_from_imu, "body_from_imu"), {}};
-          if (rig_imu->samples.empty()) throw DataError("the IMU has no sample");
-        }
+        const std::optional<RigImu> rig_imu = RigImuFrom(imu, body_from_imu);
         const Rig rig = ReadRig(path);
         const std::vector<std::vector<RadarScan>> scans = LoadRigScans(rig);
         RigCalibration calibration;
