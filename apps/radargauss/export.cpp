@@ -103,13 +103,9 @@ int RunRigExport(const ExportSettings& s) {
   }
   const Rig rig = ReadRig(s.rig);
   const std::vector<RadarScan> frames = RigFramesOfRun(rig, ReadRunFolder(s.run));
-  std::optional<Trajectory> reference;
+  std::optional<Trajectory> reference;  // T_world_ref = T_world_body T_body_ref
   if (!s.sequence.ground_truth.empty()) {
-    const SE3d& body_from_reference = rig.radars.front().body_from_radar;
-    reference.emplace();
-    for (const StampedPose& p : ReadTum(s.sequence.ground_truth)) {
-      reference->Append(p.time, p.pose * body_from_reference);
-    }
+    reference = ReadRadarTrajectory(s.sequence.ground_truth, rig.radars.front().body_from_radar);
   }
   WriteRunForViewer(s.run, frames, reference, s.mcap);
   std::printf("wrote %s (the frames of %zu radars in the reference radar's frame)\n", s.mcap.c_str(),
