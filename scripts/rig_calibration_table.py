@@ -17,12 +17,19 @@ With --imu, the same radars (the same scans) with scripts/rig_table.py's
 table-4 IMU on the body, given to calibrate --imu: the reference's
 odometry with its window and its rates from the gyro.
 
+With --online, the same given rigs to `radargauss odometry --rig
+--rig-calibrate` (docs/design/rig.md, "Online calibration"): per radar the
+errors of the rig it writes, beside the stated stds (their norms), and per
+world and draw the RPE of the odometry at the true rig, at the given one,
+and with the online calibration.
+
     scripts/rig_calibration_table.py [--tool build/release/bin/radargauss] [--work /tmp/rig_calibration]
-                                     [--worlds demo,realistic] [--draws 1] [--imu]
+                                     [--worlds demo,realistic] [--draws 1] [--imu] [--online]
 """
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -77,6 +84,107 @@ def perturbed_rig(text, rng):
     return "\n".join(out) + "\n"
 
 
+def read_rig(path):
+    """Each radar's name, rotation matrix, translation and clock offset from a rig file."""
+    radars = []
+    for line in open(path):
+        stripped = line.strip()
+        if stripped.startswith("- name:"):
+            radars.append({"name": stripped.split(":", 1)[1].strip(), "clock": 0.0})
+        elif stripped.startswith("extrinsic:") and radars:
+            values = np.array(json.loads(stripped.split(":", 1)[1]))
+            radars[-1]["R"], radars[-1]["t"] = matrix(values[3:]), values[:3]
+        elif stripped.startswith("clock_offset:") and radars:
+            radars[-1]["clock"] = float(stripped.split(":", 1)[1])
+    return radars
+
+
+def rotation_angle_deg(R):
+    return float(np.degrees(np.arccos(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0))))
+
+
+def run_rig_odometry(tool, rig, gt, out, flags):
+    """The RPE t % of `odometry --rig`, and its standard output."""
+    subprocess.run(["rm", "-rf", out], check=True)
+    result = subprocess.run([tool, "odometry", "--rig", rig, "--gt", gt, "--out", out] + flags,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if result.returncode != 0:
+        sys.exit(f"rig_calibration_table: odometry failed: {result.stderr.strip()}")
+    return json.load(open(os.path.join(out, "evaluation.json")))["rpe"]["translation_percent"], result.stdout
+
+
+TRUTH_RPE = {}
+
+
+def online_rows(args, world, rig_dir, given, draw):
+    """The online calibration of one given rig: rows per radar, and the RPEs at the truth, given and online."""
+    truth_file = os.path.join(rig_dir, "rig.yaml")
+    gt = os.path.join(rig_dir, "gt_body_tum.txt")
+    tag = f"{os.path.basename(rig_dir)}_{draw}"
+    if rig_dir not in TRUTH_RPE:  # once per world
+        TRUTH_RPE[rig_dir] = run_rig_odometry(args.tool, truth_file, gt, os.path.join(args.work, f"truth_{tag}"),
+                                              [])[0]
+    rpe_truth = TRUTH_RPE[rig_dir]
+    rpe_given, _ = run_rig_odometry(args.tool, given, gt, os.path.join(args.work, f"given_{tag}"), [])
+    out = os.path.join(args.work, f"online_{tag}")
+    rpe_online, stdout = run_rig_odometry(args.tool, given, gt, out, ["--rig-calibrate"] + args.flags.split())
+    stds = {m.group(1): (float(m.group(2)), float(m.group(3)), float(m.group(4)))
+            for m in re.finditer(r"^  (\S+): moved .*; std \(norm\) ([\d.]+) deg, ([\d.]+) m, ([\d.]+) ms", stdout, re.M)}
+    rows = []
+    truth, before, after = read_rig(truth_file), read_rig(given), read_rig(os.path.join(out, "rig.yaml"))
+    for true_radar, given_radar, radar in list(zip(truth, before, after))[1:]:
+        errors = [(rotation_angle_deg(true_radar["R"].T @ r["R"]), float(np.linalg.norm(r["t"] - true_radar["t"])),
+                   1e3 * abs(r["clock"] - true_radar["clock"])) for r in (given_radar, radar)]
+        rows.append((radar["name"], errors[0], errors[1], stds.get(radar["name"], (np.inf,) * 3)))
+    return rows, (rpe_truth, rpe_given, rpe_online)
+
+
+def online_table(args):
+    print("| world | radar | given: deg, m, ms | online: rotation deg (std) | translation m (std) | clock ms (std) |")
+    print("|---|---|---|---|---|---|")
+    rpes = []
+    for world, config, scans in ODOMETRY_WORLDS:
+        if world.split()[0].replace("-", "_") not in args.worlds.split(","):
+            continue
+        rig_dir = simulated_rig_dir(args, world, config, scans)
+        within, count = np.zeros(3), 0
+        for draw in range(1, args.draws + 1):
+            rows, rpe = online_rows(args, world, rig_dir, given_rig(rig_dir, draw), draw)
+            rpes.append((world, draw) + rpe)
+            for name, before, after, std in rows:
+                within += [after[k] <= 3 * std[k] for k in range(3)]
+                count += 1
+                print(f"| {world} | {name} | {before[0]:.2f}, {before[1]:.3f}, {before[2]:.1f} | {after[0]:.3f} "
+                      f"({std[0]:.3f}) | {after[1]:.4f} ({std[1]:.4f}) | {after[2]:.2f} ({std[2]:.2f}) |")
+        print(f"| {world} | within 3 sigma | | {within[0]:.0f} of {count} | {within[1]:.0f} of {count} | "
+              f"{within[2]:.0f} of {count} |")
+    print()
+    print("| world | draw | RPE t % at the true rig | at the given rig | with the online calibration |")
+    print("|---|---|---|---|---|")
+    for world, draw, truth, given, online in rpes:
+        print(f"| {world} | {draw} | {truth:.3f} | {given:.3f} | {online:.3f} |")
+
+
+def simulated_rig_dir(args, world, config, scans):
+    """The world's simulated rig (once per --work), with table 4's IMU under --imu."""
+    rig_dir = os.path.join(args.work, world.split()[0].replace("-", "_") + ("_imu" if args.imu else ""))
+    if not os.path.exists(os.path.join(rig_dir, "rig.yaml")):
+        with open(rig_dir + ".yaml", "w") as f:
+            text = odometry_rig_config(config, scans)
+            f.write(text.replace("world:\n", "world:\n" + IMU_WORLD_KEYS, 1) if args.imu else text)
+        subprocess.run([args.tool, "simulate", "--rig-config", rig_dir + ".yaml", "--out", rig_dir], check=True,
+                       stdout=subprocess.DEVNULL)
+    return rig_dir
+
+
+def given_rig(rig_dir, draw):
+    """The draw's given rig: the simulated one moved off (seed `draw`)."""
+    given = os.path.join(rig_dir, f"rig_off_{draw}.yaml")
+    with open(given, "w") as f:
+        f.write(perturbed_rig(open(os.path.join(rig_dir, "rig.yaml")).read(), np.random.default_rng(draw)))
+    return given
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -87,26 +195,24 @@ def main():
     parser.add_argument("--flags", default="", help="further flags of radargauss calibrate")
     parser.add_argument("--imu", action="store_true",
                         help="the same radars with table 4's IMU on the body (calibrate --imu): the same scans")
+    parser.add_argument("--online", action="store_true",
+                        help="the online calibration of odometry --rig --rig-calibrate instead of calibrate")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
+    if args.online:
+        if args.imu:
+            sys.exit("rig_calibration_table: --online runs without the IMU")
+        online_table(args)
+        return
     print("| world | radar | rotation error deg (std) | translation error m (std) | clock error ms (std) |")
     print("|---|---|---|---|---|")
     for world, config, scans in ODOMETRY_WORLDS:
         if world.split()[0].replace("-", "_") not in args.worlds.split(","):
             continue
-        rig_dir = os.path.join(args.work, world.split()[0].replace("-", "_") + ("_imu" if args.imu else ""))
-        if not os.path.exists(os.path.join(rig_dir, "rig.yaml")):
-            with open(rig_dir + ".yaml", "w") as f:
-                text = odometry_rig_config(config, scans)
-                f.write(text.replace("world:\n", "world:\n" + IMU_WORLD_KEYS, 1) if args.imu else text)
-            subprocess.run([args.tool, "simulate", "--rig-config", rig_dir + ".yaml", "--out", rig_dir], check=True,
-                           stdout=subprocess.DEVNULL)
+        rig_dir = simulated_rig_dir(args, world, config, scans)
         within, count = np.zeros(3), 0
         for draw in range(1, args.draws + 1):
-            rng = np.random.default_rng(draw)
-            given = os.path.join(rig_dir, f"rig_off_{draw}.yaml")
-            with open(given, "w") as f:
-                f.write(perturbed_rig(open(os.path.join(rig_dir, "rig.yaml")).read(), rng))
+            given = given_rig(rig_dir, draw)
             out = os.path.join(args.work, f"calibrated_{os.path.basename(rig_dir)}_{draw}")
             subprocess.run(["rm", "-rf", out], check=True)
             result = subprocess.run([args.tool, "calibrate", "--rig", given, "--compare",

@@ -133,13 +133,7 @@ int RunCalibrate(const CalibrateSettings& s) {
                  "radargauss: warning: the IMU's window never ran (or dropped the IMU): the reference's "
                  "rates come from its poses\n");
   }
-  // The calibrated rig beside the results, its scans' paths absolute.
-  Rig calibrated = result.rig;
-  for (RigRadar& radar : calibrated.radars) {
-    if (!radar.scans.sequence_dir.empty()) radar.scans.sequence_dir = fs::absolute(radar.scans.sequence_dir).string();
-    if (!radar.scans.bag.empty()) radar.scans.bag = fs::absolute(radar.scans.bag).string();
-  }
-  WriteRig((fs::path(folder.path()) / "rig.yaml").string(), calibrated);
+  WriteRigWithAbsolutePaths((fs::path(folder.path()) / "rig.yaml").string(), result.rig);
   nlohmann::json report = nlohmann::json::array();
   std::printf(
       "| radar | scans | Doppler / map points | moved deg | moved m | clock moved ms | rotation std deg | "

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "radargauss/io/rig.hpp"
 #include "radargauss/io/sequence.hpp"
 #include "radargauss/map/pipeline.hpp"
 
@@ -48,6 +49,9 @@ void AddSequenceOptions(
 // naming the flags otherwise. What a folder holds is checked as it is
 // written (read_file.hpp, ProtectInputs).
 void CheckRunPaths(const CLI::App& command, const std::string& config_path);
+// `rig` written to `path` with its scans' paths absolute: a results folder's
+// rig file reads from anywhere.
+void WriteRigWithAbsolutePaths(const std::string& path, Rig rig);
 
 // Throws DataError when a weight w > 0 needs RCS and no scan of the sequence
 // has it: before any map is built or scan matched.

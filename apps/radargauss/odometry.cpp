@@ -83,6 +83,24 @@ void PrintInertial(const InertialMotion& inertial) {
   }
 }
 
+// The online calibration's estimates, one line per radar.
+void PrintOnlineCalibration(const RigOnlineCalibration& calibration, const Rig& rig) {
+  std::printf("online calibration: %zu windows\n", calibration.windows());
+  for (std::size_t r = 1; r < calibration.radars(); ++r) {
+    const SE3d moved = (rig.radars.front().body_from_radar.Inverse() * rig.radars[r].body_from_radar).Inverse() *
+                       calibration.reference_from_radar(r);
+    const RigOnlineCalibration::Vector7d std = calibration.std(r);
+    const Eigen::Vector3i& observed = calibration.observed_directions(r);
+    std::printf(
+        "  %s: moved %.3f deg, %.3f m, clock %.1f ms; std (norm) %.3f deg, %.3f m, %.1f ms; observed directions: "
+        "rotation %d of 3, "
+        "translation %d of 3, clock %d of 1\n",
+        rig.radars[r].name.c_str(), moved.rotation().Log().norm() * 180.0 / M_PI, moved.translation().norm(),
+        calibration.clock_change(r) * 1e3, std.head<3>().norm() * 180.0 / M_PI, std.segment<3>(3).norm(), std(6) * 1e3,
+        observed(0), observed(1), observed(2));
+  }
+}
+
 // The body's odometry from a rig's radars (docs/design/rig.md, "Odometry on a rig").
 int RunRigOdometry(const OdometrySettings& s) {
   const OdometryOptions& options = s.odometry;
@@ -98,7 +116,7 @@ int RunRigOdometry(const OdometrySettings& s) {
     reference =
         ReadRadarTrajectory(s.sequence.ground_truth, ResolveExtrinsic(s.sequence.extrinsic, s.sequence.ground_truth));
   }
-  StagedFolder folder = RunFolder(s, {"odometry.tum", "body.tum", "levelled.tum", "map.rgm", "map.ply"});
+  StagedFolder folder = RunFolder(s, {"odometry.tum", "body.tum", "levelled.tum", "map.rgm", "map.ply", "rig.yaml"});
   std::vector<SE3d> mountings;
   for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
   std::unique_ptr<MotionModel> motion =
@@ -121,6 +139,11 @@ int RunRigOdometry(const OdometrySettings& s) {
   WriteOdometry(folder.path(), odometry.odometry());
   WriteTum((std::filesystem::path(folder.path()) / "body.tum").string(), body);
   const std::string table = evaluation ? WriteEvaluation(folder.path(), *evaluation) : std::string();
+  const RigOnlineCalibration* calibration = odometry.frames().online_calibration();
+  if (calibration) {
+    WriteRigWithAbsolutePaths((std::filesystem::path(folder.path()) / "rig.yaml").string(),
+                              OnlineCalibratedRig(rig, odometry.frames()));
+  }
   folder.Commit();
   std::printf("rig: %zu radars, %zu scans in %zu frames, %zu with their velocity measured (%zu by the rig's twist)",
               rig.radars.size(), scans, odometry.frame_radars().size(), odometry.velocity_measured(),
@@ -131,15 +154,16 @@ int RunRigOdometry(const OdometrySettings& s) {
     std::printf("; %.2f ms per frame (median, p90 %.2f)", MedianOfSorted(times), PercentileOfSorted(times, 0.9));
   }
   std::printf("\n");
+  if (calibration) PrintOnlineCalibration(*calibration, rig);
   PrintSummary(Summarise(odometry.odometry()));
   const InertialMotion* inertial = InertialMotionOf(odometry.odometry());
   if (inertial) PrintInertial(*inertial);
   std::printf("%s", table.c_str());
   std::printf(
-      "wrote %s (body.tum: T_world_body; odometry.tum, per_scan.csv and summary.json of the %s odometry%s%s%s)\n",
+      "wrote %s (body.tum: T_world_body; odometry.tum, per_scan.csv and summary.json of the %s odometry%s%s%s%s)\n",
       s.out.c_str(), rig.radars.size() == 1 ? "radar's" : "body's",
       options.map.keep_evicted ? ", map.rgm, map.ply" : "", inertial ? ", inertial.csv" : "",
-      evaluation ? ", evaluation.json, evaluation.md" : "");
+      evaluation ? ", evaluation.json, evaluation.md" : "", calibration ? ", rig.yaml: the rig calibrated online" : "");
   return 0;
 }
 

@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "radargauss/core/atomic_file.hpp"
 #include "radargauss/core/error.hpp"
+#include "radargauss/io/rig.hpp"
 
 namespace radargauss::cli {
 
@@ -86,6 +87,14 @@ void CheckRunPaths(const CLI::App& command, const std::string& config_path) {
       CheckOutputFolder(out.path);
     }
   }
+}
+
+void WriteRigWithAbsolutePaths(const std::string& path, Rig rig) {
+  for (RigRadar& radar : rig.radars) {
+    if (!radar.scans.sequence_dir.empty()) radar.scans.sequence_dir = fs::absolute(radar.scans.sequence_dir).string();
+    if (!radar.scans.bag.empty()) radar.scans.bag = fs::absolute(radar.scans.bag).string();
+  }
+  WriteRig(path, rig);
 }
 
 }  // namespace radargauss::cli

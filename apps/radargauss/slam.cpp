@@ -81,15 +81,21 @@ int RunRigSlam(const SlamSettings& s) {
     reference = ReadRadarTrajectory(s.odometry.sequence.ground_truth,
                                     ResolveExtrinsic(s.odometry.sequence.extrinsic, s.odometry.sequence.ground_truth));
   }
-  StagedFolder folder = RunFolder(s.odometry, {"slam.tum", "body.tum", "odometry", "map.rgm", "map.ply", "map_tiles"});
+  StagedFolder folder =
+      RunFolder(s.odometry, {"slam.tum", "body.tum", "odometry", "map.rgm", "map.ply", "map_tiles", "rig.yaml"});
   const SE3d& body_from_reference = rig.radars.front().body_from_radar;
   options.odometry = ReferenceRadarOptions(options.odometry, body_from_reference);
   RadarSlam slam(options, s.study,
                  MakeRigMotionModel(imu.inertial, body_from_reference, imu.radar_from_imu, imu.samples));
-  const std::size_t scans = RegisterRigFrames(rig, options.odometry, [&](const RigFrame& frame) {
-    slam.Register(frame.scan, frame.velocity);
-    return RegisteredFrame{slam.odometry().pose(slam.odometry().scans() - 1)};
-  });
+  Rig calibrated;
+  const std::size_t scans = RegisterRigFrames(
+      rig, options.odometry,
+      [&](const RigFrame& frame) {
+        slam.Register(frame.scan, frame.velocity);
+        return RegisteredFrame{slam.odometry().pose(slam.odometry().scans() - 1)};
+      },
+      &calibrated);
+  const bool online_calibration = options.odometry.rig.calibrate && rig.radars.size() > 1;
   slam.Finish();
   const GaussianMap map = s.no_map ? GaussianMap() : PlaceMapOf(slam, s.odometry.rig);
   const std::string out = folder.path();
@@ -98,6 +104,7 @@ int RunRigSlam(const SlamSettings& s) {
   const Trajectory body = BodyTrajectory(slam.trajectory(), body_from_reference);
   WriteTum((std::filesystem::path(out) / "body.tum").string(), body);
   if (!s.no_map) WriteMaps(out, map, s.map_tiles);
+  if (online_calibration) WriteRigWithAbsolutePaths((std::filesystem::path(out) / "rig.yaml").string(), calibrated);
   std::string tables;
   if (reference) {
     WriteEvaluation((std::filesystem::path(out) / "odometry").string(),
@@ -110,8 +117,9 @@ int RunRigSlam(const SlamSettings& s) {
   std::printf("%s", tables.c_str());
   std::printf(
       "wrote %s (body.tum: T_world_body; slam.tum, keyframes.csv, loops.csv, per_scan.csv, slam.json of the "
-      "reference radar%s%s, odometry/%s)\n",
+      "reference radar%s%s%s, odometry/%s)\n",
       s.odometry.out.c_str(), s.no_map ? "" : ", map.rgm, map.ply", s.map_tiles > 0.0 ? ", map_tiles/" : "",
+      online_calibration ? ", rig.yaml: the rig calibrated online" : "",
       reference ? ", evaluation.json, evaluation.md (the body's)" : "");
   return 0;
 }

@@ -109,6 +109,20 @@ void BindRigRuns(py::module_& m) {
         if (const InertialMotion* window = InertialMotionOf(odometry.odometry())) {
           out["inertial_state"] = window->states().empty() ? py::none() : StateToDict(window->states().back());
         }
+        if (const RigOnlineCalibration* calibration = odometry.frames().online_calibration()) {
+          py::list calibrated;
+          for (const RigRadar& radar : OnlineCalibratedRig(rig, odometry.frames()).radars) {
+            calibrated.append(RadarToDict(radar));
+          }
+          Array stds = NewArray({py::ssize_t(calibration->radars()), 7});  // the reference's: zeros
+          auto view = stds.mutable_unchecked<2>();
+          for (std::size_t r = 0; r < calibration->radars(); ++r) {
+            for (int k = 0; k < 7; ++k) view(py::ssize_t(r), k) = r == 0 ? 0.0 : calibration->std(r)(k);
+          }
+          out["rig"] = calibrated;
+          out["calibration_std"] = stds;
+          out["calibration_windows"] = calibration->windows();
+        }
         return out;
       },
       py::arg("path"), py::arg("imu") = py::none(), py::arg("body_from_imu") = py::none(),
@@ -118,6 +132,9 @@ void BindRigRuns(py::module_& m) {
       "with the IMU's window, inertial_state (the newest state, in the first radar's frame; None before the "
       "window started).\n\nimu: array (N, 7) [stamp wx wy wz ax ay az] on the body's clock (s, rad/s, m/s^2, "
       "the IMU's frame); body_from_imu: (4, 4) or [x y z qx qy qz qw], T_body_imu, default identity.\n\n"
+      "With rig_calibrate=True (the online calibration, docs/design/rig.md, \"Online calibration\"): rig (the "
+      "radars as read_rig gives them, calibrated), calibration_std ((radars, 7): rotation rad, translation m, "
+      "clock s; zeros for the reference) and calibration_windows.\n\n"
       "Keywords: RadarOdometry's (odometry_options) and RadarInertialOdometry's (option_fields('radar_inertial'))");
   m.def(
       "calibrate_rig",

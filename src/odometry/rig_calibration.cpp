@@ -66,7 +66,9 @@ void ValidateOptions(const RigCalibrationOptions& options) {
 
 namespace {
 
+using rig_calibration::BuildReferenceMap;
 using rig_calibration::GyroRatesOf;
+using rig_calibration::ReferenceMap;
 using rig_calibration::ReferenceTrack;
 
 // A radar's static points used: the Doppler filter's inliers, gated around
@@ -90,30 +92,6 @@ std::vector<std::size_t> UsedPoints(const RadarScan& scan, const ReferenceMotion
   return used;
 }
 
-// The reference radar's map, with when the reference saw each Gaussian:
-// its odometry drifts, and a point matched to what the reference saw long
-// before carries that drift into the extrinsic.
-struct ReferenceMap {
-  GaussianIndex index;
-  std::vector<double> first_seen, last_seen;  // s, the body's clock
-};
-
-ReferenceMap BuildReferenceMap(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
-                               const MapOptions& options) {
-  const MapGeometry geometry = BuildMapGeometry(scans, poses, options);
-  ReferenceMap map{GaussianIndex(geometry.map.gaussians),
-                   std::vector<double>(geometry.map.gaussians.size(), std::numeric_limits<double>::infinity()),
-                   std::vector<double>(geometry.map.gaussians.size(), -std::numeric_limits<double>::infinity())};
-  for (std::size_t i = 0; i < geometry.association.size(); ++i) {
-    if (geometry.association[i] < 0) continue;
-    const std::size_t g = std::size_t(geometry.association[i]);
-    const double stamp = scans[geometry.cloud.scan[i]].timestamp;
-    map.first_seen[g] = std::min(map.first_seen[g], stamp);
-    map.last_seen[g] = std::max(map.last_seen[g], stamp);
-  }
-  return map;
-}
-
 struct RadarBlocks {
   Eigen::Vector4d rotation;  // x y z w of R_ref_radar
   Eigen::Vector3d translation;
@@ -131,31 +109,11 @@ Eigen::Matrix<double, 7, 1> TangentStd(ceres::Problem& problem, RadarBlocks& blo
   using Matrix7d = Eigen::Matrix<double, 7, 7>;
   using Vector7d = Eigen::Matrix<double, 7, 1>;
   Vector7d std = Vector7d::Constant(std::numeric_limits<double>::infinity());
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.parameter_blocks = {blocks.rotation.data(), blocks.translation.data(), &blocks.clock_change};
-  evaluate.residual_blocks = residuals;
-  std::vector<double> values;
-  ceres::CRSMatrix crs;
-  problem.Evaluate(evaluate, nullptr, &values, nullptr, &crs);
-  if (crs.num_cols != 7) return std;
-  Matrix7d information = Matrix7d::Zero(), spread = Matrix7d::Zero();
-  Vector7d gradient = Vector7d::Zero();
-  int row = 0;
-  for (std::size_t b = 0; b < residuals.size(); ++b) {
-    const int size = problem.GetCostFunctionForResidualBlock(residuals[b])->num_residuals();
-    for (int k = 0; k < size; ++k, ++row) {
-      Vector7d j = Vector7d::Zero();
-      for (int e = crs.rows[std::size_t(row)]; e < crs.rows[std::size_t(row) + 1]; ++e) {
-        j(crs.cols[std::size_t(e)]) = crs.values[std::size_t(e)];
-      }
-      information += j * j.transpose();
-      gradient += j * values[std::size_t(row)];
-    }
-    if (b + 1 == residuals.size() || scan_of[b + 1] != scan_of[b]) {  // the scan's residuals end here
-      spread += gradient * gradient.transpose();
-      gradient.setZero();
-    }
-  }
+  const std::optional<rig_calibration::ClusteredMoments> moments = rig_calibration::ClusteredByScan(
+      problem, {blocks.rotation.data(), blocks.translation.data(), &blocks.clock_change}, residuals, scan_of);
+  if (!moments) return std;
+  const Matrix7d& information = moments->information;
+  const Matrix7d& spread = moments->spread;
   const Eigen::SelfAdjointEigenSolver<Matrix7d> eigen(information);
   const double largest = eigen.eigenvalues().maxCoeff();
   Matrix7d inverse = Matrix7d::Zero();
@@ -202,17 +160,11 @@ void AddScanResiduals(const RadarScan& scan, std::size_t s, const std::vector<st
     out.scan_of.push_back(s);
     ++out.doppler;
     if (options.map_weight <= 0.0 || !with_map) continue;
-    const int g = map.index.Associate(world_from_reference * (extrinsic * point.position),
-                                      options.association_gate * options.association_gate);
-    if (g < 0 || t < map.first_seen[std::size_t(g)] - options.map_max_age ||
-        t > map.last_seen[std::size_t(g)] + options.map_max_age) {
-      continue;
-    }
-    // The Gaussian in the reference's frame at the scan's time: mean T^-1 mu, sqrt information L^T R.
+    ceres::CostFunction* cost = map.PointCost(point.position, t, extrinsic, world_from_reference, reference_from_world,
+                                              motion, options.association_gate, options.map_max_age);
+    if (cost == nullptr) continue;
     out.ids.push_back(problem.AddResidualBlock(
-        new RigPointCostFunction(point.position, reference_from_world * map.index.Mean(std::size_t(g)),
-                                 map.index.SqrtInformationT(std::size_t(g)) * world_from_reference.rotation().Matrix(),
-                                 motion),
+        cost,
         new ceres::ScaledLoss(new ceres::HuberLoss(options.loss_scale), options.map_weight, ceres::TAKE_OWNERSHIP),
         blocks.rotation.data(), blocks.translation.data(), &blocks.clock_change));
     out.scan_of.push_back(s);

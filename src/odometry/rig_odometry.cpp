@@ -43,6 +43,44 @@ const OptionTable<RigOdometryOptions>& RigOdometryOptionTable() {
                 "bias tilts them); off"),
       RADARGAUSS_OPTION(O, "rig_motion_compensation", motion_compensation)
           .Help("a rig's scans moved from their stamps to their frame's by its velocity and rotation rate"),
+      RADARGAUSS_OPTION(O, "rig_calibrate", calibrate)
+          .Help("estimate each radar's extrinsic and clock offset while driving, where the motion observes them"),
+      RADARGAUSS_OPTION(O, "rig_calibration_window", calibration_window)
+          .Above(0.0)
+          .Unit("s")
+          .Help("the online calibration's window: the reference's frames per estimate"),
+      RADARGAUSS_OPTION(O, "rig_calibration_doppler_std", calibration_doppler_std)
+          .Above(0.0)
+          .Unit("m/s")
+          .Help("the online calibration's Doppler residual sigma"),
+      RADARGAUSS_OPTION(O, "rig_calibration_map_weight", calibration_map_weight)
+          .AtLeast(0.0)
+          .Help("the online calibration's points against the reference radar's map, their weight (0: the Doppler "
+                "alone)"),
+      RADARGAUSS_OPTION(O, "rig_calibration_prior_deg", calibration_prior_deg)
+          .Above(0.0)
+          .Unit("deg")
+          .Help("how far the rig file's mounting rotations may be off"),
+      RADARGAUSS_OPTION(O, "rig_calibration_prior_m", calibration_prior_m)
+          .Above(0.0)
+          .Unit("m")
+          .Help("how far the rig file's mounting translations may be off"),
+      RADARGAUSS_OPTION(O, "rig_calibration_prior_s", calibration_prior_s)
+          .Above(0.0)
+          .Unit("s")
+          .Help("how far the rig file's clock offsets may be off"),
+      RADARGAUSS_OPTION(O, "rig_calibration_observed_deg", calibration_observed_deg)
+          .Above(0.0)
+          .Unit("deg")
+          .Help("a window moves a rotation direction only where its data alone reach this std"),
+      RADARGAUSS_OPTION(O, "rig_calibration_observed_m", calibration_observed_m)
+          .Above(0.0)
+          .Unit("m")
+          .Help("a window moves a translation direction only where its data alone reach this std"),
+      RADARGAUSS_OPTION(O, "rig_calibration_observed_s", calibration_observed_s)
+          .Above(0.0)
+          .Unit("s")
+          .Help("a window moves the clock offset only where its data alone reach this std"),
   };
   return table;
 }
@@ -60,6 +98,9 @@ RigFrames::RigFrames(std::vector<SE3d> body_from_radar, const OdometryOptions& o
   }
   const SE3d reference_from_body = body_from_radar_.front().Inverse();
   for (const SE3d& mounting : body_from_radar_) reference_from_radar_.push_back(reference_from_body * mounting);
+  if (rig_options_.calibrate && body_from_radar_.size() > 1) {
+    online_calibration_.emplace(reference_from_radar_, rig_options_);
+  }
 }
 
 std::optional<RigFrame> RigFrames::Add(std::size_t radar, const RadarScan& scan) {
@@ -92,6 +133,18 @@ std::optional<RigFrame> RigFrames::Finish() {
 void RigFrames::Registered(double stamp, const SE3d& pose) {
   registered_.emplace_back(stamp, pose);
   if (registered_.size() > 2) registered_.erase(registered_.begin());
+  if (!online_calibration_ || !reference_velocity_ || reference_velocity_->first != stamp) return;
+  online_calibration_->AddReference(stamp, pose, reference_velocity_->second);
+  if (online_calibration_->Update()) {
+    for (std::size_t r = 1; r < reference_from_radar_.size(); ++r) {
+      reference_from_radar_[r] = online_calibration_->reference_from_radar(r);
+    }
+  }
+}
+
+void RigFrames::ForgetMotion() {
+  registered_.clear();
+  if (online_calibration_) online_calibration_->Forget();
 }
 
 Eigen::Matrix<double, 6, 1> RigFrames::LastTwist() const {
@@ -132,6 +185,7 @@ RigFrames::FrameVelocity RigFrames::MeasureVelocity(const std::optional<Velocity
       decided[k] = true;
       out.measured = RadarOdometry::MeasuredVelocity{own.velocity, own.covariance, std::nullopt};
       out.twist.head<3>() = own.velocity;
+      out.reference = own.velocity;
       reference = std::move(own);
     }
   }
@@ -207,9 +261,13 @@ RigFrame RigFrames::Close() {
   for (std::size_t k = 0; k < pending_.size(); ++k) {
     const RadarScan& scan = pending_[k];
     SE3d to_frame = reference_from_radar_[pending_radars_[k]];
-    if (rig_options_.motion_compensation && scan.timestamp != stamp) {
-      to_frame = SE3d::Exp(velocity.twist * (scan.timestamp - stamp)) * to_frame;
+    // Its time on the body's clock, with the online calibration's change of its offset.
+    const double time =
+        scan.timestamp - (online_calibration_ ? online_calibration_->clock_change(pending_radars_[k]) : 0.0);
+    if (rig_options_.motion_compensation && time != stamp) {
+      to_frame = SE3d::Exp(velocity.twist * (time - stamp)) * to_frame;
     }
+    if (online_calibration_) online_calibration_->AddScan(pending_radars_[k], scan, velocity.static_points[k]);
     frame.has_rcs = frame.has_rcs && scan.has_rcs;
     for (std::size_t i = 0; i < scan.points.size(); ++i) {
       if (!velocity.static_points[k][i]) continue;
@@ -220,6 +278,8 @@ RigFrame RigFrames::Close() {
     }
   }
   if (velocity.measured) last_measured_ = MeasuredAt{stamp, *velocity.measured};
+  reference_velocity_.reset();
+  if (velocity.reference) reference_velocity_.emplace(stamp, *velocity.reference);
   RigFrame out{std::move(frame), velocity.measured, velocity.by_rig, std::move(pending_radars_),
                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()};
   pending_radars_.clear();
@@ -238,6 +298,17 @@ OdometryOptions ReferenceRadarOptions(OdometryOptions options, const SE3d& body_
   options.mounting_deg =
       Eigen::Vector3d(std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)), 0.0) * (180.0 / M_PI);
   return options;
+}
+
+Rig OnlineCalibratedRig(const Rig& given, const RigFrames& frames) {
+  Rig rig = given;
+  const RigOnlineCalibration* calibration = frames.online_calibration();
+  if (calibration == nullptr || calibration->radars() != rig.radars.size()) return rig;
+  for (std::size_t r = 1; r < rig.radars.size(); ++r) {
+    rig.radars[r].body_from_radar = frames.body_from_reference() * calibration->reference_from_radar(r);
+    rig.radars[r].clock_offset += calibration->clock_change(r);
+  }
+  return rig;
 }
 
 std::unique_ptr<MotionModel> MakeRigMotionModel(const RadarInertialOptions& options, const SE3d& body_from_reference,
@@ -278,7 +349,7 @@ void RigOdometry::RegisterFrame(RigFrame frame) {
 }
 
 std::size_t RegisterRigFrames(const Rig& rig, const OdometryOptions& options,
-                              const std::function<RegisteredFrame(const RigFrame&)>& front_end) {
+                              const std::function<RegisteredFrame(const RigFrame&)>& front_end, Rig* calibrated) {
   std::vector<SE3d> mountings;
   for (const RigRadar& radar : rig.radars) mountings.push_back(radar.body_from_radar);
   RigFrames frames(mountings, options);
@@ -303,6 +374,7 @@ std::size_t RegisterRigFrames(const Rig& rig, const OdometryOptions& options,
   if (rig.radars.size() > 1) {
     if (const std::optional<RigFrame> frame = frames.Finish()) give(*frame);
   }
+  if (calibrated != nullptr) *calibrated = OnlineCalibratedRig(rig, frames);
   return scans;
 }
 

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The reference radar's motion for the calibration of a rig (docs/design/rig.md,
-// "Calibration of a rig"): its velocity, angular velocity and their rates at
-// any instant of its odometry's drive, the angular velocity from the gyro
-// where an IMU's window ran. Internal to src/odometry.
+// The reference radar's motion and map for the calibration of a rig, offline
+// and online (docs/design/rig.md, "Calibration of a rig", "Online
+// calibration"): its velocity, angular velocity and their rates at any
+// instant of its drive, the angular velocity from the gyro where an IMU's
+// window ran; its map and the residual of a point against it. Internal to src/odometry.
 #pragma once
 
 #include <algorithm>
@@ -11,9 +12,16 @@
 #include <utility>
 #include <vector>
 
+#include <ceres/cost_function.h>
+#include <ceres/crs_matrix.h>
+#include <ceres/problem.h>
+
 #include <Eigen/Core>
 
+#include "radargauss/core/types.hpp"
 #include "radargauss/lie/se3.hpp"
+#include "radargauss/map/gaussian_map.hpp"
+#include "radargauss/map/pipeline.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
 #include "radargauss/residuals/rig_doppler_residual.hpp"
@@ -97,5 +105,39 @@ class ReferenceTrack {
 // the window's gyro bias at the nearest state; none where the window never
 // started or dropped the IMU.
 std::vector<GyroSample> GyroRatesOf(const InertialMotion& inertial, std::vector<ImuSample> imu);
+
+// A problem's Gauss-Newton information over the 7 tangent directions of a
+// radar's rotation, translation and clock, H = J^T J, and the spread of its
+// gradients clustered by scan, B = sum_s g_s g_s^T (g_s = J_s^T r_s): a scan's
+// residuals share its reference motion's errors, so they are not counted as
+// independent (docs/design/rig.md, "Calibration of a rig").
+struct ClusteredMoments {
+  Eigen::Matrix<double, 7, 7> information, spread;
+};
+// `residuals` in the order of their scans (scan_of); none when the problem's
+// Jacobian has other than 7 columns.
+std::optional<ClusteredMoments> ClusteredByScan(ceres::Problem& problem, const std::vector<double*>& blocks,
+                                                const std::vector<ceres::ResidualBlockId>& residuals,
+                                                const std::vector<std::size_t>& scan_of);
+
+// The reference radar's map, with when the reference saw each Gaussian:
+// its odometry drifts, and a point matched to what the reference saw long
+// before carries that drift into the extrinsic.
+struct ReferenceMap {
+  GaussianIndex index;
+  std::vector<double> first_seen, last_seen;  // s, the body's clock
+
+  // The residual of a radar's point (its frame) seen at t against the
+  // Gaussian it meets within `gate` (Mahalanobis) that the reference saw
+  // within `max_age` of t: the Gaussian in the reference's frame at t (mean
+  // T^-1 mu, sqrt information L^T R); null when it meets none.
+  ceres::CostFunction* PointCost(const Eigen::Vector3d& point, double t, const SE3d& extrinsic,
+                                 const SE3d& world_from_reference, const SE3d& reference_from_world,
+                                 const ReferenceMotion& motion, double gate, double max_age) const;
+};
+
+// The map of the reference's scans at its poses T_world_ref (stamps on the body's clock).
+ReferenceMap BuildReferenceMap(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,
+                               const MapOptions& options);
 
 }  // namespace radargauss::rig_calibration

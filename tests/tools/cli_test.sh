@@ -227,6 +227,12 @@ expect_fail "a rig and a sequence" "drop --sequence" -- "$tool" info --rig "$wor
 expect_ok "odometry on a rig" "rig: 2 radars, 20 scans in 10 frames" -- \
   "$tool" odometry --rig "$work/rig.yaml" --out "$work/rig_odometry"
 [[ -s "$work/rig_odometry/body.tum" ]] || { echo "FAIL: odometry --rig wrote no body.tum"; failed=1; }
+expect_ok "odometry on a rig calibrating it online" "online calibration: [1-9][0-9]* windows" -- \
+  "$tool" odometry --rig "$work/rig.yaml" --rig-calibrate --rig-calibration-window 0.3 --out "$work/rig_online"
+expect_ok "the rig calibrated online is a rig" "rear: 10 scans" -- "$tool" info --rig "$work/rig_online/rig.yaml"
+expect_fail "an online calibration without a window" "rig-calibration-window" -- \
+  "$tool" odometry --rig "$work/rig.yaml" --rig-calibrate --rig-calibration-window 0 --out "$work/rig_online_bad"
+[[ ! -e "$work/rig_online_bad" ]] || { echo "FAIL: a refused online calibration left its folder"; failed=1; }
 expect_ok "export a rig's run" "the frames of 2 radars" -- \
   "$tool" export "$work/rig_odometry" --rig "$work/rig.yaml" --mcap "$work/rig_odometry.mcap"
 expect_fail "export a rig's run with a sequence" "drop --sequence" -- \

@@ -57,6 +57,21 @@ struct RigOdometryOptions {
   std::string rotation_rate = "yaw";
   // Each scan's points moved from its stamp to the frame's at the frame's velocity and the last rotation rate.
   bool motion_compensation = true;
+  // Each radar's extrinsic and clock offset estimated while driving, in
+  // windows of calibration_window s, where the window's Doppler observes
+  // them (odometry/rig_online_calibration.hpp); the frames that follow use them.
+  bool calibrate = false;
+  double calibration_window = 2.5;        // s of the reference's frames per estimate
+  double calibration_doppler_std = 0.05;  // m/s: a Doppler residual's sigma
+  double calibration_map_weight = 1.0;    // of the points against the reference's map (0: the Doppler alone)
+  // How far the rig file's mountings may be off (the first prior's stds) ...
+  double calibration_prior_deg = 2.0;
+  double calibration_prior_m = 0.1;
+  double calibration_prior_s = 0.02;
+  // ... and the std a window's data must reach in a direction to move it there.
+  double calibration_observed_deg = 0.2;
+  double calibration_observed_m = 0.03;
+  double calibration_observed_s = 0.002;
 };
 const OptionTable<RigOdometryOptions>& RigOdometryOptionTable();
 

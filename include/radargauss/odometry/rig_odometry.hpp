@@ -34,6 +34,7 @@
 #include "radargauss/lie/se3.hpp"
 #include "radargauss/odometry/radar_inertial.hpp"
 #include "radargauss/odometry/radar_odometry.hpp"
+#include "radargauss/odometry/rig_online_calibration.hpp"
 
 namespace radargauss {
 
@@ -66,12 +67,19 @@ class RigFrames {
   // moves the next frames' scans comes from the last two.
   void Registered(double stamp, const SE3d& pose);
   // The front end's poses jumped (a relocalisation's fix, a restart): the
-  // rotation rate waits for two frames registered after it.
-  void ForgetMotion() { registered_.clear(); }
+  // rotation rate waits for two frames registered after it, the online
+  // calibration for a new window.
+  void ForgetMotion();
 
   std::size_t radars() const { return body_from_radar_.size(); }
   const SE3d& body_from_reference() const { return body_from_radar_.front(); }
+  // Each radar's T_ref_radar as the frames use it: the rig file's, or the
+  // online calibration's estimate (options.rig.calibrate).
   const std::vector<SE3d>& reference_from_radar() const { return reference_from_radar_; }
+  // The online calibration, when options.rig.calibrate on a rig of several radars.
+  const RigOnlineCalibration* online_calibration() const {
+    return online_calibration_ ? &*online_calibration_ : nullptr;
+  }
 
  private:
   // A frame's velocity: measured (by the rig's twist or the reference
@@ -82,6 +90,7 @@ class RigFrames {
     bool by_rig = false;
     std::vector<std::vector<bool>> static_points;
     Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();
+    std::optional<Eigen::Vector3d> reference;  // the reference radar's own velocity
   };
   // The odometry's Doppler gate (OdometryOptions).
   struct GateOptions {
@@ -113,6 +122,10 @@ class RigFrames {
     RadarOdometry::MeasuredVelocity velocity;
   };
   std::optional<MeasuredAt> last_measured_;  // the gate's centre
+  std::optional<RigOnlineCalibration> online_calibration_;
+  // The last frame's stamp and its reference radar's own velocity, for the
+  // online calibration once the frame is registered.
+  std::optional<std::pair<double, Eigen::Vector3d>> reference_velocity_;
 };
 
 // What a front end tells of a frame it registered: the pose T_world_ref it
@@ -126,8 +139,11 @@ struct RegisteredFrame {
 // registers (RadarSlam, Relocalizer): a rig of one radar gives each scan
 // as it is, as its own frame without a velocity. Returns the scans read;
 // throws DataError as ForEachRigScan and RigFrames do, naming the scan's source.
+// `calibrated`, when given: the rig as the online calibration left it
+// (OnlineCalibratedRig; `rig` itself without options.rig.calibrate).
 std::size_t RegisterRigFrames(const Rig& rig, const OdometryOptions& options,
-                              const std::function<RegisteredFrame(const RigFrame&)>& front_end);
+                              const std::function<RegisteredFrame(const RigFrame&)>& front_end,
+                              Rig* calibrated = nullptr);
 
 // The odometry's options for a rig's reference radar: its mounting (the
 // vehicle's vertical for the rotation term and the yaw rate's axis) is the
@@ -135,6 +151,11 @@ std::size_t RegisterRigFrames(const Rig& rig, const OdometryOptions& options,
 // std::invalid_argument for a `mounting` given apart: a rig's mountings are
 // in its file.
 OdometryOptions ReferenceRadarOptions(OdometryOptions options, const SE3d& body_from_reference);
+
+// `given` with the online calibration's mountings (T_body_radar = T_body_ref
+// T_ref_radar) and clock offsets (the given plus the estimated change); as
+// given without it.
+Rig OnlineCalibratedRig(const Rig& given, const RigFrames& frames);
 
 // The motion model of a rig's IMU (MakeMotionModel) for the reference radar's
 // odometry: in its frame, T_ref_imu = T_body_ref^-1 T_body_imu
@@ -183,6 +204,8 @@ class RigOdometry {
   const RadarScan& last_frame() const { return last_frame_; }
   // Each frame's time (ms): its twist, its points moved and its odometry step (empty with one radar).
   const std::vector<double>& frame_times_ms() const { return frame_times_ms_; }
+  // The frames' maker: each radar's mounting as used, the online calibration.
+  const RigFrames& frames() const { return frames_; }
 
  private:
   void RegisterFrame(RigFrame frame);
