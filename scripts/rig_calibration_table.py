@@ -90,7 +90,7 @@ def read_rig(path):
     for line in open(path):
         stripped = line.strip()
         if stripped.startswith("- name:"):
-            radars.append({"name": stripped.split(":", 1)[1].strip(), "clock": 0.0})
+            radars.append({"name": stripped.split(":", 1)[1].strip().strip('"'), "clock": 0.0})
         elif stripped.startswith("extrinsic:") and radars:
             values = np.array(json.loads(stripped.split(":", 1)[1]))
             radars[-1]["R"], radars[-1]["t"] = matrix(values[3:]), values[:3]

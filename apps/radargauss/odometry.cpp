@@ -94,10 +94,10 @@ void PrintOnlineCalibration(const RigOnlineCalibration& calibration, const Rig& 
     std::printf(
         "  %s: moved %.3f deg, %.3f m, clock %.1f ms; std (norm) %.3f deg, %.3f m, %.1f ms; observed directions: "
         "rotation %d of 3, "
-        "translation %d of 3, clock %d of 1\n",
+        "translation %d of 3, clock %d of 1; %zu windows set aside\n",
         rig.radars[r].name.c_str(), moved.rotation().Log().norm() * 180.0 / M_PI, moved.translation().norm(),
         calibration.clock_change(r) * 1e3, std.head<3>().norm() * 180.0 / M_PI, std.segment<3>(3).norm(), std(6) * 1e3,
-        observed(0), observed(1), observed(2));
+        observed(0), observed(1), observed(2), calibration.windows_set_aside(r));
   }
 }
 

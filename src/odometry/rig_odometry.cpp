@@ -189,6 +189,10 @@ RigFrames::FrameVelocity RigFrames::MeasureVelocity(const std::optional<Velocity
       reference = std::move(own);
     }
   }
+  // A radar the online calibration has not observed yet stays out of the twist.
+  newest.erase(
+      std::remove_if(newest.begin(), newest.end(), [&](std::size_t k) { return !Admitted(pending_radars_[k]); }),
+      newest.end());
   if (rig_options_.rig_velocity && newest.size() > 1) {
     // The rig's twist at the reference radar, gated by the prediction, and
     // its rotation rate around the last one: a car that fills one radar's
@@ -268,6 +272,7 @@ RigFrame RigFrames::Close() {
       to_frame = SE3d::Exp(velocity.twist * (time - stamp)) * to_frame;
     }
     if (online_calibration_) online_calibration_->AddScan(pending_radars_[k], scan, velocity.static_points[k]);
+    if (!Admitted(pending_radars_[k])) continue;  // its points wait for its mounting, as its Doppler does
     frame.has_rcs = frame.has_rcs && scan.has_rcs;
     for (std::size_t i = 0; i < scan.points.size(); ++i) {
       if (!velocity.static_points[k][i]) continue;

@@ -29,6 +29,7 @@ constexpr std::size_t kPointsPerScan = 40;  // a scan's static points kept, spre
 constexpr double kLossScale = 2.0;          // Huber, in sigmas (and Mahalanobis distance)
 constexpr double kAssociationGate = 3.0;    // Mahalanobis distance of a point to its Gaussian
 constexpr int kRounds = 4;                  // per window: the rotation, the translation, the clock twice
+constexpr double kImprobableMove = 24.32;   // chi-square, 7 degrees of freedom, 99.9 %
 constexpr double kMapMaxAge = 2.0;          // s: a point meets the Gaussians the reference saw within this
 constexpr double kDegree = M_PI / 180.0;
 
@@ -257,7 +258,18 @@ bool RigOnlineCalibration::Solve(std::size_t radar, const std::vector<OdometrySt
     if (last) data = WindowInformation(problem, {rotation.data(), translation.data(), &clock}, ids, scan_of);
     moved_clock += clock;
   }
-  estimate.free = SE3d(SO3d::FromXyzw(rotation.data()), translation);
+  // A window whose estimate the rig file holds improbable (beyond the 99.9 %
+  // bound of chi-square with 7 degrees of freedom under the prior) is set
+  // aside: a reference motion gone wrong, or another minimum.
+  const SE3d solved(SO3d::FromXyzw(rotation.data()), translation);
+  Vector7d from_given;
+  from_given << (estimate.given.rotation().Inverse() * solved.rotation()).Log(),
+      solved.translation() - estimate.given.translation(), estimate.free_clock + moved_clock;
+  if (!(from_given.dot(estimate.prior_information * from_given) <= kImprobableMove)) {
+    ++estimate.windows_set_aside;
+    return false;
+  }
+  estimate.free = solved;
   estimate.free_clock += moved_clock;
   estimate.information += data;
   return Apply(estimate);

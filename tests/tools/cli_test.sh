@@ -268,6 +268,10 @@ expect_fail "a rig and a sequence to convert" "drop --sequence" -- \
 expect_ok "slam on a rig" "rig: 2 radars, 20 scans in 10 frames" -- \
   "$tool" slam --rig "$work/rig.yaml" --submap-distance 2 --out "$work/rig_slam"
 [[ -s "$work/rig_slam/body.tum" && -s "$work/rig_slam/map.rgm" ]] || { echo "FAIL: slam --rig wrote no body.tum or map"; failed=1; }
+expect_ok "slam on a rig calibrating it online" "rig.yaml: the rig calibrated online" -- \
+  "$tool" slam --rig "$work/rig.yaml" --submap-distance 2 --rig-calibrate --rig-calibration-window 0.3 \
+  --out "$work/rig_slam_online"
+expect_ok "the rig slam calibrated online is a rig" "rear: 10 scans" -- "$tool" info --rig "$work/rig_slam_online/rig.yaml"
 printf 'radars:\n  - {name: front, sequence: seq10, extrinsic: [0, 0, 0, 0, 0, 0, 1]}\n' > "$work/rig_front.yaml"
 "$tool" slam --rig "$work/rig_front.yaml" --submap-distance 2 --out "$work/rig_slam_one" >/dev/null
 "$tool" slam --sequence "$work/seq10" --submap-distance 2 --out "$work/slam_one" >/dev/null

@@ -104,6 +104,10 @@ class RigFrames {
   // Scan k's static points by its radar's own Doppler filter.
   std::vector<bool> OwnStaticPoints(std::size_t k, const std::optional<VelocityGate>& gate,
                                     const FrameVelocity& frame) const;
+  // Whether radar `radar`'s scans join the rig's twist and the frame's
+  // points: always, but with the online calibration, once it has observed
+  // the radar's mounting (until then the frames are the others').
+  bool Admitted(std::size_t radar) const { return !online_calibration_ || online_calibration_->Calibrated(radar); }
   // The reference radar's twist [v; w] (its frame) between the last two frames registered; zero before.
   Eigen::Matrix<double, 6, 1> LastTwist() const;
 

@@ -13,7 +13,8 @@
 // calibration gate (solvers/calibration_gate.hpp) then applies only the
 // directions that the drive so far observes: the rotation about the
 // velocity needs turns, the translation needs turns (the lever arm w x t),
-// the clock needs changes of speed.
+// the clock needs changes of speed. A window whose estimate lies improbably
+// far from the rig file, under the prior, is set aside.
 //
 //   RigOnlineCalibration calibration(reference_from_radar, options.rig);
 //   calibration.AddReference(stamp, T_world_ref, velocity);   // each frame
@@ -74,6 +75,16 @@ class RigOnlineCalibration {
   // How many directions of its rotation, translation and clock the drive so far observes (3, 3, 1: all).
   const Eigen::Vector3i& observed_directions(std::size_t r) const { return estimates_[r].observed_directions; }
   std::size_t windows() const { return windows_; }
+  // Whether the drive so far observes radar r's mounting: its rotation and
+  // clock in full, its translation but at most one direction (the
+  // reference: always).
+  bool Calibrated(std::size_t r) const {
+    const Eigen::Vector3i& observed = estimates_[r].observed_directions;
+    return r == 0 || (observed(0) == 3 && observed(1) >= 2 && observed(2) == 1);
+  }
+  // The windows whose estimate of radar r lay improbably far from the rig
+  // file (chi-square of 7 degrees of freedom under the prior, beyond 99.9 %): set aside.
+  std::size_t windows_set_aside(std::size_t r) const { return estimates_[r].windows_set_aside; }
 
  private:
   // A radar's estimate: the free one (sequential least squares over the
@@ -86,6 +97,7 @@ class RigOnlineCalibration {
     Matrix7d information = Matrix7d::Zero();  // the prior's and every window's
     Matrix7d covariance = Matrix7d::Zero();   // of the applied estimate
     Eigen::Vector3i observed_directions = Eigen::Vector3i::Zero();
+    std::size_t windows_set_aside = 0;
   };
   struct WindowScan {
     std::size_t radar = 0;
