@@ -143,10 +143,7 @@ def online_table(args):
     print("| world | radar | given: deg, m, ms | online: rotation deg (std) | translation m (std) | clock ms (std) |")
     print("|---|---|---|---|---|---|")
     rpes = []
-    for world, config, scans in ODOMETRY_WORLDS:
-        if world.split()[0].replace("-", "_") not in args.worlds.split(","):
-            continue
-        rig_dir = simulated_rig_dir(args, world, config, scans)
+    for world, rig_dir in selected_worlds(args):
         within, count = np.zeros(3), 0
         for draw in range(1, args.draws + 1):
             rows, rpe = online_rows(args, world, rig_dir, given_rig(rig_dir, draw), draw)
@@ -175,6 +172,13 @@ def simulated_rig_dir(args, world, config, scans):
         subprocess.run([args.tool, "simulate", "--rig-config", rig_dir + ".yaml", "--out", rig_dir], check=True,
                        stdout=subprocess.DEVNULL)
     return rig_dir
+
+
+def selected_worlds(args):
+    """Each world of --worlds and its simulated rig's folder."""
+    for world, config, scans in ODOMETRY_WORLDS:
+        if world.split()[0].replace("-", "_") in args.worlds.split(","):
+            yield world, simulated_rig_dir(args, world, config, scans)
 
 
 def given_rig(rig_dir, draw):
@@ -206,10 +210,7 @@ def main():
         return
     print("| world | radar | rotation error deg (std) | translation error m (std) | clock error ms (std) |")
     print("|---|---|---|---|---|")
-    for world, config, scans in ODOMETRY_WORLDS:
-        if world.split()[0].replace("-", "_") not in args.worlds.split(","):
-            continue
-        rig_dir = simulated_rig_dir(args, world, config, scans)
+    for world, rig_dir in selected_worlds(args):
         within, count = np.zeros(3), 0
         for draw in range(1, args.draws + 1):
             given = given_rig(rig_dir, draw)

@@ -212,12 +212,7 @@ RadarCalibration CalibrateRadar(const RigRadar& radar, const SE3d& reference_fro
     if (!options.estimate_rotation) problem.SetParameterBlockConstant(blocks.rotation.data());
     if (!options.estimate_translation || !with_map) problem.SetParameterBlockConstant(blocks.translation.data());
     if (!options.estimate_clock_offset || !with_clock) problem.SetParameterBlockConstant(&blocks.clock_change);
-    ceres::Solver::Options solver;
-    solver.linear_solver_type = ceres::DENSE_QR;
-    solver.max_num_iterations = 50;
-    solver.num_threads = 1;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver, &problem, &summary);
+    rig_calibration::SolveDense(problem, 50);
     std = TangentStd(problem, blocks, residuals.ids, residuals.scan_of, options.min_relative_eigenvalue);
     clock_offset += blocks.clock_change;
     blocks.clock_change = 0.0;

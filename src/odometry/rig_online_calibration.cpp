@@ -249,12 +249,7 @@ bool RigOnlineCalibration::Solve(std::size_t radar, const std::vector<OdometrySt
                              translation.data(), &clock);
     if (round < 1) problem.SetParameterBlockConstant(translation.data());
     if (round < 2) problem.SetParameterBlockConstant(&clock);
-    ceres::Solver::Options solver;
-    solver.linear_solver_type = ceres::DENSE_QR;
-    solver.max_num_iterations = 20;
-    solver.num_threads = 1;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver, &problem, &summary);
+    rig_calibration::SolveDense(problem, 20);
     if (last) data = WindowInformation(problem, {rotation.data(), translation.data(), &clock}, ids, scan_of);
     moved_clock += clock;
   }

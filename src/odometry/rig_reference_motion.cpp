@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include <ceres/solver.h>
+
 #include "radargauss/residuals/rig_doppler_residual.hpp"
 
 namespace radargauss::rig_calibration {
@@ -62,6 +64,15 @@ std::optional<ClusteredMoments> ClusteredByScan(ceres::Problem& problem, const s
     }
   }
   return moments;
+}
+
+void SolveDense(ceres::Problem& problem, int max_iterations) {
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = max_iterations;
+  solver.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
 }
 
 ReferenceMap BuildReferenceMap(const std::vector<RadarScan>& scans, const std::vector<SE3d>& poses,

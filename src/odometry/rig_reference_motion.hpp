@@ -120,6 +120,9 @@ std::optional<ClusteredMoments> ClusteredByScan(ceres::Problem& problem, const s
                                                 const std::vector<ceres::ResidualBlockId>& residuals,
                                                 const std::vector<std::size_t>& scan_of);
 
+// A calibration's small problem solved: Levenberg-Marquardt on dense QR, one thread.
+void SolveDense(ceres::Problem& problem, int max_iterations);
+
 // The reference radar's map, with when the reference saw each Gaussian:
 // its odometry drifts, and a point matched to what the reference saw long
 // before carries that drift into the extrinsic.
