@@ -23,14 +23,15 @@
 #include "radargauss/solvers/calibration_gate.hpp"
 #include "radargauss/solvers/marginalization.hpp"
 #include "radargauss/solvers/window_solvers.hpp"
+#include "inertial_window_problem.hpp"
 
 namespace radargauss {
+
+using inertial_window::kElevationBiasPrior;
 
 namespace {
 
 constexpr double kClockRelinearisation = 0.002;  // s
-// The first state's prior on the elevation bias (std).
-constexpr double kElevationBiasPrior = 2.0 * M_PI / 180.0;  // rad: a radar's bias is a fraction of a degree
 
 // W with W^T W = information, for a positive semi-definite information.
 Eigen::MatrixXd SqrtInformation(const Eigen::MatrixXd& information) {
@@ -38,8 +39,6 @@ Eigen::MatrixXd SqrtInformation(const Eigen::MatrixXd& information) {
   const Eigen::VectorXd roots = eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt();
   return roots.asDiagonal() * eigen.eigenvectors().transpose();
 }
-
-using CostPointer = std::shared_ptr<ceres::CostFunction>;
 
 // r_i = (x_i - mean_i) / sigma_i on one Euclidean block: the first state's
 // priors. (Not ceres::NormalPrior: its Eigen members are allocated inside
@@ -68,225 +67,6 @@ class DiagonalPrior final : public ceres::CostFunction {
 };
 
 }  // namespace
-
-// One state and the terms that end at it.
-struct InertialWindow::Node {
-  double stamp = 0.0;
-  Eigen::Vector4d rotation = Eigen::Vector4d(0, 0, 0, 1);  // R_world_imu, x y z w
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  Eigen::Matrix<double, 9, 1> motion = Eigen::Matrix<double, 9, 1>::Zero();  // v, b_g, b_a
-  std::optional<ImuPreintegration> from_previous;  // the IMU between the node before and this one
-  CostPointer imu, pose, velocity, vehicle;        // terms on this node (imu: from the one before)
-  // The measurements, kept to make their terms again at a new clock offset.
-  std::optional<std::pair<SE3d, Eigen::Matrix<double, 6, 6>>> pose_measurement;  // pose, W
-  struct VelocityMeasurement {
-    Eigen::Vector3d velocity;
-    Eigen::Matrix3d sqrt_information;
-    double elevation_bias_removed = 0.0;  // rad
-  };
-  std::optional<VelocityMeasurement> velocity_measurement;
-  std::vector<std::pair<CostPointer, std::vector<double*>>> first_priors;  // the first state's
-
-  InertialState State() const {
-    InertialState s;
-    s.stamp = stamp;
-    s.pose = SE3d(SO3d::FromXyzw(rotation.data()), position);
-    s.velocity = motion.segment<3>(kMotionVelocity);
-    s.bias.gyro = motion.segment<3>(kMotionGyroBias);
-    s.bias.accel = motion.segment<3>(kMotionAccelBias);
-    return s;
-  }
-  ImuBias Bias() const { return {motion.segment<3>(kMotionGyroBias), motion.segment<3>(kMotionAccelBias)}; }
-};
-
-struct InertialWindow::Impl {
-  std::deque<Node> nodes;  // a deque keeps the blocks' addresses as states come and go
-  std::vector<ImuSample> imu;
-  SO3Manifold so3;
-  Eigen::Vector4d extrinsic_rotation;  // R_imu_radar, x y z w
-  Eigen::Vector3d extrinsic_translation;
-  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
-  double clock_offset[1] = {0.0};    // t_d: the block
-  double clock_linearisation = 0.0;  // t_0: where the samples were read
-  bool clock_held = false;           // held at a bound since the last solve: every term read again
-  double elevation_bias[1] = {0.0};  // b: the block
-  std::shared_ptr<MarginalizationPrior> prior;
-
-  // The IMU's reading in force at a scan's stamp, at the clock offset t_0.
-  ImuAtScan ImuAt(double stamp) const {
-    const double t = stamp + clock_linearisation;
-    auto after =
-        std::upper_bound(imu.begin(), imu.end(), t, [](double s, const ImuSample& sample) { return s < sample.stamp; });
-    if (after != imu.begin()) --after;
-    if (after == imu.end()) throw DataError("no IMU sample at " + std::to_string(t) + " s");
-    return {after->angular_velocity, after->specific_force, clock_linearisation};
-  }
-  void MakeRadarTerms(Node& node) const {
-    if (node.pose_measurement) {
-      node.pose = std::make_shared<RadarPoseCostFunction>(node.pose_measurement->first, node.pose_measurement->second,
-                                                          ImuAt(node.stamp));
-    }
-    if (node.velocity_measurement) {
-      const Node::VelocityMeasurement& m = *node.velocity_measurement;
-      node.velocity = std::make_shared<RadarVelocityCostFunction>(m.velocity, m.sqrt_information, ImuAt(node.stamp),
-                                                                  m.elevation_bias_removed);
-    }
-  }
-
-  // The blocks the solvers move, in a fixed order.
-  std::vector<double*> VariableBlocks(const InertialWindowOptions& options) {
-    std::vector<double*> blocks;
-    for (Node& node : nodes) {
-      blocks.insert(blocks.end(), {node.rotation.data(), node.position.data(), node.motion.data()});
-    }
-    for (double* global : GlobalBlocks(options)) blocks.push_back(global);
-    return blocks;
-  }
-  std::vector<double*> GlobalBlocks(const InertialWindowOptions& options) {
-    std::vector<double*> blocks;
-    if (options.estimate_tilt) blocks.push_back(tilt.data());
-    if (options.estimate_extrinsic_rotation) blocks.push_back(extrinsic_rotation.data());
-    if (options.estimate_extrinsic_translation) blocks.push_back(extrinsic_translation.data());
-    if (options.estimate_clock_offset) blocks.push_back(clock_offset);
-    if (options.estimate_elevation_bias) blocks.push_back(elevation_bias);
-    return blocks;
-  }
-
-  // Where the clock offset may lie with the window's oldest state and a
-  // newest at `newest`: within [-kMaxClockOffset, kMaxClockOffset] and
-  // within the IMU's samples at both ends, so that every term can be
-  // integrated at it. Empty (lowest > highest) when the data leaves no room.
-  std::pair<double, double> ClockOffsetBounds(double newest) const {
-    return {std::max(-kMaxClockOffset, imu.front().stamp - nodes.front().stamp),
-            std::min(kMaxClockOffset, imu.back().stamp - newest)};
-  }
-
-  // Before a state at `stamp` is added: an offset at which its IMU interval
-  // would pass the IMU's last sample is held at the largest the data covers
-  // (when there is room; otherwise the interval is refused as the data's
-  // fault), and the next Solve reads every term again at it.
-  void HoldClockOffsetFor(double stamp) {
-    const auto [lowest, highest] = ClockOffsetBounds(stamp);
-    if (std::max(clock_offset[0], clock_linearisation) <= highest || highest < lowest) return;
-    clock_offset[0] = std::min(clock_offset[0], highest);
-    clock_linearisation = std::min(clock_linearisation, highest);
-    clock_held = true;
-  }
-
-  // After a solve: the estimate put back within its bounds; whether it had left them.
-  bool HoldClockOffsetInBounds() {
-    const auto [lowest, highest] = ClockOffsetBounds(nodes.back().stamp);
-    double& offset = clock_offset[0];
-    if (lowest > highest || (offset >= lowest && offset <= highest)) return false;
-    offset = std::clamp(offset, lowest, highest);
-    return true;
-  }
-
-  // Every term of the window in `problem`; the ids of those on the oldest state in `oldest_terms`.
-  void Build(ceres::Problem& problem, const InertialWindowOptions& options,
-             std::vector<ceres::ResidualBlockId>* oldest_terms) {
-    for (Node& node : nodes) {
-      problem.AddParameterBlock(node.rotation.data(), 4, &so3);
-      problem.AddParameterBlock(node.position.data(), 3);
-      problem.AddParameterBlock(node.motion.data(), 9);
-    }
-    problem.AddParameterBlock(extrinsic_rotation.data(), 4, &so3);
-    problem.AddParameterBlock(extrinsic_translation.data(), 3);
-    problem.AddParameterBlock(tilt.data(), 2);
-    problem.AddParameterBlock(clock_offset, 1);
-    problem.AddParameterBlock(elevation_bias, 1);
-    if (!options.estimate_clock_offset) problem.SetParameterBlockConstant(clock_offset);
-    if (!options.estimate_elevation_bias) problem.SetParameterBlockConstant(elevation_bias);
-    if (!options.estimate_extrinsic_rotation) problem.SetParameterBlockConstant(extrinsic_rotation.data());
-    if (!options.estimate_extrinsic_translation) problem.SetParameterBlockConstant(extrinsic_translation.data());
-    if (!options.estimate_tilt) problem.SetParameterBlockConstant(tilt.data());
-    std::vector<ceres::ResidualBlockId> ids;  // the terms on the oldest state
-    for (std::size_t k = 0; k < nodes.size(); ++k) {
-      Node& node = nodes[k];
-      const auto on_oldest = [&](ceres::ResidualBlockId id, bool touches_oldest) {
-        if (touches_oldest) ids.push_back(id);
-      };
-      for (auto& [cost, blocks] : node.first_priors) {
-        on_oldest(problem.AddResidualBlock(cost.get(), nullptr, blocks), k == 0);
-      }
-      if (node.pose) {
-        on_oldest(problem.AddResidualBlock(
-                      node.pose.get(), nullptr,
-                      {node.rotation.data(), node.position.data(), node.motion.data(), extrinsic_rotation.data(),
-                       extrinsic_translation.data(), tilt.data(), clock_offset}),
-                  k == 0);
-      }
-      if (node.velocity) {
-        on_oldest(problem.AddResidualBlock(node.velocity.get(), nullptr,
-                                           {node.rotation.data(), node.motion.data(), extrinsic_rotation.data(),
-                                            extrinsic_translation.data(), clock_offset, elevation_bias}),
-                  k == 0);
-      }
-      if (node.vehicle) {
-        on_oldest(problem.AddResidualBlock(node.vehicle.get(), nullptr, node.rotation.data(), node.motion.data()),
-                  k == 0);
-      }
-      if (k > 0 && node.imu) {
-        Node& before = nodes[k - 1];
-        on_oldest(problem.AddResidualBlock(node.imu.get(), nullptr,
-                                           {before.rotation.data(), before.position.data(), before.motion.data(),
-                                            node.rotation.data(), node.position.data(), node.motion.data()}),
-                  k == 1);
-      }
-    }
-    if (prior) ids.push_back(problem.AddResidualBlock(prior.get(), nullptr, prior->parameter_blocks()));
-    if (oldest_terms != nullptr) *oldest_terms = ids;
-  }
-
-  // The calibration gate: each estimated calibration block's observation,
-  // and with options.calibration_gate a term in `problem` holding it along
-  // what the data do not observe.
-  CalibrationObservation ObserveCalibration(ceres::Problem& problem, const InertialWindowOptions& options,
-                                            std::vector<std::unique_ptr<ceres::CostFunction>>& holds) {
-    CalibrationObservation result;
-    struct Estimated {
-      bool on;
-      GatedBlock block;
-      int* directions;  // where the result goes
-      double* std;
-    };
-    const Estimated table[] = {
-        {options.estimate_extrinsic_rotation,
-         {extrinsic_rotation.data(), 3, true, options.extrinsic_rotation_prior_deg * M_PI / 180.0,
-          options.observed_rotation_std_deg * kRadiansPerDegree},
-         &result.extrinsic_rotation,
-         result.extrinsic_rotation_std.data()},
-        {options.estimate_extrinsic_translation,
-         {extrinsic_translation.data(), 3, false, options.extrinsic_translation_prior,
-          options.observed_translation_std},
-         &result.extrinsic_translation,
-         result.extrinsic_translation_std.data()},
-        {options.estimate_clock_offset,
-         {clock_offset, 1, false, options.clock_offset_prior, options.observed_clock_std},
-         &result.clock_offset,
-         &result.clock_offset_std},
-        {options.estimate_elevation_bias,
-         {elevation_bias, 1, false, kElevationBiasPrior, options.observed_elevation_bias_std_deg * kRadiansPerDegree},
-         &result.elevation_bias,
-         &result.elevation_bias_std},
-    };
-    std::vector<GatedBlock> gated;
-    std::vector<const Estimated*> estimated;
-    for (const Estimated& e : table) {
-      if (!e.on) continue;
-      gated.push_back(e.block);
-      estimated.push_back(&e);
-    }
-    const std::vector<BlockObservation> observed =
-        GateCalibration(problem, VariableBlocks(options), gated, options.calibration_gate, holds);
-    for (std::size_t k = 0; k < estimated.size(); ++k) {
-      const int size = estimated[k]->block.size;
-      *estimated[k]->directions = size - int(observed[k].unobserved.cols());
-      Eigen::Map<Eigen::VectorXd>(estimated[k]->std, size) = observed[k].std();
-    }
-    return result;
-  }
-};
 
 InertialWindow::InertialWindow(const InertialWindowOptions& options, const SE3d& radar_from_imu)
     : options_(options), impl_(std::make_unique<Impl>()) {
