@@ -8,8 +8,8 @@
 // positions against that map (residuals/rig_doppler_residual.hpp).
 //
 // The drive is cut into windows of `calibration_window` s. In each, a
-// radar's estimate is solved from the window's Doppler with the estimate so
-// far as a prior (a sequential least squares over the windows). The
+// radar's estimate is solved from the window's Doppler and map, with the
+// estimate so far as a prior (a sequential least squares over the windows). The
 // calibration gate (solvers/calibration_gate.hpp) then applies only the
 // directions that the drive so far observes: the rotation about the
 // velocity needs turns, the translation needs turns (the lever arm w x t),
