@@ -113,12 +113,8 @@ class OdometryOptions(MatchOptions, total=False):
     rig_calibration_window: float  # 2.5
     rig_calibration_doppler_std: float  # 0.05
     rig_calibration_map_weight: float  # 1.0
-    rig_calibration_prior_deg: float  # 2.0
-    rig_calibration_prior_m: float  # 0.1
-    rig_calibration_prior_s: float  # 0.02
-    rig_calibration_observed_deg: float  # 0.2
-    rig_calibration_observed_m: float  # 0.03
-    rig_calibration_observed_s: float  # 0.002
+    rig_calibration_prior: Sequence[float]  # [2.0, 0.1, 0.02]
+    rig_calibration_observed: Sequence[float]  # [0.2, 0.03, 0.002]
 
 class PlaceSearchOptions(TypedDict, total=False):
     """what RadarSlam and Relocalizer share beyond RadarOdometry's"""

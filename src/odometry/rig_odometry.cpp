@@ -57,30 +57,14 @@ const OptionTable<RigOdometryOptions>& RigOdometryOptionTable() {
           .AtLeast(0.0)
           .Help("the online calibration's points against the reference radar's map, their weight (0: the Doppler "
                 "alone)"),
-      RADARGAUSS_OPTION(O, "rig_calibration_prior_deg", calibration_prior_deg)
+      RADARGAUSS_OPTION(O, "rig_calibration_prior", calibration_prior)
           .Above(0.0)
-          .Unit("deg")
-          .Help("how far the rig file's mounting rotations may be off"),
-      RADARGAUSS_OPTION(O, "rig_calibration_prior_m", calibration_prior_m)
+          .Unit("deg m s")
+          .Help("how far the rig file's mountings may be off: rotation, translation, clock"),
+      RADARGAUSS_OPTION(O, "rig_calibration_observed", calibration_observed)
           .Above(0.0)
-          .Unit("m")
-          .Help("how far the rig file's mounting translations may be off"),
-      RADARGAUSS_OPTION(O, "rig_calibration_prior_s", calibration_prior_s)
-          .Above(0.0)
-          .Unit("s")
-          .Help("how far the rig file's clock offsets may be off"),
-      RADARGAUSS_OPTION(O, "rig_calibration_observed_deg", calibration_observed_deg)
-          .Above(0.0)
-          .Unit("deg")
-          .Help("a window moves a rotation direction only where its data alone reach this std"),
-      RADARGAUSS_OPTION(O, "rig_calibration_observed_m", calibration_observed_m)
-          .Above(0.0)
-          .Unit("m")
-          .Help("a window moves a translation direction only where its data alone reach this std"),
-      RADARGAUSS_OPTION(O, "rig_calibration_observed_s", calibration_observed_s)
-          .Above(0.0)
-          .Unit("s")
-          .Help("a window moves the clock offset only where its data alone reach this std"),
+          .Unit("deg m s")
+          .Help("the std the drive must reach in a direction of a rotation, translation, clock to move it"),
   };
   return table;
 }

@@ -101,8 +101,8 @@ RigOnlineCalibration::RigOnlineCalibration(std::vector<SE3d> reference_from_rada
     : options_(options) {
   CheckOptions(RigOdometryOptionTable(), options_);
   Vector7d prior_std;
-  prior_std << Eigen::Vector3d::Constant(options.calibration_prior_deg * kDegree),
-      Eigen::Vector3d::Constant(options.calibration_prior_m), options.calibration_prior_s;
+  prior_std << Eigen::Vector3d::Constant(options.calibration_prior(0) * kDegree),
+      Eigen::Vector3d::Constant(options.calibration_prior(1)), options.calibration_prior(2);
   for (const SE3d& mounting : reference_from_radar) {
     Estimate estimate;
     estimate.given = estimate.free = estimate.applied = mounting;
@@ -277,8 +277,8 @@ bool RigOnlineCalibration::Apply(Estimate& estimate) const {
   Vector7d change;
   change << (estimate.given.rotation().Inverse() * estimate.free.rotation()).Log(),
       estimate.free.translation() - estimate.given.translation(), estimate.free_clock;
-  const double observed_std[3] = {options_.calibration_observed_deg * kDegree, options_.calibration_observed_m,
-                                  options_.calibration_observed_s};
+  const double observed_std[3] = {options_.calibration_observed(0) * kDegree, options_.calibration_observed(1),
+                                  options_.calibration_observed(2)};
   const int offsets[3] = {0, 3, 6}, sizes[3] = {3, 3, 1};
   // The applied estimate's covariance: the free one's along the observed
   // directions, the prior's along the others (the given mounting's).

@@ -91,7 +91,7 @@ TEST(RigOnlineCalibration, TurnsAndChangesOfSpeedBringTheGivenMountingToThePlant
   const SE3d given(truth.rotation() * SO3d::Exp(Eigen::Vector3d(1.0, -1.0, 1.0).normalized() * (2.0 * kDegree)),
                    truth.translation() + 0.05 * Eigen::Vector3d(-1.0, 1.0, 1.0).normalized());
   RigOdometryOptions options = CalibrationOn();
-  options.calibration_observed_deg = 0.5;  // the rotation about the velocity: seen through the lever arm only
+  options.calibration_observed(0) = 0.5;  // the rotation about the velocity: seen through the lever arm only
   RigOnlineCalibration calibration({SE3d(), given}, options);
   PlantedDrive drive;
   drive.speed_swing = 2.0;

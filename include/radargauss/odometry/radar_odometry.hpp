@@ -64,14 +64,11 @@ struct RigOdometryOptions {
   double calibration_window = 2.5;        // s of the reference's frames per estimate
   double calibration_doppler_std = 0.05;  // m/s: a Doppler residual's sigma
   double calibration_map_weight = 1.0;    // of the points against the reference's map (0: the Doppler alone)
-  // How far the rig file's mountings may be off (the first prior's stds) ...
-  double calibration_prior_deg = 2.0;
-  double calibration_prior_m = 0.1;
-  double calibration_prior_s = 0.02;
-  // ... and the std a window's data must reach in a direction to move it there.
-  double calibration_observed_deg = 0.2;
-  double calibration_observed_m = 0.03;
-  double calibration_observed_s = 0.002;
+  // How far the rig file's mountings may be off (the first prior's stds of
+  // the rotation, the translation and the clock: deg, m, s) ...
+  Eigen::Vector3d calibration_prior{2.0, 0.1, 0.02};
+  // ... and the std the drive's data must reach in a direction to move it there (deg, m, s).
+  Eigen::Vector3d calibration_observed{0.2, 0.03, 0.002};
 };
 const OptionTable<RigOdometryOptions>& RigOdometryOptionTable();
 
